@@ -1,0 +1,150 @@
+//! `wormwear` — command-line interface over the wormwear library.
+//!
+//! Exit codes: 0 success, 1 computation or output error, 2 invalid input (bad file or arguments).
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use wormwear::geometry::{Geometry, GeometrySummary};
+use wormwear::input::{self, GearSet, InputError};
+use wormwear::output;
+
+mod geometry_cmd;
+
+#[derive(Parser)]
+#[command(
+    name = "wormwear",
+    version,
+    about = "Loaded contact and wear of steel-worm / bronze-wheel worm gears",
+    after_help = "Examples:\n  wormwear check examples/gear-1x40-design.toml\n  \
+                  wormwear geometry examples/gear-1x40-design.toml -o out/1x40"
+)]
+struct Cli {
+    /// Print only errors.
+    #[arg(short, long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a gear file and print derived data (lead angle, modules, radii, flank area...).
+    #[command(after_help = "Example:\n  wormwear check examples/gear-1x40-design.toml --json")]
+    Check {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Generate worm and wheel geometry: sections (CSV, SVG), flank grids (CSV), STL, summary.json.
+    #[command(
+        after_help = "Example:\n  wormwear geometry examples/gear-1x40-design.toml -o out/1x40"
+    )]
+    Geometry {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+/// Error classes mapped to exit codes.
+enum Failure {
+    Input(anyhow::Error),
+    Run(anyhow::Error),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Check { file, json } => check(file, *json),
+        Command::Geometry { file, output } => geometry(file, output, cli.quiet),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Loads and validates a gear file; input problems map to exit code 2.
+fn load(file: &Path) -> Result<GearSet, Failure> {
+    input::load(file).map_err(|e: InputError| {
+        Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display())))
+    })
+}
+
+/// Builds the geometry; a gear that validates but cannot be generated is an input problem too.
+fn build_geometry(gear: &GearSet, file: &Path) -> Result<Geometry, Failure> {
+    Geometry::build(gear).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("geometry of {}", file.display())))
+    })
+}
+
+fn check(file: &Path, json: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let geo = build_geometry(&gear, file)?;
+    let summary = GeometrySummary::new(&gear, &geo);
+    if json {
+        let text = serde_json::to_string_pretty(&summary)
+            .context("encoding JSON")
+            .map_err(Failure::Run)?;
+        println!("{text}");
+        return Ok(());
+    }
+    println!("{}: valid", file.display());
+    if !gear.title.is_empty() {
+        println!("  {}", gear.title);
+    }
+    let value = serde_json::to_value(&summary).map_err(|e| Failure::Run(e.into()))?;
+    if let serde_json::Value::Object(map) = value {
+        for (k, v) in map {
+            match v {
+                serde_json::Value::Number(n) => {
+                    let x = n.as_f64().unwrap_or(f64::NAN);
+                    if n.is_i64() || n.is_u64() {
+                        println!("  {k:<32} {n}");
+                    } else {
+                        println!("  {k:<32} {x:.6}");
+                    }
+                }
+                serde_json::Value::Array(a) if a.is_empty() => {}
+                serde_json::Value::Array(a) => {
+                    for w in a {
+                        println!("  warning: {}", w.as_str().unwrap_or_default());
+                    }
+                }
+                serde_json::Value::Null => println!("  {k:<32} -"),
+                other => println!("  {k:<32} {}", other.to_string().trim_matches('"')),
+            }
+        }
+    }
+    Ok(())
+}
+
+fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let geo = build_geometry(&gear, file)?;
+    geometry_cmd::write_geometry(&gear, &geo, file, dir).map_err(Failure::Run)?;
+    if !quiet {
+        let s = GeometrySummary::new(&gear, &geo);
+        println!(
+            "geometry written to {}: lead angle {:.3} deg, active flank {:.1} mm^2",
+            dir.display(),
+            s.lead_angle_deg,
+            s.active_flank_area_mm2
+        );
+    }
+    let _ = output::write_atomic; // output helpers are used by geometry_cmd
+    Ok(())
+}

@@ -1,0 +1,198 @@
+//! Stage 1 — gear geometry (MODEL §2-3): worm and hob thread surfaces from their tools, wheel
+//! flanks from a simulation of hobbing, on the global flank grid.
+//!
+//! [`Geometry::build`] is the entry point; its result is a plain struct the next stages read.
+
+pub mod hobbing;
+pub mod placement;
+pub mod profile;
+pub mod roots;
+pub mod sections;
+pub mod stl;
+pub mod thread;
+pub mod wheel;
+
+use crate::input::{GearSet, ProfileType};
+pub use hobbing::{EnvelopePoint, Hobbing, PointKind};
+pub use thread::{Flank, ThreadSurface};
+pub use wheel::{BlankLimits, FlankPoint, WheelFlank};
+
+/// Why the geometry could not be built from a (validated) gear set.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum GeometryError {
+    #[error("thread profile: {0}")]
+    Profile(String),
+    #[error("wheel generation: {0}")]
+    Wheel(String),
+}
+
+/// Worm, hob and wheel flanks of a gear set.
+#[derive(Debug, Clone)]
+pub struct Geometry {
+    pub worm: ThreadSurface,
+    pub hob: ThreadSurface,
+    /// Wheel flanks of the reference tooth space: index 0 mates with the worm's left flank,
+    /// index 1 with its right flank.
+    pub wheel_flanks: [WheelFlank; 2],
+    pub blank: BlankLimits,
+    /// Number of wheel teeth.
+    pub teeth: u32,
+}
+
+impl Geometry {
+    /// Builds all flanks with the grid of the gear set's analysis settings.
+    pub fn build(gear: &GearSet) -> Result<Self, GeometryError> {
+        Self::build_with_grid(
+            gear,
+            gear.analysis.flank_cells_height,
+            gear.analysis.flank_cells_face,
+        )
+    }
+
+    /// Builds all flanks with an explicit grid (cells along the height and the face width).
+    pub fn build_with_grid(
+        gear: &GearSet,
+        cells_height: usize,
+        cells_face: usize,
+    ) -> Result<Self, GeometryError> {
+        let worm = ThreadSurface::new(&gear.worm)?;
+        let hob = ThreadSurface::new(&gear.hob)?;
+        let blank = BlankLimits {
+            face_width: gear.wheel.face_width,
+            outer_radius: gear.wheel.outer_radius,
+            gorge_radius: gear.gorge_radius(),
+            centre_distance: gear.nominal_centre_distance,
+        };
+        let hobbing = Hobbing::new(&hob, gear.cutting, gear.wheel.teeth);
+        let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)?;
+        let right =
+            wheel::generate_flank(&hobbing, Flank::Right, &blank, cells_height, cells_face)?;
+        Ok(Self {
+            worm,
+            hob,
+            wheel_flanks: [left, right],
+            blank,
+            teeth: gear.wheel.teeth,
+        })
+    }
+
+    /// The wheel flank that mates with the worm's `flank`.
+    pub fn wheel_flank(&self, flank: Flank) -> &WheelFlank {
+        match flank {
+            Flank::Left => &self.wheel_flanks[0],
+            Flank::Right => &self.wheel_flanks[1],
+        }
+    }
+
+    /// The hobbing set-up this geometry was generated with.
+    pub fn hobbing<'a>(&'a self, gear: &GearSet) -> Hobbing<'a> {
+        Hobbing::new(&self.hob, gear.cutting, self.teeth)
+    }
+}
+
+/// Derived quantities reported by `check` and in `summary.json` (units in the names).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GeometrySummary {
+    pub worm_profile: ProfileType,
+    pub starts: u32,
+    pub teeth: u32,
+    pub ratio: f64,
+    pub lead_mm: f64,
+    pub lead_angle_deg: f64,
+    pub axial_module_mm: f64,
+    pub normal_module_mm: f64,
+    /// Measured on the worm surface at the reference radius (left flank).
+    pub axial_pressure_angle_deg: f64,
+    pub normal_pressure_angle_deg: f64,
+    /// Base radius (profile I only).
+    pub base_radius_mm: Option<f64>,
+    pub worm_reference_radius_mm: f64,
+    pub worm_tip_thickness_axial_mm: f64,
+    pub wheel_reference_radius_mm: f64,
+    pub wheel_profile_shift: f64,
+    /// Throat (tip) radius r_a2 at the median plane.
+    pub throat_radius_mm: f64,
+    /// Gorge radius r_g = a - r_a2 of the tip torus.
+    pub gorge_radius_mm: f64,
+    pub outer_radius_mm: f64,
+    pub face_width_mm: f64,
+    /// Wheel root radius at the median plane, a0 - r_a0.
+    pub wheel_root_radius_mm: f64,
+    /// Bottom clearance between worm tip and wheel root at the median plane (operating).
+    pub bottom_clearance_mm: f64,
+    pub centre_distance_mm: f64,
+    pub cutting_centre_distance_mm: f64,
+    pub hob_lead_angle_deg: f64,
+    /// Sliding speed at the pitch point, r1 omega1 / cos(gamma) (MODEL §4.5).
+    pub pitch_sliding_speed_m_s: f64,
+    /// Active flank area of the flank loaded by the operating rotation (whole grid).
+    pub active_flank_area_mm2: f64,
+    pub active_flank_area_left_mm2: f64,
+    pub active_flank_area_right_mm2: f64,
+    /// Lowest and highest radius of the active flank (over the face width).
+    pub active_flank_min_radius_mm: f64,
+    pub active_flank_max_radius_mm: f64,
+    pub flank_cells_height: usize,
+    pub flank_cells_face: usize,
+    pub warnings: Vec<String>,
+}
+
+impl GeometrySummary {
+    /// Derived data of a gear set and its built geometry.
+    pub fn new(gear: &GearSet, geo: &Geometry) -> Self {
+        let deg = 180.0 / std::f64::consts::PI;
+        let w = &geo.worm;
+        let r1 = gear.worm.reference_radius;
+        let gamma = gear.worm.lead_angle();
+        let loaded = match gear.rotation {
+            crate::input::Rotation::Positive => Flank::Left,
+            crate::input::Rotation::Negative => Flank::Right,
+        };
+        let [l, r] = &geo.wheel_flanks;
+        let fold = |f: fn(f64, f64) -> f64, init: f64, v: &[f64]| v.iter().copied().fold(init, f);
+        let min_r =
+            fold(f64::min, f64::INFINITY, &l.r_low).min(fold(f64::min, f64::INFINITY, &r.r_low));
+        let max_r = fold(f64::max, 0.0, &l.r_high).max(fold(f64::max, 0.0, &r.r_high));
+        let root2 = gear.cutting.centre_distance - gear.hob.tip_radius;
+        Self {
+            worm_profile: gear.worm.profile,
+            starts: gear.worm.starts,
+            teeth: gear.wheel.teeth,
+            ratio: gear.ratio(),
+            lead_mm: gear.worm.lead() * 1e3,
+            lead_angle_deg: gamma * deg,
+            axial_module_mm: gear.worm.axial_module() * 1e3,
+            normal_module_mm: gear.worm.axial_module() * gamma.cos() * 1e3,
+            axial_pressure_angle_deg: w.axial_pressure_angle_at(r1) * deg,
+            normal_pressure_angle_deg: w.normal_pressure_angle_at(r1) * deg,
+            base_radius_mm: (gear.worm.profile == ProfileType::I)
+                .then(|| gear.worm.base_radius() * 1e3),
+            worm_reference_radius_mm: r1 * 1e3,
+            worm_tip_thickness_axial_mm: w.axial_thickness_at(gear.worm.tip_radius) * 1e3,
+            wheel_reference_radius_mm: gear.wheel_reference_radius() * 1e3,
+            wheel_profile_shift: (gear.nominal_centre_distance
+                - r1
+                - gear.wheel_reference_radius())
+                / gear.worm.axial_module(),
+            throat_radius_mm: gear.wheel.throat_radius * 1e3,
+            gorge_radius_mm: gear.gorge_radius() * 1e3,
+            outer_radius_mm: gear.wheel.outer_radius * 1e3,
+            face_width_mm: gear.wheel.face_width * 1e3,
+            wheel_root_radius_mm: root2 * 1e3,
+            bottom_clearance_mm: (gear.operating.centre_distance - gear.worm.tip_radius - root2)
+                * 1e3,
+            centre_distance_mm: gear.operating.centre_distance * 1e3,
+            cutting_centre_distance_mm: gear.cutting.centre_distance * 1e3,
+            hob_lead_angle_deg: gear.hob.lead_angle() * deg,
+            pitch_sliding_speed_m_s: r1 * gear.conditions.worm_speed / gamma.cos(),
+            active_flank_area_mm2: geo.wheel_flank(loaded).active_area() * 1e6,
+            active_flank_area_left_mm2: l.active_area() * 1e6,
+            active_flank_area_right_mm2: r.active_area() * 1e6,
+            active_flank_min_radius_mm: min_r * 1e3,
+            active_flank_max_radius_mm: max_r * 1e3,
+            flank_cells_height: l.cells_height,
+            flank_cells_face: l.cells_face,
+            warnings: gear.warnings.clone(),
+        }
+    }
+}

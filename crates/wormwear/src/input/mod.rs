@@ -1,0 +1,321 @@
+//! Input model: the TOML gear file ([`schema`]), its validation, and the checked gear set in SI
+//! units that every pipeline stage consumes.
+//!
+//! Loading never panics: syntax errors come back as [`InputError::Syntax`] (with the TOML
+//! parser's line and key), and every semantic problem as a [`FieldError`] naming the field, its
+//! value and the allowed range. All problems found are reported together.
+
+pub mod schema;
+mod validate;
+
+use std::f64::consts::PI;
+use std::fmt;
+use std::path::Path;
+
+pub use schema::GearFile;
+
+/// Profile type of a worm or hob thread (ISO 10828 designations; MODEL §2.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum ProfileType {
+    /// ZA: straight edge in the axial plane.
+    A,
+    /// ZN: straight edge in the plane normal to the reference helix.
+    N,
+    /// ZI: involute helicoid (straight generator tangent to the base cylinder).
+    I,
+    /// ZK: ground by a biconical wheel.
+    K,
+    /// ZC: ground by a wheel with a circular-arc profile.
+    C,
+}
+
+/// Hand of the thread.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Hand {
+    Right,
+    Left,
+}
+
+impl Hand {
+    /// +1 for a right-hand thread, -1 for a left-hand one (sign of the helix term in MODEL §2.1).
+    pub fn sign(self) -> f64 {
+        match self {
+            Hand::Right => 1.0,
+            Hand::Left => -1.0,
+        }
+    }
+}
+
+/// Grinding wheel of a K or C thread (SI: m, rad).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GrindingWheel {
+    /// Radius R_g at the point that grinds the reference cylinder, m.
+    pub radius: f64,
+    /// Distance between grinding-wheel axis and thread axis, m.
+    pub axis_distance: f64,
+    /// Profile angle alpha_0 of the wheel flank, rad.
+    pub profile_angle: f64,
+    /// Radius rho_0 of the circular-arc profile, m (C only).
+    pub profile_radius: Option<f64>,
+}
+
+/// A checked worm or hob thread, SI units (m, rad).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ThreadDef {
+    pub profile: ProfileType,
+    pub starts: u32,
+    pub hand: Hand,
+    /// Axial pitch p_x, m.
+    pub axial_pitch: f64,
+    /// Reference radius r1, m.
+    pub reference_radius: f64,
+    /// Tip radius, m.
+    pub tip_radius: f64,
+    /// Root radius, m.
+    pub root_radius: f64,
+    /// Nominal axial pressure angle of the tool, rad.
+    pub axial_pressure_angle: f64,
+    /// Nominal normal pressure angle of the tool, rad (tan a_n = tan a_x cos gamma).
+    pub normal_pressure_angle: f64,
+    /// Axial thread thickness at the reference radius, m.
+    pub axial_thickness: f64,
+    /// Grinding wheel (K and C only).
+    pub grinding_wheel: Option<GrindingWheel>,
+}
+
+impl ThreadDef {
+    /// Axial module m_x = p_x / pi, m.
+    pub fn axial_module(&self) -> f64 {
+        self.axial_pitch / PI
+    }
+    /// Lead p_z = z1 p_x, m.
+    pub fn lead(&self) -> f64 {
+        self.axial_pitch * self.starts as f64
+    }
+    /// Lead per radian h = p_z / (2 pi), m/rad.
+    pub fn lead_per_rad(&self) -> f64 {
+        self.lead() / (2.0 * PI)
+    }
+    /// Lead angle at the reference radius, tan(gamma) = p_z / (2 pi r1), rad.
+    pub fn lead_angle(&self) -> f64 {
+        (self.lead_per_rad() / self.reference_radius).atan()
+    }
+    /// Base radius of the involute helicoid (profile I; MODEL §2.2): r_b = r1 cos(alpha_t),
+    /// tan(alpha_t) = tan(alpha_n) / sin(gamma). m.
+    pub fn base_radius(&self) -> f64 {
+        let alpha_t = (self.normal_pressure_angle.tan() / self.lead_angle().sin()).atan();
+        self.reference_radius * alpha_t.cos()
+    }
+}
+
+/// Relative placement of a worm (or the hob) with respect to the wheel (MODEL §1).
+///
+/// The worm axis passes through (0, -a, offset) of the wheel frame with direction
+/// (cos i, 0, sin i): `offset` along z2, `inclination` i a rotation about the line of centres.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Placement {
+    /// Centre distance a, m.
+    pub centre_distance: f64,
+    /// Offset of the worm axis along the wheel axis, m.
+    pub offset: f64,
+    /// Inclination of the worm axis out of the wheel median plane, rad.
+    pub inclination: f64,
+}
+
+/// Wheel blank and body, SI.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct WheelBlank {
+    pub teeth: u32,
+    /// Face width b2, m.
+    pub face_width: f64,
+    /// Outer radius r_e2, m.
+    pub outer_radius: f64,
+    /// Throat (tip) radius r_a2 at the median plane, m.
+    pub throat_radius: f64,
+    /// Rim thickness under the root, m (None: twice the tooth height, fixed by the bending stage).
+    pub rim_thickness: Option<f64>,
+    pub web_thickness: Option<f64>,
+    pub hub_radius: Option<f64>,
+    pub shaft_radius: Option<f64>,
+    /// Bearing positions along z2, m.
+    pub bearing_positions: Option<Vec<f64>>,
+}
+
+/// Elastic and wear properties of one member, SI.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Material {
+    pub name: String,
+    /// Young's modulus, Pa.
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    /// Hardness, Pa.
+    pub hardness: f64,
+    /// Archard coefficient K (dimensionless).
+    pub wear_coefficient: f64,
+    /// Density, kg/m^3.
+    pub density: f64,
+    /// Pitting limit stress sigma_Hlim, Pa.
+    pub pitting_limit: f64,
+}
+
+/// Lubricant, SI (MODEL §6).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Lubricant {
+    pub name: String,
+    /// eta0, Pa s.
+    pub viscosity: f64,
+    /// alpha_pv, 1/Pa.
+    pub pressure_viscosity: f64,
+    /// beta*, K.
+    pub thermo_viscosity: f64,
+    /// K_f, W/(m K).
+    pub thermal_conductivity: f64,
+    /// Oil temperature, K.
+    pub temperature: f64,
+    /// Composite RMS roughness, m.
+    pub composite_roughness: f64,
+}
+
+/// Where the load is given.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum Torque {
+    /// Driving torque on the worm, N m.
+    Worm(f64),
+    /// Output torque on the wheel, N m.
+    Wheel(f64),
+}
+
+/// Operating conditions, SI.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Conditions {
+    pub torque: Torque,
+    /// Worm angular speed, rad/s.
+    pub worm_speed: f64,
+}
+
+/// Worm rotation sense; selects the loaded flank pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Rotation {
+    /// Thread advances towards -x1: the worm's left flank (facing -x1) drives.
+    Positive,
+    /// Thread advances towards +x1: the right flank drives.
+    Negative,
+}
+
+/// Analysis settings (grid sizes, positions...).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Analysis {
+    pub flank_cells_height: usize,
+    pub flank_cells_face: usize,
+    pub positions: usize,
+    pub teeth_each_side: usize,
+    /// Marking thickness j, m.
+    pub marking_thickness: f64,
+    /// Rack-plane offsets z1 for the sections, m.
+    pub section_offsets: Vec<f64>,
+    pub stl_worm_threads: usize,
+    /// 0 = all teeth.
+    pub stl_wheel_teeth: usize,
+}
+
+/// A validated gear set: everything the pipeline needs, SI units.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GearSet {
+    pub title: String,
+    pub worm: ThreadDef,
+    pub hob: ThreadDef,
+    /// Hob placement during cutting.
+    pub cutting: Placement,
+    pub wheel: WheelBlank,
+    /// Nominal operating centre distance (the blank's throat torus is centred on it), m.
+    pub nominal_centre_distance: f64,
+    /// Operating placement of the worm: nominal + misalignments.
+    pub operating: Placement,
+    pub rotation: Rotation,
+    pub worm_material: Material,
+    pub wheel_material: Material,
+    pub lubricant: Lubricant,
+    pub conditions: Conditions,
+    pub analysis: Analysis,
+    /// Non-fatal remarks found during validation.
+    pub warnings: Vec<String>,
+}
+
+impl GearSet {
+    /// Wheel reference radius r2 = z2 p_x / (2 pi), m.
+    pub fn wheel_reference_radius(&self) -> f64 {
+        self.wheel.teeth as f64 * self.worm.axial_pitch / (2.0 * PI)
+    }
+    /// Gorge (throat form) radius r_g = a - r_a2, m.
+    pub fn gorge_radius(&self) -> f64 {
+        self.nominal_centre_distance - self.wheel.throat_radius
+    }
+    /// Transmission ratio u = z2 / z1.
+    pub fn ratio(&self) -> f64 {
+        self.wheel.teeth as f64 / self.worm.starts as f64
+    }
+}
+
+/// One semantic problem of the input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field} = {value}: {problem}")]
+pub struct FieldError {
+    /// Dotted path of the field, e.g. `worm.tip_radius_mm`.
+    pub field: String,
+    /// The value as written (with units where useful).
+    pub value: String,
+    /// What is wrong and the allowed range.
+    pub problem: String,
+}
+
+/// Why a gear file could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    #[error("cannot read {path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Syntax(String),
+    #[error("{}", FieldErrors(.0))]
+    Invalid(Vec<FieldError>),
+}
+
+struct FieldErrors<'a>(&'a [FieldError]);
+
+impl fmt::Display for FieldErrors<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} problem(s) in the gear file:", self.0.len())?;
+        for e in self.0 {
+            write!(f, "\n  - {e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl InputError {
+    /// The field errors, if this is a validation failure.
+    pub fn field_errors(&self) -> &[FieldError] {
+        match self {
+            InputError::Invalid(v) => v,
+            _ => &[],
+        }
+    }
+}
+
+/// Parses and validates a gear file given as TOML text.
+pub fn load_from_str(text: &str) -> Result<GearSet, InputError> {
+    let file: GearFile = toml::from_str(text).map_err(|e| InputError::Syntax(e.to_string()))?;
+    validate::validate(&file)
+}
+
+/// Reads, parses and validates a gear file.
+pub fn load(path: &Path) -> Result<GearSet, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    load_from_str(&text)
+}

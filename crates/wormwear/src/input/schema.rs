@@ -1,0 +1,294 @@
+//! The TOML gear file as written by the user (units in the field names: mm, deg, rpm, GPa...).
+//!
+//! These structs mirror the file one to one; `deny_unknown_fields` makes a misspelt key an
+//! error. Nothing here is validated: [`super::validate`] turns a [`GearFile`] into a checked
+//! [`super::GearSet`] in SI units.
+
+use serde::{Deserialize, Serialize};
+
+/// Whole input file.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearFile {
+    /// Free text shown in reports.
+    #[serde(default)]
+    pub title: Option<String>,
+    pub worm: ThreadSpec,
+    pub hob: ThreadSpec,
+    pub cutting: SettingSpec,
+    pub wheel: WheelSpec,
+    pub operating: OperatingSpec,
+    #[serde(default)]
+    pub materials: MaterialsSpec,
+    #[serde(default)]
+    pub lubricant: LubricantSpec,
+    pub conditions: ConditionsSpec,
+    #[serde(default)]
+    pub analysis: AnalysisSpec,
+}
+
+/// Worm or hob thread (both are helicoids; MODEL §2, §3.1).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThreadSpec {
+    /// Profile type: "A", "N", "I", "K" or "C" (ISO 10828 ZA, ZN, ZI, ZK, ZC).
+    pub profile: String,
+    /// Number of starts z1.
+    pub starts: i64,
+    /// "right" or "left".
+    pub hand: String,
+    /// Axial module m_x, mm (give this or `lead_mm`).
+    #[serde(default)]
+    pub axial_module_mm: Option<f64>,
+    /// Lead p_z = z1 pi m_x, mm (give this or `axial_module_mm`).
+    #[serde(default)]
+    pub lead_mm: Option<f64>,
+    /// Reference radius r1, mm.
+    pub reference_radius_mm: f64,
+    /// Tip radius r_a, mm.
+    pub tip_radius_mm: f64,
+    /// Root radius r_f, mm.
+    pub root_radius_mm: f64,
+    /// Pressure angle of the tool, degrees, in the plane named by `pressure_angle_plane`.
+    pub pressure_angle_deg: f64,
+    /// "axial" or "normal" (normal to the reference helix).
+    #[serde(default = "default_plane")]
+    pub pressure_angle_plane: String,
+    /// Axial thread thickness at the reference radius, mm.
+    pub axial_thickness_mm: f64,
+    /// Grinding wheel, profiles K and C only.
+    #[serde(default)]
+    pub grinding_wheel: Option<GrindingWheelSpec>,
+}
+
+fn default_plane() -> String {
+    "axial".to_string()
+}
+
+/// Grinding wheel of K (biconical) and C (circular-arc) worms (MODEL §2.2).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrindingWheelSpec {
+    /// Radius R_g of the grinding wheel at the point that grinds the worm reference cylinder, mm.
+    pub radius_mm: f64,
+    /// Distance between grinding-wheel axis and worm axis, mm (default r1 + R_g).
+    #[serde(default)]
+    pub axis_distance_mm: Option<f64>,
+    /// Profile angle alpha_0 of the wheel flank, degrees (default: the thread's normal
+    /// pressure angle).
+    #[serde(default)]
+    pub profile_angle_deg: Option<f64>,
+    /// Radius rho_0 of the circular-arc wheel profile, mm (profile C only).
+    #[serde(default)]
+    pub profile_radius_mm: Option<f64>,
+}
+
+/// Relative placement of worm (or hob) and wheel (MODEL §1).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettingSpec {
+    /// Centre distance, mm.
+    pub centre_distance_mm: f64,
+    /// Offset of the worm/hob axis along the wheel axis z2, mm.
+    #[serde(default)]
+    pub offset_mm: f64,
+    /// Inclination of the worm/hob axis out of the wheel median plane (rotation about the
+    /// line of centres), degrees.
+    #[serde(default)]
+    pub inclination_deg: f64,
+}
+
+/// Operating set-up: nominal centre distance plus misalignments.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OperatingSpec {
+    /// Nominal operating centre distance a, mm (the blank's throat torus is centred on it).
+    pub centre_distance_mm: f64,
+    /// Centre-distance error added to a in operation, mm.
+    #[serde(default)]
+    pub centre_distance_error_mm: f64,
+    /// Worm offset along the wheel axis z2, mm.
+    #[serde(default)]
+    pub worm_offset_mm: f64,
+    /// Inclination of the worm axis out of the wheel median plane (shaft-angle error), degrees.
+    #[serde(default)]
+    pub inclination_deg: f64,
+    /// Worm rotation sense: "positive" (thread advances towards -x1, loads the left flank)
+    /// or "negative" (loads the right flank).
+    #[serde(default = "default_rotation")]
+    pub worm_rotation: String,
+}
+
+fn default_rotation() -> String {
+    "positive".to_string()
+}
+
+/// Wheel blank and body (MODEL §3.3; body dimensions are for the bending model).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WheelSpec {
+    /// Number of teeth z2.
+    pub teeth: i64,
+    /// Face width b2, mm.
+    pub face_width_mm: f64,
+    /// Outer (cylinder) radius r_e2, mm.
+    pub outer_radius_mm: f64,
+    /// Throat (tip) radius r_a2 at the median plane, mm.
+    pub throat_radius_mm: f64,
+    /// Rim thickness under the tooth root, mm (default: twice the tooth height).
+    #[serde(default)]
+    pub rim_thickness_mm: Option<f64>,
+    /// Web thickness, mm (default: face width / 3).
+    #[serde(default)]
+    pub web_thickness_mm: Option<f64>,
+    /// Hub outer radius, mm (default: 0.35 x reference radius).
+    #[serde(default)]
+    pub hub_radius_mm: Option<f64>,
+    /// Shaft radius, mm (default: 0.2 x reference radius).
+    #[serde(default)]
+    pub shaft_radius_mm: Option<f64>,
+    /// Bearing positions along the wheel shaft (z2), mm (default: +/- face width).
+    #[serde(default)]
+    pub bearing_positions_mm: Option<Vec<f64>>,
+}
+
+/// Materials of worm and wheel (MODEL §11 defaults).
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialsSpec {
+    #[serde(default)]
+    pub worm: Option<MaterialSpec>,
+    #[serde(default)]
+    pub wheel: Option<MaterialSpec>,
+}
+
+/// One material.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Young's modulus, GPa.
+    pub youngs_modulus_gpa: f64,
+    /// Poisson's ratio.
+    pub poisson_ratio: f64,
+    /// Hardness H used by Archard's law, GPa (wheel only; optional for the worm).
+    #[serde(default)]
+    pub hardness_gpa: Option<f64>,
+    /// Dry/boundary Archard wear coefficient K (wheel only).
+    #[serde(default)]
+    pub wear_coefficient: Option<f64>,
+    /// Density, kg/m^3.
+    #[serde(default)]
+    pub density_kg_m3: Option<f64>,
+    /// Pitting limit stress sigma_Hlim, MPa (wheel only, ratings).
+    #[serde(default)]
+    pub pitting_limit_mpa: Option<f64>,
+}
+
+/// Lubricant (MODEL §6, §11 defaults).
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LubricantSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Dynamic viscosity eta0 at ambient pressure and oil temperature, Pa s.
+    #[serde(default)]
+    pub viscosity_pa_s: Option<f64>,
+    /// Pressure-viscosity coefficient alpha_pv, 1/GPa.
+    #[serde(default)]
+    pub pressure_viscosity_per_gpa: Option<f64>,
+    /// Thermo-viscosity coefficient beta*, K.
+    #[serde(default)]
+    pub thermo_viscosity_k: Option<f64>,
+    /// Thermal conductivity K_f, W/(m K).
+    #[serde(default)]
+    pub thermal_conductivity_w_m_k: Option<f64>,
+    /// Oil temperature, degrees Celsius.
+    #[serde(default)]
+    pub temperature_c: Option<f64>,
+    /// Composite RMS roughness R_q of worm and wheel, um.
+    #[serde(default)]
+    pub composite_roughness_um: Option<f64>,
+}
+
+/// Operating conditions.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConditionsSpec {
+    /// Driving torque on the worm, N m (give this or `wheel_torque_nm`).
+    #[serde(default)]
+    pub worm_torque_nm: Option<f64>,
+    /// Output torque on the wheel, N m (worm torque then follows from the efficiency).
+    #[serde(default)]
+    pub wheel_torque_nm: Option<f64>,
+    /// Worm speed, rpm.
+    pub worm_speed_rpm: f64,
+}
+
+/// Analysis settings. Every field has a default.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Cells of the global wheel-flank grid along the profile height.
+    #[serde(default = "default_grid_height")]
+    pub flank_cells_height: i64,
+    /// Cells of the global wheel-flank grid along the face width.
+    #[serde(default = "default_grid_face")]
+    pub flank_cells_face: i64,
+    /// Kinematic positions per wheel tooth pitch (MODEL §4.1).
+    #[serde(default = "default_positions")]
+    pub positions: i64,
+    /// Teeth studied on each side of the reference tooth (2 gives k = -2..2).
+    #[serde(default = "default_teeth_each_side")]
+    pub teeth_each_side: i64,
+    /// Marking-film thickness j of the no-load pattern, um (MODEL §4.4).
+    #[serde(default = "default_marking")]
+    pub marking_thickness_um: f64,
+    /// Offsets z1 of the rack planes in which sections are drawn, mm.
+    #[serde(default)]
+    pub section_offsets_mm: Option<Vec<f64>>,
+    /// Threads of the worm written to the STL file.
+    #[serde(default = "default_stl_threads")]
+    pub stl_worm_threads: i64,
+    /// Teeth of the wheel written to the STL file (0 = all).
+    #[serde(default = "default_stl_teeth")]
+    pub stl_wheel_teeth: i64,
+}
+
+fn default_grid_height() -> i64 {
+    40
+}
+fn default_grid_face() -> i64 {
+    60
+}
+fn default_positions() -> i64 {
+    20
+}
+fn default_teeth_each_side() -> i64 {
+    2
+}
+fn default_marking() -> f64 {
+    10.0
+}
+fn default_stl_threads() -> i64 {
+    3
+}
+fn default_stl_teeth() -> i64 {
+    5
+}
+
+impl Default for AnalysisSpec {
+    fn default() -> Self {
+        Self {
+            flank_cells_height: default_grid_height(),
+            flank_cells_face: default_grid_face(),
+            positions: default_positions(),
+            teeth_each_side: default_teeth_each_side(),
+            marking_thickness_um: default_marking(),
+            section_offsets_mm: None,
+            stl_worm_threads: default_stl_threads(),
+            stl_wheel_teeth: default_stl_teeth(),
+        }
+    }
+}

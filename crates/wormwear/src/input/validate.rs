@@ -1,0 +1,994 @@
+//! Validation of a parsed gear file and conversion to SI (MODEL §1-3, §11 defaults).
+//!
+//! Every check names the field, the value and the allowed range. Checks that depend on values
+//! already found invalid are skipped, so one mistake gives one message.
+
+use super::schema::*;
+use super::*;
+
+const MM: f64 = 1e-3;
+const DEG: f64 = PI / 180.0;
+
+/// Collects field errors.
+#[derive(Default)]
+struct Checker {
+    errors: Vec<FieldError>,
+}
+
+impl Checker {
+    fn fail(&mut self, field: &str, value: impl fmt::Display, problem: impl Into<String>) {
+        self.errors.push(FieldError {
+            field: field.to_string(),
+            value: value.to_string(),
+            problem: problem.into(),
+        });
+    }
+
+    /// Finite and inside [lo, hi] (inclusive). Returns the value when valid.
+    fn range(&mut self, field: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Option<f64> {
+        if !v.is_finite() {
+            self.fail(
+                field,
+                v,
+                format!("must be a finite number in [{lo}, {hi}] {unit}"),
+            );
+            None
+        } else if v < lo || v > hi {
+            self.fail(
+                field,
+                v,
+                format!("out of range: allowed [{lo}, {hi}] {unit}"),
+            );
+            None
+        } else {
+            Some(v)
+        }
+    }
+
+    /// Finite and strictly positive, at most `hi`.
+    fn positive(&mut self, field: &str, v: f64, hi: f64, unit: &str) -> Option<f64> {
+        if !v.is_finite() || v <= 0.0 || v > hi {
+            self.fail(
+                field,
+                v,
+                format!("must be a finite number > 0 and <= {hi} {unit}"),
+            );
+            None
+        } else {
+            Some(v)
+        }
+    }
+
+    fn int_range(&mut self, field: &str, v: i64, lo: i64, hi: i64) -> Option<i64> {
+        if v < lo || v > hi {
+            self.fail(
+                field,
+                v,
+                format!("out of range: allowed integers [{lo}, {hi}]"),
+            );
+            None
+        } else {
+            Some(v)
+        }
+    }
+
+    fn choice<T: Copy>(&mut self, field: &str, v: &str, options: &[(&str, T)]) -> Option<T> {
+        let found = options
+            .iter()
+            .find(|(name, _)| name.eq_ignore_ascii_case(v.trim()));
+        match found {
+            Some((_, t)) => Some(*t),
+            None => {
+                let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
+                self.fail(
+                    field,
+                    format!("\"{v}\""),
+                    format!("must be one of {}", names.join(", ")),
+                );
+                None
+            }
+        }
+    }
+}
+
+pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
+    let mut ck = Checker::default();
+    let mut warnings = Vec::new();
+
+    let worm = thread(&mut ck, "worm", &f.worm);
+    let hob = thread(&mut ck, "hob", &f.hob);
+
+    let cutting = Placement {
+        centre_distance: ck
+            .positive(
+                "cutting.centre_distance_mm",
+                f.cutting.centre_distance_mm,
+                10_000.0,
+                "mm",
+            )
+            .unwrap_or(f64::NAN)
+            * MM,
+        offset: ck
+            .range(
+                "cutting.offset_mm",
+                f.cutting.offset_mm,
+                -1000.0,
+                1000.0,
+                "mm",
+            )
+            .unwrap_or(f64::NAN)
+            * MM,
+        inclination: ck
+            .range(
+                "cutting.inclination_deg",
+                f.cutting.inclination_deg,
+                -20.0,
+                20.0,
+                "deg",
+            )
+            .unwrap_or(f64::NAN)
+            * DEG,
+    };
+
+    let nominal_a = ck
+        .positive(
+            "operating.centre_distance_mm",
+            f.operating.centre_distance_mm,
+            10_000.0,
+            "mm",
+        )
+        .map(|v| v * MM);
+    let da = ck
+        .range(
+            "operating.centre_distance_error_mm",
+            f.operating.centre_distance_error_mm,
+            -1.0,
+            1.0,
+            "mm",
+        )
+        .map(|v| v * MM);
+    let worm_offset = ck
+        .range(
+            "operating.worm_offset_mm",
+            f.operating.worm_offset_mm,
+            -5.0,
+            5.0,
+            "mm",
+        )
+        .map(|v| v * MM);
+    let inclination = ck
+        .range(
+            "operating.inclination_deg",
+            f.operating.inclination_deg,
+            -2.0,
+            2.0,
+            "deg",
+        )
+        .map(|v| v * DEG);
+    let rotation = ck.choice(
+        "operating.worm_rotation",
+        &f.operating.worm_rotation,
+        &[
+            ("positive", Rotation::Positive),
+            ("negative", Rotation::Negative),
+        ],
+    );
+
+    let w = &f.wheel;
+    let teeth = ck
+        .int_range("wheel.teeth", w.teeth, 10, 500)
+        .map(|v| v as u32);
+    let face_width = ck
+        .positive("wheel.face_width_mm", w.face_width_mm, 2000.0, "mm")
+        .map(|v| v * MM);
+    let outer_radius = ck
+        .positive("wheel.outer_radius_mm", w.outer_radius_mm, 5000.0, "mm")
+        .map(|v| v * MM);
+    let throat_radius = ck
+        .positive("wheel.throat_radius_mm", w.throat_radius_mm, 5000.0, "mm")
+        .map(|v| v * MM);
+    let opt_len = |ck: &mut Checker, name: &str, v: Option<f64>| -> Option<f64> {
+        v.and_then(|x| ck.positive(name, x, 5000.0, "mm"))
+            .map(|x| x * MM)
+    };
+    let rim_thickness = opt_len(&mut ck, "wheel.rim_thickness_mm", w.rim_thickness_mm);
+    let web_thickness = opt_len(&mut ck, "wheel.web_thickness_mm", w.web_thickness_mm);
+    let hub_radius = opt_len(&mut ck, "wheel.hub_radius_mm", w.hub_radius_mm);
+    let shaft_radius = opt_len(&mut ck, "wheel.shaft_radius_mm", w.shaft_radius_mm);
+    let bearing_positions = w.bearing_positions_mm.as_ref().map(|v| {
+        v.iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                ck.range(
+                    &format!("wheel.bearing_positions_mm[{i}]"),
+                    x,
+                    -5000.0,
+                    5000.0,
+                    "mm",
+                )
+                .unwrap_or(f64::NAN)
+                    * MM
+            })
+            .collect::<Vec<_>>()
+    });
+
+    if let (Some(re), Some(ra)) = (outer_radius, throat_radius) {
+        if re < ra {
+            ck.fail(
+                "wheel.outer_radius_mm",
+                w.outer_radius_mm,
+                format!("must be >= wheel.throat_radius_mm = {}", w.throat_radius_mm),
+            );
+        }
+    }
+    if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
+        if sh >= hub {
+            ck.fail(
+                "wheel.shaft_radius_mm",
+                w.shaft_radius_mm.unwrap_or_default(),
+                format!(
+                    "must be < wheel.hub_radius_mm = {}",
+                    w.hub_radius_mm.unwrap_or_default()
+                ),
+            );
+        }
+    }
+
+    let worm_material = material(
+        &mut ck,
+        "materials.worm",
+        f.materials.worm.as_ref(),
+        Material {
+            name: "case-hardened steel (default)".into(),
+            youngs_modulus: 203e9,
+            poisson_ratio: 0.29,
+            hardness: 7.0e9,
+            wear_coefficient: 0.0,
+            density: 7850.0,
+            pitting_limit: f64::INFINITY,
+        },
+    );
+    let wheel_material = material(
+        &mut ck,
+        "materials.wheel",
+        f.materials.wheel.as_ref(),
+        Material {
+            name: "chill-cast phosphor bronze CuSn12 (default)".into(),
+            youngs_modulus: 110e9,
+            poisson_ratio: 0.29,
+            hardness: 1.0e9,
+            wear_coefficient: 2.5e-8,
+            density: 8800.0,
+            pitting_limit: 425e6,
+        },
+    );
+    let lubricant = lubricant(&mut ck, &f.lubricant);
+    let conditions = conditions(&mut ck, &f.conditions);
+
+    let a = &f.analysis;
+    let flank_cells_height =
+        ck.int_range("analysis.flank_cells_height", a.flank_cells_height, 4, 400);
+    let flank_cells_face = ck.int_range("analysis.flank_cells_face", a.flank_cells_face, 4, 400);
+    let positions = ck.int_range("analysis.positions", a.positions, 4, 720);
+    let teeth_each_side = ck.int_range("analysis.teeth_each_side", a.teeth_each_side, 1, 10);
+    let marking = ck
+        .positive(
+            "analysis.marking_thickness_um",
+            a.marking_thickness_um,
+            1000.0,
+            "um",
+        )
+        .map(|v| v * 1e-6);
+    let stl_threads = ck.int_range("analysis.stl_worm_threads", a.stl_worm_threads, 1, 50);
+    let stl_teeth = ck.int_range("analysis.stl_wheel_teeth", a.stl_wheel_teeth, 0, 500);
+    if let (Some(n), Some(z2)) = (stl_teeth, teeth) {
+        if n > z2 as i64 {
+            ck.fail(
+                "analysis.stl_wheel_teeth",
+                n,
+                format!("allowed [0, wheel.teeth = {z2}] (0 = all)"),
+            );
+        }
+    }
+    let section_offsets = match (&a.section_offsets_mm, face_width) {
+        (Some(v), Some(b)) => v
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &z)| {
+                ck.range(
+                    &format!("analysis.section_offsets_mm[{i}]"),
+                    z,
+                    -0.5 * b / MM,
+                    0.5 * b / MM,
+                    "mm (inside the face width)",
+                )
+                .map(|z| z * MM)
+            })
+            .collect(),
+        (None, Some(b)) => vec![-0.25 * b, 0.0, 0.25 * b],
+        _ => vec![],
+    };
+
+    // Cross-field checks, only when the fields involved are individually valid.
+    if let (Some(wm), Some(hb)) = (&worm, &hob) {
+        if ((hb.axial_pitch - wm.axial_pitch) / wm.axial_pitch).abs() > 1e-6 {
+            ck.fail(
+                "hob.axial_module_mm",
+                format!(
+                    "{:.6} (lead {:.6} mm)",
+                    hb.axial_module() / MM,
+                    hb.lead() / MM
+                ),
+                format!(
+                    "the hob must have the worm's axial pitch: axial module {:.6} mm \
+                     (relative difference allowed 1e-6)",
+                    wm.axial_module() / MM
+                ),
+            );
+        }
+        if hb.hand != wm.hand {
+            ck.fail(
+                "hob.hand",
+                format!("{:?}", hb.hand),
+                format!("must equal worm.hand ({:?})", wm.hand),
+            );
+        }
+        if let (Some(an), Some(z2), Some(b), Some(re), Some(ra)) =
+            (nominal_a, teeth, face_width, outer_radius, throat_radius)
+        {
+            let a0 = cutting.centre_distance;
+            let gorge = an - ra;
+            // Worm root must clear the wheel throat.
+            if gorge <= wm.root_radius {
+                ck.fail(
+                    "wheel.throat_radius_mm",
+                    w.throat_radius_mm,
+                    format!(
+                        "must be < operating.centre_distance_mm - worm.root_radius_mm = {:.4} mm \
+                         (the wheel tip would hit the worm root)",
+                        (an - wm.root_radius) / MM
+                    ),
+                );
+            }
+            // Hob root must not cut the blank's throat.
+            if a0.is_finite() && a0 - ra < hb.root_radius {
+                ck.fail(
+                    "hob.root_radius_mm",
+                    hb.root_radius / MM,
+                    format!(
+                        "must be <= cutting.centre_distance_mm - wheel.throat_radius_mm = {:.4} mm \
+                         (the hob root would cut the wheel tip)",
+                        (a0 - ra) / MM
+                    ),
+                );
+            }
+            // The hob tip must cut the wheel root deep enough for the worm tip.
+            if a0.is_finite() {
+                let clearance = (an - wm.tip_radius) - (a0 - hb.tip_radius);
+                if clearance < 0.0 {
+                    ck.fail(
+                        "hob.tip_radius_mm",
+                        hb.tip_radius / MM,
+                        format!(
+                            "must be >= worm.tip_radius_mm + (cutting - operating centre distance) \
+                             = {:.4} mm (the worm tip would hit the wheel root)",
+                            (wm.tip_radius + a0 - an) / MM
+                        ),
+                    );
+                }
+                if hb.tip_radius < wm.tip_radius + a0 - an + 1e-9 && clearance >= 0.0 {
+                    warnings.push(
+                        "no bottom clearance: the hob tip radius equals the worm tip radius"
+                            .to_string(),
+                    );
+                }
+            }
+            // Centre distance consistent with the radii (implied wheel profile shift).
+            let r2 = z2 as f64 * wm.axial_pitch / (2.0 * PI);
+            let x2 = (an - wm.reference_radius - r2) / wm.axial_module();
+            if x2.abs() > 1.5 {
+                ck.fail(
+                    "operating.centre_distance_mm",
+                    an / MM,
+                    format!(
+                        "inconsistent with worm.reference_radius_mm + wheel reference radius \
+                         (z2 m_x / 2 = {:.4} mm): the implied profile shift x2 = {:.3} is outside \
+                         [-1.5, 1.5]",
+                        r2 / MM,
+                        x2
+                    ),
+                );
+            } else if x2.abs() > 1.0 {
+                warnings.push(format!("large wheel profile shift x2 = {x2:.3}"));
+            }
+            if ra < r2 {
+                warnings.push(format!(
+                    "wheel throat radius {:.3} mm is below the reference radius {:.3} mm",
+                    ra / MM,
+                    r2 / MM
+                ));
+            }
+            // Face width the worm can reach: at |z| = b/2 the blank top must be inside the
+            // worm tip cylinder.
+            let reach = reachable_half_width(an, re, gorge, wm.tip_radius);
+            if 0.5 * b >= reach {
+                ck.fail(
+                    "wheel.face_width_mm",
+                    b / MM,
+                    format!(
+                        "larger than the worm can reach: must be < {:.3} mm (twice the half-width \
+                         at which the blank top leaves the worm tip cylinder)",
+                        2.0 * reach / MM
+                    ),
+                );
+            }
+            if let Some(off) = worm_offset {
+                if off.abs() >= 0.5 * b {
+                    ck.fail(
+                        "operating.worm_offset_mm",
+                        off / MM,
+                        format!(
+                            "must be inside the face width: |offset| < {} mm",
+                            0.5 * b / MM
+                        ),
+                    );
+                }
+            }
+            if cutting.offset.is_finite() && cutting.offset.abs() >= 0.5 * b {
+                ck.fail(
+                    "cutting.offset_mm",
+                    cutting.offset / MM,
+                    format!(
+                        "must be inside the face width: |offset| < {} mm",
+                        0.5 * b / MM
+                    ),
+                );
+            }
+            let lead_diff = hb.lead_angle() - wm.lead_angle();
+            if (lead_diff - cutting.inclination).abs() > 1.0 * DEG {
+                warnings.push(format!(
+                    "hob lead angle differs from the worm's by {:.3} deg and the hob inclination is \
+                     {:.3} deg: the wheel will have a lead mismatch",
+                    lead_diff / DEG,
+                    cutting.inclination / DEG
+                ));
+            }
+        }
+    }
+
+    if !ck.errors.is_empty() {
+        return Err(InputError::Invalid(ck.errors));
+    }
+    // All Options are Some here: every None above came with an error.
+    let (Some(worm), Some(hob), Some(nominal_a), Some(da), Some(worm_offset), Some(inclination)) =
+        (worm, hob, nominal_a, da, worm_offset, inclination)
+    else {
+        unreachable_input()?
+    };
+    let (Some(teeth), Some(face_width), Some(outer_radius), Some(throat_radius), Some(rotation)) =
+        (teeth, face_width, outer_radius, throat_radius, rotation)
+    else {
+        unreachable_input()?
+    };
+    let (Some(h), Some(fw), Some(p), Some(t), Some(m), Some(st), Some(sw)) = (
+        flank_cells_height,
+        flank_cells_face,
+        positions,
+        teeth_each_side,
+        marking,
+        stl_threads,
+        stl_teeth,
+    ) else {
+        unreachable_input()?
+    };
+    let (Some(worm_material), Some(wheel_material), Some(lubricant), Some(conditions)) =
+        (worm_material, wheel_material, lubricant, conditions)
+    else {
+        unreachable_input()?
+    };
+    Ok(GearSet {
+        title: f.title.clone().unwrap_or_default(),
+        worm,
+        hob,
+        cutting,
+        wheel: WheelBlank {
+            teeth,
+            face_width,
+            outer_radius,
+            throat_radius,
+            rim_thickness,
+            web_thickness,
+            hub_radius,
+            shaft_radius,
+            bearing_positions,
+        },
+        nominal_centre_distance: nominal_a,
+        operating: Placement {
+            centre_distance: nominal_a + da,
+            offset: worm_offset,
+            inclination,
+        },
+        rotation,
+        worm_material,
+        wheel_material,
+        lubricant,
+        conditions,
+        analysis: Analysis {
+            flank_cells_height: h as usize,
+            flank_cells_face: fw as usize,
+            positions: p as usize,
+            teeth_each_side: t as usize,
+            marking_thickness: m,
+            section_offsets,
+            stl_worm_threads: st as usize,
+            stl_wheel_teeth: sw as usize,
+        },
+        warnings,
+    })
+}
+
+/// Internal consistency guard: a missing value without a recorded error is a bug, reported as
+/// an error rather than a panic.
+fn unreachable_input<T>() -> Result<T, InputError> {
+    Err(InputError::Invalid(vec![FieldError {
+        field: "(internal)".into(),
+        value: "-".into(),
+        problem: "validation lost a value without reporting why; please report this file".into(),
+    }]))
+}
+
+/// Largest |z| at which the wheel blank top (outer cylinder clipped by the throat torus) is
+/// still inside the worm tip cylinder of radius `tip` (worm axis at distance `a`). m.
+fn reachable_half_width(a: f64, outer: f64, gorge: f64, tip: f64) -> f64 {
+    let top_distance = |z: f64| {
+        let r_top = if z.abs() < gorge {
+            outer.min(a - (gorge * gorge - z * z).sqrt())
+        } else {
+            outer
+        };
+        ((a - r_top).powi(2) + z * z).sqrt()
+    };
+    if top_distance(0.0) >= tip {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, tip);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if top_distance(mid) < tip {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<ThreadDef> {
+    let field = |f: &str| format!("{name}.{f}");
+    let n_errors = ck.errors.len();
+    let profile = ck.choice(
+        &field("profile"),
+        &t.profile,
+        &[
+            ("A", ProfileType::A),
+            ("N", ProfileType::N),
+            ("I", ProfileType::I),
+            ("K", ProfileType::K),
+            ("C", ProfileType::C),
+            ("ZA", ProfileType::A),
+            ("ZN", ProfileType::N),
+            ("ZI", ProfileType::I),
+            ("ZK", ProfileType::K),
+            ("ZC", ProfileType::C),
+        ],
+    );
+    let starts = ck.int_range(&field("starts"), t.starts, 1, 10);
+    let hand = ck.choice(
+        &field("hand"),
+        &t.hand,
+        &[("right", Hand::Right), ("left", Hand::Left)],
+    );
+    let axial_pitch = match (t.axial_module_mm, t.lead_mm, starts) {
+        (Some(_), Some(_), _) => {
+            ck.fail(
+                &field("lead_mm"),
+                t.lead_mm.unwrap_or_default(),
+                format!(
+                    "give either {} or {}, not both",
+                    field("axial_module_mm"),
+                    field("lead_mm")
+                ),
+            );
+            None
+        }
+        (None, None, _) => {
+            ck.fail(
+                &field("axial_module_mm"),
+                "(missing)",
+                format!("give {} or {}", field("axial_module_mm"), field("lead_mm")),
+            );
+            None
+        }
+        (Some(m), None, _) => ck
+            .range(&field("axial_module_mm"), m, 0.1, 100.0, "mm")
+            .map(|m| m * PI * MM),
+        (None, Some(l), Some(z)) => ck
+            .range(&field("lead_mm"), l, 0.1, 5000.0, "mm")
+            .map(|l| l * MM / z as f64),
+        (None, Some(_), None) => None,
+    };
+    let r1 = ck.positive(
+        &field("reference_radius_mm"),
+        t.reference_radius_mm,
+        2000.0,
+        "mm",
+    );
+    let ra = ck.positive(&field("tip_radius_mm"), t.tip_radius_mm, 2000.0, "mm");
+    let rf = ck.positive(&field("root_radius_mm"), t.root_radius_mm, 2000.0, "mm");
+    if let (Some(r1), Some(ra), Some(rf)) = (r1, ra, rf) {
+        if ra <= rf {
+            ck.fail(
+                &field("tip_radius_mm"),
+                ra,
+                format!(
+                    "must be greater than {} = {rf} mm (tip below root)",
+                    field("root_radius_mm")
+                ),
+            );
+        } else if r1 <= rf || r1 >= ra {
+            ck.fail(
+                &field("reference_radius_mm"),
+                r1,
+                format!("must lie strictly between the root ({rf} mm) and tip ({ra} mm) radii"),
+            );
+        }
+    }
+    let alpha = ck.range(
+        &field("pressure_angle_deg"),
+        t.pressure_angle_deg,
+        5.0,
+        40.0,
+        "deg",
+    );
+    let plane = ck.choice(
+        &field("pressure_angle_plane"),
+        &t.pressure_angle_plane,
+        &[("axial", true), ("normal", false)],
+    );
+    let thickness = ck.positive(
+        &field("axial_thickness_mm"),
+        t.axial_thickness_mm,
+        1000.0,
+        "mm",
+    );
+    match (profile, &t.grinding_wheel) {
+        (Some(ProfileType::K | ProfileType::C), None) => {
+            ck.fail(
+                &field("grinding_wheel"),
+                "(missing)",
+                "profiles K and C need a [grinding_wheel] table (radius_mm, ...)",
+            );
+        }
+        (Some(ProfileType::A | ProfileType::N | ProfileType::I), Some(_)) => {
+            ck.fail(
+                &field("grinding_wheel"),
+                "(given)",
+                "a grinding wheel is only used by profiles K and C",
+            );
+        }
+        _ => {}
+    }
+    if ck.errors.len() > n_errors {
+        return None;
+    }
+    let (profile, starts, hand, p_x, r1, ra, rf, alpha, axial_plane, s) = (
+        profile?,
+        starts?,
+        hand?,
+        axial_pitch?,
+        r1? * MM,
+        ra? * MM,
+        rf? * MM,
+        alpha? * DEG,
+        plane?,
+        thickness? * MM,
+    );
+    let lead_angle = (starts as f64 * p_x / (2.0 * PI * r1)).atan();
+    if lead_angle > 45.0 * DEG {
+        ck.fail(
+            &field("reference_radius_mm"),
+            r1 / MM,
+            format!(
+                "lead angle {:.2} deg exceeds 45 deg: the reference radius must be >= {:.4} mm",
+                lead_angle / DEG,
+                starts as f64 * p_x / (2.0 * PI) / MM
+            ),
+        );
+        return None;
+    }
+    let (alpha_x, alpha_n) = if axial_plane {
+        (alpha, (alpha.tan() * lead_angle.cos()).atan())
+    } else {
+        ((alpha.tan() / lead_angle.cos()).atan(), alpha)
+    };
+    if s >= p_x {
+        ck.fail(
+            &field("axial_thickness_mm"),
+            s / MM,
+            format!("must be less than the axial pitch {:.4} mm", p_x / MM),
+        );
+        return None;
+    }
+    // Straight-line estimate of the thread thickness at the tip and of the space at the root.
+    let tip_thickness = s - 2.0 * (ra - r1) * alpha_x.tan();
+    if tip_thickness <= 0.0 {
+        ck.fail(
+            &field("tip_radius_mm"),
+            ra / MM,
+            format!(
+                "the thread is pointed below its tip: with this thickness and pressure angle the \
+                 tip radius must be < {:.4} mm",
+                (r1 + 0.5 * s / alpha_x.tan()) / MM
+            ),
+        );
+    }
+    let root_space = p_x - s - 2.0 * (r1 - rf) * alpha_x.tan();
+    if root_space <= 0.0 {
+        ck.fail(
+            &field("root_radius_mm"),
+            rf / MM,
+            format!(
+                "the thread space closes above the root: the root radius must be > {:.4} mm",
+                (r1 - 0.5 * (p_x - s) / alpha_x.tan()) / MM
+            ),
+        );
+    }
+    let mut def = ThreadDef {
+        profile,
+        starts: starts as u32,
+        hand,
+        axial_pitch: p_x,
+        reference_radius: r1,
+        tip_radius: ra,
+        root_radius: rf,
+        axial_pressure_angle: alpha_x,
+        normal_pressure_angle: alpha_n,
+        axial_thickness: s,
+        grinding_wheel: None,
+    };
+    if profile == ProfileType::I {
+        let rb = def.base_radius();
+        if rb >= rf {
+            ck.fail(
+                &field("root_radius_mm"),
+                rf / MM,
+                format!(
+                    "profile I needs the root above the base cylinder: must be > base radius {:.4} mm",
+                    rb / MM
+                ),
+            );
+        }
+    }
+    if let (Some(gw), ProfileType::K | ProfileType::C) = (&t.grinding_wheel, profile) {
+        let gfield = |f: &str| format!("{name}.grinding_wheel.{f}");
+        let rg = ck.range(
+            &gfield("radius_mm"),
+            gw.radius_mm,
+            (ra - rf) / MM * 1.5,
+            2000.0,
+            "mm",
+        );
+        let angle = match gw.profile_angle_deg {
+            Some(v) => ck
+                .range(&gfield("profile_angle_deg"), v, 5.0, 40.0, "deg")
+                .map(|v| v * DEG),
+            None => Some(alpha_n),
+        };
+        let dist = match (gw.axis_distance_mm, rg) {
+            (Some(d), Some(rg)) => ck
+                .range(
+                    &gfield("axis_distance_mm"),
+                    d,
+                    (r1 / MM + rg) - 0.5 * (ra - rf) / MM,
+                    (r1 / MM + rg) + 0.5 * (ra - rf) / MM,
+                    "mm (reference radius + grinding-wheel radius +/- half the thread height)",
+                )
+                .map(|d| d * MM),
+            (None, Some(rg)) => Some(r1 + rg * MM),
+            _ => None,
+        };
+        let rho0 = match (profile, gw.profile_radius_mm) {
+            (ProfileType::C, Some(v)) => ck
+                .range(
+                    &gfield("profile_radius_mm"),
+                    v,
+                    2.0 * (ra - rf) / MM,
+                    10_000.0,
+                    "mm",
+                )
+                .map(|v| Some(v * MM)),
+            (ProfileType::C, None) => {
+                ck.fail(
+                    &gfield("profile_radius_mm"),
+                    "(missing)",
+                    "profile C needs the arc radius rho_0",
+                );
+                None
+            }
+            (_, Some(v)) => {
+                ck.fail(
+                    &gfield("profile_radius_mm"),
+                    v,
+                    "only profile C has a circular-arc wheel",
+                );
+                None
+            }
+            (_, None) => Some(None),
+        };
+        if let (Some(rg), Some(angle), Some(dist), Some(rho0)) = (rg, angle, dist, rho0) {
+            def.grinding_wheel = Some(GrindingWheel {
+                radius: rg * MM,
+                axis_distance: dist,
+                profile_angle: angle,
+                profile_radius: rho0,
+            });
+        } else {
+            return None;
+        }
+    }
+    if tip_thickness <= 0.0 || root_space <= 0.0 {
+        return None;
+    }
+    Some(def)
+}
+
+fn material(
+    ck: &mut Checker,
+    name: &str,
+    m: Option<&MaterialSpec>,
+    default: Material,
+) -> Option<Material> {
+    let Some(m) = m else { return Some(default) };
+    let field = |f: &str| format!("{name}.{f}");
+    let e = ck.range(
+        &field("youngs_modulus_gpa"),
+        m.youngs_modulus_gpa,
+        1.0,
+        2000.0,
+        "GPa",
+    );
+    let nu = ck.range(&field("poisson_ratio"), m.poisson_ratio, 0.0, 0.499, "");
+    let h = match m.hardness_gpa {
+        Some(v) => ck
+            .range(&field("hardness_gpa"), v, 0.01, 100.0, "GPa")
+            .map(|v| v * 1e9),
+        None => Some(default.hardness),
+    };
+    let k = match m.wear_coefficient {
+        Some(v) => ck.range(&field("wear_coefficient"), v, 0.0, 1e-2, ""),
+        None => Some(default.wear_coefficient),
+    };
+    let rho = match m.density_kg_m3 {
+        Some(v) => ck.range(&field("density_kg_m3"), v, 100.0, 30_000.0, "kg/m^3"),
+        None => Some(default.density),
+    };
+    let lim = match m.pitting_limit_mpa {
+        Some(v) => ck
+            .range(&field("pitting_limit_mpa"), v, 10.0, 10_000.0, "MPa")
+            .map(|v| v * 1e6),
+        None => Some(default.pitting_limit),
+    };
+    Some(Material {
+        name: m.name.clone().unwrap_or_else(|| name.to_string()),
+        youngs_modulus: e? * 1e9,
+        poisson_ratio: nu?,
+        hardness: h?,
+        wear_coefficient: k?,
+        density: rho?,
+        pitting_limit: lim?,
+    })
+}
+
+fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant> {
+    let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
+        Some(v) => ck.range(&format!("lubricant.{f}"), v, lo, hi, unit),
+        None => Some(d),
+    };
+    let eta = get(
+        "viscosity_pa_s",
+        l.viscosity_pa_s,
+        0.227,
+        1e-4,
+        100.0,
+        "Pa s",
+    );
+    let apv = get(
+        "pressure_viscosity_per_gpa",
+        l.pressure_viscosity_per_gpa,
+        9.5,
+        0.0,
+        100.0,
+        "1/GPa",
+    );
+    let beta = get(
+        "thermo_viscosity_k",
+        l.thermo_viscosity_k,
+        3200.0,
+        0.0,
+        100_000.0,
+        "K",
+    );
+    let kf = get(
+        "thermal_conductivity_w_m_k",
+        l.thermal_conductivity_w_m_k,
+        0.148,
+        0.01,
+        10.0,
+        "W/(m K)",
+    );
+    let t = get(
+        "temperature_c",
+        l.temperature_c,
+        333.0 - 273.15,
+        -50.0,
+        250.0,
+        "degC",
+    );
+    let rq = get(
+        "composite_roughness_um",
+        l.composite_roughness_um,
+        1.0,
+        0.001,
+        100.0,
+        "um",
+    );
+    Some(Lubricant {
+        name: l
+            .name
+            .clone()
+            .unwrap_or_else(|| "polyglycol (default)".into()),
+        viscosity: eta?,
+        pressure_viscosity: apv? * 1e-9,
+        thermo_viscosity: beta?,
+        thermal_conductivity: kf?,
+        temperature: t? + 273.15,
+        composite_roughness: rq? * 1e-6,
+    })
+}
+
+fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
+    let torque = match (c.worm_torque_nm, c.wheel_torque_nm) {
+        (Some(t), None) => ck
+            .positive("conditions.worm_torque_nm", t, 1e6, "N m")
+            .map(Torque::Worm),
+        (None, Some(t)) => ck
+            .positive("conditions.wheel_torque_nm", t, 1e8, "N m")
+            .map(Torque::Wheel),
+        (Some(_), Some(_)) => {
+            ck.fail(
+                "conditions.wheel_torque_nm",
+                c.wheel_torque_nm.unwrap_or_default(),
+                "give either conditions.worm_torque_nm or conditions.wheel_torque_nm, not both",
+            );
+            None
+        }
+        (None, None) => {
+            ck.fail(
+                "conditions.worm_torque_nm",
+                "(missing)",
+                "give conditions.worm_torque_nm or conditions.wheel_torque_nm",
+            );
+            None
+        }
+    };
+    let speed = ck.positive(
+        "conditions.worm_speed_rpm",
+        c.worm_speed_rpm,
+        20_000.0,
+        "rpm",
+    );
+    Some(Conditions {
+        torque: torque?,
+        worm_speed: speed? * 2.0 * PI / 60.0,
+    })
+}

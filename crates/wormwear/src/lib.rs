@@ -1,0 +1,13 @@
+//! wormwear — loaded tooth contact and wear of steel-worm / bronze-wheel worm gears.
+//!
+//! The pipeline runs one way through its stages, each a module whose result is a plain struct
+//! the next one consumes (see `../shared/spec/MODEL.md` §0):
+//!
+//! 1. [`input`] — the validated gear file, SI units;
+//! 2. [`geometry`] — worm and hob helicoids, wheel flanks by hobbing simulation (MODEL §2-3).
+//!
+//! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
+
+pub mod geometry;
+pub mod input;
+pub mod output;

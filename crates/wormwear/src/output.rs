@@ -1,0 +1,145 @@
+//! Result files: atomic writes, the shared `summary.json`, CSV tables.
+//!
+//! Every file is written to a temporary sibling and renamed into place, so an interrupted run
+//! never leaves a half-written file. `summary.json` is one JSON object; each command adds or
+//! replaces its own section and keeps the others.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Error writing results.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot encode {what}: {message}")]
+    Encode { what: String, message: String },
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+    move |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    {
+        let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp))?;
+        f.write_all(bytes).map_err(io_err(&tmp))?;
+        f.sync_all().map_err(io_err(&tmp))?;
+    }
+    std::fs::rename(&tmp, path).map_err(io_err(path))
+}
+
+/// Adds or replaces `section` in `dir/summary.json`, keeping the other sections.
+pub fn update_summary(
+    dir: &Path,
+    section: &str,
+    value: serde_json::Value,
+) -> Result<(), OutputError> {
+    let path = dir.join("summary.json");
+    let mut root = match std::fs::read_to_string(&path) {
+        Ok(text) => match serde_json::from_str::<serde_json::Value>(&text) {
+            Ok(serde_json::Value::Object(m)) => m,
+            _ => serde_json::Map::new(),
+        },
+        Err(_) => serde_json::Map::new(),
+    };
+    root.insert(section.to_string(), value);
+    let text = serde_json::to_string_pretty(&serde_json::Value::Object(root)).map_err(|e| {
+        OutputError::Encode {
+            what: "summary.json".into(),
+            message: e.to_string(),
+        }
+    })?;
+    write_atomic(&path, text.as_bytes())
+}
+
+/// A CSV table built in memory and written atomically.
+#[derive(Debug, Clone)]
+pub struct Csv {
+    text: String,
+    columns: usize,
+}
+
+impl Csv {
+    /// Table with a header row (column names carry their units, e.g. `r_mm`).
+    pub fn new(header: &[&str]) -> Self {
+        Self {
+            text: header.join(",") + "\n",
+            columns: header.len(),
+        }
+    }
+
+    /// Appends a row of numbers (must match the header length).
+    pub fn row(&mut self, values: &[f64]) {
+        debug_assert_eq!(values.len(), self.columns);
+        for (k, v) in values.iter().enumerate() {
+            if k > 0 {
+                self.text.push(',');
+            }
+            let _ = write!(self.text, "{v:.10e}");
+        }
+        self.text.push('\n');
+    }
+
+    /// Appends a row whose first cell is a label.
+    pub fn labelled_row(&mut self, label: &str, values: &[f64]) {
+        self.text.push_str(label);
+        for v in values {
+            let _ = write!(self.text, ",{v:.10e}");
+        }
+        self.text.push('\n');
+    }
+
+    /// Writes the table atomically.
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
+        write_atomic(path, self.text.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn summary_sections_are_merged() {
+        let dir = std::env::temp_dir().join(format!("wormwear-out-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        update_summary(&dir, "a", serde_json::json!({"x": 1})).unwrap();
+        update_summary(&dir, "b", serde_json::json!({"y": 2})).unwrap();
+        update_summary(&dir, "a", serde_json::json!({"x": 3})).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(v["a"]["x"], 3);
+        assert_eq!(v["b"]["y"], 2);
+        // No temporary files left behind.
+        let leftovers = std::fs::read_dir(&dir).unwrap().filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains(".tmp")
+        });
+        assert_eq!(leftovers.count(), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
