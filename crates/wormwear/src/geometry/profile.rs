@@ -126,14 +126,33 @@ impl ProfileGenerator {
             ProfileType::N => {
                 // Blade in the plane normal to the reference helix through the thread middle
                 // (0, r1, 0); w is the in-plane direction perpendicular to the radius.
+                // The blade's offset c along w is solved so that the axial thickness at r1 is
+                // exact with the blade in that plane (ZN1, thread-normal section); the later
+                // thickness shift is then zero to round-off.
                 let w = Vector3::new(cg, 0.0, -sg);
-                let c = -0.5 * def.axial_thickness * cg;
                 let an = def.normal_pressure_angle;
-                ProfileGenerator::Line {
+                let d = Vector3::new(0.0, an.cos(), 0.0) + w * an.sin();
+                let line = |c: f64| ProfileGenerator::Line {
                     p0: Vector3::new(0.0, r1, 0.0) + w * c,
-                    d: Vector3::new(0.0, an.cos(), 0.0) + w * an.sin(),
+                    d,
                     h,
+                };
+                let target = -0.5 * def.axial_thickness;
+                let miss = |c: f64| line(c).eval(r1).map(|(x, _)| x - target);
+                let mut c = target * cg;
+                for _ in 0..8 {
+                    let (m0, m1) = (miss(c), miss(c + 1e-7));
+                    let (Some(m0), Some(m1)) = (m0, m1) else {
+                        return Err(GeometryError::Profile(
+                            "the ZN blade does not reach the reference radius".into(),
+                        ));
+                    };
+                    if m0.abs() < 1e-15 {
+                        break;
+                    }
+                    c -= m0 * 1e-7 / (m1 - m0);
                 }
+                line(c)
             }
             ProfileType::I => {
                 // Generator tangent to the base helix at (0, r_b, 0).

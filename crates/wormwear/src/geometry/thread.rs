@@ -140,6 +140,11 @@ impl ThreadSurface {
         })
     }
 
+    /// x shift applied to the raw tool generator to make the thickness at r1 exact, m.
+    pub fn generator_shift(&self) -> f64 {
+        self.shift
+    }
+
     /// Axial thread thickness at radius rho, m.
     pub fn axial_thickness_at(&self, rho: f64) -> f64 {
         self.axial_profile(Flank::Right, rho).0 - self.axial_profile(Flank::Left, rho).0
