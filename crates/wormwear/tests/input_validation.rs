@@ -1,0 +1,377 @@
+//! Malformed gear files: each gives a clear message naming the field, the value and the allowed
+//! range, and nothing panics on any input (property test over random and garbled TOML).
+
+use proptest::prelude::*;
+use std::path::Path;
+use wormwear::geometry::Geometry;
+use wormwear::input::{self, InputError};
+
+fn example_text(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name);
+    std::fs::read_to_string(path).unwrap()
+}
+
+fn design() -> String {
+    example_text("gear-1x40-design.toml")
+}
+
+/// Replaces the first line starting with `key =` inside `[table]` by `replacement`.
+fn set(text: &str, table: &str, key: &str, replacement: &str) -> String {
+    let mut out = Vec::new();
+    let mut current = String::new();
+    let mut done = false;
+    for line in text.lines() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            current = t.trim_matches(|c| c == '[' || c == ']').to_string();
+        }
+        let k = t.split('=').next().unwrap_or("").trim();
+        if !done && current == table && k == key {
+            out.push(replacement.to_string());
+            done = true;
+        } else {
+            out.push(line.to_string());
+        }
+    }
+    assert!(done, "{table}.{key} not found");
+    out.join("\n")
+}
+
+fn remove(text: &str, table: &str, key: &str) -> String {
+    set(text, table, key, "")
+}
+
+/// Loads and returns the error message, failing if the file loads.
+fn error_of(text: &str) -> String {
+    match input::load_from_str(text) {
+        Ok(_) => panic!("file was accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_mentions(message: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(
+            message.contains(p),
+            "message does not mention {p:?}:\n{message}"
+        );
+    }
+}
+
+#[test]
+fn examples_are_valid() {
+    for name in [
+        "gear-1x40-design.toml",
+        "gear-1x40-case-a.toml",
+        "gear-1x40-case-b.toml",
+        "gear-1x40-case-c.toml",
+        "gear-k-2x25.toml",
+    ] {
+        let g = input::load_from_str(&example_text(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(g.warnings.is_empty(), "{name}: {:?}", g.warnings);
+    }
+}
+
+#[test]
+fn unknown_key_is_rejected() {
+    let text = set(&design(), "worm", "tip_radius_mm", "tip_radius = 30.95");
+    assert_mentions(
+        &error_of(&text),
+        &["unknown field `tip_radius`", "tip_radius_mm"],
+    );
+}
+
+#[test]
+fn missing_field_is_named() {
+    let text = remove(&design(), "wheel", "teeth");
+    assert_mentions(&error_of(&text), &["missing field `teeth`"]);
+}
+
+#[test]
+fn nan_and_infinity_are_rejected() {
+    let text = set(&design(), "worm", "tip_radius_mm", "tip_radius_mm = nan");
+    assert_mentions(&error_of(&text), &["worm.tip_radius_mm = NaN", "finite"]);
+    let text = set(
+        &design(),
+        "conditions",
+        "worm_speed_rpm",
+        "worm_speed_rpm = inf",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["conditions.worm_speed_rpm = inf", "finite"],
+    );
+}
+
+#[test]
+fn negative_and_zero_sizes_are_rejected() {
+    let text = set(&design(), "wheel", "face_width_mm", "face_width_mm = -45.0");
+    assert_mentions(&error_of(&text), &["wheel.face_width_mm = -45", "> 0"]);
+    let text = set(
+        &design(),
+        "wheel",
+        "outer_radius_mm",
+        "outer_radius_mm = 0.0",
+    );
+    assert_mentions(&error_of(&text), &["wheel.outer_radius_mm = 0", "> 0"]);
+}
+
+#[test]
+fn tip_below_root_is_rejected() {
+    let text = set(&design(), "worm", "tip_radius_mm", "tip_radius_mm = 19.0");
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "worm.tip_radius_mm = 19",
+            "root_radius_mm = 20.06",
+            "tip below root",
+        ],
+    );
+}
+
+#[test]
+fn pressure_angle_out_of_range() {
+    let text = set(
+        &design(),
+        "worm",
+        "pressure_angle_deg",
+        "pressure_angle_deg = 60.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["worm.pressure_angle_deg = 60", "allowed [5, 40] deg"],
+    );
+}
+
+#[test]
+fn centre_distance_inconsistent_with_radii() {
+    let text = set(
+        &design(),
+        "operating",
+        "centre_distance_mm",
+        "centre_distance_mm = 140.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "operating.centre_distance_mm = 140",
+            "profile shift",
+            "[-1.5, 1.5]",
+        ],
+    );
+    // Wheel throat above the worm root.
+    let text = set(
+        &design(),
+        "wheel",
+        "throat_radius_mm",
+        "throat_radius_mm = 106.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wheel.throat_radius_mm = 106", "worm root"],
+    );
+}
+
+#[test]
+fn face_width_beyond_the_worm_reach() {
+    let text = set(&design(), "wheel", "face_width_mm", "face_width_mm = 60.0");
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "wheel.face_width_mm = 60",
+            "larger than the worm can reach",
+            "54.1",
+        ],
+    );
+}
+
+#[test]
+fn hob_that_cannot_cut_the_wheel() {
+    // Tip too small: the worm tip would hit the wheel root.
+    let text = set(&design(), "hob", "tip_radius_mm", "tip_radius_mm = 30.0");
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "hob.tip_radius_mm = 30",
+            "worm tip would hit the wheel root",
+        ],
+    );
+    // Root too high: the hob core would cut the wheel tip.
+    let text = set(&design(), "hob", "root_radius_mm", "root_radius_mm = 22.0");
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "hob.root_radius_mm = 22",
+            "hob root would cut the wheel tip",
+        ],
+    );
+    // Wrong pitch.
+    let text = set(&design(), "hob", "lead_mm", "lead_mm = 16.0");
+    assert_mentions(&error_of(&text), &["hob.axial_module_mm", "axial pitch"]);
+    // Wrong hand.
+    let text = set(&design(), "hob", "hand", "hand = \"left\"");
+    assert_mentions(&error_of(&text), &["hob.hand", "must equal worm.hand"]);
+}
+
+#[test]
+fn bad_choices_and_exclusive_fields() {
+    let text = set(&design(), "worm", "profile", "profile = \"Q\"");
+    assert_mentions(
+        &error_of(&text),
+        &["worm.profile = \"Q\"", "must be one of A, N, I, K, C"],
+    );
+    let text = set(
+        &design(),
+        "worm",
+        "lead_mm",
+        "lead_mm = 15.551\naxial_module_mm = 4.95",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["give either worm.axial_module_mm or worm.lead_mm"],
+    );
+    let text = set(
+        &design(),
+        "conditions",
+        "worm_torque_nm",
+        "worm_torque_nm = 60.0\nwheel_torque_nm = 2000.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["conditions.wheel_torque_nm", "not both"],
+    );
+    let text = set(&design(), "worm", "profile", "profile = \"K\"");
+    assert_mentions(
+        &error_of(&text),
+        &["worm.grinding_wheel", "profiles K and C need"],
+    );
+}
+
+#[test]
+fn pointed_thread_and_closed_space() {
+    let text = set(&design(), "worm", "tip_radius_mm", "tip_radius_mm = 36.0");
+    assert_mentions(&error_of(&text), &["worm.tip_radius_mm = 36", "pointed"]);
+    let text = set(
+        &design(),
+        "worm",
+        "axial_thickness_mm",
+        "axial_thickness_mm = 16.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["worm.axial_thickness_mm = 16", "less than the axial pitch"],
+    );
+}
+
+#[test]
+fn integer_ranges_and_wrong_types() {
+    let text = set(&design(), "wheel", "teeth", "teeth = 3");
+    assert_mentions(
+        &error_of(&text),
+        &["wheel.teeth = 3", "allowed integers [10, 500]"],
+    );
+    let text = set(&design(), "analysis", "positions", "positions = 1");
+    assert_mentions(&error_of(&text), &["analysis.positions = 1", "[4, 720]"]);
+    let text = set(&design(), "wheel", "teeth", "teeth = \"forty\"");
+    assert_mentions(&error_of(&text), &["invalid type", "teeth"]);
+}
+
+#[test]
+fn syntax_error_gives_the_line() {
+    let text = design().replacen("[wheel]", "[wheel", 1);
+    let e = input::load_from_str(&text).unwrap_err();
+    assert!(matches!(e, InputError::Syntax(_)));
+    assert_mentions(&e.to_string(), &["line"]);
+}
+
+#[test]
+fn several_problems_are_reported_together() {
+    let text = set(&design(), "wheel", "face_width_mm", "face_width_mm = -1.0");
+    let text = set(
+        &text,
+        "worm",
+        "pressure_angle_deg",
+        "pressure_angle_deg = 90.0",
+    );
+    let e = input::load_from_str(&text).unwrap_err();
+    let fields: Vec<&str> = e.field_errors().iter().map(|f| f.field.as_str()).collect();
+    assert!(
+        fields.contains(&"wheel.face_width_mm") && fields.contains(&"worm.pressure_angle_deg"),
+        "{fields:?}"
+    );
+}
+
+#[test]
+fn missing_file_is_an_io_error() {
+    let e = input::load(Path::new("/nonexistent/gear.toml")).unwrap_err();
+    assert!(matches!(e, InputError::Io { .. }));
+    assert_mentions(&e.to_string(), &["/nonexistent/gear.toml"]);
+}
+
+/// Numeric values that break naive code.
+fn nasty_number() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just("nan".to_string()),
+        Just("inf".to_string()),
+        Just("-inf".to_string()),
+        Just("0".to_string()),
+        Just("-0.0".to_string()),
+        Just("1e308".to_string()),
+        Just("-1e308".to_string()),
+        Just("1e-300".to_string()),
+        Just("9223372036854775807".to_string()),
+        Just("-9223372036854775808".to_string()),
+        (-1e4f64..1e4).prop_map(|v| format!("{v:.6}")),
+        (0.5f64..2.0).prop_map(|f| format!("{f}")),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 160, ..ProptestConfig::default() })]
+
+    /// Arbitrary text never panics the loader.
+    #[test]
+    fn random_text_never_panics(text in "\\PC{0,400}") {
+        let _ = input::load_from_str(&text);
+    }
+
+    /// Garbled example files (a numeric value replaced, scaled, or a line dropped or
+    /// duplicated) never panic the loader, and any file that validates also builds its geometry
+    /// without panicking (it may return an error).
+    #[test]
+    fn garbled_examples_never_panic(
+        which in 0usize..2,
+        line_pick in 0usize..10_000,
+        action in 0usize..4,
+        number in nasty_number(),
+        scale in 0.3f64..3.0,
+    ) {
+        let base = example_text(if which == 0 { "gear-1x40-design.toml" } else { "gear-k-2x25.toml" });
+        let lines: Vec<&str> = base.lines().collect();
+        let numeric: Vec<usize> = lines
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.contains('=') && l.split('=').nth(1).map(|v| v.trim().starts_with(|c: char| c.is_ascii_digit() || c == '-')).unwrap_or(false))
+            .map(|(i, _)| i)
+            .collect();
+        let idx = numeric[line_pick % numeric.len()];
+        let mut out: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
+        let key = lines[idx].split('=').next().unwrap().trim().to_string();
+        match action {
+            0 => out[idx] = format!("{key} = {number}"),
+            1 => {
+                let v: f64 = lines[idx].split('=').nth(1).unwrap().split('#').next().unwrap().trim()
+                    .parse().unwrap_or(1.0);
+                out[idx] = format!("{key} = {}", v * scale);
+            }
+            2 => out[idx].clear(),
+            _ => out.insert(idx, lines[idx].to_string()),
+        }
+        let text = out.join("\n");
+        if let Ok(gear) = input::load_from_str(&text) {
+            let _ = Geometry::build_with_grid(&gear, 4, 4);
+        }
+    }
+}
