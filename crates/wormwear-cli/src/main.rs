@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
-use wormwear::output;
 
 mod geometry_cmd;
 
@@ -135,7 +134,7 @@ fn check(file: &Path, json: bool) -> Result<(), Failure> {
 fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
     let geo = build_geometry(&gear, file)?;
-    geometry_cmd::write_geometry(&gear, &geo, file, dir).map_err(Failure::Run)?;
+    geometry_cmd::write_geometry(&gear, &geo, file, dir, quiet).map_err(Failure::Run)?;
     if !quiet {
         let s = GeometrySummary::new(&gear, &geo);
         println!(
@@ -145,6 +144,5 @@ fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
             s.active_flank_area_mm2
         );
     }
-    let _ = output::write_atomic; // output helpers are used by geometry_cmd
     Ok(())
 }

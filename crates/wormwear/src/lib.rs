@@ -11,3 +11,4 @@
 pub mod geometry;
 pub mod input;
 pub mod output;
+pub mod plot;

@@ -4,6 +4,8 @@
 //! never leaves a half-written file. `summary.json` is one JSON object; each command adds or
 //! replaces its own section and keeps the others.
 
+pub mod geometry;
+
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,139 @@
+//! The `wormwear` binary end to end: exit codes, messages, output files.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_wormwear"))
+}
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name)
+}
+
+#[test]
+fn check_accepts_every_example() {
+    for name in [
+        "gear-1x40-design.toml",
+        "gear-1x40-case-a.toml",
+        "gear-1x40-case-b.toml",
+        "gear-1x40-case-c.toml",
+        "gear-k-2x25.toml",
+    ] {
+        let out = bin().arg("check").arg(example(name)).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains("valid") && text.contains("lead_angle_deg"),
+            "{text}"
+        );
+    }
+}
+
+#[test]
+fn check_json_has_the_derived_quantities() {
+    let out = bin()
+        .args(["check", "--json"])
+        .arg(example("gear-1x40-design.toml"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Published values of the 1/40 gear: lead angle 5.437 deg, axial module 4.95 mm.
+    assert!((v["lead_angle_deg"].as_f64().unwrap() - 5.437).abs() < 0.001);
+    assert!((v["axial_module_mm"].as_f64().unwrap() - 4.95).abs() < 0.001);
+    assert!((v["axial_pressure_angle_deg"].as_f64().unwrap() - 21.81).abs() < 1e-9);
+    assert!((v["throat_radius_mm"].as_f64().unwrap() - 103.94).abs() < 1e-9);
+    assert!(v["active_flank_area_mm2"].as_f64().unwrap() > 100.0);
+}
+
+#[test]
+fn invalid_file_exits_2_with_the_field_on_stderr() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
+        .unwrap()
+        .replace("pressure_angle_deg = 21.81", "pressure_angle_deg = 85.0");
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, text).unwrap();
+    let out = bin().arg("check").arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("worm.pressure_angle_deg = 85") && err.contains("allowed [5, 40] deg"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty());
+    // Missing file: also an input error.
+    let out = bin()
+        .arg("check")
+        .arg(dir.path().join("none.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn geometry_writes_sections_grids_stl_and_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = bin()
+        .args(["geometry", "--quiet"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "section_z+0.000mm.csv",
+        "section_z+0.000mm.svg",
+        "section_z+11.250mm.svg",
+        "axial_profiles.csv",
+        "wheel_flank_left_nodes.csv",
+        "wheel_flank_right_cells.csv",
+        "wheel_flank_outline.svg",
+        "worm.stl",
+        "wheel.stl",
+    ] {
+        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert!(meta.len() > 100, "{f} is empty");
+    }
+    // Binary STL: 84-byte header + 50 bytes per triangle.
+    let stl = std::fs::read(out_dir.join("wheel.stl")).unwrap();
+    let n = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
+    assert_eq!(stl.len(), 84 + 50 * n);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let g = &summary["geometry"];
+    for key in [
+        "lead_angle_deg",
+        "axial_module_mm",
+        "normal_module_mm",
+        "axial_pressure_angle_deg",
+        "normal_pressure_angle_deg",
+        "base_radius_mm",
+        "throat_radius_mm",
+        "active_flank_area_mm2",
+    ] {
+        assert!(g.get(key).is_some(), "summary.json geometry lacks {key}");
+    }
+    assert!(summary["input"]["file"]
+        .as_str()
+        .unwrap()
+        .ends_with("gear-1x40-design.toml"));
+    // Section CSV: header then worm and wheel rows in mm.
+    let csv = std::fs::read_to_string(out_dir.join("section_z+0.000mm.csv")).unwrap();
+    assert!(csv.starts_with("member,x_mm,y_mm\n"));
+    assert!(csv.contains("\nworm,") && csv.contains("\nwheel,"));
+}

@@ -1,0 +1,219 @@
+//! Files of the geometry stage: sections in rack planes (CSV + SVG), worm axial profiles, wheel
+//! flank grids (CSV), flank outline (SVG), STL of worm and wheel, and the `geometry` section of
+//! `summary.json`.
+
+use super::{update_summary, write_atomic, Csv, OutputError};
+use crate::geometry::sections::rack_plane_section;
+use crate::geometry::stl::{wheel_mesh, worm_mesh};
+use crate::geometry::{Flank, Geometry, GeometryError, GeometrySummary};
+use crate::input::GearSet;
+use crate::plot::{line_chart, Series};
+use std::path::{Path, PathBuf};
+
+/// Error of the geometry outputs.
+#[derive(Debug, thiserror::Error)]
+pub enum GeometryOutputError {
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error(transparent)]
+    Geometry(#[from] GeometryError),
+}
+
+const MM: f64 = 1e3;
+
+/// Writes every geometry output into `dir`; returns the files written.
+pub fn write_geometry(
+    gear: &GearSet,
+    geo: &Geometry,
+    input_file: &Path,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, GeometryOutputError> {
+    let mut files = Vec::new();
+    // Sections in rack planes.
+    for &offset in &gear.analysis.section_offsets {
+        let section = rack_plane_section(gear, geo, offset, 2)?;
+        let stem = format!("section_z{:+.3}mm", offset * MM);
+        let mut csv = Csv::new(&["member", "x_mm", "y_mm"]);
+        for c in &section.curves {
+            for &(x, y) in &c.points {
+                csv.labelled_row(c.member, &[x * MM, y * MM]);
+            }
+        }
+        let path = dir.join(format!("{stem}.csv"));
+        csv.write(&path)?;
+        files.push(path);
+        let series: Vec<Series> = section
+            .curves
+            .iter()
+            .map(|c| Series {
+                label: if c.member == "worm" {
+                    "worm thread".into()
+                } else {
+                    "wheel teeth".into()
+                },
+                points: c.points.iter().map(|&(x, y)| (x * MM, y * MM)).collect(),
+                color: if c.member == "worm" { 0 } else { 1 },
+                bold: false,
+            })
+            .collect();
+        let path = dir.join(format!("{stem}.svg"));
+        line_chart(
+            &path,
+            &format!(
+                "Rack-plane section at z = {:+.2} mm (worm frame, rotation 0)",
+                offset * MM
+            ),
+            "x1 along the worm axis (mm)",
+            "y1 towards the wheel centre (mm)",
+            &series,
+            true,
+        )?;
+        files.push(path);
+    }
+    // Worm and hob axial profiles.
+    let mut csv = Csv::new(&[
+        "rho_mm",
+        "worm_left_x_mm",
+        "worm_right_x_mm",
+        "hob_left_x_mm",
+        "hob_right_x_mm",
+    ]);
+    let (lo, hi) = (
+        gear.worm.root_radius.min(gear.hob.root_radius),
+        gear.worm.tip_radius.max(gear.hob.tip_radius),
+    );
+    for k in 0..=200 {
+        let rho = lo + (hi - lo) * k as f64 / 200.0;
+        csv.row(&[
+            rho * MM,
+            geo.worm.axial_profile(Flank::Left, rho).0 * MM,
+            geo.worm.axial_profile(Flank::Right, rho).0 * MM,
+            geo.hob.axial_profile(Flank::Left, rho).0 * MM,
+            geo.hob.axial_profile(Flank::Right, rho).0 * MM,
+        ]);
+    }
+    let path = dir.join("axial_profiles.csv");
+    csv.write(&path)?;
+    files.push(path);
+    // Wheel flank grids.
+    for wf in &geo.wheel_flanks {
+        let name = wf.flank.name();
+        let mut nodes = Csv::new(&[
+            "i",
+            "j",
+            "r_mm",
+            "z_mm",
+            "theta_rad",
+            "x2_mm",
+            "y2_mm",
+            "nx",
+            "ny",
+            "nz",
+            "hob_radius_mm",
+        ]);
+        for j in 0..=wf.cells_face {
+            for i in 0..=wf.cells_height {
+                let n = wf.node(i, j);
+                let p = n.position();
+                nodes.row(&[
+                    i as f64,
+                    j as f64,
+                    n.r * MM,
+                    n.z * MM,
+                    n.theta,
+                    p.x * MM,
+                    p.y * MM,
+                    n.normal[0],
+                    n.normal[1],
+                    n.normal[2],
+                    n.hob_radius * MM,
+                ]);
+            }
+        }
+        let path = dir.join(format!("wheel_flank_{name}_nodes.csv"));
+        nodes.write(&path)?;
+        files.push(path);
+        let mut cells = Csv::new(&["i", "j", "r_mm", "z_mm", "theta_rad", "area_mm2", "active"]);
+        for j in 0..wf.cells_face {
+            for i in 0..wf.cells_height {
+                let k = j * wf.cells_height + i;
+                let c = &wf.cells[k];
+                cells.row(&[
+                    i as f64,
+                    j as f64,
+                    c.r * MM,
+                    c.z * MM,
+                    c.theta,
+                    wf.cell_area[k] * MM * MM,
+                    if wf.active[k] { 1.0 } else { 0.0 },
+                ]);
+            }
+        }
+        let path = dir.join(format!("wheel_flank_{name}_cells.csv"));
+        cells.write(&path)?;
+        files.push(path);
+    }
+    // Outline of the active flank in (z, r).
+    let mut series = Vec::new();
+    for (k, wf) in geo.wheel_flanks.iter().enumerate() {
+        let mut outline: Vec<(f64, f64)> =
+            wf.z.iter()
+                .zip(&wf.r_low)
+                .map(|(z, r)| (z * MM, r * MM))
+                .collect();
+        outline.extend(
+            wf.z.iter()
+                .zip(&wf.r_high)
+                .rev()
+                .map(|(z, r)| (z * MM, r * MM)),
+        );
+        outline.push(outline[0]);
+        series.push(Series {
+            label: format!("{}-mating flank", wf.flank.name()),
+            points: outline,
+            color: k,
+            bold: false,
+        });
+    }
+    let path = dir.join("wheel_flank_outline.svg");
+    line_chart(
+        &path,
+        "Active wheel flank (generated by the hob flank, inside the blank)",
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &series,
+        false,
+    )?;
+    files.push(path);
+    // STL.
+    let path = dir.join("worm.stl");
+    write_atomic(
+        &path,
+        &worm_mesh(gear, geo, gear.analysis.stl_worm_threads).to_binary_stl("worm", MM),
+    )?;
+    files.push(path);
+    let path = dir.join("wheel.stl");
+    write_atomic(
+        &path,
+        &wheel_mesh(gear, geo, gear.analysis.stl_wheel_teeth).to_binary_stl("wheel", MM),
+    )?;
+    files.push(path);
+    // summary.json
+    let summary = GeometrySummary::new(gear, geo);
+    update_summary(
+        dir,
+        "input",
+        serde_json::json!({
+            "file": input_file.display().to_string(),
+            "title": gear.title,
+            "program_version": env!("CARGO_PKG_VERSION"),
+        }),
+    )?;
+    let value = serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
+        what: "geometry summary".into(),
+        message: e.to_string(),
+    })?;
+    update_summary(dir, "geometry", value)?;
+    files.push(dir.join("summary.json"));
+    Ok(files)
+}
