@@ -409,3 +409,36 @@ fn meshing_function_vanishes_on_the_grid() {
         }
     }
 }
+
+#[test]
+fn hob_offset_translates_the_tooth_space_along_the_wheel_axis() {
+    // Moving the hob by d along z2 moves the whole cutting motion, so theta_w(r, z) with the
+    // offset equals theta_w(r, z - d) without it.
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build_with_grid(&g, 4, 4).unwrap();
+    let d = 1.5 * MM;
+    let base = g.cutting;
+    let mut moved = base;
+    moved.offset = d;
+    let h0 = Hobbing::new(&geo.hob, base, g.wheel.teeth);
+    let h1 = Hobbing::new(&geo.hob, moved, g.wheel.teeth);
+    let mut compared = 0;
+    for flank in Flank::BOTH {
+        for r_mm in [97.0, 100.0, 103.0] {
+            for z_mm in [-10.0, -3.0, 0.0, 4.0, 12.0] {
+                let (r, z) = (r_mm * MM, z_mm * MM);
+                let (a, b) = (h1.envelope(flank, r, z), h0.envelope(flank, r, z - d));
+                assert_eq!(a.kind, b.kind);
+                if a.kind == wormwear::geometry::PointKind::Flank {
+                    assert!(
+                        r * (a.theta - b.theta).abs() < 1e-9,
+                        "offset: {:e} m",
+                        r * (a.theta - b.theta).abs()
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared > 20);
+}
