@@ -184,6 +184,9 @@ fn oversize_hob_localises_the_contact() {
     };
     let f_conj = near_fraction(&conj);
     let f_over = near_fraction(&over);
+    eprintln!(
+        "share of nodes within 5 um of first contact: conjugate {f_conj:.3}, oversize {f_over:.3}"
+    );
     assert!(
         f_over < 0.5 * f_conj,
         "oversize hob should localise the contact: share of nodes within 5 um of first contact \
@@ -311,19 +314,25 @@ fn left_hand_gear_is_the_mirror_of_the_right_hand_one() {
     }
 }
 
-fn bilinear_centre_error(wf: &WheelFlank) -> f64 {
+/// Largest error (m, at the flank radius) of theta_w interpolated linearly between nodes at the
+/// exact (r, z) of the cell centres: linear in r along the two neighbouring node columns, then
+/// linear in z. Only columns with |z| < `z_max` (the blank top has a kink where the throat
+/// torus meets the outer cylinder, which lowers the order locally).
+fn bilinear_centre_error(wf: &WheelFlank, z_max: f64) -> f64 {
     let mut worst: f64 = 0.0;
     for j in 0..wf.cells_face {
+        if wf.z[j].abs() > z_max || wf.z[j + 1].abs() > z_max {
+            continue;
+        }
         for i in 0..wf.cells_height {
             let c = wf.cell(i, j);
-            let corners = [
-                wf.node(i, j),
-                wf.node(i + 1, j),
-                wf.node(i, j + 1),
-                wf.node(i + 1, j + 1),
-            ];
-            let mean = corners.iter().map(|n| n.theta).sum::<f64>() / 4.0;
-            worst = worst.max(c.r * (c.theta - mean).abs());
+            let along = |jj: usize| {
+                let (a, b) = (wf.node(i, jj), wf.node(i + 1, jj));
+                a.theta + (b.theta - a.theta) * (c.r - a.r) / (b.r - a.r)
+            };
+            let w = (c.z - wf.z[j]) / (wf.z[j + 1] - wf.z[j]);
+            let interpolated = along(j) * (1.0 - w) + along(j + 1) * w;
+            worst = worst.max(c.r * (c.theta - interpolated).abs());
         }
     }
     worst
@@ -361,9 +370,18 @@ fn grid_refinement_is_consistent_and_converges() {
             "area convergence ratio {ratio} ({ac}, {af}, {aff})"
         );
         assert!((af - aff).abs() / aff < 1e-3);
-        // Bilinear interpolation of theta_w between nodes: second-order error.
-        let (ec, ef) = (bilinear_centre_error(c), bilinear_centre_error(f));
-        assert!(ec / ef > 3.0, "interpolation error {ec:e} -> {ef:e} m");
+        // Bilinear interpolation of theta_w between nodes: second-order error (the flank is
+        // curved along z: theta_zz ~ tan(alpha) / ((a - r) r), so linear interpolation across
+        // columns is not exact to the grid; later stages work on node columns).
+        let z_max = 12.0 * MM;
+        let (ec, ef) = (
+            bilinear_centre_error(c, z_max),
+            bilinear_centre_error(f, z_max),
+        );
+        eprintln!(
+            "{flank:?}: areas {ac:e} {af:e} {aff:e} m^2; bilinear centre error {ec:e} -> {ef:e} m"
+        );
+        assert!(ec / ef > 3.5, "interpolation error {ec:e} -> {ef:e} m");
     }
 }
 
