@@ -4,11 +4,14 @@
 //! the next one consumes (see `../shared/spec/MODEL.md` §0):
 //!
 //! 1. [`input`] — the validated gear file, SI units;
-//! 2. [`geometry`] — worm and hob helicoids, wheel flanks by hobbing simulation (MODEL §2-3).
+//! 2. [`geometry`] — worm and hob helicoids, wheel flanks by hobbing simulation (MODEL §2-3);
+//! 3. [`kinematics`] — unloaded meshing analysis: gaps, kinematic error, no-load pattern,
+//!    sliding velocities (MODEL §4).
 //!
 //! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
 
 pub mod geometry;
 pub mod input;
+pub mod kinematics;
 pub mod output;
 pub mod plot;

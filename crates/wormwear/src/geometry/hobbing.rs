@@ -136,19 +136,17 @@ impl<'a> Hobbing<'a> {
                 best = (k, v);
             }
         }
+        // Refine around the best sample (also when it is an end sample: the maximum may lie
+        // between it and its neighbour), then classify by where the refined maximum lies.
         let (k, v) = best;
-        if k == 0 || k == ENVELOPE_SAMPLES - 1 {
-            let psi = lo + step * k as f64;
-            return EnvelopePoint {
-                kind: PointKind::Fillet,
-                theta: sign * v,
-                psi,
-                hob_radius: self.hob_radius(r, z, psi),
-            };
-        }
-        let a = lo + step * (k - 1) as f64;
-        let b = lo + step * (k + 1) as f64;
-        let (psi, v) = brent_max(f, a, b, PSI_TOL);
+        let a = lo + step * k.saturating_sub(1) as f64;
+        let b = lo + step * (k + 1).min(ENVELOPE_SAMPLES - 1) as f64;
+        let (psi, v_refined) = brent_max(f, a, b, PSI_TOL);
+        let (psi, v) = if v_refined >= v {
+            (psi, v_refined)
+        } else {
+            (lo + step * k as f64, v)
+        };
         let at_end = (psi - lo).abs() < 1e3 * PSI_TOL || (hi - psi).abs() < 1e3 * PSI_TOL;
         EnvelopePoint {
             kind: if at_end {

@@ -71,6 +71,13 @@ pub fn to_wheel_body(v: &Vector3<f64>, theta2: f64) -> Vector3<f64> {
     Vector3::new(v.x * c - v.y * s, v.x * s + v.y * c, v.z)
 }
 
+/// Turns a wheel body-frame vector into the stationary wheel frame for a wheel turned by theta2
+/// (the motion of [`wheel_point`]; inverse of [`to_wheel_body`]).
+#[inline]
+pub fn from_wheel_body(v: &Vector3<f64>, theta2: f64) -> Vector3<f64> {
+    to_wheel_body(v, -theta2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,775 @@
+//! Stage 2 — unloaded meshing analysis, TCA (MODEL §4, §12a, §12b).
+//!
+//! For N_p positions over one wheel tooth pitch and teeth k = -K..K, the gaps between the
+//! loaded wheel flank and the worm, through the operating placement (misalignments included):
+//!
+//! - linear gap e along the worm axis and the exact angular gap e_ang (the wheel rotation,
+//!   against its driven sense, that closes e at the point; Newton on e), at every node and cell
+//!   centre of every tooth at every position;
+//! - on every face slice (node column) the contact point: the minimum of e_ang along r,
+//!   refined on the column's Hermite interpolant of theta_w (exact to ~1e-11 m);
+//! - the unloaded kinematic error Delta_theta2 = -min e_ang (lag, driven sense) and the initial
+//!   separations e_ang - min e_ang >= 0 for the loaded problem (MODEL §4.3);
+//! - the no-load pattern for a marking thickness j (MODEL §4.4);
+//! - the contact map: for each flank node, the moment it meets the worm flank (from the worm's
+//!   own envelope on the wheel, the machinery of hobbing with the worm as cutter), the worm
+//!   radius there, the worm-tip trace, and the sliding velocities with material velocities
+//!   (MODEL §4.5): magnitude, along/across the contact line, rolling velocities u1, u2 across the
+//!   line, speed of the line over the wheel; and on the contact lines the relative curvature
+//!   radius across the line (MODEL §4.6).
+//!
+//! Positions: theta2_n = sigma (phase + n / N_p) tau (tau = 2 pi / z2, sigma = +1 when the worm
+//! turns in the positive sense; the phase centres the studied range on the contact zone of the
+//! flank's central node); tooth k sits at body angle theta_w + sigma k tau, so tooth k at position
+//! n is the reference tooth at extended position n + k N_p (MODEL §4.1).
+
+use crate::geometry::hobbing::{Hobbing, PointKind};
+use crate::geometry::placement::{from_wheel_body, wheel_point};
+use crate::geometry::roots::brent_max;
+use crate::geometry::{Flank, Geometry, ThreadSurface, WheelFlank};
+use crate::input::{GearSet, Placement, Rotation};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Why the TCA failed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum KinematicsError {
+    #[error("no contact: the worm flank never reaches the wheel flank at position {0}")]
+    NoContact(usize),
+}
+
+/// Gap of a wheel point to the worm flank at given rotations.
+#[derive(Debug, Clone, Copy)]
+pub struct GapEvaluator<'a> {
+    pub worm: &'a ThreadSurface,
+    pub placement: Placement,
+    /// Loaded worm flank.
+    pub flank: Flank,
+    /// +1: wheel driven towards increasing theta2 (positive worm rotation), -1 otherwise.
+    pub sigma: f64,
+    /// z2 / z1.
+    pub ratio: f64,
+}
+
+impl<'a> GapEvaluator<'a> {
+    /// Evaluator for the gear's operating set-up and loaded flank.
+    pub fn new(gear: &GearSet, geo: &'a Geometry) -> Self {
+        let flank = loaded_flank(gear);
+        Self {
+            worm: &geo.worm,
+            placement: gear.operating,
+            flank,
+            sigma: -flank.sign(),
+            ratio: gear.ratio(),
+        }
+    }
+
+    /// Linear gap along the worm axis of the wheel point (r, theta_body, z) with the wheel at
+    /// theta2 and the worm at theta1, its derivative with respect to the stationary angle, and
+    /// the point's radius from the worm axis. m, m/rad, m.
+    #[inline]
+    pub fn linear(&self, r: f64, theta: f64, z: f64, theta2: f64, theta1: f64) -> (f64, f64, f64) {
+        let p = wheel_point(r, theta, z, theta2);
+        let q = self.placement.wheel_to_worm(&p);
+        let (e, rho) = self.worm.axial_gap(self.flank, &q, theta1);
+        let (_, xy, xz) = self.worm.flank_x(self.flank, q.y, q.z);
+        let dq = self
+            .placement
+            .vector_wheel_to_worm(&Vector3::new(p.y, -p.x, 0.0));
+        let de = xy * dq.y + xz * dq.z - dq.x;
+        (e, de * -self.flank.sign(), rho)
+    }
+
+    /// Exact angular gap: the rotation of the wheel against its driven sense that closes the
+    /// linear gap at the point, with the worm fixed (Newton). +infinity when the point is
+    /// outside the worm tip cylinder (the flank cannot reach it). rad.
+    #[inline]
+    pub fn angular(&self, r: f64, theta: f64, z: f64, theta2: f64, theta1: f64) -> f64 {
+        let tip = self.worm.def.tip_radius;
+        let (e, de, rho) = self.linear(r, theta, z, theta2, theta1);
+        if rho > tip || de.abs() < 1e-12 {
+            return f64::INFINITY;
+        }
+        // e(psi - sigma delta) = 0, de/dpsi has the sign of sigma.
+        let mut delta = e / (self.sigma * de);
+        for _ in 0..6 {
+            let (e, de, _) = self.linear(r, theta, z, theta2 - self.sigma * delta, theta1);
+            let step = e / (self.sigma * de);
+            delta += step;
+            if step.abs() < 1e-15 {
+                break;
+            }
+        }
+        delta
+    }
+
+    /// Lever arm converting an angular separation into a normal distance at a wheel point:
+    /// |(P x n)_z| (MODEL §5.3), m.
+    pub fn lever(point: &Vector3<f64>, normal: &Vector3<f64>) -> f64 {
+        (point.x * normal.y - point.y * normal.x).abs()
+    }
+}
+
+/// The worm flank loaded by the operating rotation.
+pub fn loaded_flank(gear: &GearSet) -> Flank {
+    match gear.rotation {
+        Rotation::Positive => Flank::Left,
+        Rotation::Negative => Flank::Right,
+    }
+}
+
+/// Material velocities at a point (MODEL §4.5), worm frame, m/s.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Velocities {
+    /// Worm material velocity V1.
+    pub worm: [f64; 3],
+    /// Wheel material velocity V2.
+    pub wheel: [f64; 3],
+    /// Sliding velocity Vg = V2 - V1.
+    pub sliding: [f64; 3],
+}
+
+/// Material velocities of worm and wheel at the point `q` (worm frame, m) for the worm turning
+/// at theta1_dot (rad/s, the thread-advance angle of MODEL §2.1; physical spin = hand x
+/// theta1_dot about +x1) and the wheel at theta2_dot = theta1_dot z1/z2.
+pub fn material_velocities(
+    q: &Vector3<f64>,
+    worm: &ThreadSurface,
+    placement: &Placement,
+    theta1_dot: f64,
+    ratio: f64,
+) -> Velocities {
+    let spin = worm.hand_sign() * theta1_dot;
+    let v1 = Vector3::new(0.0, -q.z, q.y) * spin;
+    let p = placement.worm_to_wheel(q);
+    let theta2_dot = theta1_dot / ratio;
+    let v2 = placement.vector_wheel_to_worm(&Vector3::new(p.y, -p.x, 0.0)) * theta2_dot;
+    let vg = v2 - v1;
+    Velocities {
+        worm: v1.into(),
+        wheel: v2.into(),
+        sliding: vg.into(),
+    }
+}
+
+/// Contact kinematics of one flank node at the moment the worm flank meets it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct NodeContact {
+    /// The worm flank (not its tip edge) reaches the node.
+    pub reachable: bool,
+    /// Wheel rotation theta2 at the contact moment (reference tooth), rad.
+    pub theta2: f64,
+    /// Radius of the contact point on the worm, m.
+    pub worm_radius: f64,
+    /// Ease-off: theta_w of the actual wheel minus that of the wheel the worm itself would
+    /// generate, times r (positive = material removed beyond conjugate), m.
+    pub ease_off: f64,
+    /// Sliding speed |Vg|, m/s.
+    pub sliding_speed: f64,
+    /// Sliding component along the contact line, m/s.
+    pub sliding_along: f64,
+    /// Sliding component across the contact line (in the tangent plane), m/s.
+    pub sliding_across: f64,
+    /// Rolling velocities across the line: of the contact relative to the worm (u1) and to the
+    /// wheel (u2), m/s (u2 = speed of the contact line over the wheel flank).
+    pub u1: f64,
+    pub u2: f64,
+    /// Sliding velocity vector and unit normal (worm frame) at the contact.
+    pub sliding: [f64; 3],
+    pub normal: [f64; 3],
+    /// Unit direction of the contact line (worm frame, at the contact moment).
+    pub line_direction: [f64; 3],
+    /// Unit direction of the contact line on the wheel flank (wheel body frame).
+    pub line_direction_body: [f64; 3],
+}
+
+/// Contact point of one face slice at one position and tooth.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SliceContact {
+    pub position: usize,
+    /// Tooth index k.
+    pub tooth: i32,
+    /// Node column j.
+    pub slice: usize,
+    /// Radius and face position of the point of minimum gap, m.
+    pub r: f64,
+    pub z: f64,
+    /// theta_w there (body frame, reference tooth), rad.
+    pub theta: f64,
+    /// Angular gap before the kinematic-error shift, rad.
+    pub angular_gap: f64,
+    /// Normal separation after the kinematic-error shift, m.
+    pub separation: f64,
+    /// Radius from the worm axis, m.
+    pub worm_radius: f64,
+    /// Minimum on the slice's end (the contact line does not cross this slice).
+    pub at_end: bool,
+    /// Relative radius of curvature across the contact line from the gap curvature, m
+    /// (NaN at slice ends).
+    pub curvature_radius: f64,
+}
+
+/// One kinematic position.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Position {
+    /// Nominal wheel rotation, rad.
+    pub theta2: f64,
+    /// Worm rotation (thread-advance angle), rad.
+    pub theta1: f64,
+    /// Unloaded kinematic error Delta_theta2 (driven sense; negative = lag), rad.
+    pub kinematic_error: f64,
+    /// Teeth within the marking thickness of contact.
+    pub teeth_in_contact: usize,
+}
+
+/// Result of the unloaded analysis.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Tca {
+    pub loaded_flank: Flank,
+    /// +1 or -1 (driven sense of the wheel).
+    pub sigma: f64,
+    /// Phase of position 0, in tooth pitches (driven sense).
+    pub phase: f64,
+    pub teeth: Vec<i32>,
+    pub positions: Vec<Position>,
+    /// Angular gaps at the loaded flank's nodes before the kinematic-error shift, index
+    /// `(n * teeth + t) * nodes + node`, rad (infinite where the worm cannot reach).
+    pub node_gaps: Vec<f64>,
+    /// Same at the cell centres, index `(n * teeth + t) * cells + cell`.
+    pub cell_gaps: Vec<f64>,
+    /// Contact points of every slice, tooth and position.
+    pub contact_lines: Vec<SliceContact>,
+    /// Per cell: minimum normal separation over all positions and teeth (mapped to the
+    /// reference tooth), m.
+    pub min_separation: Vec<f64>,
+    /// Per cell: marked by the no-load pattern (min separation <= j).
+    pub marked: Vec<bool>,
+    pub marking_thickness: f64,
+    pub pattern_area: f64,
+    pub active_area: f64,
+    /// Per node column: lowest radius the worm flank reaches (trace of the worm tip), m.
+    pub tip_trace: Vec<(f64, f64)>,
+    /// Per node of the loaded flank.
+    pub node_contact: Vec<NodeContact>,
+    /// Sliding speed at the pitch point, r1 omega1 / cos(gamma) by material velocities, m/s.
+    pub pitch_sliding_speed: f64,
+    pub warnings: Vec<String>,
+}
+
+impl Tca {
+    /// Number of teeth studied.
+    pub fn tooth_count(&self) -> usize {
+        self.teeth.len()
+    }
+
+    /// Initial angular separation (MODEL §4.3) of node `node` of tooth index `t` at position n:
+    /// e_ang - min e_ang >= 0, rad (infinite where unreachable).
+    pub fn initial_separation(&self, n: usize, t: usize, node: usize, nodes: usize) -> f64 {
+        let g = self.node_gaps[(n * self.teeth.len() + t) * nodes + node];
+        g + self.positions[n].kinematic_error
+    }
+
+    /// Mean and peak-to-peak of the unloaded kinematic error, rad.
+    pub fn kinematic_error_stats(&self) -> (f64, f64) {
+        let ke: Vec<f64> = self.positions.iter().map(|p| p.kinematic_error).collect();
+        let mean = ke.iter().sum::<f64>() / ke.len() as f64;
+        let (lo, hi) = ke
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        (mean, hi - lo)
+    }
+
+    /// Largest sliding speed over the reachable flank, m/s.
+    pub fn max_sliding_speed(&self) -> f64 {
+        self.node_contact
+            .iter()
+            .filter(|c| c.reachable)
+            .map(|c| c.sliding_speed)
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Settings of the analysis (from `[analysis]`).
+#[derive(Debug, Clone, Copy)]
+pub struct TcaSettings {
+    pub positions: usize,
+    pub teeth_each_side: usize,
+    pub marking_thickness: f64,
+}
+
+impl TcaSettings {
+    pub fn from_gear(gear: &GearSet) -> Self {
+        Self {
+            positions: gear.analysis.positions,
+            teeth_each_side: gear.analysis.teeth_each_side,
+            marking_thickness: gear.analysis.marking_thickness,
+        }
+    }
+}
+
+/// Runs the unloaded analysis with the gear's settings.
+pub fn analyse(gear: &GearSet, geo: &Geometry) -> Result<Tca, KinematicsError> {
+    analyse_with(gear, geo, TcaSettings::from_gear(gear))
+}
+
+/// Minimum of the angular gap along node column j, refined between the neighbours of the best
+/// node on the column's Hermite interpolant. Returns (r, gap, at_end).
+fn slice_minimum(
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    j: usize,
+    gaps: &[f64],
+    body_offset: f64,
+    theta2: f64,
+    theta1: f64,
+) -> (f64, f64, bool) {
+    let ni = wf.cells_height;
+    let col = |i: usize| gaps[j * (ni + 1) + i];
+    let (mut best, mut best_gap) = (0, f64::INFINITY);
+    for i in 0..=ni {
+        if col(i) < best_gap {
+            best = i;
+            best_gap = col(i);
+        }
+    }
+    if !best_gap.is_finite() {
+        return (wf.node(0, j).r, f64::INFINITY, true);
+    }
+    let z = wf.z[j];
+    let f = |r: f64| {
+        let (theta, _) = wf.column_theta(j, r);
+        let g = ev.angular(r, theta + body_offset, z, theta2, theta1);
+        if g.is_finite() {
+            -g
+        } else {
+            -1.0
+        }
+    };
+    let lo = wf.node(best.saturating_sub(1), j).r;
+    let hi = wf.node((best + 1).min(ni), j).r;
+    let (r, neg) = brent_max(f, lo, hi, 1e-12);
+    let (r, gap) = if -neg <= best_gap {
+        (r, -neg)
+    } else {
+        (wf.node(best, j).r, best_gap)
+    };
+    // A contact-line crossing is a proper interior minimum: finite, larger gaps on both sides.
+    let h = 0.25 * (wf.r_high[j] - wf.r_low[j]) / ni as f64;
+    let at_end = !(f(r - h) < -gap && f(r + h) < -gap) || -f(r - h) >= 1.0 || -f(r + h) >= 1.0;
+    (r, gap, at_end)
+}
+
+/// Runs the unloaded analysis (MODEL §4).
+pub fn analyse_with(
+    gear: &GearSet,
+    geo: &Geometry,
+    settings: TcaSettings,
+) -> Result<Tca, KinematicsError> {
+    let ev = GapEvaluator::new(gear, geo);
+    let flank = ev.flank;
+    let sigma = ev.sigma;
+    let wf = geo.wheel_flank(flank);
+    let z2 = geo.teeth as f64;
+    let tau = 2.0 * PI / z2;
+    let np = settings.positions;
+    let kk = settings.teeth_each_side as i32;
+    let teeth: Vec<i32> = (-kk..=kk).collect();
+    let nt = teeth.len();
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let n_nodes = wf.nodes.len();
+    let n_cells = wf.cells.len();
+
+    // Contact map: the worm's own envelope on the wheel flank.
+    let worm_cut = Hobbing::new(&geo.worm, gear.operating, geo.teeth);
+    let theta1_dot = sigma * gear.conditions.worm_speed;
+    let envelopes: Vec<_> = wf
+        .nodes
+        .par_iter()
+        .map(|p| worm_cut.envelope(flank, p.r, p.z))
+        .collect();
+    let contact_theta2: Vec<f64> = envelopes
+        .iter()
+        .zip(&wf.nodes)
+        .map(|(e, p)| e.psi - p.theta)
+        .collect();
+    let reachable_mask: Vec<bool> = envelopes
+        .iter()
+        .map(|e| e.kind == PointKind::Flank)
+        .collect();
+    // Centre the studied extended positions [phase - K, phase + K + 1) (in pitches) on the
+    // contact moment of the flank's central node.
+    let centre = contact_theta2[(nj / 2) * (ni + 1) + ni / 2];
+    let phase = if centre.is_finite() {
+        sigma * centre / tau - 0.5
+    } else {
+        0.0
+    };
+    let node_contact: Vec<NodeContact> = (0..n_nodes)
+        .map(|k| {
+            let (i, j) = (k % (ni + 1), k / (ni + 1));
+            node_contact(
+                gear,
+                geo,
+                &ev,
+                wf,
+                &envelopes[k],
+                &contact_theta2,
+                &reachable_mask,
+                i,
+                j,
+                theta1_dot,
+            )
+        })
+        .collect();
+    // Gaps at nodes and cells, slice minima: one task per (position, tooth).
+    struct Block {
+        node_gaps: Vec<f64>,
+        cell_gaps: Vec<f64>,
+        slices: Vec<(f64, f64, bool)>,
+    }
+    let blocks: Vec<Block> = (0..np * nt)
+        .into_par_iter()
+        .map(|b| {
+            let (n, t) = (b / nt, b % nt);
+            let theta2 = sigma * (phase + n as f64 / np as f64) * tau;
+            let theta1 = theta2 * ev.ratio;
+            let offset = sigma * teeth[t] as f64 * tau;
+            let node_gaps: Vec<f64> = wf
+                .nodes
+                .iter()
+                .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
+                .collect();
+            let cell_gaps: Vec<f64> = wf
+                .cells
+                .iter()
+                .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
+                .collect();
+            let slices = (0..=nj)
+                .map(|j| slice_minimum(&ev, wf, j, &node_gaps, offset, theta2, theta1))
+                .collect();
+            Block {
+                node_gaps,
+                cell_gaps,
+                slices,
+            }
+        })
+        .collect();
+
+    // Kinematic error per position.
+    let mut positions = Vec::with_capacity(np);
+    for n in 0..np {
+        let theta2 = sigma * (phase + n as f64 / np as f64) * tau;
+        let min = (0..nt)
+            .flat_map(|t| blocks[n * nt + t].slices.iter().map(|s| s.1))
+            .chain((0..nt).flat_map(|t| blocks[n * nt + t].cell_gaps.iter().copied()))
+            .fold(f64::INFINITY, f64::min);
+        if !min.is_finite() {
+            return Err(KinematicsError::NoContact(n));
+        }
+        positions.push(Position {
+            theta2,
+            theta1: theta2 * ev.ratio,
+            kinematic_error: -min,
+            teeth_in_contact: 0,
+        });
+    }
+
+    // Levers (angular -> normal distance) per cell and node.
+    let cell_lever: Vec<f64> = wf
+        .cells
+        .iter()
+        .map(|c| GapEvaluator::lever(&c.position(), &c.normal_vec()))
+        .collect();
+
+    // No-load pattern and teeth in contact.
+    let j_mark = settings.marking_thickness;
+    let mut min_separation = vec![f64::INFINITY; n_cells];
+    let mut warnings = Vec::new();
+    // Extended positions n + k N_p cover [-K N_p, (K + 1) N_p); if the tooth at either end of
+    // that range is near contact, teeth beyond the studied ones may touch too.
+    let mut end_touch = f64::INFINITY;
+    for n in 0..np {
+        let ke = positions[n].kinematic_error;
+        let mut in_contact = 0;
+        for t in 0..nt {
+            let block = &blocks[n * nt + t];
+            let mut tooth_min = f64::INFINITY;
+            for c in 0..n_cells {
+                let sep = (block.cell_gaps[c] + ke) * cell_lever[c];
+                tooth_min = tooth_min.min(sep);
+                if sep < min_separation[c] {
+                    min_separation[c] = sep;
+                }
+            }
+            if tooth_min <= j_mark {
+                in_contact += 1;
+            }
+            if (t == 0 && n == 0) || (t == nt - 1 && n == np - 1) {
+                end_touch = end_touch.min(tooth_min);
+            }
+        }
+        positions[n].teeth_in_contact = in_contact;
+    }
+    if end_touch <= j_mark {
+        warnings.push(format!(
+            "the outermost studied tooth (k = +-{kk}) is within {:.2} um of contact at the end of \
+             the studied range: teeth beyond it may touch; increase analysis.teeth_each_side",
+            end_touch * 1e6
+        ));
+    }
+    let marked: Vec<bool> = min_separation.iter().map(|&s| s <= j_mark).collect();
+    let pattern_area: f64 = wf
+        .cell_area
+        .iter()
+        .zip(&marked)
+        .filter(|(_, &m)| m)
+        .map(|(a, _)| a)
+        .sum();
+    let active_area = wf.active_area();
+
+    let tip_trace: Vec<(f64, f64)> =
+        wf.z.par_iter()
+            .enumerate()
+            .map(|(j, &z)| {
+                let top = wf.node(ni, j).r;
+                match worm_cut.radial_limits(flank, z, top) {
+                    Ok((lo, _)) => (z, lo.max(wf.node(0, j).r)),
+                    Err(_) => (z, top),
+                }
+            })
+            .collect();
+
+    // Contact lines.
+    let mut contact_lines = Vec::with_capacity(np * nt * (nj + 1));
+    for n in 0..np {
+        let ke = positions[n].kinematic_error;
+        let (theta2, theta1) = (positions[n].theta2, positions[n].theta1);
+        for t in 0..nt {
+            let offset = sigma * teeth[t] as f64 * tau;
+            for (j, &(r, gap, at_end)) in blocks[n * nt + t].slices.iter().enumerate() {
+                if !gap.is_finite() {
+                    continue;
+                }
+                let z = wf.z[j];
+                let (theta, _) = wf.column_theta(j, r);
+                let p = wheel_point(r, theta + offset, z, theta2);
+                let q = ev.placement.wheel_to_worm(&p);
+                let rho = (q.y * q.y + q.z * q.z).sqrt();
+                let normal = ev.worm.outward_normal(flank, q.y, q.z);
+                let n_wheel = ev.placement.vector_worm_to_wheel(&normal);
+                let lever = GapEvaluator::lever(&p, &n_wheel);
+                let curvature_radius = if at_end {
+                    f64::NAN
+                } else {
+                    curvature_radius(&ev, wf, j, r, offset, theta2, theta1, lever, &node_contact)
+                };
+                contact_lines.push(SliceContact {
+                    position: n,
+                    tooth: teeth[t],
+                    slice: j,
+                    r,
+                    z,
+                    theta,
+                    angular_gap: gap,
+                    separation: (gap + ke) * lever,
+                    worm_radius: rho,
+                    at_end,
+                    curvature_radius,
+                });
+            }
+        }
+    }
+
+    let r1 = gear.worm.reference_radius;
+    let pitch = material_velocities(
+        &Vector3::new(0.0, r1, 0.0),
+        &geo.worm,
+        &Placement::aligned(gear.nominal_centre_distance),
+        theta1_dot,
+        ev.ratio,
+    );
+    let pitch_sliding_speed = Vector3::from(pitch.sliding).norm();
+
+    let mut node_gaps = Vec::with_capacity(np * nt * n_nodes);
+    let mut cell_gaps = Vec::with_capacity(np * nt * n_cells);
+    for b in &blocks {
+        node_gaps.extend_from_slice(&b.node_gaps);
+        cell_gaps.extend_from_slice(&b.cell_gaps);
+    }
+    Ok(Tca {
+        loaded_flank: flank,
+        sigma,
+        phase,
+        teeth,
+        positions,
+        node_gaps,
+        cell_gaps,
+        contact_lines,
+        min_separation,
+        marked,
+        marking_thickness: j_mark,
+        pattern_area,
+        active_area,
+        tip_trace,
+        node_contact,
+        pitch_sliding_speed,
+        warnings,
+    })
+}
+
+/// Relative radius of curvature across the contact line on slice j at r: R = sin^2(beta) / g''
+/// with g the normal gap along the slice (arc length s) and beta the angle between the slice
+/// and the contact line (MODEL §4.6: gap ~ xi^2 / 2R across the line). m.
+#[allow(clippy::too_many_arguments)]
+fn curvature_radius(
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    j: usize,
+    r: f64,
+    offset: f64,
+    theta2: f64,
+    theta1: f64,
+    lever: f64,
+    contacts: &[NodeContact],
+) -> f64 {
+    let z = wf.z[j];
+    let h = 0.25 * (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64;
+    let gap =
+        |rr: f64| ev.angular(rr, wf.column_theta(j, rr).0 + offset, z, theta2, theta1) * lever;
+    let (gm, g0, gp) = (gap(r - h), gap(r), gap(r + h));
+    let pos = |rr: f64| wheel_point(rr, wf.column_theta(j, rr).0, z, 0.0);
+    let ds = (pos(r + h) - pos(r - h)).norm() / 2.0;
+    let g2 = (gp - 2.0 * g0 + gm) / (ds * ds);
+    // Angle between the slice and the contact line (body frame), from the nearest node.
+    let i = (((r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]) * wf.cells_height as f64).round()
+        as usize)
+        .min(wf.cells_height);
+    let c = &contacts[j * (wf.cells_height + 1) + i];
+    let slice_dir = (pos(r + h) - pos(r - h)).normalize();
+    let sin_b = slice_dir
+        .cross(&Vector3::from(c.line_direction_body))
+        .norm();
+    if g2 > 0.0 {
+        sin_b * sin_b / g2
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Contact kinematics of node (i, j) from the worm's envelope at that node.
+#[allow(clippy::too_many_arguments)]
+fn node_contact(
+    gear: &GearSet,
+    geo: &Geometry,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    env: &crate::geometry::EnvelopePoint,
+    contact_theta2: &[f64],
+    reachable_mask: &[bool],
+    i: usize,
+    j: usize,
+    theta1_dot: f64,
+) -> NodeContact {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let node = wf.node(i, j);
+    let reachable = env.kind == PointKind::Flank;
+    let theta2 = contact_theta2[j * (ni + 1) + i];
+    let p = wheel_point(node.r, node.theta, node.z, theta2);
+    let q = ev.placement.wheel_to_worm(&p);
+    let rho = (q.y * q.y + q.z * q.z).sqrt();
+    let v = material_velocities(&q, &geo.worm, &ev.placement, theta1_dot, ev.ratio);
+    let vg = Vector3::from(v.sliding);
+    // Normal: the wheel node's normal (body) turned to the contact moment, in the worm frame,
+    // oriented like the worm's outward normal (out of the worm, into the wheel).
+    let n = -ev
+        .placement
+        .vector_wheel_to_worm(&from_wheel_body(&node.normal_vec(), theta2));
+    // Surface gradient of the contact moment (body frame), by differences on the node grid.
+    // Neighbours the worm flank reaches (their contact moments are meaningful).
+    let idx = |i: usize, j: usize| j * (ni + 1) + i;
+    let ok = |i: usize, j: usize| reachable_mask[idx(i, j)];
+    let pick = |lo: usize, mid: usize, hi: usize, f: &dyn Fn(usize) -> bool| -> (usize, usize) {
+        match (f(lo), f(hi)) {
+            (true, true) => (lo, hi),
+            (true, false) => (lo, mid),
+            (false, true) => (mid, hi),
+            (false, false) => (mid, mid),
+        }
+    };
+    let (i0, i1) = pick(i.saturating_sub(1), i, (i + 1).min(ni), &|ii| ok(ii, j));
+    let (j0, j1) = pick(j.saturating_sub(1), j, (j + 1).min(nj), &|jj| ok(i, jj));
+    if i0 == i1 || j0 == j1 || !reachable {
+        return NodeContact {
+            reachable: false,
+            theta2,
+            worm_radius: rho,
+            ease_off: f64::NAN,
+            sliding_speed: vg.norm(),
+            sliding_along: f64::NAN,
+            sliding_across: f64::NAN,
+            u1: f64::NAN,
+            u2: f64::NAN,
+            sliding: vg.into(),
+            normal: n.into(),
+            line_direction: [f64::NAN; 3],
+            line_direction_body: [f64::NAN; 3],
+        };
+    }
+    let pi = (wf.node(i1, j).position() - wf.node(i0, j).position()) / (i1 - i0) as f64;
+    let pj = (wf.node(i, j1).position() - wf.node(i, j0).position()) / (j1 - j0) as f64;
+    let fi = (contact_theta2[idx(i1, j)] - contact_theta2[idx(i0, j)]) / (i1 - i0) as f64;
+    let fj = (contact_theta2[idx(i, j1)] - contact_theta2[idx(i, j0)]) / (j1 - j0) as f64;
+    // grad = a pi + b pj with grad . pi = fi, grad . pj = fj.
+    let (g11, g12, g22) = (pi.dot(&pi), pi.dot(&pj), pj.dot(&pj));
+    let det = g11 * g22 - g12 * g12;
+    let a = (fi * g22 - fj * g12) / det;
+    let b = (fj * g11 - fi * g12) / det;
+    // Keep the tangential part (the chords pi, pj are not exactly tangent).
+    let nb = node.normal_vec();
+    let grad_body = pi * a + pj * b;
+    let grad_body = grad_body - nb * grad_body.dot(&nb);
+    let grad = ev
+        .placement
+        .vector_wheel_to_worm(&from_wheel_body(&grad_body, theta2));
+    let theta2_dot = theta1_dot / ev.ratio;
+    let g2 = grad.norm_squared();
+    let (line, across, w2, line_body) = if g2 > 0.0 && g2.is_finite() {
+        let nu = grad / g2.sqrt();
+        let t = n.cross(&nu).normalize();
+        let t_body = node.normal_vec().cross(&grad_body).normalize();
+        (t, nu, grad * (theta2_dot / g2), t_body)
+    } else {
+        (
+            Vector3::zeros(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+    };
+    let u2 = w2.dot(&across);
+    let u1 = (vg + w2).dot(&across);
+    let ease_off = if reachable {
+        node.r * (node.theta - env.theta) * -ev.flank.sign()
+    } else {
+        f64::NAN
+    };
+    let _ = gear;
+    NodeContact {
+        reachable,
+        theta2,
+        worm_radius: rho,
+        ease_off,
+        sliding_speed: vg.norm(),
+        sliding_along: vg.dot(&line),
+        sliding_across: vg.dot(&across),
+        u1,
+        u2,
+        sliding: vg.into(),
+        normal: n.into(),
+        line_direction: line.into(),
+        line_direction_body: line_body.into(),
+    }
+}
