@@ -17,7 +17,8 @@ mod geometry_cmd;
     version,
     about = "Loaded contact and wear of steel-worm / bronze-wheel worm gears",
     after_help = "Examples:\n  wormwear check examples/gear-1x40-design.toml\n  \
-                  wormwear geometry examples/gear-1x40-design.toml -o out/1x40"
+                  wormwear geometry examples/gear-1x40-design.toml -o out/1x40\n  \
+                  wormwear tca examples/gear-1x40-design.toml -o out/1x40"
 )]
 struct Cli {
     /// Print only errors.
@@ -49,6 +50,15 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
+    #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
+    Tca {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 /// Error classes mapped to exit codes.
@@ -62,6 +72,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),
+        Command::Tca { file, output } => tca(file, output, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -142,6 +153,36 @@ fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
             dir.display(),
             s.lead_angle_deg,
             s.active_flank_area_mm2
+        );
+    }
+    Ok(())
+}
+
+fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let geo = build_geometry(&gear, file)?;
+    let result = wormwear::kinematics::analyse(&gear, &geo)
+        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
+    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
+        .map_err(|e| Failure::Run(e.into()))?;
+    let files =
+        wormwear::output::tca::write_tca(&geo, &result, dir).map_err(|e| Failure::Run(e.into()))?;
+    for w in &result.warnings {
+        eprintln!("warning: {w}");
+    }
+    if !quiet {
+        for f in &files {
+            println!("  wrote {}", f.display());
+        }
+        let s = wormwear::output::tca::TcaSummary::new(&result);
+        println!(
+            "tca: kinematic error mean {:.3e} rad, p2p {:.3e} rad; pattern {:.1} % of the flank; \
+             sliding max {:.2} m/s, pitch {:.3} m/s",
+            s.kinematic_error_mean_rad,
+            s.kinematic_error_p2p_rad,
+            100.0 * s.pattern_area_fraction,
+            s.max_sliding_speed_m_s,
+            s.sliding_speed_at_pitch_m_s
         );
     }
     Ok(())

@@ -137,3 +137,45 @@ fn geometry_writes_sections_grids_stl_and_summary() {
     assert!(csv.starts_with("member,x_mm,y_mm\n"));
     assert!(csv.contains("\nworm,") && csv.contains("\nwheel,"));
 }
+
+#[test]
+fn tca_writes_its_section_plots_and_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = bin()
+        .args(["tca", "--quiet"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in [
+        "tca_kinematic_error.csv",
+        "tca_kinematic_error.svg",
+        "tca_pattern.csv",
+        "tca_pattern.svg",
+        "tca_flank_map.csv",
+        "tca_sliding_speed.svg",
+        "tca_contact_lines.csv",
+    ] {
+        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert!(meta.len() > 100, "{f} is empty");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    // Earlier sections are kept, the tca section has the quantities the issue asks for.
+    assert!(summary["geometry"]["lead_angle_deg"].is_number());
+    let t = &summary["tca"];
+    for key in [
+        "kinematic_error_mean_rad",
+        "kinematic_error_p2p_rad",
+        "pattern_area_fraction",
+        "max_sliding_speed_m_s",
+        "sliding_speed_at_pitch_m_s",
+    ] {
+        assert!(t[key].is_number(), "tca section lacks {key}");
+    }
+    let frac = t["pattern_area_fraction"].as_f64().unwrap();
+    assert!(frac > 0.0 && frac <= 1.0);
+}

@@ -1,4 +1,5 @@
-//! Geometry benchmarks (issue: 1/40 worm and wheel with a 60 x 40 grid per flank under 1 s).
+//! Geometry and TCA benchmarks (targets: 1/40 geometry, 60 x 40 grid per flank, under 1 s;
+//! full TCA of the 1/40 gear, 20 positions x 5 teeth x default grid, under 0.2 s).
 //! Run: cargo bench -p wormwear --bench geometry
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -29,6 +30,14 @@ fn bench(c: &mut Criterion) {
     group.bench_function("ZK thread surface (grinding envelope table)", |b| {
         b.iter(|| ThreadSurface::new(black_box(&gk.worm)).unwrap())
     });
+    group.finish();
+    let mut group = c.benchmark_group("tca");
+    group.sample_size(20);
+    let geo = Geometry::build(&g140).unwrap();
+    group.bench_function(
+        "1x40 full TCA, 20 positions x 5 teeth x 40 x 60 grid",
+        |b| b.iter(|| wormwear::kinematics::analyse(black_box(&g140), black_box(&geo)).unwrap()),
+    );
     group.finish();
 }
 

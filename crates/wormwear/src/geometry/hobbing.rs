@@ -17,7 +17,7 @@
 //! extremum on the interval's end means the point is cut by the hob's tip edge (root fillet),
 //! not by its flank.
 
-use super::placement::{to_wheel_body, wheel_point};
+use super::placement::{to_wheel_body, wheel_point, PlacementFrame};
 use super::roots::{bisect, brent_max};
 use super::thread::{Flank, ThreadSurface};
 use super::GeometryError;
@@ -55,6 +55,7 @@ pub struct EnvelopePoint {
 pub struct Hobbing<'a> {
     pub hob: &'a ThreadSurface,
     pub setting: Placement,
+    frame: PlacementFrame,
     /// r_2 = p_x z2 / 2pi: the wheel radius that rolls on the hob's axial pitch line, m.
     pub rolling_radius: f64,
 }
@@ -70,6 +71,7 @@ impl<'a> Hobbing<'a> {
         Self {
             hob,
             setting,
+            frame: setting.into(),
             rolling_radius: hob.axial_pitch() * teeth as f64 / (2.0 * PI),
         }
     }
@@ -77,7 +79,7 @@ impl<'a> Hobbing<'a> {
     /// The wheel point (r, psi, z) in the hob frame.
     #[inline]
     fn hob_point(&self, r: f64, z: f64, psi: f64) -> Vector3<f64> {
-        self.setting.wheel_to_worm(&wheel_point(r, psi, z, 0.0))
+        self.frame.wheel_to_worm(&wheel_point(r, psi, z, 0.0))
     }
 
     /// Radius of the wheel point (r, psi, z) from the hob axis, m.

@@ -55,6 +55,46 @@ impl Placement {
     }
 }
 
+/// A [`Placement`] with its axes precomputed, for hot loops (same transforms).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlacementFrame {
+    pub placement: Placement,
+    e1: Vector3<f64>,
+    e3: Vector3<f64>,
+}
+
+impl From<Placement> for PlacementFrame {
+    fn from(placement: Placement) -> Self {
+        let (e1, e3) = placement.axes();
+        Self { placement, e1, e3 }
+    }
+}
+
+impl PlacementFrame {
+    /// Worm-frame coordinates of a wheel-frame point, m.
+    #[inline]
+    pub fn wheel_to_worm(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let d = Vector3::new(
+            p.x,
+            p.y + self.placement.centre_distance,
+            p.z - self.placement.offset,
+        );
+        Vector3::new(self.e1.dot(&d), d.y, self.e3.dot(&d))
+    }
+
+    /// Worm-frame components of a wheel-frame vector.
+    #[inline]
+    pub fn vector_wheel_to_worm(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(self.e1.dot(v), v.y, self.e3.dot(v))
+    }
+
+    /// Wheel-frame components of a worm-frame vector.
+    #[inline]
+    pub fn vector_worm_to_wheel(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        self.e1 * v.x + Vector3::new(0.0, v.y, 0.0) + self.e3 * v.z
+    }
+}
+
 /// Stationary wheel-frame position of the wheel material point (r, theta, z) when the wheel has
 /// turned by theta2 (MODEL §1: x2 = r cos(theta + theta2), y2 = -r sin(theta + theta2)). m.
 #[inline]
@@ -98,6 +138,20 @@ mod tests {
         // Wheel centre is at (0, a, 0) in the worm frame.
         let o2 = nominal.wheel_to_worm(&Vector3::zeros());
         assert!((o2 - Vector3::new(0.0, 0.125, 0.0)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn precomputed_frame_matches_placement() {
+        let p = Placement {
+            centre_distance: 0.125,
+            offset: -0.001,
+            inclination: -0.02,
+        };
+        let f = PlacementFrame::from(p);
+        let x = Vector3::new(0.03, -0.1, 0.012);
+        assert!((f.wheel_to_worm(&x) - p.wheel_to_worm(&x)).norm() < 1e-16);
+        assert!((f.vector_wheel_to_worm(&x) - p.vector_wheel_to_worm(&x)).norm() < 1e-16);
+        assert!((f.vector_worm_to_wheel(&x) - p.vector_worm_to_wheel(&x)).norm() < 1e-16);
     }
 
     #[test]

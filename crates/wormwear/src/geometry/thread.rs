@@ -181,22 +181,37 @@ impl ThreadSurface {
     /// axial thickness at r1). Also returns the point's radius rho. m.
     #[inline]
     pub fn axial_gap(&self, flank: Flank, p: &Vector3<f64>, theta1: f64) -> (f64, f64) {
-        let (x_flank, _, _) = self.flank_x(flank, p.y, p.z);
+        let (gap, _, _, rho, _) = self.axial_gap_with_gradient(flank, p, theta1, None);
+        (gap, rho)
+    }
+
+    /// As [`Self::axial_gap`], with the partial derivatives dX/dy, dX/dz of the flank at the
+    /// point (one flank evaluation) and the thread index used: (gap, dX/dy, dX/dz, rho, k).
+    /// With `thread = Some(k)` the gap is measured to thread k instead of the nearest one (keeps
+    /// iterations on one thread).
+    #[inline]
+    pub fn axial_gap_with_gradient(
+        &self,
+        flank: Flank,
+        p: &Vector3<f64>,
+        theta1: f64,
+        thread: Option<f64>,
+    ) -> (f64, f64, f64, f64, f64) {
+        let (x_flank, xy, xz) = self.flank_x(flank, p.y, p.z);
         let half = 0.5 * self.def.axial_thickness;
         let rho = (p.y * p.y + p.z * p.z).sqrt();
-        let gap = match flank {
+        let t = p.x + self.h * theta1 - x_flank;
+        let (gap, k) = match flank {
             Flank::Left => {
-                let t = p.x + self.h * theta1 - x_flank;
-                let k = ((t - half) / self.pitch).ceil();
-                k * self.pitch - t
+                let k = thread.unwrap_or_else(|| ((t - half) / self.pitch).ceil());
+                (k * self.pitch - t, k)
             }
             Flank::Right => {
-                let t = p.x + self.h * theta1 - x_flank;
-                let k = ((t + half) / self.pitch).floor();
-                t - k * self.pitch
+                let k = thread.unwrap_or_else(|| ((t + half) / self.pitch).floor());
+                (t - k * self.pitch, k)
             }
         };
-        (gap, rho)
+        (gap, xy, xz, rho, k)
     }
 
     /// Point of `flank` of thread k at radius rho and polar angle phi (thread frame, rotation 0). m.

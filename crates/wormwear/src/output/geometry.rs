@@ -198,8 +198,18 @@ pub fn write_geometry(
         &wheel_mesh(gear, geo, gear.analysis.stl_wheel_teeth).to_binary_stl("wheel", MM),
     )?;
     files.push(path);
-    // summary.json
-    let summary = GeometrySummary::new(gear, geo);
+    write_geometry_summary(gear, geo, input_file, dir)?;
+    files.push(dir.join("summary.json"));
+    Ok(files)
+}
+
+/// Writes the `input` and `geometry` sections of `dir/summary.json` (every command does).
+pub fn write_geometry_summary(
+    gear: &GearSet,
+    geo: &Geometry,
+    input_file: &Path,
+    dir: &Path,
+) -> Result<(), OutputError> {
     update_summary(
         dir,
         "input",
@@ -209,11 +219,10 @@ pub fn write_geometry(
             "program_version": env!("CARGO_PKG_VERSION"),
         }),
     )?;
-    let value = serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
-        what: "geometry summary".into(),
-        message: e.to_string(),
-    })?;
-    update_summary(dir, "geometry", value)?;
-    files.push(dir.join("summary.json"));
-    Ok(files)
+    let value =
+        serde_json::to_value(GeometrySummary::new(gear, geo)).map_err(|e| OutputError::Encode {
+            what: "geometry summary".into(),
+            message: e.to_string(),
+        })?;
+    update_summary(dir, "geometry", value)
 }

@@ -5,6 +5,7 @@
 //! replaces its own section and keeps the others.
 
 pub mod geometry;
+pub mod tca;
 
 use std::fmt::Write as _;
 use std::io::Write as _;

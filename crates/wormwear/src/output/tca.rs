@@ -1,0 +1,337 @@
+//! Files of the unloaded analysis: `tca` section of summary.json, CSV tables (kinematic error,
+//! flank contact map, no-load pattern, contact lines) and SVG plots (no-load pattern, kinematic
+//! error, sliding speed) on the wheel flank in (z, r).
+
+use super::{update_summary, Csv, OutputError};
+use crate::geometry::{Geometry, WheelFlank};
+use crate::kinematics::Tca;
+use crate::plot::{flank_map, line_chart_spanned, MapCell, Series};
+use std::path::{Path, PathBuf};
+
+const MM: f64 = 1e3;
+const UM: f64 = 1e6;
+
+/// Summary of the unloaded analysis (units in the names).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TcaSummary {
+    pub loaded_flank: String,
+    pub positions: usize,
+    pub teeth_studied: Vec<i32>,
+    /// Phase of position 0 in tooth pitches (driven sense).
+    pub position_phase_pitch: f64,
+    pub kinematic_error_mean_rad: f64,
+    pub kinematic_error_p2p_rad: f64,
+    pub marking_thickness_um: f64,
+    pub pattern_area_mm2: f64,
+    pub active_flank_area_mm2: f64,
+    /// Marked area / active flank area.
+    pub pattern_area_fraction: f64,
+    pub min_teeth_in_contact: usize,
+    pub max_teeth_in_contact: usize,
+    pub max_sliding_speed_m_s: f64,
+    /// r1 omega1 / cos(gamma) from material velocities at the pitch point.
+    pub sliding_speed_at_pitch_m_s: f64,
+    pub warnings: Vec<String>,
+}
+
+impl TcaSummary {
+    pub fn new(tca: &Tca) -> Self {
+        let (mean, p2p) = tca.kinematic_error_stats();
+        let counts = tca.positions.iter().map(|p| p.teeth_in_contact);
+        Self {
+            loaded_flank: tca.loaded_flank.name().to_string(),
+            positions: tca.positions.len(),
+            teeth_studied: tca.teeth.clone(),
+            position_phase_pitch: tca.phase,
+            kinematic_error_mean_rad: mean,
+            kinematic_error_p2p_rad: p2p,
+            marking_thickness_um: tca.marking_thickness * UM,
+            pattern_area_mm2: tca.pattern_area * MM * MM,
+            active_flank_area_mm2: tca.active_area * MM * MM,
+            pattern_area_fraction: tca.pattern_area / tca.active_area,
+            min_teeth_in_contact: counts.clone().min().unwrap_or(0),
+            max_teeth_in_contact: counts.max().unwrap_or(0),
+            max_sliding_speed_m_s: tca.max_sliding_speed(),
+            sliding_speed_at_pitch_m_s: tca.pitch_sliding_speed,
+            warnings: tca.warnings.clone(),
+        }
+    }
+}
+
+/// Cells of the flank grid as map quads in (z, r) mm with the given per-cell values.
+pub fn flank_cells(wf: &WheelFlank, values: &[f64]) -> Vec<MapCell> {
+    let mut cells = Vec::with_capacity(values.len());
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let c = |i: usize, j: usize| {
+                let n = wf.node(i, j);
+                (n.z * MM, n.r * MM)
+            };
+            cells.push(MapCell {
+                corners: [c(i, j), c(i + 1, j), c(i + 1, j + 1), c(i, j + 1)],
+                value: values[j * wf.cells_height + i],
+            });
+        }
+    }
+    cells
+}
+
+/// Cell edges separating marked from unmarked cells (the outline of a pattern), (z, r) mm.
+pub fn pattern_outline(wf: &WheelFlank, marked: &[bool]) -> Vec<((f64, f64), (f64, f64))> {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let at = |i: usize, j: usize| marked[j * ni + i];
+    let p = |i: usize, j: usize| {
+        let n = wf.node(i, j);
+        (n.z * MM, n.r * MM)
+    };
+    let mut segs = Vec::new();
+    for j in 0..nj {
+        for i in 0..ni {
+            let m = at(i, j);
+            // Edge along the height between columns j and j + 1, at face index j + 1.
+            let right = if j + 1 < nj { at(i, j + 1) } else { false };
+            if m != right && (m || right) {
+                segs.push((p(i, j + 1), p(i + 1, j + 1)));
+            }
+            let up = if i + 1 < ni { at(i + 1, j) } else { false };
+            if m != up && (m || up) {
+                segs.push((p(i + 1, j), p(i + 1, j + 1)));
+            }
+            if j == 0 && m {
+                segs.push((p(i, 0), p(i + 1, 0)));
+            }
+            if i == 0 && m {
+                segs.push((p(0, j), p(0, j + 1)));
+            }
+        }
+    }
+    segs
+}
+
+/// Writes every TCA output into `dir`; returns the files written.
+pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let mut files = Vec::new();
+    // Kinematic error.
+    let mut csv = Csv::new(&[
+        "position",
+        "theta1_rad",
+        "theta2_rad",
+        "kinematic_error_rad",
+        "teeth_in_contact",
+    ]);
+    for (n, p) in tca.positions.iter().enumerate() {
+        csv.row(&[
+            n as f64,
+            p.theta1,
+            p.theta2,
+            p.kinematic_error,
+            p.teeth_in_contact as f64,
+        ]);
+    }
+    let path = dir.join("tca_kinematic_error.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let np = tca.positions.len();
+    let ke: Vec<(f64, f64)> = (0..=np)
+        .map(|n| {
+            (
+                n as f64 / np as f64,
+                tca.positions[n % np].kinematic_error * UM,
+            )
+        })
+        .collect();
+    let path = dir.join("tca_kinematic_error.svg");
+    let (mean, p2p) = tca.kinematic_error_stats();
+    line_chart_spanned(
+        &path,
+        &format!(
+            "Unloaded kinematic error (mean {:.4} urad, p2p {:.4} urad; negative: wheel lags)",
+            mean * UM,
+            p2p * UM
+        ),
+        "wheel rotation (tooth pitches from position 0)",
+        "kinematic error (urad, wheel)",
+        &[Series {
+            label: String::new(),
+            points: ke,
+            color: 0,
+            bold: true,
+        }],
+        false,
+        0.02,
+    )?;
+    files.push(path);
+    // Pattern.
+    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "min_separation_um", "marked"]);
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let k = j * wf.cells_height + i;
+            let c = &wf.cells[k];
+            csv.row(&[
+                i as f64,
+                j as f64,
+                c.r * MM,
+                c.z * MM,
+                tca.min_separation[k] * UM,
+                tca.marked[k] as u8 as f64,
+            ]);
+        }
+    }
+    let path = dir.join("tca_pattern.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let trace = Series {
+        label: "worm tip trace".into(),
+        points: tca
+            .tip_trace
+            .iter()
+            .map(|&(z, r)| (z * MM, r * MM))
+            .collect(),
+        color: 1,
+        bold: true,
+    };
+    let j_um = tca.marking_thickness * UM;
+    let sep_um: Vec<f64> = tca.min_separation.iter().map(|s| s * UM).collect();
+    let path = dir.join("tca_pattern.svg");
+    flank_map(
+        &path,
+        &format!(
+            "No-load contact pattern, marking {j_um:.0} um: {:.1} % of the active flank ({} flank)",
+            100.0 * tca.pattern_area / tca.active_area,
+            tca.loaded_flank.name()
+        ),
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &flank_cells(wf, &sep_um),
+        (0.0, 3.0 * j_um),
+        "separation (um)",
+        &[trace.clone()],
+        &pattern_outline(wf, &tca.marked),
+    )?;
+    files.push(path);
+    // Contact map per node.
+    let mut csv = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "reachable",
+        "contact_theta2_rad",
+        "worm_radius_mm",
+        "ease_off_um",
+        "sliding_speed_m_s",
+        "sliding_along_m_s",
+        "sliding_across_m_s",
+        "u1_m_s",
+        "u2_m_s",
+    ]);
+    for j in 0..=wf.cells_face {
+        for i in 0..=wf.cells_height {
+            let k = j * (wf.cells_height + 1) + i;
+            let (n, c) = (wf.node(i, j), &tca.node_contact[k]);
+            csv.row(&[
+                i as f64,
+                j as f64,
+                n.r * MM,
+                n.z * MM,
+                c.reachable as u8 as f64,
+                c.theta2,
+                c.worm_radius * MM,
+                c.ease_off * UM,
+                c.sliding_speed,
+                c.sliding_along,
+                c.sliding_across,
+                c.u1,
+                c.u2,
+            ]);
+        }
+    }
+    let path = dir.join("tca_flank_map.csv");
+    csv.write(&path)?;
+    files.push(path);
+    // Sliding speed map: cell value = mean of its reachable corner nodes.
+    let node_value = |i: usize, j: usize| {
+        let c = &tca.node_contact[j * (wf.cells_height + 1) + i];
+        if c.reachable {
+            c.sliding_speed
+        } else {
+            f64::NAN
+        }
+    };
+    let mut speed = Vec::with_capacity(wf.cells.len());
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let v = [
+                node_value(i, j),
+                node_value(i + 1, j),
+                node_value(i, j + 1),
+                node_value(i + 1, j + 1),
+            ];
+            let ok: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+            speed.push(if ok.len() >= 2 {
+                ok.iter().sum::<f64>() / ok.len() as f64
+            } else {
+                f64::NAN
+            });
+        }
+    }
+    let (lo, hi) = speed
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let path = dir.join("tca_sliding_speed.svg");
+    flank_map(
+        &path,
+        &format!(
+            "Sliding speed at contact (max {:.2} m/s, pitch point {:.2} m/s); grey: not reached by the worm flank",
+            tca.max_sliding_speed(),
+            tca.pitch_sliding_speed
+        ),
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &flank_cells(wf, &speed),
+        (lo, hi),
+        "|Vg| (m/s)",
+        &[trace],
+        &[],
+    )?;
+    files.push(path);
+    // Contact lines.
+    let mut csv = Csv::new(&[
+        "position",
+        "tooth",
+        "slice",
+        "r_mm",
+        "z_mm",
+        "separation_um",
+        "worm_radius_mm",
+        "at_end",
+        "curvature_radius_mm",
+    ]);
+    for c in &tca.contact_lines {
+        csv.row(&[
+            c.position as f64,
+            c.tooth as f64,
+            c.slice as f64,
+            c.r * MM,
+            c.z * MM,
+            c.separation * UM,
+            c.worm_radius * MM,
+            c.at_end as u8 as f64,
+            c.curvature_radius * MM,
+        ]);
+    }
+    let path = dir.join("tca_contact_lines.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let value = serde_json::to_value(TcaSummary::new(tca)).map_err(|e| OutputError::Encode {
+        what: "tca summary".into(),
+        message: e.to_string(),
+    })?;
+    update_summary(dir, "tca", value)?;
+    files.push(dir.join("summary.json"));
+    Ok(files)
+}
