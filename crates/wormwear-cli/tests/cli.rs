@@ -149,7 +149,11 @@ fn tca_writes_its_section_plots_and_tables() {
         .arg(&out_dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     for f in [
         "tca_kinematic_error.csv",
         "tca_kinematic_error.svg",
@@ -163,7 +167,8 @@ fn tca_writes_its_section_plots_and_tables() {
         assert!(meta.len() > 100, "{f} is empty");
     }
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
     // Earlier sections are kept, the tca section has the quantities the issue asks for.
     assert!(summary["geometry"]["lead_angle_deg"].is_number());
     let t = &summary["tca"];
