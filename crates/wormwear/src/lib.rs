@@ -10,8 +10,10 @@
 //!
 //! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
 
+pub mod contact;
 pub mod geometry;
 pub mod input;
 pub mod kinematics;
+pub mod ltca;
 pub mod output;
 pub mod plot;

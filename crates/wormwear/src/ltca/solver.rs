@@ -1,0 +1,434 @@
+//! Solvers of the load-sharing problem (MODEL §5.2-5.4) in the form
+//!
+//! ```text
+//! y_i = sum_j K_ij q_j + e_i - alpha >= 0,   q_i >= 0,   q_i y_i = 0,   sum_i q_i = W
+//! ```
+//!
+//! K symmetric positive definite (block diagonal: one dense block per tooth, plus an optional
+//! low-rank term F C F^T for bending), e_i the initial separations, alpha the rigid approach
+//! (the multiplier of the load constraint). In the LTCA, q_i = l_i f_i is the moment of cell i's
+//! force about the wheel axis (l_i the lever), K_ij = C_ij / (l_i l_j) and W the wheel torque,
+//! so y, e and alpha are angles of the wheel — exactly MODEL §5.2 with R_i = 1/l_i.
+//!
+//! Two solvers: the Polonsky-Keer conjugate gradient with active set (fast, default) and the
+//! published fixed point on the approach (reference).
+
+/// Dense symmetric block on a contiguous range of unknowns.
+#[derive(Debug, Clone)]
+pub struct Block {
+    pub start: usize,
+    pub size: usize,
+    /// Row-major size x size.
+    pub matrix: Vec<f64>,
+}
+
+/// Low-rank symmetric term F C F^T (rows of F per unknown, C k x k).
+#[derive(Debug, Clone)]
+pub struct LowRank {
+    pub rank: usize,
+    /// Row-major n x rank.
+    pub f: Vec<f64>,
+    /// Row-major rank x rank, symmetric.
+    pub core: Vec<f64>,
+}
+
+/// The complementarity problem.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    pub blocks: Vec<Block>,
+    pub low_rank: Option<LowRank>,
+    /// Initial separations e_i.
+    pub separation: Vec<f64>,
+    /// Total load W (sum of q).
+    pub load: f64,
+}
+
+/// Which solver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum SolverKind {
+    /// Polonsky-Keer conjugate gradient with active set.
+    ConjugateGradient,
+    /// The published fixed point on the approach (MODEL §5.4).
+    FixedPoint,
+}
+
+/// Convergence settings.
+#[derive(Debug, Clone, Copy)]
+pub struct SolverSettings {
+    pub kind: SolverKind,
+    /// Relative tolerance on the gaps of loaded cells (|y_i| / alpha) and on the change of q.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            kind: SolverKind::ConjugateGradient,
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+        }
+    }
+}
+
+/// Residuals of a solution.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Residuals {
+    /// |sum q - W| / W.
+    pub load: f64,
+    /// max over loaded cells of |y_i| / alpha (complementarity: gap where loaded).
+    pub complementarity: f64,
+    /// min_i y_i / alpha (negative = penetration outside the loaded set).
+    pub min_gap: f64,
+    /// min_i q_i / max_i q_i (must be >= 0).
+    pub min_load: f64,
+    pub iterations: usize,
+}
+
+/// Solution of the problem.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    pub q: Vec<f64>,
+    /// Rigid approach alpha (same units as e).
+    pub approach: f64,
+    /// Final gaps y_i.
+    pub gap: Vec<f64>,
+    pub residuals: Residuals,
+}
+
+/// Why a solve failed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SolverError {
+    #[error("the {kind:?} solver did not converge in {iterations} iterations (residual {residual:e}, tolerance {tolerance:e})")]
+    NotConverged {
+        kind: SolverKind,
+        iterations: usize,
+        residual: f64,
+        tolerance: f64,
+    },
+    #[error("empty contact problem (no cell can touch)")]
+    Empty,
+    #[error("invalid problem: {0}")]
+    Invalid(String),
+}
+
+impl Problem {
+    /// Number of unknowns.
+    pub fn len(&self) -> usize {
+        self.separation.len()
+    }
+
+    /// True when there are no unknowns.
+    pub fn is_empty(&self) -> bool {
+        self.separation.is_empty()
+    }
+
+    /// y = K x.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for b in &self.blocks {
+            let xs = &x[b.start..b.start + b.size];
+            for (r, yr) in y[b.start..b.start + b.size].iter_mut().enumerate() {
+                let row = &b.matrix[r * b.size..(r + 1) * b.size];
+                *yr = row.iter().zip(xs).map(|(a, b)| a * b).sum();
+            }
+        }
+        if let Some(lr) = &self.low_rank {
+            let k = lr.rank;
+            let mut ft = vec![0.0; k];
+            for (i, xi) in x.iter().enumerate() {
+                for (c, v) in ft.iter_mut().enumerate() {
+                    *v += lr.f[i * k + c] * xi;
+                }
+            }
+            let mut cft = vec![0.0; k];
+            for (r, v) in cft.iter_mut().enumerate() {
+                *v = (0..k).map(|c| lr.core[r * k + c] * ft[c]).sum();
+            }
+            for (i, yi) in y.iter_mut().enumerate() {
+                *yi += (0..k).map(|c| lr.f[i * k + c] * cft[c]).sum::<f64>();
+            }
+        }
+    }
+
+    /// Residuals of q with approach alpha.
+    fn residuals(&self, q: &[f64], gap: &[f64], approach: f64, iterations: usize) -> Residuals {
+        let scale = approach.abs().max(f64::MIN_POSITIVE);
+        let qmax = q.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        let mut comp: f64 = 0.0;
+        let mut min_gap = f64::INFINITY;
+        for (qi, yi) in q.iter().zip(gap) {
+            if *qi > 0.0 {
+                comp = comp.max(yi.abs() * (qi / qmax).min(1.0));
+            }
+            if yi.is_finite() {
+                min_gap = min_gap.min(*yi);
+            }
+        }
+        Residuals {
+            load: (q.iter().sum::<f64>() - self.load).abs() / self.load,
+            complementarity: comp / scale,
+            min_gap: min_gap / scale,
+            min_load: q.iter().copied().fold(f64::INFINITY, f64::min) / qmax,
+            iterations,
+        }
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        if self.is_empty() {
+            return Err(SolverError::Empty);
+        }
+        if !(self.load > 0.0 && self.load.is_finite()) {
+            return Err(SolverError::Invalid(format!(
+                "load {} must be positive",
+                self.load
+            )));
+        }
+        if !self.separation.iter().any(|e| e.is_finite()) {
+            return Err(SolverError::Empty);
+        }
+        Ok(())
+    }
+}
+
+/// Solves the problem with the chosen solver; `warm` is an optional starting q.
+pub fn solve(
+    problem: &Problem,
+    settings: &SolverSettings,
+    warm: Option<&[f64]>,
+) -> Result<Solution, SolverError> {
+    problem.validate()?;
+    match settings.kind {
+        SolverKind::ConjugateGradient => conjugate_gradient(problem, settings, warm),
+        SolverKind::FixedPoint => fixed_point(problem, settings, warm),
+    }
+}
+
+/// Starting point: the given one if usable, else the load spread over the cells whose initial
+/// separation is within a small band of the smallest.
+fn initial(problem: &Problem, warm: Option<&[f64]>) -> Vec<f64> {
+    let n = problem.len();
+    if let Some(w) = warm {
+        if w.len() == n && w.iter().any(|&v| v > 0.0) {
+            let s: f64 = w.iter().sum();
+            return w.iter().map(|&v| v.max(0.0) * problem.load / s).collect();
+        }
+    }
+    let emin = problem
+        .separation
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let finite: Vec<f64> = problem
+        .separation
+        .iter()
+        .copied()
+        .filter(|e| e.is_finite())
+        .collect();
+    let emax = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let band = emin + 0.05 * (emax - emin).max(0.0);
+    let chosen: Vec<bool> = problem
+        .separation
+        .iter()
+        .map(|&e| e.is_finite() && e <= band)
+        .collect();
+    let count = chosen.iter().filter(|&&c| c).count().max(1);
+    chosen
+        .iter()
+        .map(|&c| if c { problem.load / count as f64 } else { 0.0 })
+        .collect()
+}
+
+/// Polonsky-Keer conjugate gradient with active set (Polonsky & Keer, Wear 1999), with the
+/// load constraint sum q = W and the approach as its multiplier.
+fn conjugate_gradient(
+    problem: &Problem,
+    settings: &SolverSettings,
+    warm: Option<&[f64]>,
+) -> Result<Solution, SolverError> {
+    let n = problem.len();
+    let e = &problem.separation;
+    let open: Vec<bool> = e.iter().map(|v| v.is_finite()).collect();
+    let mut q = initial(problem, warm);
+    let mut g = vec![0.0; n];
+    let mut t = vec![0.0; n];
+    let mut r = vec![0.0; n];
+    let mut u = vec![0.0; n];
+    let mut delta = 0.0;
+    let mut g_old = 1.0;
+    let mut approach = 0.0;
+    let mut last_change = f64::INFINITY;
+    for it in 1..=settings.max_iterations {
+        problem.apply(&q, &mut u);
+        for i in 0..n {
+            g[i] = if open[i] { u[i] + e[i] } else { f64::INFINITY };
+        }
+        let (mut sum, mut count) = (0.0, 0usize);
+        for i in 0..n {
+            if q[i] > 0.0 {
+                sum += g[i];
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return Err(SolverError::Invalid("no loaded cell left".into()));
+        }
+        let gbar = sum / count as f64;
+        approach = gbar;
+        for gi in g.iter_mut() {
+            *gi -= gbar;
+        }
+        // Convergence: loaded cells touch, others do not penetrate, q settled.
+        let mut worst: f64 = 0.0;
+        for i in 0..n {
+            if q[i] > 0.0 {
+                worst = worst.max(g[i].abs());
+            } else if open[i] && g[i] < 0.0 {
+                worst = worst.max(-g[i]);
+            }
+        }
+        let scale = approach.abs().max(f64::MIN_POSITIVE);
+        if worst / scale < settings.tolerance && last_change < settings.tolerance.sqrt() {
+            let gap: Vec<f64> = g.clone();
+            let residuals = problem.residuals(&q, &gap, approach, it);
+            return Ok(Solution {
+                q,
+                approach,
+                gap,
+                residuals,
+            });
+        }
+        let gsum: f64 = (0..n).filter(|&i| q[i] > 0.0).map(|i| g[i] * g[i]).sum();
+        for i in 0..n {
+            t[i] = if q[i] > 0.0 {
+                g[i] + delta * (gsum / g_old) * t[i]
+            } else {
+                0.0
+            };
+        }
+        g_old = gsum.max(f64::MIN_POSITIVE);
+        problem.apply(&t, &mut r);
+        let rbar = (0..n).filter(|&i| q[i] > 0.0).map(|i| r[i]).sum::<f64>() / count as f64;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..n {
+            if q[i] > 0.0 {
+                num += g[i] * t[i];
+                den += (r[i] - rbar) * t[i];
+            }
+        }
+        let tau = if den > 0.0 { num / den } else { 0.0 };
+        let q_old = q.clone();
+        for i in 0..n {
+            if q[i] > 0.0 {
+                q[i] = (q[i] - tau * t[i]).max(0.0);
+            }
+        }
+        // Cells outside the loaded set that would penetrate join it (PK's overlap step).
+        let gmax = g
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let tau_overlap = if tau > 0.0 {
+            tau
+        } else {
+            problem.load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
+        };
+        let mut overlap = false;
+        for i in 0..n {
+            if q_old[i] == 0.0 && open[i] && g[i] < 0.0 {
+                q[i] = -tau_overlap * g[i];
+                overlap = true;
+            }
+        }
+        delta = if overlap { 0.0 } else { 1.0 };
+        let total: f64 = q.iter().sum();
+        if total <= 0.0 {
+            return Err(SolverError::Invalid("load vanished".into()));
+        }
+        let s = problem.load / total;
+        q.iter_mut().for_each(|v| *v *= s);
+        last_change = q
+            .iter()
+            .zip(&q_old)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f64>()
+            / problem.load;
+    }
+    let gap = g.clone();
+    let res = problem.residuals(&q, &gap, approach, settings.max_iterations);
+    Err(SolverError::NotConverged {
+        kind: SolverKind::ConjugateGradient,
+        iterations: settings.max_iterations,
+        residual: res.complementarity.max(-res.min_gap),
+        tolerance: settings.tolerance,
+    })
+}
+
+/// The published fixed point (MODEL §5.4): with y0 = K q + e,
+/// alpha = W / sum(q_i / y0_i), q_i <- alpha q_i / y0_i. Cells start loaded where e is within
+/// the band of the starting point and stay loaded until their share falls below 1e-14 W.
+fn fixed_point(
+    problem: &Problem,
+    settings: &SolverSettings,
+    warm: Option<&[f64]>,
+) -> Result<Solution, SolverError> {
+    let n = problem.len();
+    let e = &problem.separation;
+    let mut q: Vec<f64> = match warm {
+        Some(_) => initial(problem, warm),
+        None => {
+            // All reachable cells start loaded (the scheme cannot load a cell it starts at 0).
+            let count = e.iter().filter(|v| v.is_finite()).count().max(1);
+            e.iter()
+                .map(|v| {
+                    if v.is_finite() {
+                        problem.load / count as f64
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        }
+    };
+    let mut y0 = vec![0.0; n];
+    let mut approach = 0.0;
+    for it in 1..=settings.max_iterations {
+        problem.apply(&q, &mut y0);
+        for i in 0..n {
+            y0[i] += e[i];
+        }
+        let denom: f64 = (0..n).filter(|&i| q[i] > 0.0).map(|i| q[i] / y0[i]).sum();
+        let new_approach = problem.load / denom;
+        let mut change = 0.0;
+        for i in 0..n {
+            if q[i] > 0.0 {
+                let v = new_approach * q[i] / y0[i];
+                let v = if v < 1e-14 * problem.load { 0.0 } else { v };
+                change += (v - q[i]).abs();
+                q[i] = v;
+            }
+        }
+        let total: f64 = q.iter().sum();
+        let s = problem.load / total;
+        q.iter_mut().for_each(|v| *v *= s);
+        let settled = (new_approach - approach).abs() <= settings.tolerance * new_approach.abs()
+            && change / problem.load < settings.tolerance;
+        approach = new_approach;
+        if settled {
+            let gap: Vec<f64> = (0..n).map(|i| y0[i] - approach).collect();
+            let residuals = problem.residuals(&q, &gap, approach, it);
+            return Ok(Solution {
+                q,
+                approach,
+                gap,
+                residuals,
+            });
+        }
+    }
+    Err(SolverError::NotConverged {
+        kind: SolverKind::FixedPoint,
+        iterations: settings.max_iterations,
+        residual: f64::NAN,
+        tolerance: settings.tolerance,
+    })
+}
