@@ -45,6 +45,11 @@ pub struct GapEvaluator<'a> {
     pub worm: &'a ThreadSurface,
     pub placement: Placement,
     frame: PlacementFrame,
+    /// Edge reliefs (normal distance added to the gap): worm tip, wheel edges (blank top and
+    /// face ends), and the blank limits they refer to.
+    pub tip_relief: crate::input::EdgeRelief,
+    pub edge_relief: crate::input::EdgeRelief,
+    pub blank: crate::geometry::BlankLimits,
     /// Loaded worm flank.
     pub flank: Flank,
     /// +1: wheel driven towards increasing theta2 (positive worm rotation), -1 otherwise.
@@ -61,6 +66,9 @@ impl<'a> GapEvaluator<'a> {
             worm: &geo.worm,
             placement: gear.operating,
             frame: gear.operating.into(),
+            tip_relief: gear.worm.tip_relief,
+            edge_relief: gear.wheel.edge_relief,
+            blank: geo.blank,
             flank,
             sigma: -flank.sign(),
             ratio: gear.ratio(),
@@ -96,8 +104,30 @@ impl<'a> GapEvaluator<'a> {
         let dq = self
             .frame
             .vector_wheel_to_worm(&Vector3::new(p.y, -p.x, 0.0));
-        let de = xy * dq.y + xz * dq.z - dq.x;
-        (e, de * -self.flank.sign(), rho, k)
+        let mut de = (xy * dq.y + xz * dq.z - dq.x) * -self.flank.sign();
+        // Edge reliefs, as normal distances turned into axial ones (|n_x| = 1 / sqrt(1 + X_y^2
+        // + X_z^2) on the worm flank).
+        let (relief, d_relief_drho) = self.relief(r, z, rho);
+        let axial = (1.0 + xy * xy + xz * xz).sqrt();
+        if relief > 0.0 {
+            de += d_relief_drho * axial * (q.y * dq.y + q.z * dq.z) / rho;
+        }
+        (e + relief * axial, de, rho, k)
+    }
+
+    /// Normal relief at a wheel point (r, z) touching the worm at radius rho: the worm's tip
+    /// relief C (s/L)^2 with s = rho - (r_a1 - L), plus the wheel's edge relief towards the blank
+    /// top and the face ends. Returns the relief (m) and its derivative with respect to rho.
+    #[inline]
+    pub fn relief(&self, r: f64, z: f64, rho: f64) -> (f64, f64) {
+        let t = self.tip_relief;
+        let (mut relief, slope) = t.at(rho - (self.worm.def.tip_radius - t.length));
+        let w = self.edge_relief;
+        if w.amount > 0.0 {
+            relief += w.at(r - (self.blank.top(z) - w.length)).0;
+            relief += w.at(z.abs() - (0.5 * self.blank.face_width - w.length)).0;
+        }
+        (relief, slope)
     }
 
     /// Exact angular gap: the rotation of the wheel against its driven sense that closes the
@@ -110,20 +140,32 @@ impl<'a> GapEvaluator<'a> {
         if rho > tip || de.abs() < 1e-12 {
             return f64::INFINITY;
         }
-        // e(psi - sigma delta) = 0, de/dpsi has the sign of sigma.
+        // e(psi - sigma delta) = 0, de/dpsi has the sign of sigma. A gap that a rotation of
+        // a tooth pitch cannot close, or a Newton that does not settle (possible inside the
+        // edge reliefs, where the relief slope can cancel the flank's), means "out of reach".
+        let limit = 2.0 * PI / self.ratio / self.worm.starts() as f64;
+        if self.sigma * de <= 0.0 {
+            return f64::INFINITY;
+        }
         let mut delta = e / (self.sigma * de);
-        for _ in 0..8 {
+        for _ in 0..12 {
+            if !delta.is_finite() || delta.abs() > limit {
+                return f64::INFINITY;
+            }
             let (e, de, _, _) =
                 self.linear_on(r, theta, z, theta2 - self.sigma * delta, theta1, Some(k));
+            if self.sigma * de <= 0.0 {
+                return f64::INFINITY;
+            }
             let step = e / (self.sigma * de);
             delta += step;
             // Exact near contact (1e-13 rad), 1e-9 relative for far points (a 1 mm gap to
             // about a nanometre).
             if step.abs() < 1e-13 + 1e-9 * delta.abs() {
-                break;
+                return delta;
             }
         }
-        delta
+        f64::INFINITY
     }
 
     /// Lever arm converting an angular separation into a normal distance at a wheel point:

@@ -17,9 +17,13 @@ fn example(name: &str) -> GearSet {
     input::load(&path).unwrap()
 }
 
+/// Hob identical to the worm and sharp edges (no tip or edge relief): the pure conjugate pair.
 fn conjugate(name: &str) -> GearSet {
     let mut g = example(name);
     g.hob = g.worm.clone();
+    g.worm.tip_relief.amount = 0.0;
+    g.hob.tip_relief.amount = 0.0;
+    g.wheel.edge_relief.amount = 0.0;
     g
 }
 
@@ -453,4 +457,22 @@ fn misalignments_enter_every_gap_through_the_placement() {
             );
         }
     }
+}
+
+#[test]
+fn edge_reliefs_are_parabolic_and_vanish_inside() {
+    // Default: 20 um at the edge, C (s/L)^2 over L = 1 mm; nothing inside the flank.
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let ev = kinematics::GapEvaluator::new(&g, &geo);
+    let ra = g.worm.tip_radius;
+    let (r_mid, top) = (100e-3, geo.blank.top(0.0));
+    assert_eq!(ev.relief(r_mid, 0.0, ra - 2e-3), (0.0, 0.0));
+    let (d, slope) = ev.relief(r_mid, 0.0, ra);
+    assert!((d - 20e-6).abs() < 1e-15 && (slope - 2.0 * 20e-6 / 1e-3).abs() < 1e-12);
+    assert!((ev.relief(r_mid, 0.0, ra - 0.5e-3).0 - 5e-6).abs() < 1e-15);
+    // Wheel: blank top and face ends.
+    assert!((ev.relief(top, 0.0, 25e-3).0 - 20e-6).abs() < 1e-15);
+    assert!((ev.relief(r_mid, 0.5 * g.wheel.face_width, 25e-3).0 - 20e-6).abs() < 1e-15);
+    assert_eq!(ev.relief(top - 1.5e-3, 10e-3, 25e-3).0, 0.0);
 }

@@ -491,3 +491,25 @@ fn column_hermite_interpolation_is_exact_to_the_grid() {
     eprintln!("column Hermite interpolation: worst error {worst:e} m");
     assert!(worst < 1e-9, "column interpolation error {worst:e} m");
 }
+
+#[test]
+fn column_normals_match_the_envelope_normals() {
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let hobbing = geo.hobbing(&g);
+    let mut worst: f64 = 0.0;
+    for flank in Flank::BOTH {
+        let wf = geo.wheel_flank(flank);
+        for j in (0..=wf.cells_face).step_by(6) {
+            for k in 0..wf.cells_height * 2 {
+                let r = wf.grid_radius((k as f64 + 0.41) / 2.0, j);
+                let exact = generate_point(&hobbing, flank, r, wf.z[j])
+                    .unwrap()
+                    .normal_vec();
+                worst = worst.max((wf.column_normal(j, r) - exact).norm());
+            }
+        }
+    }
+    eprintln!("column normal error {worst:e} rad");
+    assert!(worst < 1e-6, "{worst:e}");
+}

@@ -40,6 +40,10 @@ fn thread(
             profile_angle: alpha_n,
             profile_radius: (profile == ProfileType::C).then_some(100.0 * MM),
         }),
+        tip_relief: wormwear::input::EdgeRelief {
+            amount: 0.0,
+            length: 1e-3,
+        },
     }
 }
 

@@ -143,6 +143,51 @@ impl WheelFlank {
         (value, d / step)
     }
 
+    /// Unit normal (body frame, out of the wheel material) at radius r on node column j, from
+    /// the Hermite theta_r of [`Self::column_theta`] and theta_z interpolated linearly between
+    /// the column's nodes (n ~ r theta_r e_r - e_theta + r theta_z e_z).
+    pub fn column_normal(&self, j: usize, r: f64) -> Vector3<f64> {
+        let ni = self.cells_height;
+        let (lo, hi) = (self.r_low[j], self.r_high[j]);
+        let f = ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64 - 1e-12);
+        let i = f as usize;
+        let w = f - i as f64;
+        let theta_z = |i: usize| {
+            let n = self.node(i, j);
+            let (s, c) = n.theta.sin_cos();
+            let n_t = -n.normal[0] * s - n.normal[1] * c;
+            -n.normal[2] / (n.r * n_t)
+        };
+        // Cubic Lagrange through four neighbouring nodes (clamped at the column ends).
+        let i0 = i.saturating_sub(1).min(ni.saturating_sub(3));
+        let x = f - i0 as f64;
+        let y: [f64; 4] = [
+            theta_z(i0),
+            theta_z(i0 + 1),
+            theta_z(i0 + 2),
+            theta_z(i0 + 3),
+        ];
+        let tz = y[0] * (x - 1.0) * (x - 2.0) * (x - 3.0) / -6.0
+            + y[1] * x * (x - 2.0) * (x - 3.0) / 2.0
+            + y[2] * x * (x - 1.0) * (x - 3.0) / -2.0
+            + y[3] * x * (x - 1.0) * (x - 2.0) / 6.0;
+        let _ = w;
+        let (theta, tr) = self.column_theta(j, r);
+        let (s, c) = theta.sin_cos();
+        let e_r = Vector3::new(c, -s, 0.0);
+        let e_t = Vector3::new(-s, -c, 0.0);
+        let v = e_r * (r * tr) - e_t + Vector3::new(0.0, 0.0, r * tz);
+        // Orientation of the stored normals: n . e_theta has the sign of -c.
+        let ref_n = self.node(i, j);
+        let (rs, rc) = ref_n.theta.sin_cos();
+        let sign = if -ref_n.normal[0] * rs - ref_n.normal[1] * rc < 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        v.normalize() * sign
+    }
+
     /// Radius of grid line i (0..=I) in column j, m.
     #[inline]
     pub fn grid_radius(&self, i: f64, j: usize) -> f64 {

@@ -81,6 +81,35 @@ pub struct ThreadDef {
     pub axial_thickness: f64,
     /// Grinding wheel (K and C only).
     pub grinding_wheel: Option<GrindingWheel>,
+    /// Tip relief: amount at the edge (m; 0 = sharp) and length from the tip (m).
+    pub tip_relief: EdgeRelief,
+}
+
+/// A parabolic edge relief C (s / L)^2 over the last L before an edge (m, m).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct EdgeRelief {
+    /// Relief C at the edge, m (0 = sharp edge).
+    pub amount: f64,
+    /// Length L of the relief zone, m.
+    pub length: f64,
+}
+
+impl EdgeRelief {
+    /// Default: 20 um over 1 mm.
+    pub const DEFAULT: EdgeRelief = EdgeRelief {
+        amount: 20e-6,
+        length: 1e-3,
+    };
+
+    /// Relief and its derivative at distance `s` into the zone (s <= 0: outside the zone).
+    #[inline]
+    pub fn at(&self, s: f64) -> (f64, f64) {
+        if self.amount <= 0.0 || s <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let k = self.amount / (self.length * self.length);
+        (k * s * s, 2.0 * k * s)
+    }
 }
 
 impl ThreadDef {
@@ -139,6 +168,8 @@ pub struct WheelBlank {
     pub shaft_radius: Option<f64>,
     /// Bearing positions along z2, m.
     pub bearing_positions: Option<Vec<f64>>,
+    /// Edge relief of the teeth (blank top, face ends).
+    pub edge_relief: EdgeRelief,
 }
 
 /// Elastic and wear properties of one member, SI.
@@ -216,6 +247,12 @@ pub struct Analysis {
     pub stl_worm_threads: usize,
     /// 0 = all teeth.
     pub stl_wheel_teeth: usize,
+    /// LTCA local mesh: slice step (node columns), cells across the line, band factor.
+    pub contact_slice_step: usize,
+    pub contact_columns: usize,
+    pub contact_band_factor: f64,
+    /// LTCA solver.
+    pub solver: crate::ltca::solver::SolverKind,
 }
 
 /// A validated gear set: everything the pipeline needs, SI units.

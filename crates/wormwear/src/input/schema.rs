@@ -59,6 +59,13 @@ pub struct ThreadSpec {
     /// Grinding wheel, profiles K and C only.
     #[serde(default)]
     pub grinding_wheel: Option<GrindingWheelSpec>,
+    /// Tip relief at the tip edge, um: parabolic, C (s / L)^2 over the last L of the flank
+    /// height (worm only; default 20 um; 0 = sharp edge).
+    #[serde(default)]
+    pub tip_relief_um: Option<f64>,
+    /// Length L of the tip relief, measured radially from the tip, mm (default 1 mm).
+    #[serde(default)]
+    pub tip_relief_length_mm: Option<f64>,
 }
 
 fn default_plane() -> String {
@@ -150,6 +157,13 @@ pub struct WheelSpec {
     /// Bearing positions along the wheel shaft (z2), mm (default: +/- face width).
     #[serde(default)]
     pub bearing_positions_mm: Option<Vec<f64>>,
+    /// Edge relief of the teeth at the blank top and the face ends, um: parabolic,
+    /// C (s / L)^2 over the last L before the edge (default 20 um; 0 = sharp edges).
+    #[serde(default)]
+    pub edge_relief_um: Option<f64>,
+    /// Length L of the edge relief, mm (default 1 mm).
+    #[serde(default)]
+    pub edge_relief_length_mm: Option<f64>,
 }
 
 /// Materials of worm and wheel (MODEL §11 defaults).
@@ -254,6 +268,32 @@ pub struct AnalysisSpec {
     /// Teeth of the wheel written to the STL file (0 = all).
     #[serde(default = "default_stl_teeth")]
     pub stl_wheel_teeth: i64,
+    /// LTCA: use every n-th node column of the flank grid as a slice of the local contact mesh.
+    #[serde(default = "default_slice_step")]
+    pub contact_slice_step: i64,
+    /// LTCA: cells across the contact line on each slice.
+    #[serde(default = "default_contact_columns")]
+    pub contact_columns: i64,
+    /// LTCA: half-width of the local mesh across the line, in Hertz half-widths at the mean
+    /// line load (widened automatically when the load reaches the band edge).
+    #[serde(default = "default_band_factor")]
+    pub contact_band_factor: f64,
+    /// LTCA solver: "conjugate-gradient" (default) or "fixed-point" (the published scheme).
+    #[serde(default = "default_solver")]
+    pub solver: String,
+}
+
+fn default_slice_step() -> i64 {
+    3
+}
+fn default_contact_columns() -> i64 {
+    15
+}
+fn default_band_factor() -> f64 {
+    3.0
+}
+fn default_solver() -> String {
+    "conjugate-gradient".to_string()
 }
 
 fn default_grid_height() -> i64 {
@@ -289,6 +329,10 @@ impl Default for AnalysisSpec {
             section_offsets_mm: None,
             stl_worm_threads: default_stl_threads(),
             stl_wheel_teeth: default_stl_teeth(),
+            contact_slice_step: default_slice_step(),
+            contact_columns: default_contact_columns(),
+            contact_band_factor: default_band_factor(),
+            solver: default_solver(),
         }
     }
 }

@@ -221,6 +221,16 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             );
         }
     }
+    let edge_relief = face_width.and_then(|b| {
+        edge_relief(
+            &mut ck,
+            "wheel.edge_relief_um",
+            w.edge_relief_um,
+            "wheel.edge_relief_length_mm",
+            w.edge_relief_length_mm,
+            0.25 * b,
+        )
+    });
     if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
         if sh >= hub {
             ck.fail(
@@ -281,6 +291,26 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         .map(|v| v * 1e-6);
     let stl_threads = ck.int_range("analysis.stl_worm_threads", a.stl_worm_threads, 1, 50);
     let stl_teeth = ck.int_range("analysis.stl_wheel_teeth", a.stl_wheel_teeth, 0, 500);
+    let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
+    let contact_columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
+    let band_factor = ck.range(
+        "analysis.contact_band_factor",
+        a.contact_band_factor,
+        1.0,
+        50.0,
+        "Hertz half-widths",
+    );
+    let solver = ck.choice(
+        "analysis.solver",
+        &a.solver,
+        &[
+            (
+                "conjugate-gradient",
+                crate::ltca::solver::SolverKind::ConjugateGradient,
+            ),
+            ("fixed-point", crate::ltca::solver::SolverKind::FixedPoint),
+        ],
+    );
     if let (Some(n), Some(z2)) = (stl_teeth, teeth) {
         if n > z2 as i64 {
             ck.fail(
@@ -486,6 +516,11 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     else {
         unreachable_input()?
     };
+    let (Some(slice_step), Some(contact_columns), Some(band_factor), Some(solver)) =
+        (slice_step, contact_columns, band_factor, solver)
+    else {
+        unreachable_input()?
+    };
     Ok(GearSet {
         title: f.title.clone().unwrap_or_default(),
         worm,
@@ -501,6 +536,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             hub_radius,
             shaft_radius,
             bearing_positions,
+            edge_relief: edge_relief.unwrap_or(EdgeRelief::DEFAULT),
         },
         nominal_centre_distance: nominal_a,
         operating: Placement {
@@ -522,6 +558,10 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             section_offsets,
             stl_worm_threads: st as usize,
             stl_wheel_teeth: sw as usize,
+            contact_slice_step: slice_step as usize,
+            contact_columns: contact_columns as usize,
+            contact_band_factor: band_factor,
+            solver,
         },
         warnings,
     })
@@ -755,7 +795,20 @@ fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<ThreadDef> {
         normal_pressure_angle: alpha_n,
         axial_thickness: s,
         grinding_wheel: None,
+        tip_relief: EdgeRelief::DEFAULT,
     };
+    let relief = edge_relief(
+        ck,
+        &field("tip_relief_um"),
+        t.tip_relief_um,
+        &field("tip_relief_length_mm"),
+        t.tip_relief_length_mm,
+        0.5 * (ra - rf),
+    );
+    match relief {
+        Some(r) => def.tip_relief = r,
+        None => return None,
+    }
     if profile == ProfileType::I {
         let rb = def.base_radius();
         if rb >= rf {
@@ -990,5 +1043,29 @@ fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
     Some(Conditions {
         torque: torque?,
         worm_speed: speed? * 2.0 * PI / 60.0,
+    })
+}
+
+/// Edge relief from (amount um, length mm), defaults 20 um over 1 mm; the length is at most
+/// `max_length` (m).
+fn edge_relief(
+    ck: &mut Checker,
+    amount_field: &str,
+    amount: Option<f64>,
+    length_field: &str,
+    length: Option<f64>,
+    max_length: f64,
+) -> Option<EdgeRelief> {
+    let a = match amount {
+        Some(v) => ck.range(amount_field, v, 0.0, 500.0, "um")? * 1e-6,
+        None => EdgeRelief::DEFAULT.amount,
+    };
+    let l = match length {
+        Some(v) => ck.range(length_field, v, 0.01, max_length / MM, "mm")? * MM,
+        None => EdgeRelief::DEFAULT.length.min(max_length),
+    };
+    Some(EdgeRelief {
+        amount: a,
+        length: l,
     })
 }

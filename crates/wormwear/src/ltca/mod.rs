@@ -1,3 +1,587 @@
-//! Stage 3 — loaded tooth contact analysis (MODEL §5).
+//! Stage 3 — loaded tooth contact analysis (MODEL §5, §12c, §12d).
+//!
+//! At each kinematic position of the TCA, around the contact line of every engaged tooth, a
+//! local mesh of slices along the face width (node columns of the global flank grid, so the
+//! flank is exact there) times columns across the line; cells know their centre, normal,
+//! tangent axes, area and tooth. Contact coefficients (Boussinesq, [`crate::contact`]) couple
+//! cells of the same tooth; bending (when a [`BendingModel`] is given) adds a low-rank term
+//! F C F^T across teeth. Unknowns q_i = l_i f_i (cell force times lever about the wheel axis),
+//! so the compatibility y_i = sum_j C_ij q_j / (S_j l_i l_j) + e_i - alpha >= 0 with
+//! sum q_i = C2 is MODEL §5.2 with R_i = 1/l_i (exact ratio, §5.3); the worm-torque equilibrium
+//! sum f_i (M_i x n_i)_x = C_m is closed by an outer update of the wheel torque C2.
 
 pub mod solver;
+
+use crate::contact::{coefficient, ContactCell, ElasticPair};
+use crate::geometry::placement::{from_wheel_body, wheel_point};
+use crate::geometry::{Flank, Geometry, WheelFlank};
+use crate::input::{GearSet, Torque};
+use crate::kinematics::{GapEvaluator, Tca};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use solver::{Block, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings};
+use std::f64::consts::PI;
+
+/// Bending influence coefficients (worm and wheel), supplied by the bending stage.
+pub trait BendingModel: Sync {
+    /// "fe" for the finite-element model.
+    fn name(&self) -> &'static str;
+    /// Low-rank term (in force units: normal displacement at i per unit normal force at j,
+    /// m/N) for the given cells (worm frame) and their teeth.
+    fn coefficients(&self, cells: &[LocalCell]) -> LowRank;
+}
+
+/// Settings of the local contact mesh and the solver.
+#[derive(Debug, Clone, Copy)]
+pub struct LtcaSettings {
+    /// Use every `slice_step`-th node column of the global grid as a slice.
+    pub slice_step: usize,
+    /// Cells across the contact line on each slice.
+    pub columns: usize,
+    /// Half-width of the band across the line, in Hertz half-widths at the mean line load.
+    pub band_factor: f64,
+    pub solver: SolverSettings,
+}
+
+impl LtcaSettings {
+    pub fn from_gear(gear: &GearSet) -> Self {
+        let a = &gear.analysis;
+        Self {
+            slice_step: a.contact_slice_step,
+            columns: a.contact_columns,
+            band_factor: a.contact_band_factor,
+            solver: SolverSettings {
+                kind: a.solver,
+                ..SolverSettings::default()
+            },
+        }
+    }
+}
+
+/// One cell of a local contact mesh.
+#[derive(Debug, Clone, Copy)]
+pub struct LocalCell {
+    pub cell: ContactCell,
+    /// Tooth index k and its index in the TCA's tooth list.
+    pub tooth: i32,
+    pub tooth_index: usize,
+    /// Slice (node column) and column across the line.
+    pub slice: usize,
+    pub column: usize,
+    /// Flank coordinates (reference tooth), m.
+    pub r: f64,
+    pub z: f64,
+    /// Lever of the normal about the wheel axis |(P x n)_z|, m.
+    pub lever: f64,
+    /// Moment of a unit normal force on the worm about its axis (M x n)_x, m.
+    pub worm_lever: f64,
+    /// Initial angular separation (after the kinematic error), rad.
+    pub separation: f64,
+    /// Edge relief (worm tip rounding, wheel edge rounding) included in it, as a normal
+    /// distance, m.
+    pub relief: f64,
+}
+
+/// Result at one position.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PositionResult {
+    pub position: usize,
+    /// Normal force carried by each studied tooth (TCA tooth order), N.
+    pub tooth_load: Vec<f64>,
+    /// Wheel torque carried, N m.
+    pub wheel_torque: f64,
+    /// Worm torque balanced, N m.
+    pub worm_torque: f64,
+    /// Rigid approach (wheel rotation against its driven sense), rad.
+    pub approach: f64,
+    /// Loaded transmission error = unloaded kinematic error - approach (driven sense,
+    /// negative = lag), rad.
+    pub transmission_error: f64,
+    /// Angular mesh stiffness C2 / approach, N m/rad.
+    pub stiffness_angular: f64,
+    /// Linear mesh stiffness F / (approach x lever at the force barycentre), N/m.
+    pub stiffness_linear: f64,
+    pub max_pressure: f64,
+    pub residuals: Residuals,
+    /// Relative worm-torque balance error |sum f (M x n)_x - C_m| / C_m.
+    pub torque_residual: f64,
+    /// Pressures of the local cells, Pa (same order as `cells`).
+    pub pressure: Vec<f64>,
+    #[serde(skip)]
+    pub cells: Vec<LocalCell>,
+    /// Band widenings needed (load at the band edge).
+    pub band_widenings: usize,
+}
+
+/// Result of the loaded analysis over the mesh cycle.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Ltca {
+    pub bending_model: String,
+    pub solver: SolverKind,
+    pub positions: Vec<PositionResult>,
+    /// Loaded contact pattern: max pressure over all positions and teeth per global cell of the
+    /// loaded flank, Pa.
+    pub pattern: Vec<f64>,
+    pub max_pressure: f64,
+    /// Mean of the non-zero pattern cells, Pa.
+    pub mean_pressure: f64,
+    /// Contact area / active flank area.
+    pub s0: f64,
+    /// Area with p > P_mean / active flank area.
+    pub s1: f64,
+    /// Area with p > P_mean / contact area.
+    pub s2: f64,
+    pub worm_torque: f64,
+    pub wheel_torque: f64,
+}
+
+impl Ltca {
+    /// Mean and peak-to-peak of the loaded transmission error, rad.
+    pub fn te_stats(&self) -> (f64, f64) {
+        stats(self.positions.iter().map(|p| p.transmission_error))
+    }
+    /// Mean angular mesh stiffness, N m/rad.
+    pub fn stiffness_mean(&self) -> f64 {
+        stats(self.positions.iter().map(|p| p.stiffness_angular)).0
+    }
+    /// Most teeth carrying load at one position.
+    pub fn max_teeth_in_contact(&self) -> usize {
+        self.positions
+            .iter()
+            .map(|p| {
+                p.tooth_load
+                    .iter()
+                    .filter(|&&f| f > 1e-9 * p.tooth_load.iter().sum::<f64>())
+                    .count()
+            })
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+fn stats(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    let v: Vec<f64> = v.collect();
+    let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    (mean, hi - lo)
+}
+
+/// Why the loaded analysis failed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum LtcaError {
+    #[error("position {position}: {source}")]
+    Solver {
+        position: usize,
+        #[source]
+        source: SolverError,
+    },
+    #[error("position {0}: no cell of any tooth can touch the worm")]
+    NoContact(usize),
+    #[error("position {0}: contact forces do not produce a worm torque in the driving sense")]
+    TorqueSign(usize),
+}
+
+/// Runs the loaded analysis with the gear's settings, without bending.
+pub fn analyse(gear: &GearSet, geo: &Geometry, tca: &Tca) -> Result<Ltca, LtcaError> {
+    analyse_with(gear, geo, tca, &LtcaSettings::from_gear(gear), None)
+}
+
+/// Hertz half-width estimate for line load w (N/m) and relative radius R, m.
+fn hertz_half_width(w: f64, radius: f64, e_star: f64) -> f64 {
+    (4.0 * w * radius / (PI * e_star)).sqrt()
+}
+
+/// Runs the loaded analysis at every TCA position (MODEL §5).
+pub fn analyse_with(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+) -> Result<Ltca, LtcaError> {
+    let pair = ElasticPair::new(
+        gear.worm_material.youngs_modulus,
+        gear.worm_material.poisson_ratio,
+        gear.wheel_material.youngs_modulus,
+        gear.wheel_material.poisson_ratio,
+    );
+    let ev = GapEvaluator::new(gear, geo);
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let (worm_torque, wheel_torque_guess) = match gear.conditions.torque {
+        Torque::Worm(t) => (Some(t), t * gear.ratio()),
+        Torque::Wheel(t) => (None, t),
+    };
+    // Line-load estimate for the band width: wheel torque / (lever ~ r2 sin alpha) / line length.
+    let step = settings.slice_step.max(1);
+    let slice_dz = wf.z[1] - wf.z[0];
+    let mut lengths = Vec::new();
+    for n in 0..tca.positions.len() {
+        let count = tca
+            .contact_lines
+            .iter()
+            .filter(|c| c.position == n && !c.at_end && c.slice % step == 0)
+            .count();
+        lengths.push(count as f64 * slice_dz * step as f64);
+    }
+    let mean_length = lengths.iter().sum::<f64>() / lengths.len() as f64;
+    let radii: Vec<f64> = tca
+        .contact_lines
+        .iter()
+        .filter(|c| !c.at_end && c.curvature_radius.is_finite())
+        .map(|c| c.curvature_radius)
+        .collect();
+    let radius = if radii.is_empty() {
+        0.03
+    } else {
+        radii.iter().sum::<f64>() / radii.len() as f64
+    };
+    let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.sin().max(0.2);
+    let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
+    let band0 = settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus);
+
+    let positions: Vec<PositionResult> = (0..tca.positions.len())
+        .into_par_iter()
+        .map(|n| {
+            solve_position(
+                gear,
+                geo,
+                tca,
+                &ev,
+                wf,
+                &pair,
+                settings,
+                bending,
+                n,
+                band0,
+                worm_torque,
+                wheel_torque_guess,
+            )
+        })
+        .collect::<Result<_, _>>()?;
+
+    // Loaded pattern on the global grid (MODEL §5.6).
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let mut pattern = vec![0.0f64; ni * nj];
+    let cell_z = |j: usize| 0.5 * (wf.z[j] + wf.z[j + 1]);
+    for pr in &positions {
+        for (c, &p) in pr.cells.iter().zip(&pr.pressure) {
+            if p <= 0.0 {
+                continue;
+            }
+            let half = 0.5 * slice_dz * step as f64;
+            for j in 0..nj {
+                let zc = cell_z(j);
+                if zc < c.z - half || zc > c.z + half {
+                    continue;
+                }
+                let lo = 0.5 * (wf.r_low[j] + wf.r_low[j + 1]);
+                let hi = 0.5 * (wf.r_high[j] + wf.r_high[j + 1]);
+                let s = (c.r - lo) / (hi - lo) * ni as f64;
+                if s < 0.0 || s >= ni as f64 {
+                    continue;
+                }
+                let k = j * ni + s as usize;
+                pattern[k] = pattern[k].max(p);
+            }
+        }
+    }
+    let active_area = wf.active_area();
+    let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
+    let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
+    let max_pressure = pattern.iter().copied().fold(0.0, f64::max);
+    let mean_pressure = if loaded.is_empty() {
+        0.0
+    } else {
+        loaded.iter().map(|&k| pattern[k]).sum::<f64>() / loaded.len() as f64
+    };
+    let above: f64 = loaded
+        .iter()
+        .filter(|&&k| pattern[k] > mean_pressure)
+        .map(|&k| wf.cell_area[k])
+        .sum();
+    let wheel_torque =
+        positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
+    let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
+    Ok(Ltca {
+        bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
+        solver: settings.solver.kind,
+        positions,
+        pattern,
+        max_pressure,
+        mean_pressure,
+        s0: contact_area / active_area,
+        s1: above / active_area,
+        s2: if contact_area > 0.0 {
+            above / contact_area
+        } else {
+            0.0
+        },
+        worm_torque,
+        wheel_torque,
+    })
+}
+
+/// Builds the local mesh of one position with band half-width `band` (m).
+#[allow(clippy::too_many_arguments)]
+fn local_mesh(
+    tca: &Tca,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    settings: &LtcaSettings,
+    teeth: u32,
+    n: usize,
+    band: f64,
+) -> Vec<LocalCell> {
+    let pos = tca.positions[n];
+    let tau = 2.0 * PI / teeth as f64;
+    let step = settings.slice_step.max(1);
+    let nc = settings.columns.max(1);
+    let ds = 2.0 * band / nc as f64;
+    let slice_dz = (wf.z[1] - wf.z[0]) * step as f64;
+    let mut cells = Vec::new();
+    // Separation threshold for slices whose minimum is not a crossing (flank edges).
+    let edge_threshold = 50e-6;
+    for line in tca
+        .contact_lines
+        .iter()
+        .filter(|c| c.position == n && c.slice % step == 0)
+    {
+        if !line.separation.is_finite() || (line.at_end && line.separation > edge_threshold) {
+            continue;
+        }
+        let t = tca.teeth.iter().position(|&k| k == line.tooth).unwrap_or(0);
+        let offset = tca.sigma * line.tooth as f64 * tau;
+        let j = line.slice;
+        let z = wf.z[j];
+        let (lo, hi) = (wf.r_low[j], wf.r_high[j]);
+        let (_, slope) = wf.column_theta(j, line.r);
+        let drds = 1.0 / (1.0 + (line.r * slope).powi(2)).sqrt();
+        for k in 0..nc {
+            let s = (k as f64 - 0.5 * (nc as f64 - 1.0)) * ds;
+            let r = line.r + s * drds;
+            if r < lo || r > hi {
+                continue;
+            }
+            let (theta, slope) = wf.column_theta(j, r);
+            let e = ev.angular(r, theta + offset, z, pos.theta2, pos.theta1);
+            if !e.is_finite() {
+                continue;
+            }
+            let nb = wf.column_normal(j, r);
+            let stat = wheel_point(r, theta + offset, z, pos.theta2);
+            let n_stat = from_wheel_body(&nb, offset + pos.theta2);
+            let lever = GapEvaluator::lever(&stat, &n_stat);
+            let centre = ev.placement.wheel_to_worm(&stat);
+            let relief = ev
+                .relief(r, z, (centre.y * centre.y + centre.z * centre.z).sqrt())
+                .0;
+            let normal = ev.placement.vector_wheel_to_worm(&n_stat);
+            // Slice direction: d P / d r in the body frame, to the worm frame.
+            let (st, ct) = (theta + offset).sin_cos();
+            let dpdr_body = Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0);
+            let dpdr = ev
+                .placement
+                .vector_wheel_to_worm(&from_wheel_body(&dpdr_body, pos.theta2));
+            let axis_nu = (dpdr - normal * dpdr.dot(&normal)).normalize();
+            let axis_zeta = normal.cross(&axis_nu);
+            cells.push(LocalCell {
+                cell: ContactCell {
+                    centre,
+                    normal,
+                    axis_nu,
+                    axis_zeta,
+                    half_nu: 0.5 * ds,
+                    half_zeta: 0.5 * slice_dz,
+                },
+                tooth: line.tooth,
+                tooth_index: t,
+                slice: j,
+                column: k,
+                r,
+                z,
+                lever,
+                worm_lever: centre.cross(&normal).x,
+                separation: e + pos.kinematic_error,
+                relief,
+            });
+        }
+    }
+    cells
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_position(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    pair: &ElasticPair,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    n: usize,
+    band0: f64,
+    worm_torque: Option<f64>,
+    wheel_torque_guess: f64,
+) -> Result<PositionResult, LtcaError> {
+    let _ = gear;
+    let mut band = band0;
+    let mut widenings = 0;
+    loop {
+        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band);
+        if cells.is_empty() {
+            return Err(LtcaError::NoContact(n));
+        }
+        // Blocks per tooth (cells are grouped by tooth in mesh order).
+        let mut blocks = Vec::new();
+        let mut start = 0;
+        while start < cells.len() {
+            let t = cells[start].tooth_index;
+            let mut end = start;
+            while end < cells.len() && cells[end].tooth_index == t {
+                end += 1;
+            }
+            let size = end - start;
+            let mut matrix = vec![0.0; size * size];
+            for a in 0..size {
+                let ci = &cells[start + a];
+                for b in 0..size {
+                    let cj = &cells[start + b];
+                    matrix[a * size + b] = coefficient(pair, &ci.cell, &cj.cell)
+                        / (cj.cell.area() * ci.lever * cj.lever);
+                }
+            }
+            // Symmetrise (the tangential term is slightly asymmetric on curved flanks).
+            for a in 0..size {
+                for b in 0..a {
+                    let m = 0.5 * (matrix[a * size + b] + matrix[b * size + a]);
+                    matrix[a * size + b] = m;
+                    matrix[b * size + a] = m;
+                }
+            }
+            blocks.push(Block {
+                start,
+                size,
+                matrix,
+            });
+            start = end;
+        }
+        let low_rank = bending.map(|b| {
+            let mut lr = b.coefficients(&cells);
+            for (i, c) in cells.iter().enumerate() {
+                for v in &mut lr.f[i * lr.rank..(i + 1) * lr.rank] {
+                    *v /= c.lever;
+                }
+            }
+            lr
+        });
+        // Sign of the worm moments: all loaded cells push the worm the same way.
+        let sign = {
+            let s: f64 = cells.iter().map(|c| c.worm_lever.signum()).sum();
+            if s == 0.0 {
+                return Err(LtcaError::TorqueSign(n));
+            }
+            s.signum()
+        };
+        let mut problem = Problem {
+            blocks,
+            low_rank,
+            separation: cells.iter().map(|c| c.separation).collect(),
+            load: wheel_torque_guess,
+        };
+        let mut warm: Option<Vec<f64>> = None;
+        let mut solution = None;
+        // Outer update of the wheel torque until the worm torque balances (MODEL §5.2).
+        for _ in 0..20 {
+            let sol =
+                solver::solve(&problem, &settings.solver, warm.as_deref()).map_err(|source| {
+                    LtcaError::Solver {
+                        position: n,
+                        source,
+                    }
+                })?;
+            let worm: f64 = cells
+                .iter()
+                .zip(&sol.q)
+                .map(|(c, q)| q / c.lever * c.worm_lever * sign)
+                .sum();
+            let done = match worm_torque {
+                Some(target) => {
+                    let ratio = target / worm;
+                    let close = (ratio - 1.0).abs() < 1e-12;
+                    problem.load *= ratio;
+                    close
+                }
+                None => true,
+            };
+            warm = Some(sol.q.clone());
+            solution = Some((sol, worm));
+            if done {
+                break;
+            }
+        }
+        let (sol, worm) = solution.expect("at least one solve");
+        // Load at the band edge: widen and redo.
+        let nc = settings.columns;
+        let qmax = sol.q.iter().copied().fold(0.0, f64::max);
+        let at_edge = cells
+            .iter()
+            .zip(&sol.q)
+            .any(|(c, &q)| q > 1e-6 * qmax && (c.column == 0 || c.column == nc - 1));
+        if at_edge && widenings < 4 {
+            band *= 1.6;
+            widenings += 1;
+            continue;
+        }
+        let forces: Vec<f64> = cells.iter().zip(&sol.q).map(|(c, q)| q / c.lever).collect();
+        let pressure: Vec<f64> = cells
+            .iter()
+            .zip(&forces)
+            .map(|(c, f)| f / c.cell.area())
+            .collect();
+        let mut tooth_load = vec![0.0; tca.teeth.len()];
+        for (c, f) in cells.iter().zip(&forces) {
+            tooth_load[c.tooth_index] += f;
+        }
+        let total_force: f64 = forces.iter().sum();
+        // Force barycentre and mean normal (MODEL §5.6) for the linear stiffness.
+        let mut b = Vector3::zeros();
+        let mut nsum = Vector3::zeros();
+        for (c, f) in cells.iter().zip(&forces) {
+            b += c.cell.centre * *f;
+            nsum += c.cell.normal * *f;
+        }
+        let b = b / total_force;
+        let nmean = nsum.normalize();
+        let b_wheel = ev.placement.worm_to_wheel(&b);
+        let n_wheel = ev.placement.vector_worm_to_wheel(&nmean);
+        let lever_b = GapEvaluator::lever(&b_wheel, &n_wheel);
+        let approach = sol.approach;
+        let target = worm_torque.unwrap_or(worm);
+        return Ok(PositionResult {
+            position: n,
+            tooth_load,
+            wheel_torque: problem.load,
+            worm_torque: worm,
+            approach,
+            transmission_error: tca.positions[n].kinematic_error - approach,
+            stiffness_angular: problem.load / approach,
+            stiffness_linear: total_force / (approach * lever_b),
+            max_pressure: pressure.iter().copied().fold(0.0, f64::max),
+            residuals: sol.residuals,
+            torque_residual: (worm - target).abs() / target,
+            pressure,
+            cells,
+            band_widenings: widenings,
+        });
+    }
+}
+
+/// Flank used by the LTCA (the TCA's loaded flank).
+pub fn loaded_flank(tca: &Tca) -> Flank {
+    tca.loaded_flank
+}
