@@ -50,6 +50,20 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Loaded tooth contact analysis: load sharing, pressures, transmission error, stiffness.
+    #[command(
+        after_help = "Example:\n  wormwear ltca examples/gear-1x40-design.toml -o out/1x40 --map-position 5"
+    )]
+    Ltca {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Position whose pressure maps are drawn (0-based).
+        #[arg(long, default_value_t = 0)]
+        map_position: usize,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -73,6 +87,11 @@ fn main() -> ExitCode {
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),
+        Command::Ltca {
+            file,
+            output,
+            map_position,
+        } => ltca(file, output, *map_position, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -183,6 +202,43 @@ fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
             100.0 * s.pattern_area_fraction,
             s.max_sliding_speed_m_s,
             s.sliding_speed_at_pitch_m_s
+        );
+    }
+    Ok(())
+}
+
+fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let geo = build_geometry(&gear, file)?;
+    let tca = wormwear::kinematics::analyse(&gear, &geo)
+        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
+    let result = wormwear::ltca::analyse(&gear, &geo, &tca).map_err(|e| {
+        Failure::Run(anyhow::Error::new(e).context("loaded tooth contact analysis"))
+    })?;
+    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
+        .map_err(|e| Failure::Run(e.into()))?;
+    wormwear::output::tca::write_tca(&geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
+    let files = wormwear::output::ltca::write_ltca(&geo, &tca, &result, dir, map_position)
+        .map_err(|e| Failure::Run(e.into()))?;
+    for w in &tca.warnings {
+        eprintln!("warning: {w}");
+    }
+    if !quiet {
+        for f in &files {
+            println!("  wrote {}", f.display());
+        }
+        let (te, p2p) = result.te_stats();
+        println!(
+            "ltca ({}): P_max {:.0} MPa, P_mean {:.0} MPa, S0 {:.2}, TE mean {:.3e} rad p2p {:.3e} rad, \
+             stiffness {:.3e} N m/rad, up to {} teeth loaded",
+            result.bending_model,
+            result.max_pressure / 1e6,
+            result.mean_pressure / 1e6,
+            result.s0,
+            te,
+            p2p,
+            result.stiffness_mean(),
+            result.max_teeth_in_contact()
         );
     }
     Ok(())

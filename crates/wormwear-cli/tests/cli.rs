@@ -184,3 +184,58 @@ fn tca_writes_its_section_plots_and_tables() {
     let frac = t["pattern_area_fraction"].as_f64().unwrap();
     assert!(frac > 0.0 && frac <= 1.0);
 }
+
+#[test]
+fn ltca_writes_its_section_plots_and_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = bin()
+        .args(["ltca", "--quiet", "--map-position", "3"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "ltca_positions.csv",
+        "ltca_pattern.csv",
+        "ltca_pressures.csv",
+        "ltca_load_sharing.svg",
+        "ltca_transmission_error.svg",
+        "ltca_mesh_stiffness.svg",
+        "ltca_pattern.svg",
+        "ltca_pressure_position3_tooth0.svg",
+    ] {
+        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert!(meta.len() > 100, "{f} is empty");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert!(summary["tca"]["kinematic_error_p2p_rad"].is_number());
+    let l = &summary["ltca"];
+    for key in [
+        "max_pressure_pa",
+        "mean_pressure_pa",
+        "contact_area_fraction",
+        "s1",
+        "s2",
+        "te_mean_rad",
+        "te_p2p_rad",
+        "mesh_stiffness_mean_nm_per_rad",
+        "max_teeth_in_contact",
+    ] {
+        assert!(l[key].is_number(), "ltca section lacks {key}");
+    }
+    assert_eq!(l["bending_model"], "none");
+    assert_eq!(l["load_share"].as_array().unwrap().len(), 20);
+    assert_eq!(l["solver_residuals"].as_array().unwrap().len(), 20);
+    for r in l["solver_residuals"].as_array().unwrap() {
+        assert!(r["torque_balance"].as_f64().unwrap() < 1e-6);
+    }
+}

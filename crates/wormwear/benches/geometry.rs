@@ -1,5 +1,6 @@
 //! Geometry and TCA benchmarks (targets: 1/40 geometry, 60 x 40 grid per flank, under 1 s;
-//! full TCA of the 1/40 gear, 20 positions x 5 teeth x default grid, under 0.2 s).
+//! full TCA of the 1/40 gear, 20 positions x 5 teeth x default grid, under 0.2 s; LTCA one
+//! position under 20 ms, 20 positions under 0.5 s).
 //! Run: cargo bench -p wormwear --bench geometry
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -38,6 +39,26 @@ fn bench(c: &mut Criterion) {
         "1x40 full TCA, 20 positions x 5 teeth x 40 x 60 grid",
         |b| b.iter(|| wormwear::kinematics::analyse(black_box(&g140), black_box(&geo)).unwrap()),
     );
+    group.finish();
+    let mut group = c.benchmark_group("ltca");
+    group.sample_size(10);
+    let tca = wormwear::kinematics::analyse(&g140, &geo).unwrap();
+    group.bench_function(
+        "1x40 LTCA, 20 positions, default local mesh, no bending",
+        |b| {
+            b.iter(|| {
+                wormwear::ltca::analyse(black_box(&g140), black_box(&geo), black_box(&tca)).unwrap()
+            })
+        },
+    );
+    let mut one = g140.clone();
+    one.analysis.positions = 1;
+    let tca1 = wormwear::kinematics::analyse(&one, &geo).unwrap();
+    group.bench_function("1x40 LTCA, one position", |b| {
+        b.iter(|| {
+            wormwear::ltca::analyse(black_box(&one), black_box(&geo), black_box(&tca1)).unwrap()
+        })
+    });
     group.finish();
 }
 

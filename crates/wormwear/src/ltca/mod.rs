@@ -215,7 +215,7 @@ pub fn analyse_with(
         Torque::Worm(t) => (Some(t), t * gear.ratio()),
         Torque::Wheel(t) => (None, t),
     };
-    // Line-load estimate for the band width: wheel torque / (lever ~ r2 sin alpha) / line length.
+    // Line-load estimate for the band width: wheel torque / lever / line length.
     let step = settings.slice_step.max(1);
     let slice_dz = wf.z[1] - wf.z[0];
     let mut lengths = Vec::new();
@@ -239,7 +239,8 @@ pub fn analyse_with(
     } else {
         radii.iter().sum::<f64>() / radii.len() as f64
     };
-    let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.sin().max(0.2);
+    // Lever of the normal about the wheel axis, |(P x n)_z| ~ r2 cos(alpha_n).
+    let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.cos();
     let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
     let band0 = settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus);
 
@@ -436,8 +437,8 @@ fn solve_position(
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
         }
-        // Blocks per tooth (cells are grouped by tooth in mesh order).
-        let mut blocks = Vec::new();
+        // Blocks per tooth (cells are grouped by tooth in mesh order), assembled in parallel.
+        let mut ranges = Vec::new();
         let mut start = 0;
         while start < cells.len() {
             let t = cells[start].tooth_index;
@@ -445,31 +446,32 @@ fn solve_position(
             while end < cells.len() && cells[end].tooth_index == t {
                 end += 1;
             }
-            let size = end - start;
-            let mut matrix = vec![0.0; size * size];
-            for a in 0..size {
-                let ci = &cells[start + a];
-                for b in 0..size {
-                    let cj = &cells[start + b];
-                    matrix[a * size + b] = coefficient(pair, &ci.cell, &cj.cell)
-                        / (cj.cell.area() * ci.lever * cj.lever);
-                }
-            }
-            // Symmetrise (the tangential term is slightly asymmetric on curved flanks).
-            for a in 0..size {
-                for b in 0..a {
-                    let m = 0.5 * (matrix[a * size + b] + matrix[b * size + a]);
-                    matrix[a * size + b] = m;
-                    matrix[b * size + a] = m;
-                }
-            }
-            blocks.push(Block {
-                start,
-                size,
-                matrix,
-            });
+            ranges.push((start, end - start));
             start = end;
         }
+        let blocks: Vec<Block> = ranges
+            .into_par_iter()
+            .map(|(start, size)| {
+                // Upper triangle, mirrored: Love's term is symmetric for the equal cells of a
+                // tooth; only the tangential term's small asymmetry on curved flanks is dropped.
+                let mut matrix = vec![0.0; size * size];
+                for a in 0..size {
+                    let ci = &cells[start + a];
+                    for b in a..size {
+                        let cj = &cells[start + b];
+                        let m = coefficient(pair, &ci.cell, &cj.cell)
+                            / (cj.cell.area() * ci.lever * cj.lever);
+                        matrix[a * size + b] = m;
+                        matrix[b * size + a] = m;
+                    }
+                }
+                Block {
+                    start,
+                    size,
+                    matrix,
+                }
+            })
+            .collect();
         let low_rank = bending.map(|b| {
             let mut lr = b.coefficients(&cells);
             for (i, c) in cells.iter().enumerate() {
@@ -512,7 +514,7 @@ fn solve_position(
             let done = match worm_torque {
                 Some(target) => {
                     let ratio = target / worm;
-                    let close = (ratio - 1.0).abs() < 1e-12;
+                    let close = (ratio - 1.0).abs() < 1e-9;
                     problem.load *= ratio;
                     close
                 }

@@ -13,6 +13,28 @@
 //! Two solvers: the Polonsky-Keer conjugate gradient with active set (fast, default) and the
 //! published fixed point on the approach (reference).
 
+/// Dot product with four independent accumulators (lets the compiler use SIMD; the summation
+/// order differs from a plain left fold only at round-off level).
+#[inline]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for k in 0..chunks {
+        let i = 4 * k;
+        acc[0] += a[i] * b[i];
+        acc[1] += a[i + 1] * b[i + 1];
+        acc[2] += a[i + 2] * b[i + 2];
+        acc[3] += a[i + 3] * b[i + 3];
+    }
+    let mut tail = 0.0;
+    for i in 4 * chunks..n {
+        tail += a[i] * b[i];
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
 /// Dense symmetric block on a contiguous range of unknowns.
 #[derive(Debug, Clone)]
 pub struct Block {
@@ -130,7 +152,7 @@ impl Problem {
             let xs = &x[b.start..b.start + b.size];
             for (r, yr) in y[b.start..b.start + b.size].iter_mut().enumerate() {
                 let row = &b.matrix[r * b.size..(r + 1) * b.size];
-                *yr = row.iter().zip(xs).map(|(a, b)| a * b).sum();
+                *yr = dot(row, xs);
             }
         }
         if let Some(lr) = &self.low_rank {

@@ -5,6 +5,7 @@
 //! replaces its own section and keeps the others.
 
 pub mod geometry;
+pub mod ltca;
 pub mod tca;
 
 use std::fmt::Write as _;

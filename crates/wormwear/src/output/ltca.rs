@@ -1,0 +1,400 @@
+//! Files of the loaded analysis: `ltca` section of summary.json, CSV tables (per position,
+//! loaded pattern, local pressures) and SVG plots (load sharing, transmission error, mesh
+//! stiffness, pressure maps of the engaged teeth at a chosen position, loaded pattern).
+
+use super::tca::flank_cells;
+use super::{update_summary, Csv, OutputError};
+use crate::geometry::{Geometry, WheelFlank};
+use crate::kinematics::Tca;
+use crate::ltca::{Ltca, PositionResult};
+use crate::plot::{flank_map, line_chart, line_chart_spanned, MapCell, Series};
+use std::path::{Path, PathBuf};
+
+const MM: f64 = 1e3;
+const UM: f64 = 1e6;
+const MPA: f64 = 1e-6;
+
+/// Summary of the loaded analysis (units in the names).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LtcaSummary {
+    pub bending_model: String,
+    pub solver: String,
+    pub worm_torque_nm: f64,
+    /// Mean over the positions.
+    pub wheel_torque_nm: f64,
+    pub max_pressure_pa: f64,
+    pub mean_pressure_pa: f64,
+    /// S0: contact area / active flank area.
+    pub contact_area_fraction: f64,
+    pub s1: f64,
+    pub s2: f64,
+    pub te_mean_rad: f64,
+    pub te_p2p_rad: f64,
+    pub mesh_stiffness_mean_nm_per_rad: f64,
+    pub mesh_stiffness_linear_mean_n_per_m: f64,
+    pub max_teeth_in_contact: usize,
+    /// Normal force per tooth (TCA tooth order) at each position, N.
+    pub load_share: Vec<LoadShare>,
+    pub solver_residuals: Vec<SolverResiduals>,
+}
+
+/// Load sharing at one position.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LoadShare {
+    pub position: usize,
+    pub teeth: Vec<i32>,
+    pub tooth_load_n: Vec<f64>,
+}
+
+/// Residuals at one position.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SolverResiduals {
+    pub position: usize,
+    pub torque_balance: f64,
+    pub complementarity: f64,
+    pub min_gap: f64,
+    pub min_pressure: f64,
+    pub iterations: usize,
+    pub cells: usize,
+}
+
+impl LtcaSummary {
+    pub fn new(tca: &Tca, ltca: &Ltca) -> Self {
+        let (te_mean, te_p2p) = ltca.te_stats();
+        let n = ltca.positions.len().max(1) as f64;
+        Self {
+            bending_model: ltca.bending_model.clone(),
+            solver: format!("{:?}", ltca.solver),
+            worm_torque_nm: ltca.worm_torque,
+            wheel_torque_nm: ltca.wheel_torque,
+            max_pressure_pa: ltca.max_pressure,
+            mean_pressure_pa: ltca.mean_pressure,
+            contact_area_fraction: ltca.s0,
+            s1: ltca.s1,
+            s2: ltca.s2,
+            te_mean_rad: te_mean,
+            te_p2p_rad: te_p2p,
+            mesh_stiffness_mean_nm_per_rad: ltca.stiffness_mean(),
+            mesh_stiffness_linear_mean_n_per_m: ltca
+                .positions
+                .iter()
+                .map(|p| p.stiffness_linear)
+                .sum::<f64>()
+                / n,
+            max_teeth_in_contact: ltca.max_teeth_in_contact(),
+            load_share: ltca
+                .positions
+                .iter()
+                .map(|p| LoadShare {
+                    position: p.position,
+                    teeth: tca.teeth.clone(),
+                    tooth_load_n: p.tooth_load.clone(),
+                })
+                .collect(),
+            solver_residuals: ltca
+                .positions
+                .iter()
+                .map(|p| SolverResiduals {
+                    position: p.position,
+                    torque_balance: p.torque_residual,
+                    complementarity: p.residuals.complementarity,
+                    min_gap: p.residuals.min_gap,
+                    min_pressure: p.residuals.min_load,
+                    iterations: p.residuals.iterations,
+                    cells: p.cells.len(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Local cells of one tooth at one position as map quads in (z, r) mm.
+fn local_cells(pr: &PositionResult, tooth: usize, wf: &WheelFlank) -> Vec<MapCell> {
+    let dz = pr.cells.first().map(|c| c.cell.half_zeta).unwrap_or(0.0);
+    pr.cells
+        .iter()
+        .zip(&pr.pressure)
+        .filter(|(c, &p)| c.tooth_index == tooth && p > 0.0)
+        .map(|(c, &p)| {
+            // Half height of the cell in r: half_nu along the slice, mapped to r.
+            let (_, slope) = wf.column_theta(c.slice, c.r);
+            let dr = c.cell.half_nu / (1.0 + (c.r * slope).powi(2)).sqrt();
+            let (z0, z1) = ((c.z - dz) * MM, (c.z + dz) * MM);
+            let (r0, r1) = ((c.r - dr) * MM, (c.r + dr) * MM);
+            MapCell {
+                corners: [(z0, r0), (z1, r0), (z1, r1), (z0, r1)],
+                value: p * MPA,
+            }
+        })
+        .collect()
+}
+
+/// Outline of the active flank in (z, r) mm.
+fn flank_outline(wf: &WheelFlank) -> Series {
+    let mut pts: Vec<(f64, f64)> =
+        wf.z.iter()
+            .zip(&wf.r_low)
+            .map(|(z, r)| (z * MM, r * MM))
+            .collect();
+    pts.extend(
+        wf.z.iter()
+            .zip(&wf.r_high)
+            .rev()
+            .map(|(z, r)| (z * MM, r * MM)),
+    );
+    pts.push(pts[0]);
+    Series {
+        label: "active flank".into(),
+        points: pts,
+        color: 5,
+        bold: false,
+    }
+}
+
+/// Writes every LTCA output into `dir`; `map_position` selects the position of the pressure
+/// maps. Returns the files written.
+pub fn write_ltca(
+    geo: &Geometry,
+    tca: &Tca,
+    ltca: &Ltca,
+    dir: &Path,
+    map_position: usize,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let mut files = Vec::new();
+    let np = ltca.positions.len();
+    // Per position table.
+    let mut header: Vec<String> = [
+        "position",
+        "wheel_torque_nm",
+        "worm_torque_nm",
+        "approach_rad",
+        "transmission_error_rad",
+        "kinematic_error_rad",
+        "stiffness_nm_per_rad",
+        "stiffness_n_per_m",
+        "max_pressure_pa",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    header.extend(tca.teeth.iter().map(|k| format!("tooth_{k}_load_n")));
+    let mut csv = Csv::new(&header.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    for p in &ltca.positions {
+        let mut row = vec![
+            p.position as f64,
+            p.wheel_torque,
+            p.worm_torque,
+            p.approach,
+            p.transmission_error,
+            tca.positions[p.position].kinematic_error,
+            p.stiffness_angular,
+            p.stiffness_linear,
+            p.max_pressure,
+        ];
+        row.extend(&p.tooth_load);
+        csv.row(&row);
+    }
+    let path = dir.join("ltca_positions.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let x = |n: usize| n as f64 / np as f64;
+    // Load sharing.
+    let series: Vec<Series> = tca
+        .teeth
+        .iter()
+        .enumerate()
+        .filter(|(t, _)| ltca.positions.iter().any(|p| p.tooth_load[*t] > 0.0))
+        .map(|(t, &k)| Series {
+            label: format!("tooth {k}"),
+            points: ltca
+                .positions
+                .iter()
+                .map(|p| (x(p.position), p.tooth_load[t] / 1e3))
+                .collect(),
+            color: t,
+            bold: false,
+        })
+        .collect();
+    let path = dir.join("ltca_load_sharing.svg");
+    line_chart(
+        &path,
+        "Load sharing between the teeth",
+        "wheel rotation (tooth pitches from position 0)",
+        "normal force on the tooth (kN)",
+        &series,
+        false,
+    )?;
+    files.push(path);
+    // Transmission error.
+    let te = Series {
+        label: "loaded TE".into(),
+        points: (0..=np)
+            .map(|n| (x(n), ltca.positions[n % np].transmission_error * UM))
+            .collect(),
+        color: 0,
+        bold: true,
+    };
+    let ke = Series {
+        label: "unloaded KE".into(),
+        points: (0..=np)
+            .map(|n| (x(n), tca.positions[n % np].kinematic_error * UM))
+            .collect(),
+        color: 5,
+        bold: false,
+    };
+    let (m, p2p) = ltca.te_stats();
+    let path = dir.join("ltca_transmission_error.svg");
+    line_chart_spanned(
+        &path,
+        &format!(
+            "Loaded transmission error (mean {:.2} urad, p2p {:.2} urad; negative: wheel lags)",
+            m * UM,
+            p2p * UM
+        ),
+        "wheel rotation (tooth pitches from position 0)",
+        "transmission error (urad, wheel)",
+        &[te, ke],
+        false,
+        0.02,
+    )?;
+    files.push(path);
+    // Stiffness.
+    let k = Series {
+        label: String::new(),
+        points: (0..=np)
+            .map(|n| (x(n), ltca.positions[n % np].stiffness_angular / 1e6))
+            .collect(),
+        color: 2,
+        bold: true,
+    };
+    let path = dir.join("ltca_mesh_stiffness.svg");
+    line_chart(
+        &path,
+        "Mesh stiffness C2 / approach",
+        "wheel rotation (tooth pitches from position 0)",
+        "angular stiffness (MN m/rad)",
+        &[k],
+        false,
+    )?;
+    files.push(path);
+    // Loaded pattern.
+    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "max_pressure_pa"]);
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let c = &wf.cells[j * wf.cells_height + i];
+            csv.row(&[
+                i as f64,
+                j as f64,
+                c.r * MM,
+                c.z * MM,
+                ltca.pattern[j * wf.cells_height + i],
+            ]);
+        }
+    }
+    let path = dir.join("ltca_pattern.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let values: Vec<f64> = ltca
+        .pattern
+        .iter()
+        .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
+        .collect();
+    let trace = Series {
+        label: "worm tip trace".into(),
+        points: tca
+            .tip_trace
+            .iter()
+            .map(|&(z, r)| (z * MM, r * MM))
+            .collect(),
+        color: 1,
+        bold: true,
+    };
+    let path = dir.join("ltca_pattern.svg");
+    flank_map(
+        &path,
+        &format!(
+            "Loaded contact pattern: max pressure over the cycle (P_max {:.0} MPa, S0 {:.2}); grey: no contact",
+            ltca.max_pressure * MPA,
+            ltca.s0
+        ),
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &flank_cells(wf, &values),
+        (0.0, ltca.max_pressure * MPA),
+        "pressure (MPa)",
+        &[trace.clone()],
+        &[],
+    )?;
+    files.push(path);
+    // Pressure maps of the engaged teeth at the chosen position.
+    let n = map_position.min(np - 1);
+    let pr = &ltca.positions[n];
+    for (t, &k) in tca.teeth.iter().enumerate() {
+        if pr.tooth_load[t] <= 0.0 {
+            continue;
+        }
+        let cells = local_cells(pr, t, wf);
+        let path = dir.join(format!("ltca_pressure_position{n}_tooth{k}.svg"));
+        flank_map(
+            &path,
+            &format!(
+                "Pressure on tooth {k} at position {n}: {:.1} kN, max {:.0} MPa",
+                pr.tooth_load[t] / 1e3,
+                pr.cells
+                    .iter()
+                    .zip(&pr.pressure)
+                    .filter(|(c, _)| c.tooth_index == t)
+                    .map(|(_, p)| *p)
+                    .fold(0.0, f64::max)
+                    * MPA
+            ),
+            "z2 across the face width (mm)",
+            "r wheel radius (mm)",
+            &cells,
+            (0.0, ltca.max_pressure * MPA),
+            "pressure (MPa)",
+            &[flank_outline(wf), trace.clone()],
+            &[],
+        )?;
+        files.push(path);
+    }
+    // Local pressures of every position.
+    let mut csv = Csv::new(&[
+        "position",
+        "tooth",
+        "slice",
+        "column",
+        "r_mm",
+        "z_mm",
+        "pressure_pa",
+        "separation_rad",
+        "relief_um",
+    ]);
+    for p in &ltca.positions {
+        for (c, pr) in p.cells.iter().zip(&p.pressure) {
+            csv.row(&[
+                p.position as f64,
+                c.tooth as f64,
+                c.slice as f64,
+                c.column as f64,
+                c.r * MM,
+                c.z * MM,
+                *pr,
+                c.separation,
+                c.relief * UM,
+            ]);
+        }
+    }
+    let path = dir.join("ltca_pressures.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let value =
+        serde_json::to_value(LtcaSummary::new(tca, ltca)).map_err(|e| OutputError::Encode {
+            what: "ltca summary".into(),
+            message: e.to_string(),
+        })?;
+    update_summary(dir, "ltca", value)?;
+    files.push(dir.join("summary.json"));
+    Ok(files)
+}
