@@ -108,8 +108,12 @@ fn both_solvers_agree_on_the_1x40() {
     }
 }
 
+/// Acceptance criterion of the LTCA issue: doubling slices and columns changes P_max by < 3 %
+/// and TE by < 2 %. NOT MET YET with the default edge reliefs (P_max +3.7 %, TE 1.2 %): the
+/// pressure peaks where a contact line runs into the worm's tip-relief zone, a transition a
+/// few mm long along the line that slices every 2.25 mm do not resolve. Kept as the target.
 #[test]
-#[ignore = "mesh refinement study: ~1 min; run with --ignored"]
+#[ignore = "refinement study (~10 s in release); fails until the along-line resolution is adaptive"]
 fn refinement_changes_pmax_and_te_little() {
     let g = example("gear-1x40-design.toml");
     let s = LtcaSettings::from_gear(&g);
@@ -168,4 +172,20 @@ fn conjugate_line_contact_approach_scales_as_line_contact_theory() {
     }
     // The exponent falls slowly with load (ln(L/b) shrinks as b grows), unlike a power law.
     assert!(exps[exps.len() - 1] < exps[0]);
+}
+
+#[test]
+fn non_convergence_is_an_error_not_a_result() {
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 4;
+    let mut s = LtcaSettings::from_gear(&g);
+    s.solver.max_iterations = 3;
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let err = ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("did not converge") && text.contains("position"),
+        "{text}"
+    );
 }
