@@ -147,14 +147,34 @@ impl Problem {
 
     /// y = K x.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        use rayon::prelude::*;
         y.iter_mut().for_each(|v| *v = 0.0);
+        // Rows in chunks across threads (blocks are contiguous and in order).
+        const CHUNK: usize = 32;
+        let mut jobs: Vec<(&Block, usize, &mut [f64])> = Vec::new();
+        let mut rest: &mut [f64] = y;
+        let mut offset = 0;
         for b in &self.blocks {
-            let xs = &x[b.start..b.start + b.size];
-            for (r, yr) in y[b.start..b.start + b.size].iter_mut().enumerate() {
-                let row = &b.matrix[r * b.size..(r + 1) * b.size];
-                *yr = dot(row, xs);
+            debug_assert_eq!(b.start, offset);
+            let (mut head, tail) = std::mem::take(&mut rest).split_at_mut(b.size);
+            rest = tail;
+            let mut r0 = 0;
+            while !head.is_empty() {
+                let take = CHUNK.min(head.len());
+                let (part, more) = std::mem::take(&mut head).split_at_mut(take);
+                jobs.push((b, r0, part));
+                head = more;
+                r0 += take;
             }
+            offset += b.size;
         }
+        jobs.into_par_iter().for_each(|(b, r0, part)| {
+            let xs = &x[b.start..b.start + b.size];
+            for (k, yr) in part.iter_mut().enumerate() {
+                let r = r0 + k;
+                *yr = dot(&b.matrix[r * b.size..(r + 1) * b.size], xs);
+            }
+        });
         if let Some(lr) = &self.low_rank {
             let k = lr.rank;
             let mut ft = vec![0.0; k];
