@@ -497,8 +497,15 @@ fn solve_position(
         };
         let mut warm: Option<Vec<f64>> = None;
         let mut solution = None;
-        // Outer update of the wheel torque until the worm torque balances (MODEL §5.2).
-        for _ in 0..20 {
+        let weights: Vec<f64> = cells
+            .iter()
+            .map(|c| c.worm_lever * sign / c.lever)
+            .collect();
+        let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
+        // Outer update of the wheel torque until the worm torque balances (MODEL §5.2): with
+        // the fast solver, one exact affine step on the loaded set after the first solve; the
+        // fixed-point solver (and any change of the loaded set) iterates.
+        for it in 0..20 {
             let sol =
                 solver::solve(&problem, &settings.solver, warm.as_deref()).map_err(|source| {
                     LtcaError::Solver {
@@ -506,25 +513,37 @@ fn solve_position(
                         source,
                     }
                 })?;
-            let worm: f64 = cells
-                .iter()
-                .zip(&sol.q)
-                .map(|(c, q)| q / c.lever * c.worm_lever * sign)
-                .sum();
-            let done = match worm_torque {
-                Some(target) => {
-                    let ratio = target / worm;
-                    let close = (ratio - 1.0).abs() < 1e-9;
-                    problem.load *= ratio;
-                    close
+            let worm = worm_of(&sol.q);
+            let target = match worm_torque {
+                Some(t) => t,
+                None => {
+                    solution = Some((sol, worm));
+                    break;
                 }
-                None => true,
             };
-            warm = Some(sol.q.clone());
-            solution = Some((sol, worm));
-            if done {
+            let ratio = target / worm;
+            if (ratio - 1.0).abs() < 1e-9 {
+                solution = Some((sol, worm));
                 break;
             }
+            if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
+                if let Some((updated, load)) =
+                    solver::affine_load_update(&problem, &sol, &weights, target, &settings.solver)
+                {
+                    problem.load = load;
+                    let worm = worm_of(&updated.q);
+                    let close = ((worm - target) / target).abs() < 1e-9;
+                    warm = Some(updated.q.clone());
+                    solution = Some((updated, worm));
+                    if close {
+                        break;
+                    }
+                    continue;
+                }
+            }
+            problem.load *= ratio;
+            warm = Some(sol.q.clone());
+            solution = Some((sol, worm));
         }
         let (sol, worm) = solution.expect("at least one solve");
         // Load at the band edge: widen and redo.

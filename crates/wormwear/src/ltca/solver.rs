@@ -474,3 +474,96 @@ fn fixed_point(
         tolerance: settings.tolerance,
     })
 }
+
+/// Exact change of the solution with the load while the loaded set stays the same
+/// (the complementarity problem is then linear): with K_AA v = 1 on the loaded set A,
+/// q(W) = q0 + (W - W0) v / sum(v) and alpha(W) = alpha0 + (W - W0) / sum(v).
+/// Finds the load at which sum(weights . q) = target and returns that solution, or None when
+/// the loaded set would change (a load turning negative or a gap closing), or CG fails.
+pub fn affine_load_update(
+    problem: &Problem,
+    solution: &Solution,
+    weights: &[f64],
+    target: f64,
+    settings: &SolverSettings,
+) -> Option<(Solution, f64)> {
+    let n = problem.len();
+    let active: Vec<bool> = solution.q.iter().map(|&q| q > 0.0).collect();
+    // CG on the loaded set for K_AA v = 1.
+    let mut v = vec![0.0; n];
+    let mut r: Vec<f64> = active.iter().map(|&a| if a { 1.0 } else { 0.0 }).collect();
+    let mut p = r.clone();
+    let mut kp = vec![0.0; n];
+    let mut rr: f64 = r.iter().map(|x| x * x).sum();
+    let rr0 = rr;
+    for _ in 0..settings.max_iterations.min(10 * n) {
+        problem.apply(&p, &mut kp);
+        for i in 0..n {
+            if !active[i] {
+                kp[i] = 0.0;
+            }
+        }
+        let pkp: f64 = p.iter().zip(&kp).map(|(a, b)| a * b).sum();
+        if pkp <= 0.0 {
+            return None;
+        }
+        let a = rr / pkp;
+        for i in 0..n {
+            v[i] += a * p[i];
+            r[i] -= a * kp[i];
+        }
+        let rr_new: f64 = r.iter().map(|x| x * x).sum();
+        if rr_new <= 1e-24 * rr0 {
+            break;
+        }
+        let beta = rr_new / rr;
+        rr = rr_new;
+        for i in 0..n {
+            p[i] = r[i] + beta * p[i];
+        }
+    }
+    let sum_v: f64 = v.iter().sum();
+    if sum_v <= 0.0 {
+        return None;
+    }
+    let t0: f64 = weights.iter().zip(&solution.q).map(|(w, q)| w * q).sum();
+    let slope: f64 = weights.iter().zip(&v).map(|(w, x)| w * x).sum::<f64>() / sum_v;
+    if slope == 0.0 || !slope.is_finite() {
+        return None;
+    }
+    let load = problem.load + (target - t0) / slope;
+    let dw = load - problem.load;
+    let q: Vec<f64> = solution
+        .q
+        .iter()
+        .zip(&v)
+        .map(|(q, x)| q + dw * x / sum_v)
+        .collect();
+    if q.iter().zip(&active).any(|(&qi, &a)| a && qi <= 0.0) {
+        return None;
+    }
+    let approach = solution.approach + dw / sum_v;
+    let mut u = vec![0.0; n];
+    problem.apply(&q, &mut u);
+    let gap: Vec<f64> = (0..n)
+        .map(|i| u[i] + problem.separation[i] - approach)
+        .collect();
+    let tol = settings.tolerance * approach.abs();
+    if (0..n).any(|i| !active[i] && problem.separation[i].is_finite() && gap[i] < -tol) {
+        return None;
+    }
+    let updated = Problem {
+        load,
+        ..problem.clone()
+    };
+    let residuals = updated.residuals(&q, &gap, approach, solution.residuals.iterations);
+    Some((
+        Solution {
+            q,
+            approach,
+            gap,
+            residuals,
+        },
+        load,
+    ))
+}
