@@ -1,0 +1,352 @@
+//! Linear elasticity with 20-node serendipity hexahedra (quadratic, 3 x 3 x 3 Gauss points),
+//! sparse direct solve (faer Cholesky). SI units: m, Pa, N.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+use rayon::prelude::*;
+
+/// Natural coordinates of the 20 nodes: 8 corners, then the 12 edge midpoints.
+pub const NATURAL: [[f64; 3]; 20] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+    [0.0, -1.0, -1.0],
+    [1.0, 0.0, -1.0],
+    [0.0, 1.0, -1.0],
+    [-1.0, 0.0, -1.0],
+    [0.0, -1.0, 1.0],
+    [1.0, 0.0, 1.0],
+    [0.0, 1.0, 1.0],
+    [-1.0, 0.0, 1.0],
+    [-1.0, -1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [-1.0, 1.0, 0.0],
+];
+
+/// Shape functions and their natural derivatives at (xi, eta, zeta).
+pub fn shape(p: [f64; 3]) -> ([f64; 20], [[f64; 3]; 20]) {
+    let mut n = [0.0; 20];
+    let mut d = [[0.0; 3]; 20];
+    for (k, c) in NATURAL.iter().enumerate() {
+        let (x, y, z) = (p[0], p[1], p[2]);
+        let (a, b, e) = (c[0], c[1], c[2]);
+        if a != 0.0 && b != 0.0 && e != 0.0 {
+            let (fx, fy, fz) = (1.0 + x * a, 1.0 + y * b, 1.0 + z * e);
+            let s = x * a + y * b + z * e - 2.0;
+            n[k] = 0.125 * fx * fy * fz * s;
+            d[k] = [
+                0.125 * a * fy * fz * (s + fx),
+                0.125 * b * fx * fz * (s + fy),
+                0.125 * e * fx * fy * (s + fz),
+            ];
+        } else if a == 0.0 {
+            let (fy, fz) = (1.0 + y * b, 1.0 + z * e);
+            n[k] = 0.25 * (1.0 - x * x) * fy * fz;
+            d[k] = [
+                -0.5 * x * fy * fz,
+                0.25 * (1.0 - x * x) * b * fz,
+                0.25 * (1.0 - x * x) * fy * e,
+            ];
+        } else if b == 0.0 {
+            let (fx, fz) = (1.0 + x * a, 1.0 + z * e);
+            n[k] = 0.25 * (1.0 - y * y) * fx * fz;
+            d[k] = [
+                0.25 * (1.0 - y * y) * a * fz,
+                -0.5 * y * fx * fz,
+                0.25 * (1.0 - y * y) * fx * e,
+            ];
+        } else {
+            let (fx, fy) = (1.0 + x * a, 1.0 + y * b);
+            n[k] = 0.25 * (1.0 - z * z) * fx * fy;
+            d[k] = [
+                0.25 * (1.0 - z * z) * a * fy,
+                0.25 * (1.0 - z * z) * fx * b,
+                -0.5 * z * fx * fy,
+            ];
+        }
+    }
+    (n, d)
+}
+
+/// Isotropic elastic material.
+#[derive(Debug, Clone, Copy)]
+pub struct Elastic {
+    /// Young's modulus, Pa.
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+}
+
+impl Elastic {
+    /// 6 x 6 constitutive matrix (Voigt: xx, yy, zz, yz, xz, xy with engineering shears).
+    fn d(&self) -> [[f64; 6]; 6] {
+        let (e, v) = (self.youngs_modulus, self.poisson_ratio);
+        let lam = e * v / ((1.0 + v) * (1.0 - 2.0 * v));
+        let mu = e / (2.0 * (1.0 + v));
+        let mut d = [[0.0; 6]; 6];
+        for i in 0..3 {
+            for j in 0..3 {
+                d[i][j] = lam;
+            }
+            d[i][i] = lam + 2.0 * mu;
+            d[i + 3][i + 3] = mu;
+        }
+        d
+    }
+}
+
+/// A mesh of 20-node hexahedra.
+#[derive(Debug, Clone)]
+pub struct Mesh {
+    pub nodes: Vec<[f64; 3]>,
+    pub elements: Vec<[usize; 20]>,
+}
+
+/// Why a finite-element solve failed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum FeError {
+    #[error("element {0} has a non-positive Jacobian (inverted or degenerate)")]
+    Jacobian(usize),
+    #[error("sparse factorisation failed: {0} (is the model restrained against rigid motion?)")]
+    Factorisation(String),
+}
+
+/// Element stiffness (60 x 60, row-major) of element `e`.
+pub fn element_stiffness(mesh: &Mesh, e: usize, material: &Elastic) -> Result<Vec<f64>, FeError> {
+    let g = [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()];
+    let w = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let d = material.d();
+    let x: Vec<[f64; 3]> = mesh.elements[e].iter().map(|&n| mesh.nodes[n]).collect();
+    let mut k = vec![0.0; 60 * 60];
+    for (ia, &ga) in g.iter().enumerate() {
+        for (ib, &gb) in g.iter().enumerate() {
+            for (ic, &gc) in g.iter().enumerate() {
+                let (_, dn) = shape([ga, gb, gc]);
+                // Jacobian J_ij = d x_j / d xi_i.
+                let mut jac = [[0.0; 3]; 3];
+                for (nd, xn) in dn.iter().zip(&x) {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            jac[i][j] += nd[i] * xn[j];
+                        }
+                    }
+                }
+                let det = jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1])
+                    - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
+                    + jac[0][2] * (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]);
+                if det <= 0.0 {
+                    return Err(FeError::Jacobian(e));
+                }
+                let inv = [
+                    [
+                        (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1]) / det,
+                        (jac[0][2] * jac[2][1] - jac[0][1] * jac[2][2]) / det,
+                        (jac[0][1] * jac[1][2] - jac[0][2] * jac[1][1]) / det,
+                    ],
+                    [
+                        (jac[1][2] * jac[2][0] - jac[1][0] * jac[2][2]) / det,
+                        (jac[0][0] * jac[2][2] - jac[0][2] * jac[2][0]) / det,
+                        (jac[0][2] * jac[1][0] - jac[0][0] * jac[1][2]) / det,
+                    ],
+                    [
+                        (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]) / det,
+                        (jac[0][1] * jac[2][0] - jac[0][0] * jac[2][1]) / det,
+                        (jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0]) / det,
+                    ],
+                ];
+                // Physical derivatives dN/dx_j = sum_i inv[j][i] dN/dxi_i.
+                let mut b = [[0.0; 60]; 6];
+                for (n, nd) in dn.iter().enumerate() {
+                    let dx = [
+                        inv[0][0] * nd[0] + inv[0][1] * nd[1] + inv[0][2] * nd[2],
+                        inv[1][0] * nd[0] + inv[1][1] * nd[1] + inv[1][2] * nd[2],
+                        inv[2][0] * nd[0] + inv[2][1] * nd[1] + inv[2][2] * nd[2],
+                    ];
+                    let c0 = 3 * n;
+                    b[0][c0] = dx[0];
+                    b[1][c0 + 1] = dx[1];
+                    b[2][c0 + 2] = dx[2];
+                    b[3][c0 + 1] = dx[2];
+                    b[3][c0 + 2] = dx[1];
+                    b[4][c0] = dx[2];
+                    b[4][c0 + 2] = dx[0];
+                    b[5][c0] = dx[1];
+                    b[5][c0 + 1] = dx[0];
+                }
+                let weight = w[ia] * w[ib] * w[ic] * det;
+                // K += B^T D B weight.
+                let mut db = [[0.0; 60]; 6];
+                for i in 0..6 {
+                    for j in 0..6 {
+                        if d[i][j] != 0.0 {
+                            for col in 0..60 {
+                                db[i][col] += d[i][j] * b[j][col];
+                            }
+                        }
+                    }
+                }
+                for r in 0..60 {
+                    for i in 0..6 {
+                        let bri = b[i][r];
+                        if bri != 0.0 {
+                            let row = &mut k[r * 60..(r + 1) * 60];
+                            for (col, v) in row.iter_mut().enumerate() {
+                                *v += bri * db[i][col] * weight;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(k)
+}
+
+/// Prescribed displacement of one degree of freedom (node, direction 0..3, value m).
+pub type Fixed = (usize, usize, f64);
+/// Nodal force (node, direction, value N).
+pub type Load = (usize, usize, f64);
+
+/// Solves K u = f with the prescribed displacements eliminated; returns the displacement of
+/// every node (m). Several load cases share one factorisation.
+pub fn solve(
+    mesh: &Mesh,
+    material: &Elastic,
+    fixed: &[Fixed],
+    loads: &[Vec<Load>],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let ndof = 3 * mesh.nodes.len();
+    let mut prescribed = vec![None; ndof];
+    for &(n, d, v) in fixed {
+        prescribed[3 * n + d] = Some(v);
+    }
+    let mut map = vec![usize::MAX; ndof];
+    let mut free = 0;
+    for (i, p) in prescribed.iter().enumerate() {
+        if p.is_none() {
+            map[i] = free;
+            free += 1;
+        }
+    }
+    let elements: Vec<Vec<f64>> = (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|e| element_stiffness(mesh, e, material))
+        .collect::<Result<_, _>>()?;
+    let mut triplets = Vec::new();
+    let ncase = loads.len();
+    let mut rhs = Mat::<f64>::zeros(free, ncase);
+    for (c, case) in loads.iter().enumerate() {
+        for &(n, d, v) in case {
+            let g = 3 * n + d;
+            if map[g] != usize::MAX {
+                rhs[(map[g], c)] += v;
+            }
+        }
+    }
+    for (e, k) in mesh.elements.iter().zip(&elements) {
+        let dofs: Vec<usize> = e
+            .iter()
+            .flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2])
+            .collect();
+        for (r, &gr) in dofs.iter().enumerate() {
+            let fr = map[gr];
+            if fr == usize::MAX {
+                continue;
+            }
+            for (c, &gc) in dofs.iter().enumerate() {
+                let v = k[r * 60 + c];
+                match prescribed[gc] {
+                    Some(u) => {
+                        for case in 0..ncase {
+                            rhs[(fr, case)] -= v * u;
+                        }
+                    }
+                    None => {
+                        let fc = map[gc];
+                        if fc <= fr {
+                            triplets.push(Triplet::new(fr, fc, v));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let llt = a
+        .sp_cholesky(Side::Lower)
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let x = llt.solve(&rhs);
+    Ok((0..ncase)
+        .map(|c| {
+            (0..mesh.nodes.len())
+                .map(|n| {
+                    let mut u = [0.0; 3];
+                    for (d, ud) in u.iter_mut().enumerate() {
+                        let g = 3 * n + d;
+                        *ud = match prescribed[g] {
+                            Some(v) => v,
+                            None => x[(map[g], c)],
+                        };
+                    }
+                    u
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// Structured mesh of the box [0, lx] x [0, ly] x [0, lz] with nx x ny x nz elements; `map`
+/// moves every node (e.g. to distort or bend the box). Also returns the lattice index of every
+/// node (half-element steps).
+pub fn box_mesh(
+    (lx, ly, lz): (f64, f64, f64),
+    (nx, ny, nz): (usize, usize, usize),
+    map: impl Fn([f64; 3]) -> [f64; 3],
+) -> (Mesh, Vec<[usize; 3]>) {
+    let (mx, my, mz) = (2 * nx + 1, 2 * ny + 1, 2 * nz + 1);
+    let mut index = vec![usize::MAX; mx * my * mz];
+    let mut nodes = Vec::new();
+    let mut lattice = Vec::new();
+    for k in 0..mz {
+        for j in 0..my {
+            for i in 0..mx {
+                let odd = (i % 2) + (j % 2) + (k % 2);
+                if odd <= 1 {
+                    index[(k * my + j) * mx + i] = nodes.len();
+                    let p = [
+                        lx * i as f64 / (mx - 1) as f64,
+                        ly * j as f64 / (my - 1) as f64,
+                        lz * k as f64 / (mz - 1) as f64,
+                    ];
+                    nodes.push(map(p));
+                    lattice.push([i, j, k]);
+                }
+            }
+        }
+    }
+    let mut elements = Vec::new();
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let mut e = [0; 20];
+                for (a, c) in NATURAL.iter().enumerate() {
+                    let (li, lj, lk) = (
+                        (2 * i as i64 + 1 + c[0] as i64) as usize,
+                        (2 * j as i64 + 1 + c[1] as i64) as usize,
+                        (2 * k as i64 + 1 + c[2] as i64) as usize,
+                    );
+                    e[a] = index[(lk * my + lj) * mx + li];
+                }
+                elements.push(e);
+            }
+        }
+    }
+    (Mesh { nodes, elements }, lattice)
+}

@@ -1,0 +1,146 @@
+//! The built-in finite elements against exact solutions: patch test (a linear displacement
+//! field is reproduced to round-off on a distorted mesh) and a cantilever against Timoshenko
+//! beam theory (bending + shear).
+
+use wormwear::bending::fe::{box_mesh, solve, Elastic, Load};
+
+const STEEL: Elastic = Elastic {
+    youngs_modulus: 210e9,
+    poisson_ratio: 0.3,
+};
+
+#[test]
+fn patch_test_linear_field_is_exact_on_a_distorted_mesh() {
+    let (l, h, w) = (0.02, 0.015, 0.01);
+    let distort = |p: [f64; 3]| {
+        let s = (p[0] / l * 3.0).sin() * (p[1] / h * 2.0).cos() * (p[2] / w * 2.5).sin();
+        [
+            p[0] + 0.0015 * s,
+            p[1] - 0.001 * s * (p[0] / l),
+            p[2] + 0.0008 * (p[1] / h) * s,
+        ]
+    };
+    let (mesh, lattice) = box_mesh((l, h, w), (3, 3, 2), distort);
+    let (mx, my, mz) = (6, 6, 4);
+    let field = |x: [f64; 3]| {
+        [
+            1e-4 + 2e-3 * x[0] - 1e-3 * x[1] + 5e-4 * x[2],
+            -2e-4 + 1e-3 * x[0] + 3e-3 * x[1] - 2e-3 * x[2],
+            3e-4 - 5e-4 * x[0] + 2e-3 * x[1] + 1e-3 * x[2],
+        ]
+    };
+    let mut fixed = Vec::new();
+    let mut interior = Vec::new();
+    for (n, ijk) in lattice.iter().enumerate() {
+        let boundary = ijk[0] == 0
+            || ijk[0] == mx
+            || ijk[1] == 0
+            || ijk[1] == my
+            || ijk[2] == 0
+            || ijk[2] == mz;
+        if boundary {
+            let u = field(mesh.nodes[n]);
+            for d in 0..3 {
+                fixed.push((n, d, u[d]));
+            }
+        } else {
+            interior.push(n);
+        }
+    }
+    assert!(interior.len() > 10);
+    let u = &solve(&mesh, &STEEL, &fixed, &[vec![]]).unwrap()[0];
+    let mut worst: f64 = 0.0;
+    for &n in &interior {
+        let exact = field(mesh.nodes[n]);
+        for d in 0..3 {
+            worst = worst.max((u[n][d] - exact[d]).abs());
+        }
+    }
+    assert!(
+        worst < 1e-15,
+        "patch test error {worst:e} m (displacements ~1e-5 m)"
+    );
+}
+
+/// Tip deflection of a cantilever (clamped at x = 0, uniform shear traction P on x = L).
+fn cantilever(l: f64, h: f64, b: f64, n: (usize, usize, usize), p: f64) -> f64 {
+    let (mesh, lattice) = box_mesh((l, h, b), n, |x| x);
+    let (mx, my, mz) = (2 * n.0, 2 * n.1, 2 * n.2);
+    let mut fixed = Vec::new();
+    let mut loads: Vec<Load> = Vec::new();
+    // Consistent nodal forces of a uniform traction on 8-node faces: corners -1/12, mid-sides
+    // +1/3 of the face force.
+    let face_force = -p / (n.1 * n.2) as f64;
+    let mut end_nodes = Vec::new();
+    for (k, ijk) in lattice.iter().enumerate() {
+        if ijk[0] == 0 {
+            for d in 0..3 {
+                fixed.push((k, d, 0.0));
+            }
+        }
+        if ijk[0] == mx {
+            end_nodes.push(k);
+            // Count the faces the node belongs to, and its role in them.
+            let (j, kk) = (ijk[1], ijk[2]);
+            let corner = j % 2 == 0 && kk % 2 == 0;
+            let faces_j: Vec<usize> = if j % 2 == 1 {
+                vec![j / 2]
+            } else {
+                [j / 2, j / 2 + 1]
+                    .iter()
+                    .filter(|&&f| f >= 1 && f <= n.1)
+                    .map(|f| f - 1)
+                    .collect()
+            };
+            let faces_k: Vec<usize> = if kk % 2 == 1 {
+                vec![kk / 2]
+            } else {
+                [kk / 2, kk / 2 + 1]
+                    .iter()
+                    .filter(|&&f| f >= 1 && f <= n.2)
+                    .map(|f| f - 1)
+                    .collect()
+            };
+            let count = (faces_j.len() * faces_k.len()) as f64;
+            let share = if corner { -1.0 / 12.0 } else { 1.0 / 3.0 };
+            loads.push((k, 1, face_force * share * count));
+        }
+    }
+    let total: f64 = loads.iter().map(|l| l.2).sum();
+    assert!(
+        (total + p).abs() < 1e-9 * p,
+        "consistent loads sum to {total}"
+    );
+    let u = &solve(&mesh, &STEEL, &fixed, &[loads]).unwrap()[0];
+    // Mean deflection of the end face (its nodes are spaced evenly in both directions).
+    let mid: Vec<f64> = end_nodes
+        .iter()
+        .filter(|&&k| lattice[k][1] == my / 2 && lattice[k][2] == mz / 2)
+        .map(|&k| u[k][1])
+        .collect();
+    -mid[0]
+}
+
+#[test]
+fn cantilever_matches_timoshenko_beam_theory() {
+    let (e, v) = (STEEL.youngs_modulus, STEEL.poisson_ratio);
+    let g = e / (2.0 * (1.0 + v));
+    let kappa = 10.0 * (1.0 + v) / (12.0 + 11.0 * v);
+    let (h, b, p) = (0.01, 0.01, 100.0);
+    for (l, n) in [(0.1, (20, 4, 2)), (0.2, (40, 2, 2))] {
+        let i = b * h * h * h / 12.0;
+        let bending = p * l * l * l / (3.0 * e * i);
+        let shear = p * l / (kappa * g * b * h);
+        let theory = bending + shear;
+        let fe = cantilever(l, h, b, n, p);
+        eprintln!(
+            "L/h = {}: FE tip deflection {:.6e} m, Timoshenko {:.6e} m (shear part {:.2} %), ratio {:.5}",
+            l / h, fe, theory, 100.0 * shear / theory, fe / theory
+        );
+        assert!(
+            (fe / theory - 1.0).abs() < 0.01,
+            "L/h = {}: {fe:e} vs {theory:e}",
+            l / h
+        );
+    }
+}
