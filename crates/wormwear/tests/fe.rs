@@ -144,3 +144,77 @@ fn cantilever_matches_timoshenko_beam_theory() {
         );
     }
 }
+
+/// Independent reference: CalculiX (`apt-get install calculix-ccx`) solves the same mesh with
+/// its C3D20 element (same shape functions, 27 Gauss points): displacements must agree to
+/// round-off. Ignored in the suite (needs the external program); run with --ignored.
+#[test]
+#[ignore = "needs CalculiX (ccx) on the PATH"]
+fn calculix_agrees_on_the_same_mesh() {
+    use wormwear::bending::fe::{calculix_deck, read_calculix_displacements};
+    let (l, h, b, p) = (0.1, 0.01, 0.01, 100.0);
+    let n = (10, 2, 2);
+    // A distorted, twisted bar so the check is not limited to a regular grid.
+    let (mesh, lattice) = box_mesh((l, h, b), n, |x| {
+        let t = 0.3 * x[0] / l;
+        let (s, c) = t.sin_cos();
+        let (y, z) = (x[1] - 0.5 * h, x[2] - 0.5 * b);
+        [
+            x[0] + 0.0005 * (x[1] / h) * (x[2] / b),
+            0.5 * h + c * y - s * z,
+            0.5 * b + s * y + c * z,
+        ]
+    });
+    let mut fixed = Vec::new();
+    let mut loads = Vec::new();
+    for (k, ijk) in lattice.iter().enumerate() {
+        if ijk[0] == 0 {
+            for d in 0..3 {
+                fixed.push((k, d, 0.0));
+            }
+        }
+        if ijk[0] == 2 * n.0 && ijk[1] == n.1 && ijk[2] == n.2 {
+            loads.push((k, 1, -p));
+            loads.push((k, 2, 0.3 * p));
+        }
+    }
+    let ours = &solve(&mesh, &STEEL, &fixed, &[loads.clone()]).unwrap()[0];
+    let dir = std::env::temp_dir().join(format!("wormwear-ccx-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("bar.inp"),
+        calculix_deck(&mesh, &STEEL, &fixed, &loads),
+    )
+    .unwrap();
+    let status = std::process::Command::new("ccx")
+        .arg("bar")
+        .current_dir(&dir)
+        .output()
+        .expect("ccx runs");
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stdout)
+    );
+    let dat = std::fs::read_to_string(dir.join("bar.dat")).unwrap();
+    let theirs =
+        read_calculix_displacements(&dat, mesh.nodes.len()).expect("displacements in bar.dat");
+    let scale = ours
+        .iter()
+        .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
+        .fold(0.0, f64::max);
+    let worst = ours
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        })
+        .fold(0.0, f64::max);
+    eprintln!(
+        "ours vs CalculiX on {} nodes: max difference {worst:e} m, max displacement {scale:e} m",
+        mesh.nodes.len()
+    );
+    // CalculiX prints 7 significant digits: 1e-6 of the largest displacement.
+    assert!(worst < 1e-6 * scale, "{worst:e} vs {scale:e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

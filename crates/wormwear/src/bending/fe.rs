@@ -350,3 +350,66 @@ pub fn box_mesh(
     }
     (Mesh { nodes, elements }, lattice)
 }
+
+/// CalculiX / Abaqus input deck of a linear static analysis of `mesh` (C3D20 elements, whose
+/// node order is this module's), for independent checks. Units as given (SI).
+pub fn calculix_deck(mesh: &Mesh, material: &Elastic, fixed: &[Fixed], loads: &[Load]) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("*HEADING\nwormwear FE check\n*NODE, NSET=NALL\n");
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        let _ = writeln!(s, "{}, {:.12e}, {:.12e}, {:.12e}", i + 1, p[0], p[1], p[2]);
+    }
+    s.push_str("*ELEMENT, TYPE=C3D20, ELSET=EALL\n");
+    for (e, nodes) in mesh.elements.iter().enumerate() {
+        let ids: Vec<String> = nodes.iter().map(|n| (n + 1).to_string()).collect();
+        // 20 nodes: 15 on the first line, the rest on a continuation line.
+        let _ = writeln!(
+            s,
+            "{}, {},\n{}",
+            e + 1,
+            ids[..15].join(", "),
+            ids[15..].join(", ")
+        );
+    }
+    let _ = write!(
+        s,
+        "*MATERIAL, NAME=M\n*ELASTIC\n{:.12e}, {:.12e}\n*SOLID SECTION, ELSET=EALL, MATERIAL=M\n*STEP\n*STATIC\n*BOUNDARY\n",
+        material.youngs_modulus, material.poisson_ratio
+    );
+    for &(n, d, v) in fixed {
+        let _ = writeln!(s, "{}, {}, {}, {:.12e}", n + 1, d + 1, d + 1, v);
+    }
+    s.push_str("*CLOAD\n");
+    for &(n, d, v) in loads {
+        let _ = writeln!(s, "{}, {}, {:.12e}", n + 1, d + 1, v);
+    }
+    s.push_str("*NODE PRINT, NSET=NALL\nU\n*END STEP\n");
+    s
+}
+
+/// Reads the nodal displacements of a CalculiX `.dat` file written by `*NODE PRINT ... U`.
+pub fn read_calculix_displacements(dat: &str, nodes: usize) -> Option<Vec<[f64; 3]>> {
+    let mut u = vec![[f64::NAN; 3]; nodes];
+    let mut in_block = false;
+    for line in dat.lines() {
+        if line.contains("displacements") {
+            in_block = true;
+            continue;
+        }
+        if !in_block {
+            continue;
+        }
+        let parts: Vec<&str> = line.split_whitespace().collect();
+        if parts.len() == 4 {
+            let id: usize = parts[0].parse().ok()?;
+            let vals: Vec<f64> = parts[1..]
+                .iter()
+                .map(|v| v.parse().ok())
+                .collect::<Option<_>>()?;
+            if id >= 1 && id <= nodes {
+                u[id - 1] = [vals[0], vals[1], vals[2]];
+            }
+        }
+    }
+    u.iter().all(|v| v[0].is_finite()).then_some(u)
+}
