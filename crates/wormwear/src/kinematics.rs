@@ -475,7 +475,6 @@ pub fn analyse_with(
         .map(|k| {
             let (i, j) = (k % (ni + 1), k / (ni + 1));
             node_contact(
-                gear,
                 geo,
                 &ev,
                 wf,
@@ -726,7 +725,6 @@ fn curvature_radius(
 /// Contact kinematics of node (i, j) from the worm's envelope at that node.
 #[allow(clippy::too_many_arguments)]
 fn node_contact(
-    gear: &GearSet,
     geo: &Geometry,
     ev: &GapEvaluator,
     wf: &WheelFlank,
@@ -820,7 +818,6 @@ fn node_contact(
     } else {
         f64::NAN
     };
-    let _ = gear;
     NodeContact {
         reachable,
         theta2,

@@ -173,6 +173,9 @@ pub fn scale_color(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// A straight segment between two chart points.
+pub type Segment = ((f64, f64), (f64, f64));
+
 /// One quadrilateral cell of a flank map, corners in (x, y) chart units, with its value.
 #[derive(Debug, Clone)]
 pub struct MapCell {
@@ -193,7 +196,7 @@ pub fn flank_map(
     range: (f64, f64),
     bar_label: &str,
     overlays: &[Series],
-    segments: &[((f64, f64), (f64, f64))],
+    segments: &[Segment],
 ) -> Result<(), OutputError> {
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,

@@ -40,8 +40,8 @@ fn patch_test_linear_field_is_exact_on_a_distorted_mesh() {
             || ijk[2] == mz;
         if boundary {
             let u = field(mesh.nodes[n]);
-            for d in 0..3 {
-                fixed.push((n, d, u[d]));
+            for (d, &ud) in u.iter().enumerate() {
+                fixed.push((n, d, ud));
             }
         } else {
             interior.push(n);

@@ -91,9 +91,7 @@ impl Elastic {
         let mu = e / (2.0 * (1.0 + v));
         let mut d = [[0.0; 6]; 6];
         for i in 0..3 {
-            for j in 0..3 {
-                d[i][j] = lam;
-            }
+            d[i][..3].fill(lam);
             d[i][i] = lam + 2.0 * mu;
             d[i + 3][i + 3] = mu;
         }

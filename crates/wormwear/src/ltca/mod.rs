@@ -14,7 +14,7 @@ pub mod solver;
 
 use crate::contact::{coefficient, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
-use crate::geometry::{Flank, Geometry, WheelFlank};
+use crate::geometry::{Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
 use crate::kinematics::{GapEvaluator, Tca};
 use nalgebra::Vector3;
@@ -248,7 +248,6 @@ pub fn analyse_with(
         .into_par_iter()
         .map(|n| {
             solve_position(
-                gear,
                 geo,
                 tca,
                 &ev,
@@ -416,7 +415,6 @@ fn local_mesh(
 
 #[allow(clippy::too_many_arguments)]
 fn solve_position(
-    gear: &GearSet,
     geo: &Geometry,
     tca: &Tca,
     ev: &GapEvaluator,
@@ -429,7 +427,6 @@ fn solve_position(
     worm_torque: Option<f64>,
     wheel_torque_guess: f64,
 ) -> Result<PositionResult, LtcaError> {
-    let _ = gear;
     let mut band = band0;
     let mut widenings = 0;
     loop {
@@ -600,9 +597,4 @@ fn solve_position(
             band_widenings: widenings,
         });
     }
-}
-
-/// Flank used by the LTCA (the TCA's loaded flank).
-pub fn loaded_flank(tca: &Tca) -> Flank {
-    tca.loaded_flank
 }

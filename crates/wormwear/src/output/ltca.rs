@@ -323,7 +323,7 @@ pub fn write_ltca(
         &flank_cells(wf, &values),
         (0.0, ltca.max_pressure * MPA),
         "pressure (MPa)",
-        &[trace.clone()],
+        std::slice::from_ref(&trace),
         &[],
     )?;
     files.push(path);

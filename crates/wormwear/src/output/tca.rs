@@ -77,7 +77,7 @@ pub fn flank_cells(wf: &WheelFlank, values: &[f64]) -> Vec<MapCell> {
 }
 
 /// Cell edges separating marked from unmarked cells (the outline of a pattern), (z, r) mm.
-pub fn pattern_outline(wf: &WheelFlank, marked: &[bool]) -> Vec<((f64, f64), (f64, f64))> {
+pub fn pattern_outline(wf: &WheelFlank, marked: &[bool]) -> Vec<crate::plot::Segment> {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let at = |i: usize, j: usize| marked[j * ni + i];
     let p = |i: usize, j: usize| {
@@ -206,7 +206,7 @@ pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, 
         &flank_cells(wf, &sep_um),
         (0.0, 3.0 * j_um),
         "separation (um)",
-        &[trace.clone()],
+        std::slice::from_ref(&trace),
         &pattern_outline(wf, &tca.marked),
     )?;
     files.push(path);
