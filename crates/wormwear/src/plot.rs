@@ -26,6 +26,46 @@ pub struct Series {
     pub bold: bool,
 }
 
+/// Draws the series as lines and, if any has a label, the legend at `position`.
+fn draw_series_with_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    series: &[Series],
+    position: SeriesLabelPosition,
+) -> Result<(), OutputError>
+where
+    DB::ErrorType: 'static,
+{
+    let mut labelled = false;
+    for s in series {
+        let color = COLORS[s.color % COLORS.len()];
+        let style = color.stroke_width(if s.bold { 3 } else { 2 });
+        let anno = chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), style))
+            .map_err(plot_err)?;
+        if !s.label.is_empty() {
+            labelled = true;
+            anno.label(s.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+            });
+        }
+    }
+    if labelled {
+        chart
+            .configure_series_labels()
+            .position(position)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .draw()
+            .map_err(plot_err)?;
+    }
+    Ok(())
+}
+
 fn plot_err(e: impl std::fmt::Display) -> OutputError {
     OutputError::Encode {
         what: "SVG chart".into(),
@@ -122,29 +162,7 @@ pub fn line_chart_spanned(
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(plot_err)?;
-        let mut labelled = false;
-        for s in series {
-            let color = COLORS[s.color % COLORS.len()];
-            let style = color.stroke_width(if s.bold { 3 } else { 2 });
-            let anno = chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), style))
-                .map_err(plot_err)?;
-            if !s.label.is_empty() {
-                labelled = true;
-                anno.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-                });
-            }
-        }
-        if labelled {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 15))
-                .draw()
-                .map_err(plot_err)?;
-        }
+        draw_series_with_legend(&mut chart, series, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, svg.as_bytes())
@@ -269,32 +287,7 @@ pub fn flank_map(
                     .map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))),
             )
             .map_err(plot_err)?;
-        let mut labelled = false;
-        for s in overlays {
-            let color = COLORS[s.color % COLORS.len()];
-            let anno = chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    color.stroke_width(if s.bold { 3 } else { 2 }),
-                ))
-                .map_err(plot_err)?;
-            if !s.label.is_empty() {
-                labelled = true;
-                anno.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-                });
-            }
-        }
-        if labelled {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperMiddle)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 15))
-                .draw()
-                .map_err(plot_err)?;
-        }
+        draw_series_with_legend(&mut chart, overlays, SeriesLabelPosition::UpperMiddle)?;
         // Colour bar.
         let mut bar_chart = ChartBuilder::on(&bar)
             .margin_top(60)

@@ -154,27 +154,14 @@ pub fn write_geometry(
         files.push(path);
     }
     // Outline of the active flank in (z, r).
-    let mut series = Vec::new();
-    for (k, wf) in geo.wheel_flanks.iter().enumerate() {
-        let mut outline: Vec<(f64, f64)> =
-            wf.z.iter()
-                .zip(&wf.r_low)
-                .map(|(z, r)| (z * MM, r * MM))
-                .collect();
-        outline.extend(
-            wf.z.iter()
-                .zip(&wf.r_high)
-                .rev()
-                .map(|(z, r)| (z * MM, r * MM)),
-        );
-        outline.push(outline[0]);
-        series.push(Series {
-            label: format!("{}-mating flank", wf.flank.name()),
-            points: outline,
-            color: k,
-            bold: false,
-        });
-    }
+    let series: Vec<Series> = geo
+        .wheel_flanks
+        .iter()
+        .enumerate()
+        .map(|(k, wf)| {
+            super::tca::flank_outline(wf, &format!("{}-mating flank", wf.flank.name()), k)
+        })
+        .collect();
     let path = dir.join("wheel_flank_outline.svg");
     line_chart(
         &path,

@@ -2,7 +2,7 @@
 //! loaded pattern, local pressures) and SVG plots (load sharing, transmission error, mesh
 //! stiffness, pressure maps of the engaged teeth at a chosen position, loaded pattern).
 
-use super::tca::flank_cells;
+use super::tca::{flank_cells, flank_outline, tip_trace_series};
 use super::{update_summary, Csv, OutputError};
 use crate::geometry::{Geometry, WheelFlank};
 use crate::kinematics::Tca;
@@ -127,28 +127,6 @@ fn local_cells(pr: &PositionResult, tooth: usize, wf: &WheelFlank) -> Vec<MapCel
             }
         })
         .collect()
-}
-
-/// Outline of the active flank in (z, r) mm.
-fn flank_outline(wf: &WheelFlank) -> Series {
-    let mut pts: Vec<(f64, f64)> =
-        wf.z.iter()
-            .zip(&wf.r_low)
-            .map(|(z, r)| (z * MM, r * MM))
-            .collect();
-    pts.extend(
-        wf.z.iter()
-            .zip(&wf.r_high)
-            .rev()
-            .map(|(z, r)| (z * MM, r * MM)),
-    );
-    pts.push(pts[0]);
-    Series {
-        label: "active flank".into(),
-        points: pts,
-        color: 5,
-        bold: false,
-    }
 }
 
 /// Writes every LTCA output into `dir`; `map_position` selects the position of the pressure
@@ -300,16 +278,7 @@ pub fn write_ltca(
         .iter()
         .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
         .collect();
-    let trace = Series {
-        label: "worm tip trace".into(),
-        points: tca
-            .tip_trace
-            .iter()
-            .map(|&(z, r)| (z * MM, r * MM))
-            .collect(),
-        color: 1,
-        bold: true,
-    };
+    let trace = tip_trace_series(tca);
     let path = dir.join("ltca_pattern.svg");
     flank_map(
         &path,
@@ -354,7 +323,7 @@ pub fn write_ltca(
             &cells,
             (0.0, ltca.max_pressure * MPA),
             "pressure (MPa)",
-            &[flank_outline(wf), trace.clone()],
+            &[flank_outline(wf, "active flank", 5), trace.clone()],
             &[],
         )?;
         files.push(path);

@@ -58,6 +58,42 @@ impl TcaSummary {
     }
 }
 
+/// The worm-tip trace as a chart series in (z, r) mm.
+pub fn tip_trace_series(tca: &Tca) -> Series {
+    Series {
+        label: "worm tip trace".into(),
+        points: tca
+            .tip_trace
+            .iter()
+            .map(|&(z, r)| (z * MM, r * MM))
+            .collect(),
+        color: 1,
+        bold: true,
+    }
+}
+
+/// Outline of the active flank (flank/fillet boundary and blank top) in (z, r) mm.
+pub fn flank_outline(wf: &WheelFlank, label: &str, color: usize) -> Series {
+    let mut pts: Vec<(f64, f64)> =
+        wf.z.iter()
+            .zip(&wf.r_low)
+            .map(|(z, r)| (z * MM, r * MM))
+            .collect();
+    pts.extend(
+        wf.z.iter()
+            .zip(&wf.r_high)
+            .rev()
+            .map(|(z, r)| (z * MM, r * MM)),
+    );
+    pts.push(pts[0]);
+    Series {
+        label: label.to_string(),
+        points: pts,
+        color,
+        bold: false,
+    }
+}
+
 /// Cells of the flank grid as map quads in (z, r) mm with the given per-cell values.
 pub fn flank_cells(wf: &WheelFlank, values: &[f64]) -> Vec<MapCell> {
     let mut cells = Vec::with_capacity(values.len());
@@ -181,16 +217,7 @@ pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, 
     let path = dir.join("tca_pattern.csv");
     csv.write(&path)?;
     files.push(path);
-    let trace = Series {
-        label: "worm tip trace".into(),
-        points: tca
-            .tip_trace
-            .iter()
-            .map(|&(z, r)| (z * MM, r * MM))
-            .collect(),
-        color: 1,
-        bold: true,
-    };
+    let trace = tip_trace_series(tca);
     let j_um = tca.marking_thickness * UM;
     let sep_um: Vec<f64> = tca.min_separation.iter().map(|s| s * UM).collect();
     let path = dir.join("tca_pattern.svg");
