@@ -2,4 +2,5 @@
 //! function basis for the LTCA. This module holds the linear-elasticity finite elements; the
 //! gear models and the function basis build on them.
 
+pub mod basis;
 pub mod fe;

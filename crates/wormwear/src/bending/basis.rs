@@ -1,0 +1,166 @@
+//! Function basis of the bending coefficients (MODEL §5.5, steps 3-4): products
+//! f_k(M) = g_a(r~) h_b(w~) of height polynomials g_a(r~) = r~^a and width functions h_b (beam
+//! mode shapes: free-free for the wheel, the average of free-free and clamped-clamped for the
+//! worm), fitted on a Q1 x Q2 grid of points: [C] = F^-1 [U] F^-T (F: row l = the functions at
+//! point l; MODEL's [f]^-T [U] [f]^-1 with points in columns), then any coefficient is
+//! C(M_i / M_j) = f(M_i)^T [C] f(M_j). Coordinates are normalised to [0, 1] by the caller
+//! (r~ along the height, w~ across the width).
+//!
+//! The beam eigenvalues are the exact roots of cos(b) cosh(b) = 1 (4.7300, 7.8532, ...); the
+//! MODEL's (q - 1/2) pi approximation is allowed but the exact values make the mode shapes satisfy
+//! their end conditions exactly (tested).
+
+use faer::linalg::solvers::Solve;
+use faer::Mat;
+
+/// Which width functions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WidthFunctions {
+    /// Free-free beam modes (wheel tooth across its face width).
+    FreeFree,
+    /// Average of free-free and clamped-clamped modes (worm thread along its length).
+    Averaged,
+}
+
+/// k-th root (k >= 1) of cos(b) cosh(b) = 1, by Newton from (k + 1/2) pi.
+pub fn beam_eigenvalue(k: usize) -> f64 {
+    let mut b = (k as f64 + 0.5) * std::f64::consts::PI;
+    for _ in 0..50 {
+        let f = b.cos() * b.cosh() - 1.0;
+        let df = -b.sin() * b.cosh() + b.cos() * b.sinh();
+        let step = f / df;
+        b -= step;
+        if step.abs() < 1e-15 * b {
+            break;
+        }
+    }
+    b
+}
+
+/// Free-free mode k >= 1 on [0, 1] and its first three derivatives (textbook form
+/// cosh + cos - s (sinh + sin), s = (cosh b - cos b) / (sinh b - sin b)).
+pub fn free_free(k: usize, x: f64) -> [f64; 4] {
+    let b = beam_eigenvalue(k);
+    let s = (b.cosh() - b.cos()) / (b.sinh() - b.sin());
+    let (bx, p) = (b * x, [1.0, b, b * b, b * b * b]);
+    let (ch, sh, c, sn) = (bx.cosh(), bx.sinh(), bx.cos(), bx.sin());
+    [
+        p[0] * (ch + c - s * (sh + sn)),
+        p[1] * (sh - sn - s * (ch + c)),
+        p[2] * (ch - c - s * (sh - sn)),
+        p[3] * (sh + sn - s * (ch - c)),
+    ]
+}
+
+/// Clamped-clamped mode k >= 1 on [0, 1] and its first three derivatives
+/// (cosh - cos - s (sinh - sin), same s).
+pub fn clamped_clamped(k: usize, x: f64) -> [f64; 4] {
+    let b = beam_eigenvalue(k);
+    let s = (b.cosh() - b.cos()) / (b.sinh() - b.sin());
+    let (bx, p) = (b * x, [1.0, b, b * b, b * b * b]);
+    let (ch, sh, c, sn) = (bx.cosh(), bx.sinh(), bx.cos(), bx.sin());
+    [
+        p[0] * (ch - c - s * (sh - sn)),
+        p[1] * (sh + sn - s * (ch - c)),
+        p[2] * (ch + c - s * (sh + sn)),
+        p[3] * (sh - sn - s * (ch + c)),
+    ]
+}
+
+/// The basis: Q1 height functions x Q2 width functions.
+#[derive(Debug, Clone, Copy)]
+pub struct Basis {
+    pub height: usize,
+    pub width: usize,
+    pub kind: WidthFunctions,
+}
+
+impl Basis {
+    /// Number of functions K = Q1 Q2.
+    pub fn len(&self) -> usize {
+        self.height * self.width
+    }
+
+    /// True for an empty basis.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Width function b at w~ in [0, 1]: 1, 1 - 2w~, then beam modes.
+    fn width_function(&self, b: usize, w: f64) -> f64 {
+        match b {
+            0 => 1.0,
+            1 => 1.0 - 2.0 * w,
+            _ => match self.kind {
+                WidthFunctions::FreeFree => free_free(b - 1, w)[0],
+                WidthFunctions::Averaged => {
+                    0.5 * (free_free(b - 1, w)[0] + clamped_clamped(b - 1, w)[0])
+                }
+            },
+        }
+    }
+
+    /// Values of the K functions at (r~, w~), index a * Q2 + b.
+    pub fn eval(&self, r: f64, w: f64) -> Vec<f64> {
+        let hw: Vec<f64> = (0..self.width).map(|b| self.width_function(b, w)).collect();
+        let mut out = Vec::with_capacity(self.len());
+        for a in 0..self.height {
+            let g = r.powi(a as i32);
+            out.extend(hw.iter().map(|h| g * h));
+        }
+        out
+    }
+
+    /// The fitting points: a uniform Q1 x Q2 grid of (r~, w~) in [0, 1]^2 (index a * Q2 + b).
+    pub fn grid(&self) -> Vec<(f64, f64)> {
+        let t = |k: usize, n: usize| {
+            if n == 1 {
+                0.5
+            } else {
+                k as f64 / (n - 1) as f64
+            }
+        };
+        (0..self.height)
+            .flat_map(|a| (0..self.width).map(move |b| (t(a, self.height), t(b, self.width))))
+            .collect()
+    }
+
+    /// [f]: row l = the functions at grid point l.
+    pub fn matrix(&self) -> Mat<f64> {
+        let pts = self.grid();
+        let k = self.len();
+        Mat::from_fn(k, k, |l, m| self.eval(pts[l].0, pts[l].1)[m])
+    }
+
+    /// Core matrix from the K x K displacement matrix U (displacement at point l due to a unit
+    /// load at point m), so that f(M_l)^T C f(M_m) = U_lm: with F the matrix whose row l holds
+    /// the functions at point l, U = F C F^T, so C = F^-1 U F^-T (the MODEL's
+    /// [f]^-T [U] [f]^-1, whose [f] has the points in its columns).
+    pub fn fit(&self, u: &Mat<f64>) -> Mat<f64> {
+        let lu = self.matrix().partial_piv_lu();
+        // X = F^-1 U, then C^T = F^-1 X^T.
+        let x = lu.solve(u);
+        let ct = lu.solve(x.transpose());
+        ct.transpose().to_owned()
+    }
+
+    /// Coefficient between two points: f(a)^T C f(b).
+    pub fn coefficient(&self, core: &Mat<f64>, a: (f64, f64), b: (f64, f64)) -> f64 {
+        let (fa, fb) = (self.eval(a.0, a.1), self.eval(b.0, b.1));
+        let mut s = 0.0;
+        for (i, x) in fa.iter().enumerate() {
+            for (j, y) in fb.iter().enumerate() {
+                s += x * core[(i, j)] * y;
+            }
+        }
+        s
+    }
+
+    /// 2-norm condition number of [f] (from its singular values).
+    pub fn condition_number(&self) -> f64 {
+        let s = self.matrix().singular_values().unwrap_or_default();
+        let max = s.iter().copied().fold(0.0, f64::max);
+        let min = s.iter().copied().fold(f64::INFINITY, f64::min);
+        max / min
+    }
+}
