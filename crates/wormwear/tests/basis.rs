@@ -66,13 +66,12 @@ fn mode_shapes_satisfy_their_end_conditions() {
 /// A smooth "displacement" kernel built from basis functions: U(a, b) = sum c_ij f_i(a) f_j(b).
 fn kernel_in_span(basis: &Basis, a: (f64, f64), b: (f64, f64)) -> f64 {
     let (fa, fb) = (basis.eval(a.0, a.1), basis.eval(b.0, b.1));
-    let k = basis.len();
     let mut s = 0.0;
-    for i in 0..k {
-        for j in 0..k {
+    for (i, x) in fa.iter().enumerate() {
+        for (j, y) in fb.iter().enumerate() {
             let c = 1.0 / (1.0 + (i as f64 - j as f64).abs())
                 * if (i + j) % 3 == 0 { -0.5 } else { 1.0 };
-            s += fa[i] * c * fb[j];
+            s += x * c * y;
         }
     }
     s
