@@ -411,3 +411,31 @@ pub fn read_calculix_displacements(dat: &str, nodes: usize) -> Option<Vec<[f64; 
     }
     u.iter().all(|v| v[0].is_finite()).then_some(u)
 }
+
+/// Volume of element `e` (Gauss integration of det J), m^3.
+pub fn element_volume(mesh: &Mesh, e: usize) -> f64 {
+    let g = [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()];
+    let w = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let x: Vec<[f64; 3]> = mesh.elements[e].iter().map(|&n| mesh.nodes[n]).collect();
+    let mut v = 0.0;
+    for (ia, &ga) in g.iter().enumerate() {
+        for (ib, &gb) in g.iter().enumerate() {
+            for (ic, &gc) in g.iter().enumerate() {
+                let (_, dn) = shape([ga, gb, gc]);
+                let mut j = [[0.0; 3]; 3];
+                for (nd, xn) in dn.iter().zip(&x) {
+                    for i in 0..3 {
+                        for k in 0..3 {
+                            j[i][k] += nd[i] * xn[k];
+                        }
+                    }
+                }
+                let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+                    - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+                    + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+                v += w[ia] * w[ib] * w[ic] * det;
+            }
+        }
+    }
+    v
+}

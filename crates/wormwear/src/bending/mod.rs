@@ -4,3 +4,4 @@
 
 pub mod basis;
 pub mod fe;
+pub mod wheel_mesh;

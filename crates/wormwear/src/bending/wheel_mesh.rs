@@ -1,0 +1,210 @@
+//! Finite-element mesh of a wheel sector: three teeth (the reference tooth and its two
+//! neighbours) standing on a rim, built from the generated flank grids (MODEL §5.5 step 1).
+//!
+//! Layers along the face width are node columns of the global flank grid (every `face_step`-th,
+//! plus the last), so the flanks are exact there (Hermite theta_w along the column). In each
+//! layer, the section in (r, theta) is split into blocks:
+//! - the rim, from its inner radius up to the root circle (cut by the hob tip), across the whole
+//!   sector, with theta nodes that match the teeth above them;
+//! - each tooth, from the root circle to the blank top, between its two flanks; below the flank
+//!   bottom (the fillet, not resolved) the boundary continues radially to the root.
+//! Nodes are placed on a half-step lattice of each block's mapping (mid-side nodes follow the
+//! curved flanks), and coincident nodes of neighbouring blocks are merged.
+//! Coordinates: wheel body frame, m.
+
+use super::fe::{Mesh, NATURAL};
+use crate::geometry::placement::wheel_point;
+use crate::geometry::{Flank, Geometry};
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+/// Mesh sizes.
+#[derive(Debug, Clone, Copy)]
+pub struct SectorMeshSettings {
+    /// Elements across each tooth.
+    pub across: usize,
+    /// Elements along the tooth height (root circle to top).
+    pub height: usize,
+    /// Elements through the rim thickness.
+    pub rim: usize,
+    /// Elements across each half tooth space in the rim.
+    pub space: usize,
+    /// Use every `face_step`-th node column of the flank grid as a layer.
+    pub face_step: usize,
+    /// Rim thickness below the root at the median plane, m.
+    pub rim_thickness: f64,
+}
+
+/// The sector mesh and what the bending stage needs to know about it.
+#[derive(Debug, Clone)]
+pub struct SectorMesh {
+    pub mesh: Mesh,
+    /// Nodes on the rim's inner surface (to clamp).
+    pub inner: Vec<usize>,
+    /// Nodes on the two side cuts of the sector.
+    pub sides: Vec<usize>,
+    /// Per tooth (-1, 0, 1): flank nodes of the left-mating flank as (layer, height index, node).
+    pub left_flank: Vec<Vec<(usize, usize, usize)>>,
+    /// Root radius at the median plane, m.
+    pub root_radius: f64,
+}
+
+/// Builds the sector mesh of the wheel from its flank grids.
+pub fn sector_mesh(
+    geo: &Geometry,
+    settings: &SectorMeshSettings,
+    hob_tip: f64,
+    cutting_centre_distance: f64,
+) -> SectorMesh {
+    let l = geo.wheel_flank(Flank::Left);
+    let r = geo.wheel_flank(Flank::Right);
+    let tau = 2.0 * PI / geo.teeth as f64;
+    let nj = l.cells_face;
+    let mut layers: Vec<usize> = (0..=nj).step_by(settings.face_step.max(1)).collect();
+    if *layers.last().unwrap_or(&0) != nj {
+        layers.push(nj);
+    }
+    // Root circle at z (hob tip torus) and the rim's inner radius.
+    let root_at = |z: f64| cutting_centre_distance - (hob_tip * hob_tip - z * z).max(0.0).sqrt();
+    let root0 = root_at(0.0);
+    let r_in = root0 - settings.rim_thickness;
+    // theta of the left-mating flank of space k and of the right-mating flank of space k + 1
+    // (tooth k spans between them), continued radially below the flank bottom.
+    let th_left =
+        |j: usize, rr: f64, k: i32| l.column_theta(j, rr.max(l.r_low[j])).0 + k as f64 * tau;
+    let th_right =
+        |j: usize, rr: f64, k: i32| r.column_theta(j, rr.max(r.r_low[j])).0 + (k + 1) as f64 * tau;
+    let mut nodes: Vec<[f64; 3]> = Vec::new();
+    let mut index: HashMap<(i64, i64, i64), usize> = HashMap::new();
+    let mut node_at = |p: [f64; 3]| -> usize {
+        let key = (
+            (p[0] * 1e9).round() as i64,
+            (p[1] * 1e9).round() as i64,
+            (p[2] * 1e9).round() as i64,
+        );
+        *index.entry(key).or_insert_with(|| {
+            nodes.push(p);
+            nodes.len() - 1
+        })
+    };
+    let mut elements = Vec::new();
+    let mut inner = Vec::new();
+    let mut sides = Vec::new();
+    let mut left_flank = vec![Vec::new(); 3];
+    // Section point of a block at parameters (u across in [0, 1], v radial in [0, 1]) in layer
+    // position w (fractional layer index, for the half-step between layers).
+    let teeth = [-1i32, 0, 1];
+    // Interpolate between two node columns for the mid-layer (half-step) points: layers are
+    // node columns; a mid-layer point is the average of the two adjacent layers' points at the
+    // same block parameters (quadratic accuracy along z is enough for the stiffness).
+    let section = |j: usize, block: usize, u: f64, v: f64| -> (f64, f64) {
+        let z = l.z[j];
+        let root = root_at(z);
+        let top = l.r_high[j].min(r.r_high[j]);
+        match block {
+            // Teeth: blocks 0..3.
+            b if b < 3 => {
+                let k = teeth[b];
+                let rr = root + (top - root) * v;
+                let (a, c) = (th_left(j, rr, k), th_right(j, rr, k));
+                (rr, a + (c - a) * u)
+            }
+            // Rim under the teeth: blocks 3..6 (theta nodes match the tooth feet).
+            b if b < 6 => {
+                let k = teeth[b - 3];
+                let rr = r_in + (root - r_in) * v;
+                let (a, c) = (th_left(j, root, k), th_right(j, root, k));
+                (rr, a + (c - a) * u)
+            }
+            // Rim under the spaces: block 6 + s for s = 0..4: left half of space -1, spaces
+            // between teeth (-1/0, 0/1) and right half of space 2.
+            b => {
+                let s = b - 6;
+                let rr = r_in + (root - r_in) * v;
+                let (a, c) = match s {
+                    0 => (
+                        0.5 * (th_right(j, root, -2) + th_left(j, root, -1)),
+                        th_left(j, root, -1),
+                    ),
+                    1 => (th_right(j, root, -1), th_left(j, root, 0)),
+                    2 => (th_right(j, root, 0), th_left(j, root, 1)),
+                    _ => (
+                        th_right(j, root, 1),
+                        0.5 * (th_right(j, root, 1) + th_left(j, root, 2)),
+                    ),
+                };
+                (rr, a + (c - a) * u)
+            }
+        }
+    };
+    let dims = |block: usize| -> (usize, usize) {
+        match block {
+            b if b < 3 => (settings.across, settings.height),
+            b if b < 6 => (settings.across, settings.rim),
+            _ => (settings.space, settings.rim),
+        }
+    };
+    for (li, win) in layers.windows(2).enumerate() {
+        let (j0, j1) = (win[0], win[1]);
+        for block in 0..10 {
+            let (nu, nv) = dims(block);
+            for iv in 0..nv {
+                for iu in 0..nu {
+                    let mut e = [0usize; 20];
+                    for (a, c) in NATURAL.iter().enumerate() {
+                        let u = (iu as f64 + 0.5 + 0.5 * c[0]) / nu as f64;
+                        let v = (iv as f64 + 0.5 + 0.5 * c[1]) / nv as f64;
+                        let point = |j: usize| {
+                            let (rr, th) = section(j, block, u, v);
+                            let p = wheel_point(rr, th, l.z[j], 0.0);
+                            [p.x, p.y, p.z]
+                        };
+                        let p = if c[2] < 0.0 {
+                            point(j0)
+                        } else if c[2] > 0.0 {
+                            point(j1)
+                        } else {
+                            let (pa, pb) = (point(j0), point(j1));
+                            [
+                                (pa[0] + pb[0]) / 2.0,
+                                (pa[1] + pb[1]) / 2.0,
+                                (pa[2] + pb[2]) / 2.0,
+                            ]
+                        };
+                        let id = node_at(p);
+                        e[a] = id;
+                        // Bookkeeping: inner surface, side cuts, left flank of each tooth.
+                        if block >= 3 && v == 0.0 {
+                            inner.push(id);
+                        }
+                        if (block == 6 && u == 0.0) || (block == 9 && u == 1.0) {
+                            sides.push(id);
+                        }
+                        if block < 3 && u == 0.0 && c[2] < 0.0 {
+                            let hi = (v * nv as f64 * 2.0).round() as usize;
+                            left_flank[block].push((li, hi, id));
+                        }
+                    }
+                    // (u, v, z) ~ (-x, -y, z) near the line of centres: right-handed.
+                    let f = e;
+                    elements.push(f);
+                }
+            }
+        }
+    }
+    inner.sort_unstable();
+    inner.dedup();
+    sides.sort_unstable();
+    sides.dedup();
+    for f in &mut left_flank {
+        f.sort_unstable();
+        f.dedup();
+    }
+    SectorMesh {
+        mesh: Mesh { nodes, elements },
+        inner,
+        sides,
+        left_flank,
+        root_radius: root0,
+    }
+}

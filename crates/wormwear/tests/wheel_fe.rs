@@ -1,0 +1,179 @@
+//! Finite-element model of the wheel sector built from the generated flanks: geometry
+//! (volume), convergence of the tooth compliance, CalculiX on the same mesh.
+
+use std::f64::consts::PI;
+use std::path::Path;
+use wormwear::bending::fe::{element_volume, solve, Elastic, Load};
+use wormwear::bending::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
+use wormwear::geometry::{Flank, Geometry};
+use wormwear::input::{self, GearSet};
+
+const BRONZE: Elastic = Elastic {
+    youngs_modulus: 110e9,
+    poisson_ratio: 0.29,
+};
+
+fn example(name: &str) -> GearSet {
+    input::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn settings(scale: usize) -> SectorMeshSettings {
+    SectorMeshSettings {
+        across: 2 * scale,
+        height: 3 * scale,
+        rim: scale,
+        space: scale,
+        face_step: 12 / scale,
+        rim_thickness: 0.02,
+    }
+}
+
+fn mesh(g: &GearSet, geo: &Geometry, scale: usize) -> SectorMesh {
+    sector_mesh(
+        geo,
+        &settings(scale),
+        g.hob.tip_radius,
+        g.cutting.centre_distance,
+    )
+}
+
+#[test]
+fn sector_volume_matches_the_flank_geometry() {
+    // Independent volume: in each layer z, the three teeth's section area
+    // int r (theta_R(r) + tau - theta_L(r)) dr from the root circle to the blank top (flanks
+    // continued radially below their bottom, as in the mesh) plus the rim annulus between its
+    // inner radius and the root circle over the sector angle; integrated over z by Simpson.
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let m = mesh(&g, &geo, 2);
+    let fe_volume: f64 = (0..m.mesh.elements.len())
+        .map(|e| element_volume(&m.mesh, e))
+        .sum();
+    let (l, r) = (geo.wheel_flank(Flank::Left), geo.wheel_flank(Flank::Right));
+    let tau = 2.0 * PI / geo.teeth as f64;
+    let root_at = |z: f64| g.cutting.centre_distance - (g.hob.tip_radius.powi(2) - z * z).sqrt();
+    let r_in = m.root_radius - 0.02;
+    let area = |j: usize| {
+        let z = l.z[j];
+        let (root, top) = (root_at(z), l.r_high[j].min(r.r_high[j]));
+        let n = 400;
+        let width = |rr: f64| {
+            let a = l.column_theta(j, rr.max(l.r_low[j])).0;
+            let b = r.column_theta(j, rr.max(r.r_low[j])).0 + tau;
+            b - a
+        };
+        let teeth: f64 = (0..n)
+            .map(|k| {
+                let rr = root + (top - root) * (k as f64 + 0.5) / n as f64;
+                rr * width(rr) * (top - root) / n as f64
+            })
+            .sum::<f64>()
+            * 3.0;
+        // Sector angle: from mid-space before tooth -1 to mid-space after tooth +1 = 3 tau.
+        let rim = 0.5 * (root * root - r_in * r_in) * 3.0 * tau;
+        teeth + rim
+    };
+    let nj = l.cells_face;
+    let h = l.z[1] - l.z[0];
+    let mut vol = 0.0;
+    for j in (0..nj).step_by(2) {
+        vol += h / 3.0 * (area(j) + 4.0 * area(j + 1) + area(j + 2));
+    }
+    eprintln!(
+        "sector volume: FE {:.6e} m^3, geometry {:.6e} m^3",
+        fe_volume, vol
+    );
+    assert!(
+        (fe_volume / vol - 1.0).abs() < 2e-3,
+        "{fe_volume:e} vs {vol:e}"
+    );
+}
+
+/// Line load of 1 N/mm along the central tooth's left-mating flank at mid-height (nodal forces
+/// normal to the flank, into the tooth), and the mean normal deflection of its tip line, m/N.
+fn tooth_compliance(
+    g: &GearSet,
+    geo: &Geometry,
+    m: &SectorMesh,
+) -> (f64, Vec<Load>, Vec<(usize, usize, f64)>) {
+    let mut fixed = Vec::new();
+    for &n in &m.inner {
+        for d in 0..3 {
+            fixed.push((n, d, 0.0));
+        }
+    }
+    let flank = &m.left_flank[1];
+    let max_h = flank.iter().map(|f| f.1).max().unwrap();
+    let mid: Vec<usize> = flank
+        .iter()
+        .filter(|f| f.1 == max_h / 2)
+        .map(|f| f.2)
+        .collect();
+    let tip: Vec<usize> = flank.iter().filter(|f| f.1 == max_h).map(|f| f.2).collect();
+    // Direction: -x2 rotated to the tooth (approximately the flank normal at the line of centres).
+    let total = g.wheel.face_width * 1e3; // 1 N/mm
+    let per = total / mid.len() as f64;
+    let loads: Vec<Load> = mid.iter().map(|&n| (n, 0, -per)).collect();
+    let u = &solve(&m.mesh, &BRONZE, &fixed, &[loads.clone()]).unwrap()[0];
+    let deflection = tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64;
+    let _ = geo;
+    (deflection / total, loads, fixed)
+}
+
+#[test]
+fn tooth_compliance_converges_under_refinement() {
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    // Scales 1..4 gave 1.813, 1.932, 1.964, 1.980 e-9 m/N (changes 6.5, 1.7, 0.8 %: converging;
+    // the nodal line load is lumped, not consistent, which slows it). The suite checks 2 -> 3.
+    let (c1, _, _) = tooth_compliance(&g, &geo, &mesh(&g, &geo, 2));
+    let (c2, _, _) = tooth_compliance(&g, &geo, &mesh(&g, &geo, 3));
+    eprintln!(
+        "tooth tip compliance: {c1:.4e} m/N -> {c2:.4e} m/N ({:.2} %)",
+        100.0 * (c2 / c1 - 1.0)
+    );
+    assert!(
+        c1 > 0.0 && c2 > c1,
+        "refinement must soften a displacement-based model"
+    );
+    assert!((c2 / c1 - 1.0).abs() < 0.03, "{c1:e} vs {c2:e}");
+}
+
+/// CalculiX on the same sector mesh and load (C3D20): same tip deflection. Ignored (needs ccx).
+#[test]
+#[ignore = "needs CalculiX (ccx) on the PATH"]
+fn calculix_agrees_on_the_wheel_sector() {
+    use wormwear::bending::fe::{calculix_deck, read_calculix_displacements};
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let m = mesh(&g, &geo, 1);
+    let (c, loads, fixed) = tooth_compliance(&g, &geo, &m);
+    let dir = std::env::temp_dir().join(format!("wormwear-ccx-sector-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("sector.inp"),
+        calculix_deck(&m.mesh, &BRONZE, &fixed, &loads),
+    )
+    .unwrap();
+    let out = std::process::Command::new("ccx")
+        .arg("sector")
+        .current_dir(&dir)
+        .output()
+        .expect("ccx runs");
+    assert!(out.status.success());
+    let dat = std::fs::read_to_string(dir.join("sector.dat")).unwrap();
+    let u = read_calculix_displacements(&dat, m.mesh.nodes.len()).expect("displacements");
+    let flank = &m.left_flank[1];
+    let max_h = flank.iter().map(|f| f.1).max().unwrap();
+    let tip: Vec<usize> = flank.iter().filter(|f| f.1 == max_h).map(|f| f.2).collect();
+    let total = g.wheel.face_width * 1e3;
+    let theirs = tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64 / total;
+    eprintln!("wheel tooth tip compliance: ours {c:.6e} m/N, CalculiX {theirs:.6e} m/N");
+    assert!((theirs / c - 1.0).abs() < 1e-5);
+    let _ = std::fs::remove_dir_all(&dir);
+}
