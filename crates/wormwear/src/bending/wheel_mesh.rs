@@ -8,6 +8,7 @@
 //!   sector, with theta nodes that match the teeth above them;
 //! - each tooth, from the root circle to the blank top, between its two flanks; below the flank
 //!   bottom (the fillet, not resolved) the boundary continues radially to the root.
+//!
 //! Nodes are placed on a half-step lattice of each block's mapping (mid-side nodes follow the
 //! curved flanks), and coincident nodes of neighbouring blocks are merged.
 //! Coordinates: wheel body frame, m.
