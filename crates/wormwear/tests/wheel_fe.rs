@@ -119,7 +119,7 @@ fn tooth_compliance(
     let total = g.wheel.face_width * 1e3; // 1 N/mm
     let per = total / mid.len() as f64;
     let loads: Vec<Load> = mid.iter().map(|&n| (n, 0, -per)).collect();
-    let u = &solve(&m.mesh, &BRONZE, &fixed, &[loads.clone()]).unwrap()[0];
+    let u = &solve(&m.mesh, &BRONZE, &fixed, std::slice::from_ref(&loads)).unwrap()[0];
     let deflection = tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64;
     let _ = geo;
     (deflection / total, loads, fixed)

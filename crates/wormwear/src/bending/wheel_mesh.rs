@@ -181,9 +181,11 @@ pub fn sector_mesh(
                         if (block == 6 && u == 0.0) || (block == 9 && u == 1.0) {
                             sides.push(id);
                         }
-                        if block < 3 && u == 0.0 && c[2] < 0.0 {
+                        if let (true, Some(flank)) =
+                            (u == 0.0 && c[2] < 0.0, left_flank.get_mut(block))
+                        {
                             let hi = (v * nv as f64 * 2.0).round() as usize;
-                            left_flank[block].push((li, hi, id));
+                            flank.push((li, hi, id));
                         }
                     }
                     // (u, v, z) ~ (-x, -y, z) near the line of centres: right-handed.
