@@ -7,6 +7,14 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_wormwear"))
 }
 
+/// Asserts each file exists in `dir` and is not empty.
+fn assert_files(dir: &Path, names: &[&str]) {
+    for f in names {
+        let meta = std::fs::metadata(dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert!(meta.len() > 100, "{f} is empty");
+    }
+}
+
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -94,20 +102,20 @@ fn geometry_writes_sections_grids_stl_and_summary() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in [
-        "section_z+0.000mm.csv",
-        "section_z+0.000mm.svg",
-        "section_z+11.250mm.svg",
-        "axial_profiles.csv",
-        "wheel_flank_left_nodes.csv",
-        "wheel_flank_right_cells.csv",
-        "wheel_flank_outline.svg",
-        "worm.stl",
-        "wheel.stl",
-    ] {
-        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
-        assert!(meta.len() > 100, "{f} is empty");
-    }
+    assert_files(
+        &out_dir,
+        &[
+            "section_z+0.000mm.csv",
+            "section_z+0.000mm.svg",
+            "section_z+11.250mm.svg",
+            "axial_profiles.csv",
+            "wheel_flank_left_nodes.csv",
+            "wheel_flank_right_cells.csv",
+            "wheel_flank_outline.svg",
+            "worm.stl",
+            "wheel.stl",
+        ],
+    );
     // Binary STL: 84-byte header + 50 bytes per triangle.
     let stl = std::fs::read(out_dir.join("wheel.stl")).unwrap();
     let n = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
@@ -154,18 +162,18 @@ fn tca_writes_its_section_plots_and_tables() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in [
-        "tca_kinematic_error.csv",
-        "tca_kinematic_error.svg",
-        "tca_pattern.csv",
-        "tca_pattern.svg",
-        "tca_flank_map.csv",
-        "tca_sliding_speed.svg",
-        "tca_contact_lines.csv",
-    ] {
-        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
-        assert!(meta.len() > 100, "{f} is empty");
-    }
+    assert_files(
+        &out_dir,
+        &[
+            "tca_kinematic_error.csv",
+            "tca_kinematic_error.svg",
+            "tca_pattern.csv",
+            "tca_pattern.svg",
+            "tca_flank_map.csv",
+            "tca_sliding_speed.svg",
+            "tca_contact_lines.csv",
+        ],
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
@@ -201,19 +209,19 @@ fn ltca_writes_its_section_plots_and_tables() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in [
-        "ltca_positions.csv",
-        "ltca_pattern.csv",
-        "ltca_pressures.csv",
-        "ltca_load_sharing.svg",
-        "ltca_transmission_error.svg",
-        "ltca_mesh_stiffness.svg",
-        "ltca_pattern.svg",
-        "ltca_pressure_position3_tooth0.svg",
-    ] {
-        let meta = std::fs::metadata(out_dir.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
-        assert!(meta.len() > 100, "{f} is empty");
-    }
+    assert_files(
+        &out_dir,
+        &[
+            "ltca_positions.csv",
+            "ltca_pattern.csv",
+            "ltca_pressures.csv",
+            "ltca_load_sharing.svg",
+            "ltca_transmission_error.svg",
+            "ltca_mesh_stiffness.svg",
+            "ltca_pattern.svg",
+            "ltca_pressure_position3_tooth0.svg",
+        ],
+    );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();

@@ -66,6 +66,24 @@ where
     Ok(())
 }
 
+/// Bounding box (x0, x1, y0, y1) of the finite points; the unit square when there is none.
+fn bounds(points: impl Iterator<Item = (f64, f64)>) -> (f64, f64, f64, f64) {
+    let mut b = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for (x, y) in points.filter(|p| p.0.is_finite() && p.1.is_finite()) {
+        b = (b.0.min(x), b.1.max(x), b.2.min(y), b.3.max(y));
+    }
+    if b.0.is_finite() {
+        b
+    } else {
+        (0.0, 1.0, 0.0, 1.0)
+    }
+}
+
 fn plot_err(e: impl std::fmt::Display) -> OutputError {
     OutputError::Encode {
         what: "SVG chart".into(),
@@ -97,25 +115,8 @@ pub fn line_chart_spanned(
     equal_aspect: bool,
     min_y_span: f64,
 ) -> Result<(), OutputError> {
-    let pts = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in pts {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if !x0.is_finite() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
+    let (mut x0, mut x1, mut y0, mut y1) =
+        bounds(series.iter().flat_map(|s| s.points.iter().copied()));
     if y1 - y0 < min_y_span {
         let ym = 0.5 * (y0 + y1);
         (y0, y1) = (ym - 0.5 * min_y_span, ym + 0.5 * min_y_span);
@@ -216,23 +217,7 @@ pub fn flank_map(
     overlays: &[Series],
     segments: &[Segment],
 ) -> Result<(), OutputError> {
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for c in cells {
-        for &(x, y) in &c.corners {
-            x0 = x0.min(x);
-            x1 = x1.max(x);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-    }
-    if !x0.is_finite() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
+    let (x0, x1, y0, y1) = bounds(cells.iter().flat_map(|c| c.corners.iter().copied()));
     let (px, py) = (0.03 * (x1 - x0), 0.05 * (y1 - y0));
     let (width, height) = (1100u32, 620u32);
     let mut svg = String::new();
