@@ -46,6 +46,10 @@ pub struct SectorMesh {
     pub sides: Vec<usize>,
     /// Per tooth (-1, 0, 1): flank nodes of the left-mating flank as (layer, height index, node).
     pub left_flank: Vec<Vec<(usize, usize, usize)>>,
+    /// Per tooth: nodes of the right-mating (opposite) flank, same layout.
+    pub right_flank: Vec<Vec<(usize, usize, usize)>>,
+    /// Node column of the flank grid of each layer.
+    pub layer_columns: Vec<usize>,
     /// Root radius at the median plane, m.
     pub root_radius: f64,
 }
@@ -92,6 +96,7 @@ pub fn sector_mesh(
     let mut inner = Vec::new();
     let mut sides = Vec::new();
     let mut left_flank = vec![Vec::new(); 3];
+    let mut right_flank = vec![Vec::new(); 3];
     // Section point of a block at parameters (u across in [0, 1], v radial in [0, 1]) in layer
     // position w (fractional layer index, for the half-step between layers).
     let teeth = [-1i32, 0, 1];
@@ -181,11 +186,14 @@ pub fn sector_mesh(
                         if (block == 6 && u == 0.0) || (block == 9 && u == 1.0) {
                             sides.push(id);
                         }
-                        if let (true, Some(flank)) =
-                            (u == 0.0 && c[2] < 0.0, left_flank.get_mut(block))
-                        {
+                        if c[2] < 0.0 {
                             let hi = (v * nv as f64 * 2.0).round() as usize;
-                            flank.push((li, hi, id));
+                            if let (true, Some(flank)) = (u == 0.0, left_flank.get_mut(block)) {
+                                flank.push((li, hi, id));
+                            }
+                            if let (true, Some(flank)) = (u == 1.0, right_flank.get_mut(block)) {
+                                flank.push((li, hi, id));
+                            }
                         }
                     }
                     // (u, v, z) ~ (-x, -y, z) near the line of centres: right-handed.
@@ -199,7 +207,29 @@ pub fn sector_mesh(
     inner.dedup();
     sides.sort_unstable();
     sides.dedup();
-    for f in &mut left_flank {
+    // The last layer's flank nodes (far face) are not first corners of any element: register
+    // them from the mapping.
+    let last = layers.len() - 1;
+    for b in 0..3 {
+        let j = layers[last];
+        let nv = dims(b).1;
+        for hi in 0..=2 * nv {
+            let v = hi as f64 / (2 * nv) as f64;
+            for (u, flank) in [(0.0, &mut left_flank[b]), (1.0, &mut right_flank[b])] {
+                let (rr, th) = section(j, b, u, v);
+                let p = wheel_point(rr, th, l.z[j], 0.0);
+                let key = (
+                    (p.x * 1e9).round() as i64,
+                    (p.y * 1e9).round() as i64,
+                    (p.z * 1e9).round() as i64,
+                );
+                if let Some(&id) = index.get(&key) {
+                    flank.push((last, hi, id));
+                }
+            }
+        }
+    }
+    for f in left_flank.iter_mut().chain(right_flank.iter_mut()) {
         f.sort_unstable();
         f.dedup();
     }
@@ -208,6 +238,8 @@ pub fn sector_mesh(
         inner,
         sides,
         left_flank,
+        right_flank,
+        layer_columns: layers,
         root_radius: root0,
     }
 }
