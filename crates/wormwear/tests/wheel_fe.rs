@@ -268,7 +268,7 @@ fn bending_coefficients_interpolate_the_fe_off_the_fit_grid() {
         let c = coord(*p);
         assert!((c.0 - q.0).abs() < 1e-12 && (c.1 - q.1).abs() < 1e-12);
     }
-    let u = Mat::from_fn(k, k, |l, c| bend(l, c));
+    let u = Mat::from_fn(k, k, &bend);
     let core = basis.fit(&u);
     let umax = (0..k).map(|l| u[(l, l)].abs()).fold(0.0, f64::max);
     let mut worst: f64 = 0.0;
