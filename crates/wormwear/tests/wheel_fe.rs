@@ -282,3 +282,49 @@ fn bending_coefficients_interpolate_the_fe_off_the_fit_grid() {
     eprintln!("bending coefficients off the fit grid: worst error {:.2} % of the largest displacement ({umax:.3e} m/N)", 100.0 * worst / umax);
     assert!(worst < 0.05 * umax);
 }
+
+#[test]
+fn ltca_with_wheel_bending_is_more_compliant_and_in_equilibrium() {
+    use wormwear::bending::wheel_model::WheelBending;
+    use wormwear::ltca::{self, LtcaSettings};
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 8;
+    let geo = Geometry::build(&g).unwrap();
+    let model = WheelBending::build(&g, &geo, &settings(2), 5, 6).unwrap();
+    // Reciprocity (Maxwell-Betti): the same-tooth core is symmetric up to round-off.
+    let k = model.basis.len();
+    let mut asym: f64 = 0.0;
+    let mut scale: f64 = 0.0;
+    for i in 0..k {
+        for j in 0..k {
+            asym = asym.max((model.same[(i, j)] - model.same[(j, i)]).abs());
+            scale = scale.max(model.same[(i, j)].abs());
+        }
+    }
+    assert!(
+        asym < 1e-8 * scale,
+        "same-tooth core not symmetric: {asym:e} vs {scale:e}"
+    );
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let s = LtcaSettings::from_gear(&g);
+    let rigid = ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap();
+    let bent = ltca::analyse_with(&g, &geo, &tca, &s, Some(&model)).unwrap();
+    assert_eq!(bent.bending_model, "fe-wheel");
+    let (te0, p0) = rigid.te_stats();
+    let (te1, p1) = bent.te_stats();
+    eprintln!(
+        "LTCA without / with wheel bending: TE mean {te0:.3e} / {te1:.3e} rad, p2p {p0:.3e} / {p1:.3e} rad, \
+         stiffness {:.3e} / {:.3e} N m/rad, P_max {:.0} / {:.0} MPa",
+        rigid.stiffness_mean(), bent.stiffness_mean(), rigid.max_pressure / 1e6, bent.max_pressure / 1e6
+    );
+    for p in &bent.positions {
+        assert!(p.torque_residual < 1e-6);
+        assert!(
+            p.residuals.complementarity < 1e-7 && p.residuals.min_gap > -1e-7,
+            "{:?}",
+            p.residuals
+        );
+    }
+    // More compliant: larger approach (more negative TE), lower mesh stiffness.
+    assert!(te1 < te0 && bent.stiffness_mean() < rigid.stiffness_mean());
+}

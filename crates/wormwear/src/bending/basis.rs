@@ -137,7 +137,15 @@ impl Basis {
     /// the functions at point l, U = F C F^T, so C = F^-1 U F^-T (the MODEL's
     /// [f]^-T [U] [f]^-1, whose [f] has the points in its columns).
     pub fn fit(&self, u: &Mat<f64>) -> Mat<f64> {
-        let lu = self.matrix().partial_piv_lu();
+        self.fit_at(&self.grid(), u)
+    }
+
+    /// As [`Self::fit`] with the K fitting points given (r~, w~), e.g. the mesh nodes nearest
+    /// to the grid.
+    pub fn fit_at(&self, points: &[(f64, f64)], u: &Mat<f64>) -> Mat<f64> {
+        let k = self.len();
+        let f = Mat::from_fn(k, k, |l, m| self.eval(points[l].0, points[l].1)[m]);
+        let lu = f.partial_piv_lu();
         // X = F^-1 U, then C^T = F^-1 X^T.
         let x = lu.solve(u);
         let ct = lu.solve(x.transpose());

@@ -5,3 +5,4 @@
 pub mod basis;
 pub mod fe;
 pub mod wheel_mesh;
+pub mod wheel_model;

@@ -1,0 +1,213 @@
+//! Wheel bending coefficients for the LTCA (MODEL §5.5): FE of the wheel sector, unit normal
+//! loads at a K = Q1 x Q2 grid of the central tooth's loaded flank, bending = opposite flank free
+//! minus blocked, projected on the normals; three tooth relations (same tooth, the tooth before,
+//! the tooth after) fitted on the free-free function basis. The worm's bending is not included:
+//! the model reports itself as "fe-wheel".
+
+use super::basis::{Basis, WidthFunctions};
+use super::fe::{solve, Elastic, FeError, Load};
+use super::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
+use crate::geometry::{Flank, Geometry};
+use crate::input::GearSet;
+use crate::ltca::solver::LowRank;
+use crate::ltca::{BendingModel, LocalCell};
+use faer::Mat;
+
+/// Wheel bending model.
+#[derive(Debug, Clone)]
+pub struct WheelBending {
+    pub basis: Basis,
+    /// Core matrices for receivers on the same tooth, the tooth before (k - 1) and after (k + 1)
+    /// the loaded one, m/N.
+    pub same: Mat<f64>,
+    pub before: Mat<f64>,
+    pub after: Mat<f64>,
+    /// Root radius and blank top as functions of z are needed to map r to r~.
+    root_centre_distance: f64,
+    hob_tip: f64,
+    face_width: f64,
+    top: Vec<(f64, f64)>,
+}
+
+impl WheelBending {
+    /// Builds the model: FE of the sector (`mesh` settings) with `height` x `width` fit points.
+    pub fn build(
+        gear: &GearSet,
+        geo: &Geometry,
+        mesh_settings: &SectorMeshSettings,
+        height: usize,
+        width: usize,
+    ) -> Result<Self, FeError> {
+        let m: SectorMesh = sector_mesh(
+            geo,
+            mesh_settings,
+            gear.hob.tip_radius,
+            gear.cutting.centre_distance,
+        );
+        let wf = geo.wheel_flank(Flank::Left);
+        let n_layers = m.layer_columns.len();
+        let max_h = m.left_flank[1].iter().map(|f| f.1).max().unwrap_or(0);
+        let basis = Basis {
+            height,
+            width,
+            kind: WidthFunctions::FreeFree,
+        };
+        // Fit points: basis grid mapped to the nearest flank nodes (layers and height indices).
+        let grid = basis.grid();
+        let pick = |(r, w): (f64, f64)| {
+            (
+                (w * (n_layers - 1) as f64).round() as usize,
+                (r * max_h as f64).round() as usize,
+            )
+        };
+        let points: Vec<(usize, usize)> = grid.iter().map(|&p| pick(p)).collect();
+        let node = |tooth: usize, (layer, h): (usize, usize)| {
+            m.left_flank[tooth]
+                .iter()
+                .find(|f| f.0 == layer && f.1 == h)
+                .map(|f| f.2)
+                .unwrap_or(usize::MAX)
+        };
+        let normal = |n: usize, layer: usize| {
+            let p = m.mesh.nodes[n];
+            let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+            wf.column_normal(m.layer_columns[layer], r)
+        };
+        let ids: Vec<Vec<usize>> = (0..3)
+            .map(|t| points.iter().map(|&p| node(t, p)).collect())
+            .collect();
+        // Normals of the same (r, z) on each tooth, in that tooth's orientation: rotate the
+        // reference normal by the tooth offset (body frame).
+        let tau = 2.0 * std::f64::consts::PI / geo.teeth as f64;
+        let normals: Vec<Vec<nalgebra::Vector3<f64>>> = (0..3)
+            .map(|t| {
+                let k = t as f64 - 1.0;
+                points
+                    .iter()
+                    .zip(&ids[1])
+                    .map(|(&(layer, _), &n)| {
+                        crate::geometry::placement::from_wheel_body(&normal(n, layer), k * tau)
+                    })
+                    .collect()
+            })
+            .collect();
+        let material = Elastic {
+            youngs_modulus: gear.wheel_material.youngs_modulus,
+            poisson_ratio: gear.wheel_material.poisson_ratio,
+        };
+        let cases: Vec<Vec<Load>> = ids[1]
+            .iter()
+            .zip(&normals[1])
+            .map(|(&n, nrm)| (0..3).map(|d| (n, d, -nrm[d])).collect())
+            .collect();
+        let mut fixed = Vec::new();
+        for &n in &m.inner {
+            for d in 0..3 {
+                fixed.push((n, d, 0.0));
+            }
+        }
+        let free = solve(&m.mesh, &material, &fixed, &cases)?;
+        let mut blocked_fixed = fixed.clone();
+        for f in &m.right_flank[1] {
+            for d in 0..3 {
+                blocked_fixed.push((f.2, d, 0.0));
+            }
+        }
+        let blocked = solve(&m.mesh, &material, &blocked_fixed, &cases)?;
+        let k = basis.len();
+        let relation = |t: usize| {
+            Mat::from_fn(k, k, |l, c| {
+                let (a, b) = (free[c][ids[t][l]], blocked[c][ids[t][l]]);
+                let n = normals[t][l];
+                -((a[0] - b[0]) * n[0] + (a[1] - b[1]) * n[1] + (a[2] - b[2]) * n[2])
+            })
+        };
+        let (u_before, u_same, u_after) = (relation(0), relation(1), relation(2));
+        // Fit at the actual node coordinates (r~ = height index / max, w~ = layer / last).
+        let coords: Vec<(f64, f64)> = points
+            .iter()
+            .map(|&(layer, h)| {
+                (
+                    h as f64 / max_h as f64,
+                    layer as f64 / (n_layers - 1) as f64,
+                )
+            })
+            .collect();
+        let top: Vec<(f64, f64)> = wf.z.iter().zip(&wf.r_high).map(|(&z, &r)| (z, r)).collect();
+        Ok(Self {
+            basis,
+            same: basis.fit_at(&coords, &u_same),
+            before: basis.fit_at(&coords, &u_before),
+            after: basis.fit_at(&coords, &u_after),
+            root_centre_distance: gear.cutting.centre_distance,
+            hob_tip: gear.hob.tip_radius,
+            face_width: gear.wheel.face_width,
+            top,
+        })
+    }
+
+    /// Basis coordinates (r~, w~) of a flank point (r, z): r~ from the root circle to the
+    /// blank top (as the sector mesh), w~ = z / b + 1/2.
+    pub fn coordinates(&self, r: f64, z: f64) -> (f64, f64) {
+        let root =
+            self.root_centre_distance - (self.hob_tip * self.hob_tip - z * z).max(0.0).sqrt();
+        // Blank top at z: linear interpolation of the node-column values.
+        let top = match self.top.iter().position(|&(zz, _)| zz >= z) {
+            Some(0) | None => self.top.last().map(|t| t.1).unwrap_or(root + 1e-3),
+            Some(i) => {
+                let (a, b) = (self.top[i - 1], self.top[i]);
+                a.1 + (b.1 - a.1) * (z - a.0) / (b.0 - a.0)
+            }
+        };
+        ((r - root) / (top - root), z / self.face_width + 0.5)
+    }
+}
+
+impl BendingModel for WheelBending {
+    fn name(&self) -> &'static str {
+        "fe-wheel"
+    }
+
+    fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
+        // Teeth present, in cell order; one block of K basis functions per tooth.
+        let mut teeth: Vec<i32> = cells.iter().map(|c| c.tooth).collect();
+        teeth.sort_unstable();
+        teeth.dedup();
+        let k = self.basis.len();
+        let rank = k * teeth.len();
+        let mut f = vec![0.0; cells.len() * rank];
+        for (i, c) in cells.iter().enumerate() {
+            let t = teeth.iter().position(|&x| x == c.tooth).unwrap_or(0);
+            let (r, w) = self.coordinates(c.r, c.z);
+            let values = self.basis.eval(r, w);
+            f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
+        }
+        let mut core = vec![0.0; rank * rank];
+        for (a, &ta) in teeth.iter().enumerate() {
+            for (b, &tb) in teeth.iter().enumerate() {
+                // Receiver tooth ta, loaded tooth tb.
+                let m = match ta - tb {
+                    0 => &self.same,
+                    -1 => &self.before,
+                    1 => &self.after,
+                    _ => continue,
+                };
+                for l in 0..k {
+                    for c in 0..k {
+                        core[(a * k + l) * rank + b * k + c] = m[(l, c)];
+                    }
+                }
+            }
+        }
+        // Symmetrise the core (reciprocity; the before/after fits are each other's transposes
+        // up to the sector's end effects).
+        for i in 0..rank {
+            for j in 0..i {
+                let v = 0.5 * (core[i * rank + j] + core[j * rank + i]);
+                core[i * rank + j] = v;
+                core[j * rank + i] = v;
+            }
+        }
+        LowRank { rank, f, core }
+    }
+}
