@@ -60,6 +60,32 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.finish();
+    let mut group = c.benchmark_group("bending");
+    group.sample_size(10);
+    let mesh = wormwear::bending::wheel_mesh::SectorMeshSettings {
+        across: 4,
+        height: 6,
+        rim: 2,
+        space: 2,
+        face_step: 6,
+        rim_thickness: 0.02,
+    };
+    group.bench_function(
+        "1x40 wheel bending model (sector FE 6117 nodes, 2 x 30 load cases, 5 x 6 basis)",
+        |b| {
+            b.iter(|| {
+                wormwear::bending::wheel_model::WheelBending::build(
+                    black_box(&g140),
+                    black_box(&geo),
+                    &mesh,
+                    5,
+                    6,
+                )
+                .unwrap()
+            })
+        },
+    );
+    group.finish();
 }
 
 criterion_group!(benches, bench);
