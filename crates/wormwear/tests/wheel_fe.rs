@@ -227,32 +227,14 @@ fn bending_coefficients_interpolate_the_fe_off_the_fit_grid() {
         .zip(&ids)
         .map(|(&(w, _), &n)| normal(w, n))
         .collect();
-    // Load cases: unit force into the tooth (-n) at each point.
-    let cases: Vec<Vec<Load>> = ids
-        .iter()
-        .zip(&normals)
-        .map(|(&n, nrm)| (0..3).map(|d| (n, d, -nrm[d])).collect())
-        .collect();
-    let mut fixed = Vec::new();
-    for &n in &m.inner {
-        for d in 0..3 {
-            fixed.push((n, d, 0.0));
-        }
-    }
-    let free = solve(&m.mesh, &BRONZE, &fixed, &cases).unwrap();
-    let mut fixed_blocked = fixed.clone();
-    for f in &m.right_flank[1] {
-        for d in 0..3 {
-            fixed_blocked.push((f.2, d, 0.0));
-        }
-    }
-    let blocked = solve(&m.mesh, &BRONZE, &fixed_blocked, &cases).unwrap();
+    let loads: Vec<(usize, nalgebra::Vector3<f64>)> =
+        ids.iter().copied().zip(normals.iter().copied()).collect();
+    let bending =
+        wormwear::bending::wheel_model::bending_displacements(&m, &BRONZE, &loads).unwrap();
     // Bending displacement at point l (into the tooth) due to a unit load at point c.
     let bend = |l: usize, c: usize| {
-        let (a, b) = (free[c][ids[l]], blocked[c][ids[l]]);
-        -((a[0] - b[0]) * normals[l][0]
-            + (a[1] - b[1]) * normals[l][1]
-            + (a[2] - b[2]) * normals[l][2])
+        let d = bending[c][ids[l]];
+        -(d[0] * normals[l][0] + d[1] * normals[l][1] + d[2] * normals[l][2])
     };
     let k = fit_points.len();
     let basis = Basis {

@@ -95,31 +95,18 @@ impl WheelBending {
             youngs_modulus: gear.wheel_material.youngs_modulus,
             poisson_ratio: gear.wheel_material.poisson_ratio,
         };
-        let cases: Vec<Vec<Load>> = ids[1]
+        let loads: Vec<(usize, nalgebra::Vector3<f64>)> = ids[1]
             .iter()
-            .zip(&normals[1])
-            .map(|(&n, nrm)| (0..3).map(|d| (n, d, -nrm[d])).collect())
+            .copied()
+            .zip(normals[1].iter().copied())
             .collect();
-        let mut fixed = Vec::new();
-        for &n in &m.inner {
-            for d in 0..3 {
-                fixed.push((n, d, 0.0));
-            }
-        }
-        let free = solve(&m.mesh, &material, &fixed, &cases)?;
-        let mut blocked_fixed = fixed.clone();
-        for f in &m.right_flank[1] {
-            for d in 0..3 {
-                blocked_fixed.push((f.2, d, 0.0));
-            }
-        }
-        let blocked = solve(&m.mesh, &material, &blocked_fixed, &cases)?;
+        let bending = bending_displacements(&m, &material, &loads)?;
         let k = basis.len();
         let relation = |t: usize| {
             Mat::from_fn(k, k, |l, c| {
-                let (a, b) = (free[c][ids[t][l]], blocked[c][ids[t][l]]);
+                let d = bending[c][ids[t][l]];
                 let n = normals[t][l];
-                -((a[0] - b[0]) * n[0] + (a[1] - b[1]) * n[1] + (a[2] - b[2]) * n[2])
+                -(d[0] * n[0] + d[1] * n[1] + d[2] * n[2])
             })
         };
         let (u_before, u_same, u_after) = (relation(0), relation(1), relation(2));
@@ -161,6 +148,44 @@ impl WheelBending {
         };
         ((r - root) / (top - root), z / self.face_width + 0.5)
     }
+}
+
+/// Bending displacements of the sector (MODEL §5.5 step 2): for each load case, a unit force
+/// into the central tooth (along -n) at the given node, the FE displacement of every node with
+/// the tooth's opposite flank free minus that with it blocked (removes the local contact and
+/// keeps the bending). Rim inner surface clamped. Index: [case][node], m/N.
+pub fn bending_displacements(
+    m: &SectorMesh,
+    material: &Elastic,
+    loads: &[(usize, nalgebra::Vector3<f64>)],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let cases: Vec<Vec<Load>> = loads
+        .iter()
+        .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
+        .collect();
+    let fixed: Vec<(usize, usize, f64)> = m
+        .inner
+        .iter()
+        .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
+        .collect();
+    let free = solve(&m.mesh, material, &fixed, &cases)?;
+    let mut blocked_fixed = fixed;
+    blocked_fixed.extend(
+        m.right_flank[1]
+            .iter()
+            .flat_map(|f| (0..3).map(move |d| (f.2, d, 0.0))),
+    );
+    let blocked = solve(&m.mesh, material, &blocked_fixed, &cases)?;
+    Ok(free
+        .iter()
+        .zip(&blocked)
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+                .collect()
+        })
+        .collect())
 }
 
 impl BendingModel for WheelBending {
