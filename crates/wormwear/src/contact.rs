@@ -38,20 +38,28 @@ impl ElasticPair {
 /// displacement per unit uniform pressure.
 #[inline]
 pub fn love_rectangle(x: f64, y: f64, a: f64, b: f64) -> f64 {
-    // Sum over the corners of  X ln(Y + R) + Y ln(X + R)  with signs, X = x -+ a, Y = y -+ b.
-    #[inline]
-    fn f(x: f64, y: f64) -> f64 {
-        let r = (x * x + y * y).sqrt();
-        let mut v = 0.0;
-        if x != 0.0 {
-            v += x * ln_t_plus_r(y, x, r);
-        }
-        if y != 0.0 {
-            v += y * ln_t_plus_r(x, y, r);
-        }
-        v
+    // Sum over the corners of  X ln(Y + R) + Y ln(X + R)  with signs, X = x -+ a,
+    // Y = y -+ b; the two corners sharing an X (or a Y) are combined into one logarithm of a
+    // ratio (4 logarithms instead of 8), each factor kept free of cancellation.
+    let (x1, x2, y1, y2) = (x + a, x - a, y + b, y - b);
+    let r11 = (x1 * x1 + y1 * y1).sqrt();
+    let r12 = (x1 * x1 + y2 * y2).sqrt();
+    let r21 = (x2 * x2 + y1 * y1).sqrt();
+    let r22 = (x2 * x2 + y2 * y2).sqrt();
+    let mut v = 0.0;
+    if x1 != 0.0 {
+        v += x1 * (t_plus_r(y1, x1, r11) / t_plus_r(y2, x1, r12)).ln();
     }
-    f(x + a, y + b) - f(x + a, y - b) - f(x - a, y + b) + f(x - a, y - b)
+    if x2 != 0.0 {
+        v -= x2 * (t_plus_r(y1, x2, r21) / t_plus_r(y2, x2, r22)).ln();
+    }
+    if y1 != 0.0 {
+        v += y1 * (t_plus_r(x1, y1, r11) / t_plus_r(x2, y1, r21)).ln();
+    }
+    if y2 != 0.0 {
+        v -= y2 * (t_plus_r(x1, y2, r12) / t_plus_r(x2, y2, r22)).ln();
+    }
+    v
 }
 
 /// Love's integral with a far-field expansion beyond `FAR` times the larger half side: the
@@ -75,13 +83,13 @@ pub fn love_rectangle_fast(x: f64, y: f64, a: f64, b: f64) -> f64 {
     }
 }
 
-/// ln(t + R), R = sqrt(t^2 + s^2), without cancellation for t < 0 (t + R = s^2 / (R - t)).
+/// t + R, R = sqrt(t^2 + s^2), without cancellation for t < 0 (t + R = s^2 / (R - t)).
 #[inline]
-fn ln_t_plus_r(t: f64, s: f64, r: f64) -> f64 {
+fn t_plus_r(t: f64, s: f64, r: f64) -> f64 {
     if t >= 0.0 {
-        (t + r).ln()
+        t + r
     } else {
-        (s * s / (r - t)).ln()
+        s * s / (r - t)
     }
 }
 
@@ -106,14 +114,16 @@ impl ContactCell {
 }
 
 /// Normal displacement at cell i (along n_i) due to unit pressure on cell j, both bodies, m/Pa
-/// (MODEL §5.5).
+/// (MODEL §5.5). Love's closed form near the source, its far-field expansion beyond six half
+/// sides ([`love_rectangle_fast`], relative error below 2e-4 there).
 #[inline]
 pub fn coefficient(pair: &ElasticPair, i: &ContactCell, j: &ContactCell) -> f64 {
     let d = i.centre - j.centre;
     let nu = d.dot(&j.axis_nu);
     let zeta = d.dot(&j.axis_zeta);
-    let normal =
-        pair.normal * love_rectangle(nu, zeta, j.half_nu, j.half_zeta) * j.normal.dot(&i.normal);
+    let normal = pair.normal
+        * love_rectangle_fast(nu, zeta, j.half_nu, j.half_zeta)
+        * j.normal.dot(&i.normal);
     let r2 = d.norm_squared();
     let tangential = if r2 > 0.0 {
         pair.tangential * j.area() * d.dot(&i.normal) / r2
@@ -144,6 +154,36 @@ mod tests {
         );
         assert!((u / v - 1.0).abs() < 1e-12);
         assert!(love_rectangle(-50.0 * a, 3.0 * a, a, 0.1 * a) > 0.0);
+    }
+
+    #[test]
+    fn love_rectangle_matches_numerical_integration() {
+        // Integral of 1/r over the rectangle by midpoint quadrature on a fine grid, for
+        // receivers outside (all sides) and on an edge (integrable singularity).
+        let (a, b) = (0.6e-3, 1.7e-3);
+        let quad = |x: f64, y: f64| {
+            let n = 1200;
+            let (hx, hy) = (2.0 * a / n as f64, 2.0 * b / n as f64);
+            let mut s = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    let u = -a + (i as f64 + 0.5) * hx - x;
+                    let v = -b + (j as f64 + 0.5) * hy - y;
+                    s += hx * hy / (u * u + v * v).sqrt();
+                }
+            }
+            s
+        };
+        for &(x, y) in &[
+            (2.3e-3, -0.4e-3),
+            (0.6e-3, 0.9e-3),
+            (-1.1e-3, 2.2e-3),
+            (0.0, 5e-3),
+        ] {
+            let exact = love_rectangle(x, y, a, b);
+            let q = quad(x, y);
+            assert!((q / exact - 1.0).abs() < 2e-3, "({x}, {y}): {q} vs {exact}");
+        }
     }
 
     #[test]

@@ -109,11 +109,10 @@ fn both_solvers_agree_on_the_1x40() {
 }
 
 /// Acceptance criterion of the LTCA issue: doubling slices and columns changes P_max by < 3 %
-/// and TE by < 2 %. NOT MET YET with the default edge reliefs (P_max +3.7 %, TE 1.2 %): the
-/// pressure peaks where a contact line runs into the worm's tip-relief zone, a transition a
-/// few mm long along the line that slices every 2.25 mm do not resolve. Kept as the target.
+/// and TE by < 2 %. The pressure peaks where a contact line runs into an edge-relief zone (worm
+/// tip, wheel face ends), a transition about a millimetre long along the line: the default
+/// mesh takes every node column as a slice (0.75 mm) to resolve it.
 #[test]
-#[ignore = "refinement study (~10 s in release); fails until the along-line resolution is adaptive"]
 fn refinement_changes_pmax_and_te_little() {
     let g = example("gear-1x40-design.toml");
     let s = LtcaSettings::from_gear(&g);

@@ -513,3 +513,59 @@ fn column_normals_match_the_envelope_normals() {
     eprintln!("column normal error {worst:e} rad");
     assert!(worst < 1e-6, "{worst:e}");
 }
+
+#[test]
+fn flank_interpolation_between_node_columns_is_exact_to_the_grid() {
+    // theta_w and the normal at (r, z) between node columns (Hermite along z with the slopes
+    // from the normals), against the envelope evaluated exactly there; at node columns the
+    // interpolation must reproduce the column values. Points inside both columns' radial
+    // ranges are interpolated; in the sliver where r_low changes between two columns one
+    // column is extended linearly in r, less accurate (bounded separately).
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let hobbing = geo.hobbing(&g);
+    let (mut worst, mut worst_normal): (f64, f64) = (0.0, 0.0);
+    let (mut sliver, mut sliver_normal): (f64, f64) = (0.0, 0.0);
+    let mut count = 0;
+    for flank in Flank::BOTH {
+        let wf = geo.wheel_flank(flank);
+        for j in (0..wf.cells_face).step_by(5) {
+            for &t in &[0.0, 0.23, 0.5, 0.81] {
+                let z = wf.z[j] + t * (wf.z[j + 1] - wf.z[j]);
+                let (lo, hi) = wf.radial_range_at(z);
+                for k in 0..=12 {
+                    let r = lo + (hi - lo) * k as f64 / 12.0;
+                    let Ok(exact) = generate_point(&hobbing, flank, r, z) else {
+                        continue;
+                    };
+                    let (theta, _) = wf.theta_at(r, z);
+                    let e = r * (theta - exact.theta).abs();
+                    let en = (wf.normal_at(r, z) - exact.normal_vec()).norm();
+                    let inside = (j..=j + 1).all(|c| r >= wf.r_low[c] && r <= wf.r_high[c]);
+                    if inside {
+                        worst = worst.max(e);
+                        worst_normal = worst_normal.max(en);
+                        count += 1;
+                    } else {
+                        sliver = sliver.max(e);
+                        sliver_normal = sliver_normal.max(en);
+                    }
+                    if t == 0.0 {
+                        assert_eq!(theta, wf.column_theta(j, r).0);
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "between columns ({count} points): theta error {worst:e} m, normal error {worst_normal:e} rad; \
+         root sliver: {sliver:e} m, {sliver_normal:e} rad"
+    );
+    assert!(count > 500);
+    assert!(worst < 1e-9, "theta interpolation error {worst:e} m");
+    assert!(
+        worst_normal < 1e-4,
+        "normal interpolation error {worst_normal:e} rad"
+    );
+    assert!(sliver < 1e-8, "theta error in the root sliver {sliver:e} m");
+}

@@ -284,10 +284,10 @@ pub struct AnalysisSpec {
 }
 
 fn default_slice_step() -> i64 {
-    3
+    1
 }
 fn default_contact_columns() -> i64 {
-    15
+    11
 }
 fn default_band_factor() -> f64 {
     3.0

@@ -71,6 +71,8 @@ pub struct LocalCell {
     /// Flank coordinates (reference tooth), m.
     pub r: f64,
     pub z: f64,
+    /// Half extent of the cell's slice along the face width, m.
+    pub half_dz: f64,
     /// Lever of the normal about the wheel axis |(P x n)_z|, m.
     pub lever: f64,
     /// Moment of a unit normal force on the worm about its axis (M x n)_x, m.
@@ -272,10 +274,13 @@ pub fn analyse_with(
             if p <= 0.0 {
                 continue;
             }
-            let half = 0.5 * slice_dz * step as f64;
+            // Global cells whose centre lies in the local cell's face extent, and always the
+            // one holding its centre (sub-slices are narrower than global cells).
+            let holding =
+                (((c.z - wf.z[0]) / (wf.z[1] - wf.z[0])).floor().max(0.0) as usize).min(nj - 1);
             for j in 0..nj {
                 let zc = cell_z(j);
-                if zc < c.z - half || zc > c.z + half {
+                if j != holding && (zc < c.z - c.half_dz || zc > c.z + c.half_dz) {
                     continue;
                 }
                 let lo = 0.5 * (wf.r_low[j] + wf.r_low[j + 1]);
@@ -325,7 +330,24 @@ pub fn analyse_with(
     })
 }
 
-/// Builds the local mesh of one position with band half-width `band` (m).
+/// One slice of a local mesh: a strip across the contact line of one tooth at face position
+/// z, with the line crossing r_line.
+#[derive(Debug, Clone, Copy)]
+struct Slice {
+    tooth: i32,
+    tooth_index: usize,
+    /// Node column.
+    base: usize,
+    z: f64,
+    /// Half extent along the face width, m.
+    half_dz: f64,
+    r_line: f64,
+    /// The line's vector over the slice extent (worm frame), None at flank ends.
+    line_step: Option<Vector3<f64>>,
+}
+
+/// Builds the local mesh of one position with band half-width `band` (m) (MODEL §5.1):
+/// every `slice_step`-th node column crossed by a tooth's contact line is a slice.
 #[allow(clippy::too_many_arguments)]
 fn local_mesh(
     tca: &Tca,
@@ -339,12 +361,35 @@ fn local_mesh(
     let pos = tca.positions[n];
     let tau = 2.0 * PI / teeth as f64;
     let step = settings.slice_step.max(1);
-    let nc = settings.columns.max(1);
-    let ds = 2.0 * band / nc as f64;
-    let slice_dz = (wf.z[1] - wf.z[0]) * step as f64;
-    let mut cells = Vec::new();
+    let base_dz = (wf.z[1] - wf.z[0]) * step as f64;
     // Separation threshold for slices whose minimum is not a crossing (flank edges).
     let edge_threshold = 50e-6;
+    // Line crossings of every node column at this position, to follow the line.
+    let crossings: std::collections::HashMap<(i32, usize), &crate::kinematics::SliceContact> = tca
+        .contact_lines
+        .iter()
+        .filter(|c| c.position == n && !c.at_end && c.separation.is_finite())
+        .map(|c| ((c.tooth, c.slice), c))
+        .collect();
+    let offset_of = |tooth: i32| tca.sigma * tooth as f64 * tau;
+    let line_point = |c: &crate::kinematics::SliceContact| {
+        wheel_point(c.r, c.theta + offset_of(c.tooth), c.z, pos.theta2)
+    };
+    // Line direction at node column j of a tooth, scaled to a face-width advance of 1 m.
+    let direction = |tooth: i32, j: usize| -> Option<Vector3<f64>> {
+        let here = crossings.get(&(tooth, j))?;
+        let before = j.checked_sub(1).and_then(|i| crossings.get(&(tooth, i)));
+        let after = crossings.get(&(tooth, j + 1));
+        let (a, b) = match (before, after) {
+            (Some(a), Some(b)) => (line_point(a), line_point(b)),
+            (Some(a), None) => (line_point(a), line_point(here)),
+            (None, Some(b)) => (line_point(here), line_point(b)),
+            (None, None) => return None,
+        };
+        let dz = b.z - a.z;
+        (dz.abs() > 0.0).then(|| ev.placement.vector_wheel_to_worm(&((b - a) / dz)))
+    };
+    let mut base = Vec::new();
     for line in tca
         .contact_lines
         .iter()
@@ -353,62 +398,112 @@ fn local_mesh(
         if !line.separation.is_finite() || (line.at_end && line.separation > edge_threshold) {
             continue;
         }
-        let t = tca.teeth.iter().position(|&k| k == line.tooth).unwrap_or(0);
-        let offset = tca.sigma * line.tooth as f64 * tau;
-        let j = line.slice;
-        let z = wf.z[j];
-        let (lo, hi) = (wf.r_low[j], wf.r_high[j]);
-        let (_, slope) = wf.column_theta(j, line.r);
-        let drds = 1.0 / (1.0 + (line.r * slope).powi(2)).sqrt();
-        for k in 0..nc {
-            let s = (k as f64 - 0.5 * (nc as f64 - 1.0)) * ds;
-            let r = line.r + s * drds;
-            if r < lo || r > hi {
-                continue;
-            }
-            let (theta, slope) = wf.column_theta(j, r);
-            let e = ev.angular(r, theta + offset, z, pos.theta2, pos.theta1);
-            if !e.is_finite() {
-                continue;
-            }
-            let nb = wf.column_normal(j, r);
-            let stat = wheel_point(r, theta + offset, z, pos.theta2);
-            let n_stat = from_wheel_body(&nb, offset + pos.theta2);
-            let lever = GapEvaluator::lever(&stat, &n_stat);
-            let centre = ev.placement.wheel_to_worm(&stat);
-            let relief = ev
-                .relief(r, z, (centre.y * centre.y + centre.z * centre.z).sqrt())
-                .0;
-            let normal = ev.placement.vector_wheel_to_worm(&n_stat);
-            // Slice direction: d P / d r in the body frame, to the worm frame.
-            let (st, ct) = (theta + offset).sin_cos();
-            let dpdr_body = Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0);
-            let dpdr = ev
-                .placement
-                .vector_wheel_to_worm(&from_wheel_body(&dpdr_body, pos.theta2));
-            let axis_nu = (dpdr - normal * dpdr.dot(&normal)).normalize();
-            let axis_zeta = normal.cross(&axis_nu);
-            cells.push(LocalCell {
-                cell: ContactCell {
-                    centre,
-                    normal,
-                    axis_nu,
-                    axis_zeta,
-                    half_nu: 0.5 * ds,
-                    half_zeta: 0.5 * slice_dz,
-                },
-                tooth: line.tooth,
-                tooth_index: t,
-                slice: j,
-                column: k,
-                r,
-                z,
-                lever,
-                worm_lever: centre.cross(&normal).x,
-                separation: e + pos.kinematic_error,
-                relief,
-            });
+        let tooth_index = tca.teeth.iter().position(|&k| k == line.tooth).unwrap_or(0);
+        base.push(Slice {
+            tooth: line.tooth,
+            tooth_index,
+            base: line.slice,
+            z: wf.z[line.slice],
+            half_dz: 0.5 * base_dz,
+            r_line: line.r,
+            line_step: if line.at_end {
+                None
+            } else {
+                direction(line.tooth, line.slice).map(|d| d * base_dz)
+            },
+        });
+    }
+    base.iter()
+        .flat_map(|s| slice_cells(s, tca, ev, wf, settings, n, band, offset_of(s.tooth)))
+        .collect()
+}
+
+/// The cells of one slice: `columns` cells of width 2 band / columns along the flank's
+/// radial direction, centred on the line crossing.
+#[allow(clippy::too_many_arguments)]
+fn slice_cells(
+    slice: &Slice,
+    tca: &Tca,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    settings: &LtcaSettings,
+    n: usize,
+    band: f64,
+    offset: f64,
+) -> Vec<LocalCell> {
+    let pos = tca.positions[n];
+    let nc = settings.columns.max(1);
+    let ds = 2.0 * band / nc as f64;
+    let z = slice.z;
+    let (lo, hi) = wf.radial_range_at(z);
+    let (_, slope) = wf.theta_at(slice.r_line, z);
+    let drds = 1.0 / (1.0 + (slice.r_line * slope).powi(2)).sqrt();
+    let mut cells = Vec::with_capacity(nc);
+    for k in 0..nc {
+        let s = (k as f64 - 0.5 * (nc as f64 - 1.0)) * ds;
+        let r = slice.r_line + s * drds;
+        if r < lo || r > hi {
+            continue;
         }
+        let (theta, slope) = wf.theta_at(r, z);
+        let e = ev.angular(r, theta + offset, z, pos.theta2, pos.theta1);
+        if !e.is_finite() {
+            continue;
+        }
+        let nb = wf.normal_at(r, z);
+        let stat = wheel_point(r, theta + offset, z, pos.theta2);
+        let n_stat = from_wheel_body(&nb, offset + pos.theta2);
+        let lever = GapEvaluator::lever(&stat, &n_stat);
+        let centre = ev.placement.wheel_to_worm(&stat);
+        let relief = ev
+            .relief(r, z, (centre.y * centre.y + centre.z * centre.z).sqrt())
+            .0;
+        let normal = ev.placement.vector_wheel_to_worm(&n_stat);
+        // Radial direction of the flank: d P / d r in the body frame, to the worm frame.
+        let (st, ct) = (theta + offset).sin_cos();
+        let dpdr_body = Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0);
+        let dpdr = ev
+            .placement
+            .vector_wheel_to_worm(&from_wheel_body(&dpdr_body, pos.theta2));
+        let radial = (dpdr - normal * dpdr.dot(&normal)).normalize();
+        // The cell is the parallelogram of sides `ds` along the radial direction and the
+        // line's step along the line, taken as the rectangle of the same area aligned with the
+        // line (exact tiling of a band of straight lines).
+        let (axis_nu, axis_zeta, half_nu, half_zeta) = match slice.line_step {
+            Some(a) => {
+                let a = a - normal * a.dot(&normal);
+                let along = a.norm();
+                let zeta = a / along;
+                (
+                    zeta.cross(&normal),
+                    zeta,
+                    0.5 * ds * radial.cross(&zeta).norm(),
+                    0.5 * along,
+                )
+            }
+            None => (radial, normal.cross(&radial), 0.5 * ds, slice.half_dz),
+        };
+        cells.push(LocalCell {
+            cell: ContactCell {
+                centre,
+                normal,
+                axis_nu,
+                axis_zeta,
+                half_nu,
+                half_zeta,
+            },
+            tooth: slice.tooth,
+            tooth_index: slice.tooth_index,
+            slice: slice.base,
+            column: k,
+            r,
+            z,
+            half_dz: slice.half_dz,
+            lever,
+            worm_lever: centre.cross(&normal).x,
+            separation: e + pos.kinematic_error,
+            relief,
+        });
     }
     cells
 }
@@ -449,8 +544,10 @@ fn solve_position(
         let blocks: Vec<Block> = ranges
             .into_par_iter()
             .map(|(start, size)| {
-                // Upper triangle, mirrored: Love's term is symmetric for the equal cells of a
-                // tooth; only the tangential term's small asymmetry on curved flanks is dropped.
+                // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
+                // of a tooth differ only slightly (line-aligned areas vary by the line's
+                // obliquity), and the tangential term's small asymmetry on curved flanks is
+                // dropped.
                 let mut matrix = vec![0.0; size * size];
                 for a in 0..size {
                     let ci = &cells[start + a];

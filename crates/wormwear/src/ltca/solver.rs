@@ -13,28 +13,6 @@
 //! Two solvers: the Polonsky-Keer conjugate gradient with active set (fast, default) and the
 //! published fixed point on the approach (reference).
 
-/// Dot product with four independent accumulators (lets the compiler use SIMD; the summation
-/// order differs from a plain left fold only at round-off level).
-#[inline]
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let chunks = n / 4;
-    for k in 0..chunks {
-        let i = 4 * k;
-        acc[0] += a[i] * b[i];
-        acc[1] += a[i + 1] * b[i + 1];
-        acc[2] += a[i + 2] * b[i + 2];
-        acc[3] += a[i + 3] * b[i + 3];
-    }
-    let mut tail = 0.0;
-    for i in 4 * chunks..n {
-        tail += a[i] * b[i];
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-}
-
 /// Dense symmetric block on a contiguous range of unknowns.
 #[derive(Debug, Clone)]
 pub struct Block {
@@ -145,36 +123,43 @@ impl Problem {
         self.separation.is_empty()
     }
 
-    /// y = K x.
+    /// y = K x. The blocks are symmetric, so y is accumulated column by column over the
+    /// non-zero entries of x only (contact loads are sparse: most band cells carry none);
+    /// blocks in parallel.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         use rayon::prelude::*;
-        y.iter_mut().for_each(|v| *v = 0.0);
-        // Rows in chunks across threads (blocks are contiguous and in order).
-        const CHUNK: usize = 32;
-        let mut jobs: Vec<(&Block, usize, &mut [f64])> = Vec::new();
+        let mut jobs: Vec<(&Block, &mut [f64])> = Vec::with_capacity(self.blocks.len());
         let mut rest: &mut [f64] = y;
-        let mut offset = 0;
         for b in &self.blocks {
-            debug_assert_eq!(b.start, offset);
-            let (mut head, tail) = std::mem::take(&mut rest).split_at_mut(b.size);
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(b.size);
+            jobs.push((b, head));
             rest = tail;
-            let mut r0 = 0;
-            while !head.is_empty() {
-                let take = CHUNK.min(head.len());
-                let (part, more) = std::mem::take(&mut head).split_at_mut(take);
-                jobs.push((b, r0, part));
-                head = more;
-                r0 += take;
-            }
-            offset += b.size;
         }
-        jobs.into_par_iter().for_each(|(b, r0, part)| {
-            let xs = &x[b.start..b.start + b.size];
-            for (k, yr) in part.iter_mut().enumerate() {
-                let r = r0 + k;
-                *yr = dot(&b.matrix[r * b.size..(r + 1) * b.size], xs);
+        let work = |(b, ys): (&Block, &mut [f64])| {
+            ys.iter_mut().for_each(|v| *v = 0.0);
+            let size = b.size;
+            for (j, &xj) in x[b.start..b.start + size].iter().enumerate() {
+                if xj == 0.0 {
+                    continue;
+                }
+                let column = &b.matrix[j * size..(j + 1) * size];
+                for (yr, k) in ys.iter_mut().zip(column) {
+                    *yr += xj * k;
+                }
             }
-        });
+        };
+        // Threads only when the product is worth a fork-join (the projection's correction
+        // products touch a handful of columns).
+        let work_total: usize = self
+            .blocks
+            .iter()
+            .map(|b| b.size * x[b.start..b.start + b.size].iter().filter(|v| **v != 0.0).count())
+            .sum();
+        if work_total > 60_000 {
+            jobs.into_par_iter().for_each(work);
+        } else {
+            jobs.into_iter().for_each(work);
+        }
         if let Some(lr) = &self.low_rank {
             let k = lr.rank;
             let mut ft = vec![0.0; k];
@@ -195,25 +180,7 @@ impl Problem {
 
     /// Residuals of q with approach alpha.
     fn residuals(&self, q: &[f64], gap: &[f64], approach: f64, iterations: usize) -> Residuals {
-        let scale = approach.abs().max(f64::MIN_POSITIVE);
-        let qmax = q.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
-        let mut comp: f64 = 0.0;
-        let mut min_gap = f64::INFINITY;
-        for (qi, yi) in q.iter().zip(gap) {
-            if *qi > 0.0 {
-                comp = comp.max(yi.abs() * (qi / qmax).min(1.0));
-            }
-            if yi.is_finite() {
-                min_gap = min_gap.min(*yi);
-            }
-        }
-        Residuals {
-            load: (q.iter().sum::<f64>() - self.load).abs() / self.load,
-            complementarity: comp / scale,
-            min_gap: min_gap / scale,
-            min_load: q.iter().copied().fold(f64::INFINITY, f64::min) / qmax,
-            iterations,
-        }
+        residuals_at_load(self.load, q, gap, approach, iterations)
     }
 
     fn validate(&self) -> Result<(), SolverError> {
@@ -300,8 +267,20 @@ fn conjugate_gradient(
     let mut g_old = 1.0;
     let mut approach = 0.0;
     let mut last_change = f64::INFINITY;
-    for it in 1..=settings.max_iterations {
-        problem.apply(&q, &mut u);
+    let mut correction = vec![0.0; n];
+    let mut kc = vec![0.0; n];
+    // u = K q is carried from one iteration to the next (one product K t per iteration, plus
+    // a product with the few entries the projection changed) and recomputed exactly every
+    // REFRESH iterations and before convergence is accepted.
+    const REFRESH: usize = 16;
+    let mut exact = false;
+    let mut it = 0;
+    while it < settings.max_iterations {
+        it += 1;
+        if !exact && (it == 1 || it % REFRESH == 0) {
+            problem.apply(&q, &mut u);
+            exact = true;
+        }
         for i in 0..n {
             g[i] = if open[i] { u[i] + e[i] } else { f64::INFINITY };
         }
@@ -331,6 +310,12 @@ fn conjugate_gradient(
         }
         let scale = approach.abs().max(f64::MIN_POSITIVE);
         if worst / scale < settings.tolerance && last_change < settings.tolerance.sqrt() {
+            if !exact {
+                problem.apply(&q, &mut u);
+                exact = true;
+                it -= 1;
+                continue;
+            }
             let gap: Vec<f64> = g.clone();
             let residuals = problem.residuals(&q, &gap, approach, it);
             return Ok(Solution {
@@ -361,8 +346,11 @@ fn conjugate_gradient(
         let tau = if den > 0.0 { num / den } else { 0.0 };
         let q_old = q.clone();
         for i in 0..n {
+            correction[i] = 0.0;
             if q[i] > 0.0 {
-                q[i] = (q[i] - tau * t[i]).max(0.0);
+                let linear = q[i] - tau * t[i];
+                q[i] = linear.max(0.0);
+                correction[i] = q[i] - linear;
             }
         }
         // Cells outside the loaded set that would penetrate join it (PK's overlap step).
@@ -379,6 +367,7 @@ fn conjugate_gradient(
         for i in 0..n {
             if q_old[i] == 0.0 && open[i] && g[i] < 0.0 {
                 q[i] = -tau_overlap * g[i];
+                correction[i] = q[i];
                 overlap = true;
             }
         }
@@ -389,6 +378,12 @@ fn conjugate_gradient(
         }
         let s = problem.load / total;
         q.iter_mut().for_each(|v| *v *= s);
+        // u <- s (u - tau K t + K c), c the projection's changes.
+        problem.apply(&correction, &mut kc);
+        for i in 0..n {
+            u[i] = s * (u[i] - tau * r[i] + kc[i]);
+        }
+        exact = false;
         last_change = q
             .iter()
             .zip(&q_old)
@@ -489,13 +484,18 @@ pub fn affine_load_update(
 ) -> Option<(Solution, f64)> {
     let n = problem.len();
     let active: Vec<bool> = solution.q.iter().map(|&q| q > 0.0).collect();
-    // CG on the loaded set for K_AA v = 1.
+    // Conjugate gradient on the loaded set for K_AA v = 1, preconditioned by the exact
+    // Cholesky factors of the contact blocks restricted to the loaded set (exact in one step
+    // without bending; the bending term is low rank, so few more steps with it).
+    let preconditioner = BlockPreconditioner::new(problem, &active);
     let mut v = vec![0.0; n];
     let mut r: Vec<f64> = active.iter().map(|&a| if a { 1.0 } else { 0.0 }).collect();
-    let mut p = r.clone();
+    let mut z = vec![0.0; n];
+    preconditioner.apply(&r, &mut z);
+    let mut p = z.clone();
     let mut kp = vec![0.0; n];
-    let mut rr: f64 = r.iter().map(|x| x * x).sum();
-    let rr0 = rr;
+    let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+    let rr0: f64 = r.iter().map(|x| x * x).sum();
     for _ in 0..settings.max_iterations.min(10 * n) {
         problem.apply(&p, &mut kp);
         for i in 0..n {
@@ -507,19 +507,21 @@ pub fn affine_load_update(
         if pkp <= 0.0 {
             return None;
         }
-        let a = rr / pkp;
+        let a = rz / pkp;
         for i in 0..n {
             v[i] += a * p[i];
             r[i] -= a * kp[i];
         }
-        let rr_new: f64 = r.iter().map(|x| x * x).sum();
-        if rr_new <= 1e-24 * rr0 {
+        let rr: f64 = r.iter().map(|x| x * x).sum();
+        if rr <= 1e-24 * rr0 {
             break;
         }
-        let beta = rr_new / rr;
-        rr = rr_new;
+        preconditioner.apply(&r, &mut z);
+        let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let beta = rz_new / rz;
+        rz = rz_new;
         for i in 0..n {
-            p[i] = r[i] + beta * p[i];
+            p[i] = z[i] + beta * p[i];
         }
     }
     let sum_v: f64 = v.iter().sum();
@@ -552,11 +554,7 @@ pub fn affine_load_update(
     if (0..n).any(|i| !active[i] && problem.separation[i].is_finite() && gap[i] < -tol) {
         return None;
     }
-    let updated = Problem {
-        load,
-        ..problem.clone()
-    };
-    let residuals = updated.residuals(&q, &gap, approach, solution.residuals.iterations);
+    let residuals = residuals_at_load(load, &q, &gap, approach, solution.residuals.iterations);
     Some((
         Solution {
             q,
@@ -566,4 +564,82 @@ pub fn affine_load_update(
         },
         load,
     ))
+}
+
+/// Residuals of q with approach alpha under total load `load`.
+fn residuals_at_load(
+    load: f64,
+    q: &[f64],
+    gap: &[f64],
+    approach: f64,
+    iterations: usize,
+) -> Residuals {
+    let scale = approach.abs().max(f64::MIN_POSITIVE);
+    let qmax = q.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let mut comp: f64 = 0.0;
+    let mut min_gap = f64::INFINITY;
+    for (qi, yi) in q.iter().zip(gap) {
+        if *qi > 0.0 {
+            comp = comp.max(yi.abs() * (qi / qmax).min(1.0));
+        }
+        if yi.is_finite() {
+            min_gap = min_gap.min(*yi);
+        }
+    }
+    Residuals {
+        load: (q.iter().sum::<f64>() - load).abs() / load,
+        complementarity: comp / scale,
+        min_gap: min_gap / scale,
+        min_load: q.iter().copied().fold(f64::INFINITY, f64::min) / qmax,
+        iterations,
+    }
+}
+
+/// Block-Jacobi preconditioner: Cholesky factors of each contact block restricted to a set of
+/// unknowns (identity where a factorisation fails).
+struct BlockPreconditioner {
+    parts: Vec<(Vec<usize>, Option<faer::linalg::solvers::Llt<f64>>)>,
+}
+
+impl BlockPreconditioner {
+    fn new(problem: &Problem, set: &[bool]) -> Self {
+        use rayon::prelude::*;
+        let parts = problem
+            .blocks
+            .par_iter()
+            .map(|b| {
+                let idx: Vec<usize> = (b.start..b.start + b.size).filter(|&i| set[i]).collect();
+                let m = faer::Mat::from_fn(idx.len(), idx.len(), |r, c| {
+                    b.matrix[(idx[r] - b.start) * b.size + (idx[c] - b.start)]
+                });
+                let llt = (!idx.is_empty())
+                    .then(|| m.llt(faer::Side::Lower).ok())
+                    .flatten();
+                (idx, llt)
+            })
+            .collect();
+        Self { parts }
+    }
+
+    /// z = M^-1 r on the set (r outside the set is ignored, z there is 0).
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        use faer::linalg::solvers::Solve;
+        z.iter_mut().for_each(|v| *v = 0.0);
+        for (idx, llt) in &self.parts {
+            match llt {
+                Some(llt) => {
+                    let mut rhs = faer::Mat::from_fn(idx.len(), 1, |k, _| r[idx[k]]);
+                    llt.solve_in_place(&mut rhs);
+                    for (k, &i) in idx.iter().enumerate() {
+                        z[i] = rhs[(k, 0)];
+                    }
+                }
+                None => {
+                    for &i in idx {
+                        z[i] = r[i];
+                    }
+                }
+            }
+        }
+    }
 }
