@@ -6,7 +6,11 @@
 //! 1. [`input`] — the validated gear file, SI units;
 //! 2. [`geometry`] — worm and hob helicoids, wheel flanks by hobbing simulation (MODEL §2-3);
 //! 3. [`kinematics`] — unloaded meshing analysis: gaps, kinematic error, no-load pattern,
-//!    sliding velocities (MODEL §4).
+//!    sliding velocities (MODEL §4);
+//! 4. [`bending`] and [`contact`] — influence coefficients; [`ltca`] — loaded contact, load
+//!    sharing, transmission error (MODEL §5);
+//! 5. [`lubrication`] — film thickness and local wear coefficient (MODEL §6); [`wear`] — Archard
+//!    wear over life, backlash (MODEL §7).
 //!
 //! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
 
@@ -16,5 +20,6 @@ pub mod geometry;
 pub mod input;
 pub mod kinematics;
 pub mod ltca;
+pub mod lubrication;
 pub mod output;
 pub mod plot;
