@@ -61,7 +61,12 @@ pub struct GapEvaluator<'a> {
 impl<'a> GapEvaluator<'a> {
     /// Evaluator for the gear's operating set-up and loaded flank.
     pub fn new(gear: &GearSet, geo: &'a Geometry) -> Self {
-        let flank = loaded_flank(gear);
+        Self::for_flank(gear, geo, loaded_flank(gear))
+    }
+
+    /// Evaluator for the operating set-up and the given worm flank (the opposite flank for
+    /// backlash: its angular gaps close by turning the wheel the other way).
+    pub fn for_flank(gear: &GearSet, geo: &'a Geometry, flank: Flank) -> Self {
         Self {
             worm: &geo.worm,
             placement: gear.operating,

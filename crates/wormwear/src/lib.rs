@@ -23,3 +23,4 @@ pub mod ltca;
 pub mod lubrication;
 pub mod output;
 pub mod plot;
+pub mod wear;

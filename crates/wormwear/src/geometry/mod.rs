@@ -15,7 +15,7 @@ pub mod wheel;
 use crate::input::{GearSet, ProfileType};
 pub use hobbing::{EnvelopePoint, Hobbing, PointKind};
 pub use thread::{Flank, ThreadSurface};
-pub use wheel::{BlankLimits, FlankPoint, WheelFlank};
+pub use wheel::{BlankLimits, FlankField, FlankPoint, WheelFlank};
 
 /// Why the geometry could not be built from a (validated) gear set.
 #[derive(Debug, Clone, thiserror::Error)]

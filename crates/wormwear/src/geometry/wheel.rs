@@ -289,6 +289,83 @@ impl WheelFlank {
     }
 }
 
+/// A scalar field on the nodes of a flank grid (e.g. the depth of material worn off normal to
+/// the flank, m), index `j * (I + 1) + i` like [`WheelFlank::nodes`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FlankField {
+    pub cells_height: usize,
+    pub cells_face: usize,
+    pub values: Vec<f64>,
+}
+
+impl FlankField {
+    /// The zero field on the grid of `wf`.
+    pub fn zeros(wf: &WheelFlank) -> Self {
+        Self {
+            cells_height: wf.cells_height,
+            cells_face: wf.cells_face,
+            values: vec![0.0; wf.nodes.len()],
+        }
+    }
+
+    /// Value at node (i, j).
+    #[inline]
+    pub fn node(&self, i: usize, j: usize) -> f64 {
+        self.values[j * (self.cells_height + 1) + i]
+    }
+
+    /// Value at (r, z) of the flank `wf` (the field's grid): linear along the node columns in
+    /// the grid's height parameter, linear between the two neighbouring columns; clamped at the
+    /// grid's edges.
+    pub fn at(&self, wf: &WheelFlank, r: f64, z: f64) -> f64 {
+        let nj = self.cells_face;
+        let ni = self.cells_height;
+        let f = ((z - wf.z[0]) / (wf.z[nj] - wf.z[0]) * nj as f64).clamp(0.0, nj as f64);
+        let j = (f as usize).min(nj - 1);
+        let w = f - j as f64;
+        let column = |j: usize| {
+            let g = ((r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]) * ni as f64)
+                .clamp(0.0, ni as f64);
+            let i = (g as usize).min(ni - 1);
+            let t = g - i as f64;
+            (1.0 - t) * self.node(i, j) + t * self.node(i + 1, j)
+        };
+        (1.0 - w) * column(j) + w * column(j + 1)
+    }
+
+    /// Cell averages (mean of the four corner nodes), index `j * I + i`.
+    pub fn cell_means(&self) -> Vec<f64> {
+        let (ni, nj) = (self.cells_height, self.cells_face);
+        let mut out = Vec::with_capacity(ni * nj);
+        for j in 0..nj {
+            for i in 0..ni {
+                out.push(
+                    0.25 * (self.node(i, j)
+                        + self.node(i + 1, j)
+                        + self.node(i, j + 1)
+                        + self.node(i + 1, j + 1)),
+                );
+            }
+        }
+        out
+    }
+
+    /// Largest value.
+    pub fn max(&self) -> f64 {
+        self.values.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// Integral over the flank of the cell means times the cell areas (a volume for a depth
+    /// field, m^3).
+    pub fn integral(&self, wf: &WheelFlank) -> f64 {
+        self.cell_means()
+            .iter()
+            .zip(&wf.cell_area)
+            .map(|(v, a)| v * a)
+            .sum()
+    }
+}
+
 /// Radius of the blank top at face position z: the outer cylinder r_e2 clipped by the throat
 /// torus of tube radius r_g around the worm axis at the nominal centre distance a. m.
 pub fn blank_top(z: f64, centre_distance: f64, outer_radius: f64, gorge_radius: f64) -> f64 {

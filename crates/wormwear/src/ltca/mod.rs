@@ -14,7 +14,7 @@ pub mod solver;
 
 use crate::contact::{coefficient, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
-use crate::geometry::{Geometry, WheelFlank};
+use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
 use crate::kinematics::{GapEvaluator, Tca};
 use nalgebra::Vector3;
@@ -205,6 +205,20 @@ pub fn analyse_with(
     settings: &LtcaSettings,
     bending: Option<&dyn BendingModel>,
 ) -> Result<Ltca, LtcaError> {
+    analyse_worn(gear, geo, tca, settings, bending, None)
+}
+
+/// [`analyse_with`] on a wheel whose loaded flank has lost `removal` (depth of material normal
+/// to the flank on the flank's node grid, m; MODEL §7.5: it adds to the initial separations,
+/// turned into an angle by each cell's lever).
+pub fn analyse_worn(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    removal: Option<&FlankField>,
+) -> Result<Ltca, LtcaError> {
     let pair = ElasticPair::new(
         gear.worm_material.youngs_modulus,
         gear.worm_material.poisson_ratio,
@@ -261,6 +275,7 @@ pub fn analyse_with(
                 band0,
                 worm_torque,
                 wheel_torque_guess,
+                removal,
             )
         })
         .collect::<Result<_, _>>()?;
@@ -357,6 +372,7 @@ fn local_mesh(
     teeth: u32,
     n: usize,
     band: f64,
+    removal: Option<&FlankField>,
 ) -> Vec<LocalCell> {
     let pos = tca.positions[n];
     let tau = 2.0 * PI / teeth as f64;
@@ -414,7 +430,19 @@ fn local_mesh(
         });
     }
     base.iter()
-        .flat_map(|s| slice_cells(s, tca, ev, wf, settings, n, band, offset_of(s.tooth)))
+        .flat_map(|s| {
+            slice_cells(
+                s,
+                tca,
+                ev,
+                wf,
+                settings,
+                n,
+                band,
+                offset_of(s.tooth),
+                removal,
+            )
+        })
         .collect()
 }
 
@@ -430,6 +458,7 @@ fn slice_cells(
     n: usize,
     band: f64,
     offset: f64,
+    removal: Option<&FlankField>,
 ) -> Vec<LocalCell> {
     let pos = tca.positions[n];
     let nc = settings.columns.max(1);
@@ -501,7 +530,9 @@ fn slice_cells(
             half_dz: slice.half_dz,
             lever,
             worm_lever: centre.cross(&normal).x,
-            separation: e + pos.kinematic_error,
+            separation: e
+                + pos.kinematic_error
+                + removal.map_or(0.0, |w| w.at(wf, r, z) / lever),
             relief,
         });
     }
@@ -521,11 +552,12 @@ fn solve_position(
     band0: f64,
     worm_torque: Option<f64>,
     wheel_torque_guess: f64,
+    removal: Option<&FlankField>,
 ) -> Result<PositionResult, LtcaError> {
     let mut band = band0;
     let mut widenings = 0;
     loop {
-        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band);
+        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, removal);
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
         }
