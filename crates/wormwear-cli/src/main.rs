@@ -64,6 +64,22 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         map_position: usize,
     },
+    /// Wear over life: Archard wear with the geometry updated step by step, backlash, TE and
+    /// pressures over cycles. Writes each completed step as it goes (resumable).
+    #[command(
+        after_help = "Examples:\n  wormwear wear examples/gear-1x40-design.toml -o out/1x40\n  \
+                      wormwear wear examples/gear-1x40-design.toml -o out/1x40 --cycles 180000 --step-cycles 30000\n  \
+                      wormwear wear examples/gear-1x40-case-b.toml -o out/b --resume"
+    )]
+    Wear {
+        /// Gear file (TOML) with a [wear] section (or give --cycles).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        life: LifeArgs,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -73,6 +89,26 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+/// Overrides of the file's [wear] section.
+#[derive(clap::Args, Debug, Clone)]
+struct LifeArgs {
+    /// Wheel cycles to simulate (overrides wear.life_cycles).
+    #[arg(long)]
+    cycles: Option<f64>,
+    /// Fixed steps of this many wheel cycles (overrides the file's step).
+    #[arg(long, conflicts_with = "step_wear_um")]
+    step_cycles: Option<f64>,
+    /// Adaptive steps removing at most this depth, um (overrides the file's step).
+    #[arg(long)]
+    step_wear_um: Option<f64>,
+    /// Ignore the pitting phases of the schedule (wear all along).
+    #[arg(long)]
+    no_pitting: bool,
+    /// Continue from the checkpoint in the output directory.
+    #[arg(long)]
+    resume: bool,
 }
 
 /// Error classes mapped to exit codes.
@@ -92,6 +128,7 @@ fn main() -> ExitCode {
             output,
             map_position,
         } => ltca(file, output, *map_position, cli.quiet),
+        Command::Wear { file, output, life } => wear(file, output, life, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -239,6 +276,130 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
             p2p,
             result.stiffness_mean(),
             result.max_teeth_in_contact()
+        );
+    }
+    Ok(())
+}
+
+/// The file's life plan with the command-line overrides applied.
+fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPlan, Failure> {
+    use wormwear::input::{Endurance, Phase, StepControl, WearPlan};
+    let bad = |m: String| Failure::Input(anyhow::anyhow!(m));
+    let mut plan = match (&gear.wear, args.cycles) {
+        (Some(p), _) => p.clone(),
+        (None, Some(_)) => WearPlan {
+            life_cycles: 0.0,
+            step: StepControl::MaxRemoval(4e-6),
+            max_substep_removal: 5e-6,
+            phases: Vec::new(),
+            endurance: Endurance::DEFAULT,
+        },
+        (None, None) => {
+            return Err(bad(
+                "the file has no [wear] section: add one (life_cycles, step_wear_um or step_cycles) or give --cycles".into(),
+            ))
+        }
+    };
+    if let Some(c) = args.cycles {
+        if !(c.is_finite() && c > 0.0 && c <= 1e12) {
+            return Err(bad(format!("--cycles = {c}: must be a number of cycles in (0, 1e12]")));
+        }
+        plan.life_cycles = c;
+    }
+    if let Some(c) = args.step_cycles {
+        if !(c.is_finite() && c > 0.0 && c <= 1e12) {
+            return Err(bad(format!("--step-cycles = {c}: must be a number of cycles in (0, 1e12]")));
+        }
+        plan.step = StepControl::Cycles(c);
+    }
+    if let Some(d) = args.step_wear_um {
+        if !(d.is_finite() && d > 0.0 && d <= 1000.0) {
+            return Err(bad(format!("--step-wear-um = {d}: must be a depth in (0, 1000] um")));
+        }
+        plan.step = StepControl::MaxRemoval(d * 1e-6);
+    }
+    if args.no_pitting {
+        plan.phases.retain(|p| matches!(p, Phase::Wear { .. }));
+    }
+    Ok(plan)
+}
+
+fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let plan = life_plan(&gear, args)?;
+    let geo = build_geometry(&gear, file)?;
+    let tca = wormwear::kinematics::analyse(&gear, &geo)
+        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let state = if args.resume {
+        match wormwear::output::wear::read_checkpoint(dir) {
+            Ok(Some(s)) => s,
+            Ok(None) => {
+                return Err(Failure::Input(anyhow::anyhow!(
+                    "--resume: no {} in {}",
+                    wormwear::output::wear::CHECKPOINT,
+                    dir.display()
+                )))
+            }
+            Err(e) => return Err(Failure::Input(anyhow::Error::new(e).context("--resume"))),
+        }
+    } else {
+        wormwear::wear::WearState::new(wf)
+    };
+    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
+        .map_err(|e| Failure::Run(e.into()))?;
+    let progress = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    };
+    let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
+        wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir)
+            .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
+        let r = view.state.records.last().expect("record");
+        progress.set_position((1000.0 * r.cycles / plan.life_cycles).round() as u64);
+        progress.set_message(format!(
+            "step {} at {:.3e} cycles: wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
+            r.step,
+            r.cycles,
+            r.max_wear_m * 1e6,
+            r.backlash_increase_m * 1e6,
+            r.max_pressure_pa / 1e6
+        ));
+        Ok(())
+    };
+    let life = wormwear::wear::LifeSettings {
+        cycles: plan.life_cycles,
+        step: plan.step,
+        max_substep_removal: plan.max_substep_removal,
+    };
+    let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
+    let end = wormwear::wear::simulate(&gear, &geo, &tca, &settings, None, &life, state, &mut on_state)
+        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("wear simulation")))?;
+    progress.finish_and_clear();
+    if !quiet {
+        let first = end.records.first().expect("record");
+        let last = end.records.last().expect("record");
+        println!(
+            "wear: {} steps to {:.4e} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
+             P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; results in {}",
+            last.step,
+            last.cycles,
+            last.max_wear_m * 1e6,
+            last.worn_volume_m3 * 1e9,
+            last.backlash_increase_m * 1e6,
+            first.max_pressure_pa / 1e6,
+            last.max_pressure_pa / 1e6,
+            first.contact_area_fraction,
+            last.contact_area_fraction,
+            dir.display()
         );
     }
     Ok(())

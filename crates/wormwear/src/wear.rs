@@ -1,18 +1,17 @@
 //! Stage 5 — wear of the bronze wheel over life (MODEL §7): Archard wear per mesh cycle on the
 //! global flank grid, wear steps with the geometry updated, backlash.
 //!
-//! Per-cycle wear (MODEL §7.2, line-load form). A wheel point M is swept once per wheel
-//! revolution by the contact band; the depth worn in that passage is
-//! (k/H) |vg| integral(p dt) = (k/H) |vg| w / u2, with w the load per unit length of the
-//! contact line when it crosses M and u2 the speed of the line over the wheel flank across
-//! itself. On each node column the loaded analysis gives, at every (position, tooth), the line
-//! crossing r and the line load w; tooth k at wheel rotation theta2 is the reference tooth at
-//! theta2 + sigma k tau, so these samples are the history of the reference tooth over its whole
-//! engagement. Between consecutive samples the crossing moves from r_a to r_b; the nodes in
-//! between take w (and the Hertz pressure, the curvature) interpolated at their own crossing.
-//! The map is therefore a smooth function sampled at nodes, converging as positions are added
-//! (no aliasing from sampling pressures at discrete instants). |vg|, u1, u2 are the kinematics of
-//! each node at its contact moment (TCA), the film and k(lambda) come from [`crate::lubrication`].
+//! Per-cycle wear (MODEL §7.2). A wheel point M is swept once per wheel revolution by the
+//! loaded band; the depth worn in that passage is (k/H) |vg| integral(p dt). On each node
+//! column the loaded analysis gives, at every (position, tooth), the pressure profile across
+//! the line; tooth k at wheel rotation theta2 is the reference tooth at theta2 + sigma k tau,
+//! so these profiles are the history of the reference tooth over its whole engagement. Between
+//! consecutive instants the band is moved continuously from one centroid to the next (its
+//! shape blended), and the time integral of the pressure at each node is taken by quadrature:
+//! the passage is resolved whatever the number of positions (sampling p only at the positions
+//! would alias, MODEL §7.2), and since the profiles come from the loaded analysis on the worn
+//! flank, the band follows the wear. |vg| is the node's sliding speed at its contact moment
+//! (TCA), the film and k(lambda) come from [`crate::lubrication`].
 
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
@@ -37,50 +36,140 @@ pub struct CycleWear {
     pub line_load: FlankField,
 }
 
-/// One sample of the line's passage over a node column.
-#[derive(Debug, Clone, Copy)]
+/// One instant of the contact band's passage over a node column: the pressure profile across
+/// the line (cell centres' radii, ascending, and pressures), its centroid, line load and the
+/// band's curvature.
+#[derive(Debug, Clone)]
 struct Sample {
     /// Time of the reference tooth, as driven wheel rotation (sigma theta2_ref), rad.
     time: f64,
-    r: f64,
+    /// Pressure centroid (the TCA line crossing when unloaded), m.
+    centre: f64,
+    profile: Vec<(f64, f64)>,
+    /// How far below the first and above the last cell centre the end pressures hold: half a
+    /// cell, or, where the band was cut by the flank's edge (worm-tip trace, blank top), up to
+    /// that edge. m.
+    extend_low: f64,
+    extend_high: f64,
     line_load: f64,
     pressure: f64,
     radius: f64,
 }
 
-/// Floor of the line's speed over the wheel, m/s: where the line runs almost along itself the
-/// passage time 1/u2 diverges while the real contact time stays bounded by the engagement.
-const MIN_LINE_SPEED: f64 = 1e-3;
+impl Sample {
+    /// Pressure at radius r of the profile shifted by `shift`, Pa: linear between cell
+    /// centres, the end cells' values over their outer halves, zero beyond.
+    fn pressure_at(&self, r: f64, shift: f64) -> f64 {
+        let x = r - shift;
+        let p = &self.profile;
+        let (Some(first), Some(last)) = (p.first(), p.last()) else {
+            return 0.0;
+        };
+        if x < first.0 {
+            return if x >= first.0 - self.extend_low {
+                first.1
+            } else {
+                0.0
+            };
+        }
+        if x > last.0 {
+            return if x <= last.0 + self.extend_high {
+                last.1
+            } else {
+                0.0
+            };
+        }
+        let k = p.partition_point(|q| q.0 <= x).clamp(1, p.len() - 1);
+        let (a, b) = (p[k - 1], p[k]);
+        if b.0 == a.0 {
+            return a.1.max(b.1);
+        }
+        a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+    }
+
+    /// Half extent of the profile (cells included) around its centre, m.
+    fn reach(&self) -> f64 {
+        match (self.profile.first(), self.profile.last()) {
+            (Some(a), Some(b)) => (self.centre - a.0 + self.extend_low)
+                .abs()
+                .max((b.0 + self.extend_high - self.centre).abs()),
+            _ => 0.0,
+        }
+    }
+}
 
 /// Wear of one mesh cycle from the loaded analysis (MODEL §7.1-7.2), on the loaded flank.
+///
+/// Between two consecutive instants a, b of the reference tooth on a node column, the loaded
+/// band is taken to translate from its centroid c_a to c_b while its shape blends from p_a to
+/// p_b; the time integral of the pressure at every node follows by quadrature over the
+/// interval (sub-steps of at most a tenth of the band width). The passage is thus resolved
+/// whatever the number of positions (no aliasing), and the band follows the worn geometry
+/// (the profiles are the loaded analysis on it). Depth = (k(lambda)/H) |vg| integral(p dt),
+/// |vg| of the node at its contact moment, lambda from the interpolated line load.
 pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> CycleWear {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let tau = 2.0 * PI / geo.teeth as f64;
     let np = tca.positions.len();
     let dt = tau / np as f64;
-    // Line load and Hertz pressure per (position, tooth, slice) from the local cells.
-    let mut loads: HashMap<(usize, i32, usize), (f64, f64)> = HashMap::new();
+    // Wheel speed, rad/s: converts wheel rotation into time.
+    let wheel_speed = gear.conditions.worm_speed / gear.ratio();
+    // Pressure profiles per (position, tooth, slice) from the local cells.
+    let mut profiles: HashMap<(usize, i32, usize), Vec<(f64, f64, f64, usize)>> =
+        HashMap::new();
+    let mut last_column = 0;
     for pr in &ltca.positions {
         for (c, &p) in pr.cells.iter().zip(&pr.pressure) {
-            let e = loads.entry((pr.position, c.tooth, c.slice)).or_insert((0.0, 0.0));
-            e.0 += p * 2.0 * c.cell.half_nu;
-            e.1 = e.1.max(p);
+            last_column = last_column.max(c.column);
+            profiles
+                .entry((pr.position, c.tooth, c.slice))
+                .or_default()
+                .push((c.r, p, 2.0 * c.cell.half_nu, c.column));
         }
     }
-    // Samples per node column, in time order.
+    // Samples per node column.
     let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); nj + 1];
     for line in &tca.contact_lines {
         let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
-        let (w, p) = loads
-            .get(&(line.position, line.tooth, line.slice))
-            .copied()
-            .unwrap_or((0.0, 0.0));
+        let mut cells = profiles
+            .remove(&(line.position, line.tooth, line.slice))
+            .unwrap_or_default();
+        cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
+        let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
+        let centre = if load > 0.0 { moment / load } else { line.r };
+        let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
+            (Some(a), Some(b)) => {
+                let spacing = if b.3 > a.3 {
+                    (b.0 - a.0) / (b.3 - a.3) as f64
+                } else {
+                    a.2
+                };
+                let j = line.slice;
+                let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
+                let low = if a.3 > 0 {
+                    (a.0 - floor).max(0.5 * spacing)
+                } else {
+                    0.5 * spacing
+                };
+                let high = if b.3 < last_column {
+                    (wf.r_high[j] - b.0).max(0.5 * spacing)
+                } else {
+                    0.5 * spacing
+                };
+                (spacing, low, high)
+            }
+            _ => (0.0, 0.0, 0.0),
+        };
         columns[line.slice].push(Sample {
             time: tca.sigma * theta2,
-            r: line.r,
-            line_load: w,
-            pressure: p,
+            centre,
+            extend_low,
+            extend_high,
+            line_load: load,
+            pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
+            profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
             radius: line.curvature_radius,
         });
     }
@@ -98,53 +187,93 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
     let mut line_load = FlankField::zeros(wf);
     lambda.values.fill(f64::NAN);
     film.values.fill(f64::NAN);
+    // Rolling velocities per node; where the TCA has none (nodes at the border of the region
+    // the worm flank reaches, whose surface gradient is undefined), the nearest node of the
+    // same column that has them.
+    let rolling: Vec<(f64, f64)> = (0..=nj)
+        .flat_map(|j| {
+            let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
+            let valid: Vec<usize> = column
+                .iter()
+                .copied()
+                .filter(|&k| tca.node_contact[k].u2.is_finite())
+                .collect();
+            column
+                .iter()
+                .map(|&k| {
+                    let src = valid
+                        .iter()
+                        .copied()
+                        .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
+                        .unwrap_or(k);
+                    let c = &tca.node_contact[src];
+                    (c.u1, c.u2)
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
     for (j, samples) in columns.iter_mut().enumerate() {
         samples.sort_by(|a, b| a.time.total_cmp(&b.time));
         for pair in samples.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
+            let (a, b) = (&pair[0], &pair[1]);
             // Consecutive instants of the same engagement only.
-            if b.time - a.time > 1.5 * dt || a.r == b.r {
+            if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
                 continue;
             }
-            if a.line_load <= 0.0 && b.line_load <= 0.0 {
-                continue;
-            }
-            let (lo, hi) = (a.r.min(b.r), a.r.max(b.r));
+            let duration = (b.time - a.time) / wheel_speed;
+            let reach = a.reach().max(b.reach());
+            let (lo, hi) = (
+                a.centre.min(b.centre) - reach,
+                a.centre.max(b.centre) + reach,
+            );
+            // Sub-steps: the band moves at most a tenth of its width per sub-step.
+            let width = (2.0 * reach).max(1e-9);
+            let steps = ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
+            let w = 0.5 * (a.line_load + b.line_load);
+            let fill = |x: f64, y: f64| {
+                if !x.is_finite() {
+                    y
+                } else if !y.is_finite() {
+                    x
+                } else {
+                    0.5 * (x + y)
+                }
+            };
             for i in 0..=ni {
                 let k = j * (ni + 1) + i;
                 let node = &wf.nodes[k];
-                if node.r < lo || node.r >= hi {
+                if node.r < lo || node.r > hi {
                     continue;
                 }
                 let nc = &tca.node_contact[k];
-                if !nc.reachable || !nc.u2.is_finite() {
+                let (u1, u2) = rolling[k];
+                let mut integral = 0.0;
+                for m in 0..steps {
+                    let s = (m as f64 + 0.5) / steps as f64;
+                    let c = a.centre + s * (b.centre - a.centre);
+                    let p = (1.0 - s) * a.pressure_at(node.r, c - a.centre)
+                        + s * b.pressure_at(node.r, c - b.centre);
+                    integral += p;
+                }
+                integral *= duration / steps as f64;
+                if integral <= 0.0 {
                     continue;
                 }
-                let f = (node.r - a.r) / (b.r - a.r);
-                let lerp = |x: f64, y: f64| {
-                    if !x.is_finite() {
-                        y
-                    } else if !y.is_finite() {
-                        x
-                    } else {
-                        x + f * (y - x)
-                    }
-                };
-                let w = lerp(a.line_load, b.line_load).max(0.0);
-                if w <= 0.0 {
-                    continue;
-                }
+                // The film is that of the Hertzian line contact with the band's peak pressure
+                // (w = 2 pi R p0^2 / E'): a band cut short by an edge or concentrated on a
+                // ridge carries little load per length but is no thicker a film for that.
+                let radius = fill(a.radius, b.radius);
+                let peak = a.pressure.max(b.pressure);
                 let contact = LineContact {
-                    radius: lerp(a.radius, b.radius),
-                    u1: nc.u1,
-                    u2: nc.u2,
-                    line_load: w,
-                    pressure: lerp(a.pressure, b.pressure),
+                    radius,
+                    u1,
+                    u2,
+                    line_load: w.max(2.0 * PI * radius * peak * peak / e_prime),
+                    pressure: peak,
                 };
                 let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
                 let kw = lubrication::wear_coefficient(k_dry, fl.lambda);
-                depth.values[k] +=
-                    kw / hardness * nc.sliding_speed * w / nc.u2.abs().max(MIN_LINE_SPEED);
+                depth.values[k] += kw / hardness * nc.sliding_speed * integral;
                 if !(lambda.values[k] <= fl.lambda) {
                     lambda.values[k] = fl.lambda;
                     film.values[k] = fl.h_min * fl.thermal_factor;
@@ -262,14 +391,7 @@ impl Backlash {
     }
 }
 
-/// How the cycles of a wear step are chosen (MODEL §7.3).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum StepControl {
-    /// Fixed number of wheel cycles per step.
-    Cycles(f64),
-    /// Adaptive: each step removes at most this depth, m.
-    MaxRemoval(f64),
-}
+pub use crate::input::StepControl;
 
 /// Life to simulate.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -277,6 +399,10 @@ pub struct LifeSettings {
     /// Total wheel cycles (revolutions).
     pub cycles: f64,
     pub step: StepControl,
+    /// Stability guard: a step that would remove more than this depth somewhere is split into
+    /// equal sub-steps, each with the pressures recomputed (explicit wear steps of about 10 um
+    /// go unstable, MODEL §7.3); 0 disables. m.
+    pub max_substep_removal: f64,
 }
 
 /// State of a life run after a completed step: what a checkpoint holds.
@@ -313,6 +439,8 @@ pub struct StepRecord {
     pub cycles: f64,
     /// Cycles of the step that led here (0 for the start).
     pub step_cycles: f64,
+    /// Sub-steps that step was split into by the stability guard (1: not split).
+    pub substeps: usize,
     /// Largest depth worn, m.
     pub max_wear_m: f64,
     /// Worn volume / active flank area (mean depth over the flank), m.
@@ -395,13 +523,18 @@ pub fn simulate(
     let initial = backlash.stats(&FlankField::zeros(wf)).linear_mean_m;
     let area = wf.active_area();
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
-    loop {
-        let l = crate::ltca::analyse_worn(gear, geo, tca, settings, bending, Some(&state.removal))
-            .map_err(|source| WearError::Ltca {
+    let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    let analyse = |removal: &FlankField, state: &WearState| {
+        crate::ltca::analyse_worn(gear, geo, tca, settings, bending, Some(removal)).map_err(
+            |source| WearError::Ltca {
                 step: state.step,
                 cycles: state.cycles,
                 source,
-            })?;
+            },
+        )
+    };
+    loop {
+        let l = analyse(&state.removal, &state)?;
         let cw = per_cycle(gear, geo, tca, &l);
         let b = backlash.stats(&state.removal);
         let (te_mean, te_p2p) = l.te_stats();
@@ -411,6 +544,7 @@ pub fn simulate(
             step: state.step,
             cycles: state.cycles,
             step_cycles,
+            substeps,
             max_wear_m: state.removal.max(),
             mean_wear_m: volume / area,
             worn_volume_m3: volume,
@@ -448,10 +582,32 @@ pub fn simulate(
             StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
             StepControl::MaxRemoval(_) => left,
         };
-        for (h, dh) in state.removal.values.iter_mut().zip(&cw.depth.values) {
-            *h += step_cycles * dh;
+        // Advance by step_cycles, in sub-steps when the guard asks for them.
+        let mut remaining = step_cycles;
+        let mut rate_map = cw;
+        substeps = 0;
+        loop {
+            let rate = rate_map.depth.max();
+            let cap = life.max_substep_removal;
+            let dc = if cap > 0.0 && rate * remaining > cap * (1.0 + 1e-9) {
+                // Equal sub-steps over what is left of the step.
+                let n = (rate * remaining / cap).ceil();
+                remaining / n
+            } else {
+                remaining
+            };
+            for (h, dh) in state.removal.values.iter_mut().zip(&rate_map.depth.values) {
+                *h += dc * dh;
+            }
+            state.cycles += dc;
+            remaining -= dc;
+            substeps += 1;
+            if remaining <= 1e-9 * step_cycles {
+                break;
+            }
+            let l = analyse(&state.removal, &state)?;
+            rate_map = per_cycle(gear, geo, tca, &l);
         }
-        state.cycles += step_cycles;
         state.step += 1;
     }
     Ok(state)

@@ -318,6 +318,14 @@ impl FlankField {
     /// the grid's height parameter, linear between the two neighbouring columns; clamped at the
     /// grid's edges.
     pub fn at(&self, wf: &WheelFlank, r: f64, z: f64) -> f64 {
+        self.at_above(wf, r, z, None)
+    }
+
+    /// [`Self::at`] for a field defined only above a floor radius per node column (e.g. wear,
+    /// only where the worm flank reaches: above the worm-tip trace): a node below the floor
+    /// does not enter the interpolation, its neighbour above it is extended instead (so a step
+    /// of the field at the floor is not smeared over the points above it).
+    pub fn at_above(&self, wf: &WheelFlank, r: f64, z: f64, floor: Option<&[f64]>) -> f64 {
         let nj = self.cells_face;
         let ni = self.cells_height;
         let f = ((z - wf.z[0]) / (wf.z[nj] - wf.z[0]) * nj as f64).clamp(0.0, nj as f64);
@@ -328,7 +336,11 @@ impl FlankField {
                 .clamp(0.0, ni as f64);
             let i = (g as usize).min(ni - 1);
             let t = g - i as f64;
-            (1.0 - t) * self.node(i, j) + t * self.node(i + 1, j)
+            let (a, b) = (self.node(i, j), self.node(i + 1, j));
+            match floor {
+                Some(fl) if wf.node(i, j).r < fl[j] && r >= fl[j] => b,
+                _ => (1.0 - t) * a + t * b,
+            }
         };
         (1.0 - w) * column(j) + w * column(j + 1)
     }

@@ -207,6 +207,64 @@ pub struct Lubricant {
     pub composite_roughness: f64,
 }
 
+/// How the cycles of a wear step are chosen (MODEL §7.3).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum StepControl {
+    /// Fixed number of wheel cycles per step.
+    Cycles(f64),
+    /// Adaptive: each step removes at most this depth, m.
+    MaxRemoval(f64),
+}
+
+/// A phase of the life schedule (MODEL §8).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Phase {
+    /// Wear until the given cycles.
+    Wear { until: f64 },
+    /// Pitting until the given cycles: cells above the pressure limit (Pa; None: from the
+    /// endurance curve at the phase's duration times 1 + margin) are pitted, no wear.
+    Pitting {
+        until: f64,
+        pressure_limit: Option<f64>,
+        margin: f64,
+    },
+}
+
+/// Power-law pressure-life curve p_lim(N) = p_ref (N / N_ref)^-exponent (Pa, cycles).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Endurance {
+    pub reference_pressure: f64,
+    pub reference_cycles: f64,
+    pub exponent: f64,
+}
+
+impl Endurance {
+    /// CuSn12 disc-roller fit of MODEL §8: 425 MPa at 11e6 cycles, exponent 0.176.
+    pub const DEFAULT: Endurance = Endurance {
+        reference_pressure: 425e6,
+        reference_cycles: 11e6,
+        exponent: 0.176,
+    };
+
+    /// Endurance pressure for a life of n cycles, Pa.
+    pub fn pressure(&self, n: f64) -> f64 {
+        self.reference_pressure * (n / self.reference_cycles).powf(-self.exponent)
+    }
+}
+
+/// Life simulation plan.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct WearPlan {
+    /// Wheel cycles to simulate.
+    pub life_cycles: f64,
+    pub step: StepControl,
+    /// Stability guard: largest removal of one sub-step, m (0: no guard).
+    pub max_substep_removal: f64,
+    /// Phase schedule (empty: wear all along).
+    pub phases: Vec<Phase>,
+    pub endurance: Endurance,
+}
+
 /// Where the load is given.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum Torque {
@@ -274,6 +332,8 @@ pub struct GearSet {
     pub lubricant: Lubricant,
     pub conditions: Conditions,
     pub analysis: Analysis,
+    /// Life to simulate, when the file asks for one.
+    pub wear: Option<WearPlan>,
     /// Non-fatal remarks found during validation.
     pub warnings: Vec<String>,
 }

@@ -25,6 +25,59 @@ pub struct GearFile {
     pub conditions: ConditionsSpec,
     #[serde(default)]
     pub analysis: AnalysisSpec,
+    /// Life to simulate (wear stage); absent: no life run.
+    #[serde(default)]
+    pub wear: Option<WearSpec>,
+}
+
+/// Life simulation (MODEL §7.3, §8).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WearSpec {
+    /// Wheel cycles (revolutions) to simulate.
+    pub life_cycles: f64,
+    /// Adaptive steps: largest depth removed per step, um (default 4 when no step is given).
+    #[serde(default)]
+    pub step_wear_um: Option<f64>,
+    /// Fixed steps of this many wheel cycles (instead of step_wear_um).
+    #[serde(default)]
+    pub step_cycles: Option<f64>,
+    /// Stability guard: a step that would remove more than this somewhere is split into
+    /// sub-steps, um (default 5; 0 disables).
+    #[serde(default)]
+    pub max_substep_wear_um: Option<f64>,
+    /// Phase schedule (MODEL §8): wear and pitting phases, each until a number of cycles.
+    #[serde(default)]
+    pub phases: Vec<PhaseSpec>,
+    /// Bronze pressure-life curve p_lim(N) = p_ref (N / N_ref)^-exponent (default: MODEL §8).
+    #[serde(default)]
+    pub endurance: Option<EnduranceSpec>,
+}
+
+/// One phase of the schedule.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseSpec {
+    /// "wear" or "pitting".
+    pub kind: String,
+    /// The phase lasts until this many cycles.
+    pub until_cycles: f64,
+    /// Pitting: pressure limit, MPa (default: the endurance curve at the phase's duration,
+    /// raised by the margin).
+    #[serde(default)]
+    pub pressure_limit_mpa: Option<f64>,
+    /// Pitting: margin on the endurance pressure (default 0.1 = +10 %).
+    #[serde(default)]
+    pub margin: Option<f64>,
+}
+
+/// Power-law pressure-life curve.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnduranceSpec {
+    pub reference_pressure_mpa: f64,
+    pub reference_cycles: f64,
+    pub exponent: f64,
 }
 
 /// Worm or hob thread (both are helicoids; MODEL §2, §3.1).

@@ -274,6 +274,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     );
     let lubricant = lubricant(&mut ck, &f.lubricant);
     let conditions = conditions(&mut ck, &f.conditions);
+    let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
 
     let a = &f.analysis;
     let flank_cells_height =
@@ -563,6 +564,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             contact_band_factor: band_factor,
             solver,
         },
+        wear,
         warnings,
     })
 }
@@ -1006,6 +1008,122 @@ fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant> {
         thermal_conductivity: kf?,
         temperature: t? + 273.15,
         composite_roughness: rq? * 1e-6,
+    })
+}
+
+fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
+    let life = ck.positive("wear.life_cycles", w.life_cycles, 1e12, "cycles");
+    let step = match (w.step_wear_um, w.step_cycles) {
+        (Some(_), Some(c)) => {
+            ck.fail(
+                "wear.step_cycles",
+                c,
+                "give either wear.step_wear_um (adaptive) or wear.step_cycles (fixed), not both",
+            );
+            None
+        }
+        (None, Some(c)) => ck
+            .positive("wear.step_cycles", c, 1e12, "cycles")
+            .map(StepControl::Cycles),
+        (Some(d), None) => ck
+            .positive("wear.step_wear_um", d, 1000.0, "um")
+            .map(|d| StepControl::MaxRemoval(d * 1e-6)),
+        (None, None) => Some(StepControl::MaxRemoval(4e-6)),
+    };
+    let endurance = match &w.endurance {
+        None => Some(Endurance::DEFAULT),
+        Some(e) => {
+            let p = ck.positive(
+                "wear.endurance.reference_pressure_mpa",
+                e.reference_pressure_mpa,
+                1e5,
+                "MPa",
+            );
+            let n = ck.positive(
+                "wear.endurance.reference_cycles",
+                e.reference_cycles,
+                1e15,
+                "cycles",
+            );
+            let x = ck.range("wear.endurance.exponent", e.exponent, 0.0, 5.0, "");
+            match (p, n, x) {
+                (Some(p), Some(n), Some(x)) => Some(Endurance {
+                    reference_pressure: p * 1e6,
+                    reference_cycles: n,
+                    exponent: x,
+                }),
+                _ => None,
+            }
+        }
+    };
+    let mut phases = Vec::new();
+    let mut previous = 0.0;
+    let mut ok = true;
+    for (k, p) in w.phases.iter().enumerate() {
+        let field = |f: &str| format!("wear.phases[{k}].{f}");
+        let until = ck.positive(&field("until_cycles"), p.until_cycles, 1e12, "cycles");
+        let Some(until) = until else {
+            ok = false;
+            continue;
+        };
+        if until <= previous {
+            ck.fail(
+                &field("until_cycles"),
+                until,
+                format!("phases must end in increasing order (previous phase ends at {previous})"),
+            );
+            ok = false;
+        }
+        previous = until;
+        let kind = ck.choice(&field("kind"), &p.kind, &[("wear", false), ("pitting", true)]);
+        match kind {
+            Some(false) => {
+                if p.pressure_limit_mpa.is_some() || p.margin.is_some() {
+                    ck.fail(
+                        &field("pressure_limit_mpa"),
+                        p.pressure_limit_mpa.or(p.margin).unwrap_or_default(),
+                        "only pitting phases take a pressure limit or margin",
+                    );
+                    ok = false;
+                }
+                phases.push(Phase::Wear { until });
+            }
+            Some(true) => {
+                let limit = match p.pressure_limit_mpa {
+                    Some(v) => ck
+                        .positive(&field("pressure_limit_mpa"), v, 1e5, "MPa")
+                        .map(|v| Some(v * 1e6)),
+                    None => Some(None),
+                };
+                let margin = ck.range(&field("margin"), p.margin.unwrap_or(0.1), 0.0, 10.0, "");
+                match (limit, margin) {
+                    (Some(pressure_limit), Some(margin)) => phases.push(Phase::Pitting {
+                        until,
+                        pressure_limit,
+                        margin,
+                    }),
+                    _ => ok = false,
+                }
+            }
+            None => ok = false,
+        }
+    }
+    if !ok {
+        return None;
+    }
+    let guard = ck.range(
+        "wear.max_substep_wear_um",
+        w.max_substep_wear_um.unwrap_or(5.0),
+        0.0,
+        1000.0,
+        "um",
+    );
+    Some(WearPlan {
+        life_cycles: life?,
+        step: step?,
+        max_substep_removal: guard? * 1e-6,
+        phases,
+        endurance: endurance?,
     })
 }
 

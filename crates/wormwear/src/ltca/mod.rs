@@ -464,6 +464,12 @@ fn slice_cells(
     let nc = settings.columns.max(1);
     let ds = 2.0 * band / nc as f64;
     let z = slice.z;
+    // Worn material exists only where the worm flank reaches (above the worm-tip trace).
+    let tip_floor: Vec<f64> = if removal.is_some() {
+        tca.tip_trace.iter().map(|t| t.1).collect()
+    } else {
+        Vec::new()
+    };
     let (lo, hi) = wf.radial_range_at(z);
     let (_, slope) = wf.theta_at(slice.r_line, z);
     let drds = 1.0 / (1.0 + (slice.r_line * slope).powi(2)).sqrt();
@@ -532,7 +538,7 @@ fn slice_cells(
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error
-                + removal.map_or(0.0, |w| w.at(wf, r, z) / lever),
+                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(&tip_floor)) / lever),
             relief,
         });
     }

@@ -7,6 +7,7 @@
 pub mod geometry;
 pub mod ltca;
 pub mod tca;
+pub mod wear;
 
 use std::fmt::Write as _;
 use std::io::Write as _;

@@ -1,0 +1,304 @@
+//! Files of a life run, written after every completed state so an interruption loses nothing:
+//! the checkpoint `wear_checkpoint.json` (resume), `wear_steps.csv`, the `wear` section of
+//! summary.json, maps of the cumulative wear, of the wear per cycle and of the film ratio on the
+//! current geometry, curves over cycles (wear, backlash, TE, pressure), and loaded patterns at
+//! log-spaced states (0, 1, 2, 4, 8, ... and the last).
+
+use super::tca::{flank_cells, flank_outline, tip_trace_series};
+use super::{update_summary, write_atomic, Csv, OutputError};
+use crate::geometry::{FlankField, Geometry};
+use crate::input::WearPlan;
+use crate::kinematics::Tca;
+use crate::plot::{flank_map, line_chart, Series};
+use crate::wear::{StepView, WearState};
+use std::path::{Path, PathBuf};
+
+const UM: f64 = 1e6;
+const MPA: f64 = 1e-6;
+
+/// Name of the checkpoint file in the output directory.
+pub const CHECKPOINT: &str = "wear_checkpoint.json";
+
+/// The `wear` section of summary.json.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct WearSummary<'a> {
+    pub life_cycles: f64,
+    pub step_control: &'a crate::input::StepControl,
+    pub bending_model: &'a str,
+    /// One record per state: the start and after each step.
+    pub steps: &'a [crate::wear::StepRecord],
+}
+
+/// Reads a checkpoint written by [`write_state`].
+pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
+    let path = dir.join(CHECKPOINT);
+    match std::fs::read_to_string(&path) {
+        Ok(text) => serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| OutputError::Encode {
+                what: path.display().to_string(),
+                message: e.to_string(),
+            }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(source) => Err(OutputError::Io { path, source }),
+    }
+}
+
+/// Writes the files of one completed state (see the module doc). Returns the files written.
+pub fn write_state(
+    geo: &Geometry,
+    tca: &Tca,
+    plan: &WearPlan,
+    view: &StepView,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let state = view.state;
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let mut files = Vec::new();
+    // Checkpoint first: it is what a resume needs.
+    let text = serde_json::to_string(state).map_err(|e| OutputError::Encode {
+        what: CHECKPOINT.into(),
+        message: e.to_string(),
+    })?;
+    let path = dir.join(CHECKPOINT);
+    write_atomic(&path, text.as_bytes())?;
+    files.push(path);
+    // Steps table and summary.
+    let mut csv = Csv::new(&[
+        "step",
+        "cycles",
+        "step_cycles",
+        "max_wear_m",
+        "mean_wear_m",
+        "worn_volume_m3",
+        "backlash_m",
+        "backlash_increase_m",
+        "max_pressure_pa",
+        "mean_pressure_pa",
+        "contact_area_fraction",
+        "s1",
+        "s2",
+        "te_mean_rad",
+        "te_p2p_rad",
+        "mesh_stiffness_mean_nm_per_rad",
+        "max_wear_per_cycle_m",
+        "lambda_min",
+    ]);
+    for r in &state.records {
+        csv.row(&[
+            r.step as f64,
+            r.cycles,
+            r.step_cycles,
+            r.max_wear_m,
+            r.mean_wear_m,
+            r.worn_volume_m3,
+            r.backlash_m,
+            r.backlash_increase_m,
+            r.max_pressure_pa,
+            r.mean_pressure_pa,
+            r.contact_area_fraction,
+            r.s1,
+            r.s2,
+            r.te_mean_rad,
+            r.te_p2p_rad,
+            r.mesh_stiffness_mean_nm_per_rad,
+            r.max_wear_per_cycle_m,
+            r.lambda_min,
+        ]);
+    }
+    let path = dir.join("wear_steps.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let summary = WearSummary {
+        life_cycles: plan.life_cycles,
+        step_control: &plan.step,
+        bending_model: &view.ltca.bending_model,
+        steps: &state.records,
+    };
+    update_summary(
+        dir,
+        "wear",
+        serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
+            what: "wear summary".into(),
+            message: e.to_string(),
+        })?,
+    )?;
+    // Maps of the current state.
+    let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
+    let map = |path: &Path, title: &str, field: &FlankField, scale: f64, bar: &str| {
+        let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
+        let hi = values
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        flank_map(
+            path,
+            title,
+            "z2 across the face width (mm)",
+            "r wheel radius (mm)",
+            &flank_cells(wf, &values),
+            (0.0, if hi > 0.0 { hi } else { 1.0 }),
+            bar,
+            &overlays,
+            &[],
+        )
+    };
+    let r = state.records.last().expect("a state has a record");
+    let path = dir.join("wear_map.svg");
+    map(
+        &path,
+        &format!(
+            "Cumulative wear after {:.4e} cycles (max {:.2} um)",
+            r.cycles,
+            r.max_wear_m * UM
+        ),
+        &state.removal,
+        UM,
+        "wear depth (um)",
+    )?;
+    files.push(path);
+    let path = dir.join("wear_per_cycle_map.svg");
+    map(
+        &path,
+        &format!(
+            "Wear per cycle at {:.4e} cycles (max {:.3e} um)",
+            r.cycles,
+            r.max_wear_per_cycle_m * UM
+        ),
+        &view.cycle.depth,
+        UM,
+        "wear per cycle (um)",
+    )?;
+    files.push(path);
+    let lambda = FlankField {
+        values: view
+            .cycle
+            .lambda
+            .values
+            .iter()
+            .map(|v| v.min(4.0))
+            .collect(),
+        ..view.cycle.lambda.clone()
+    };
+    let path = dir.join("wear_film_ratio_map.svg");
+    flank_map(
+        &path,
+        &format!(
+            "Film ratio lambda at {:.4e} cycles (clipped at 4: no wear above)",
+            r.cycles
+        ),
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &flank_cells(wf, &lambda.cell_means()),
+        (0.0, 4.0),
+        "lambda",
+        &overlays,
+        &[],
+    )?;
+    files.push(path);
+    let mut csv = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "wear_m",
+        "wear_per_cycle_m",
+        "lambda",
+        "film_m",
+    ]);
+    for j in 0..=wf.cells_face {
+        for i in 0..=wf.cells_height {
+            let k = j * (wf.cells_height + 1) + i;
+            let n = wf.node(i, j);
+            csv.row(&[
+                i as f64,
+                j as f64,
+                n.r * 1e3,
+                n.z * 1e3,
+                state.removal.values[k],
+                view.cycle.depth.values[k],
+                view.cycle.lambda.values[k],
+                view.cycle.film.values[k],
+            ]);
+        }
+    }
+    let path = dir.join("wear_map.csv");
+    csv.write(&path)?;
+    files.push(path);
+    // Loaded pattern at log-spaced states.
+    if state.step == 0 || state.step.is_power_of_two() {
+        let path = dir.join(format!("wear_pattern_step{}.svg", state.step));
+        let values: Vec<f64> = view
+            .ltca
+            .pattern
+            .iter()
+            .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
+            .collect();
+        flank_map(
+            &path,
+            &format!(
+                "Loaded pattern at {:.4e} cycles (P_max {:.0} MPa, S0 {:.2})",
+                r.cycles,
+                r.max_pressure_pa * MPA,
+                r.contact_area_fraction
+            ),
+            "z2 across the face width (mm)",
+            "r wheel radius (mm)",
+            &flank_cells(wf, &values),
+            (0.0, r.max_pressure_pa * MPA),
+            "pressure (MPa)",
+            &overlays,
+            &[],
+        )?;
+        files.push(path);
+    }
+    // Curves over cycles.
+    let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
+        label: label.to_string(),
+        points: state.records.iter().map(|r| (r.cycles, f(r))).collect(),
+        color,
+        bold: true,
+    };
+    let charts: [(&str, &str, &str, Vec<Series>); 4] = [
+        (
+            "wear_backlash.svg",
+            "Backlash increase (tangential at r2, mean over positions)",
+            "backlash increase (um)",
+            vec![curve(&|r| r.backlash_increase_m * UM, "", 0)],
+        ),
+        (
+            "wear_depth.svg",
+            "Wear depth",
+            "depth (um)",
+            vec![
+                curve(&|r| r.max_wear_m * UM, "max", 1),
+                curve(&|r| r.mean_wear_m * UM, "mean over the flank", 0),
+            ],
+        ),
+        (
+            "wear_transmission_error.svg",
+            "Loaded transmission error over life",
+            "TE (urad, wheel)",
+            vec![
+                curve(&|r| r.te_mean_rad * UM, "mean", 0),
+                curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
+            ],
+        ),
+        (
+            "wear_pressure.svg",
+            "Contact pressure over life",
+            "pressure (MPa)",
+            vec![
+                curve(&|r| r.max_pressure_pa * MPA, "P_max", 1),
+                curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
+            ],
+        ),
+    ];
+    for (name, title, y, series) in charts {
+        let path = dir.join(name);
+        line_chart(&path, title, "wheel cycles", y, &series, false)?;
+        files.push(path);
+    }
+    Ok(files)
+}
