@@ -302,19 +302,25 @@ fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPla
     };
     if let Some(c) = args.cycles {
         if !(c.is_finite() && c > 0.0 && c <= 1e12) {
-            return Err(bad(format!("--cycles = {c}: must be a number of cycles in (0, 1e12]")));
+            return Err(bad(format!(
+                "--cycles = {c}: must be a number of cycles in (0, 1e12]"
+            )));
         }
         plan.life_cycles = c;
     }
     if let Some(c) = args.step_cycles {
         if !(c.is_finite() && c > 0.0 && c <= 1e12) {
-            return Err(bad(format!("--step-cycles = {c}: must be a number of cycles in (0, 1e12]")));
+            return Err(bad(format!(
+                "--step-cycles = {c}: must be a number of cycles in (0, 1e12]"
+            )));
         }
         plan.step = StepControl::Cycles(c);
     }
     if let Some(d) = args.step_wear_um {
         if !(d.is_finite() && d > 0.0 && d <= 1000.0) {
-            return Err(bad(format!("--step-wear-um = {d}: must be a depth in (0, 1000] um")));
+            return Err(bad(format!(
+                "--step-wear-um = {d}: must be a depth in (0, 1000] um"
+            )));
         }
         plan.step = StepControl::MaxRemoval(d * 1e-6);
     }
@@ -381,8 +387,17 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
         max_substep_removal: plan.max_substep_removal,
     };
     let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
-    let end = wormwear::wear::simulate(&gear, &geo, &tca, &settings, None, &life, state, &mut on_state)
-        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("wear simulation")))?;
+    let end = wormwear::wear::simulate(
+        &gear,
+        &geo,
+        &tca,
+        &settings,
+        None,
+        &life,
+        state,
+        &mut on_state,
+    )
+    .map_err(|e| Failure::Run(anyhow::Error::new(e).context("wear simulation")))?;
     progress.finish_and_clear();
     if !quiet {
         let first = end.records.first().expect("record");

@@ -83,8 +83,8 @@ pub fn thermal_factor(lub: &Lubricant, e_prime: f64, c: &LineContact) -> f64 {
         return 1.0;
     }
     let t = lub.temperature;
-    let lt = lub.viscosity * lub.thermo_viscosity * sum * sum
-        / (4.0 * lub.thermal_conductivity * t * t);
+    let lt =
+        lub.viscosity * lub.thermo_viscosity * sum * sum / (4.0 * lub.thermal_conductivity * t * t);
     let s = 2.0 * (c.u1 - c.u2).abs() / sum;
     let phi = (1.0 - 13.2 * (c.pressure / e_prime) * lt.powf(0.42))
         / (1.0 + 0.213 * (1.0 + 2.23 * s.powf(0.83)) * lt.powf(0.64));
@@ -177,7 +177,9 @@ mod tests {
             let wd = w / (e_prime * radius);
             let g = lub.pressure_viscosity * e_prime;
             let dh = 2.65 * u.powf(0.7) * g.powf(0.54) * wd.powf(-0.13) * radius;
-            eprintln!("u_m {um} w {w} R {radius}: Moes-Venner {h:.3e} m, Dowson-Higginson {dh:.3e} m");
+            eprintln!(
+                "u_m {um} w {w} R {radius}: Moes-Venner {h:.3e} m, Dowson-Higginson {dh:.3e} m"
+            );
             assert!((h / dh - 1.0).abs() < 0.08, "{h} vs {dh}");
         }
     }
@@ -207,7 +209,10 @@ mod tests {
                 pressure: 5e8,
             };
             let phi = thermal_factor(&lub, e_prime, &c);
-            assert!(phi > last && phi <= 1.0, "Phi_T must rise towards 1 as L_T -> 0");
+            assert!(
+                phi > last && phi <= 1.0,
+                "Phi_T must rise towards 1 as L_T -> 0"
+            );
             last = phi;
         }
         assert!(1.0 - last < 1e-3, "Phi_T at L_T -> 0: {last}");
@@ -217,7 +222,10 @@ mod tests {
     fn wear_coefficient_is_continuous() {
         let k = 2.5e-8;
         for &x in &[0.5, 4.0] {
-            let (a, b) = (wear_coefficient(k, x - 1e-12), wear_coefficient(k, x + 1e-12));
+            let (a, b) = (
+                wear_coefficient(k, x - 1e-12),
+                wear_coefficient(k, x + 1e-12),
+            );
             assert!((a - b).abs() < 1e-18, "jump at lambda = {x}");
         }
         assert_eq!(wear_coefficient(k, 0.1), k);

@@ -16,8 +16,8 @@
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::kinematics::{GapEvaluator, Tca};
-use crate::lubrication::{self, LineContact};
 use crate::ltca::Ltca;
+use crate::lubrication::{self, LineContact};
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -116,8 +116,9 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
     // Wheel speed, rad/s: converts wheel rotation into time.
     let wheel_speed = gear.conditions.worm_speed / gear.ratio();
     // Pressure profiles per (position, tooth, slice) from the local cells.
-    let mut profiles: HashMap<(usize, i32, usize), Vec<(f64, f64, f64, usize)>> =
-        HashMap::new();
+    // (r, p, width across the line, column) of the cells, per (position, tooth, slice).
+    type Profile = Vec<(f64, f64, f64, usize)>;
+    let mut profiles: HashMap<(usize, i32, usize), Profile> = HashMap::new();
     let mut last_column = 0;
     for pr in &ltca.positions {
         for (c, &p) in pr.cells.iter().zip(&pr.pressure) {
@@ -228,7 +229,8 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
             );
             // Sub-steps: the band moves at most a tenth of its width per sub-step.
             let width = (2.0 * reach).max(1e-9);
-            let steps = ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
+            let steps =
+                ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
             let w = 0.5 * (a.line_load + b.line_load);
             let fill = |x: f64, y: f64| {
                 if !x.is_finite() {
@@ -274,7 +276,7 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
                 let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
                 let kw = lubrication::wear_coefficient(k_dry, fl.lambda);
                 depth.values[k] += kw / hardness * nc.sliding_speed * integral;
-                if !(lambda.values[k] <= fl.lambda) {
+                if lambda.values[k].is_nan() || fl.lambda < lambda.values[k] {
                     lambda.values[k] = fl.lambda;
                     film.values[k] = fl.h_min * fl.thermal_factor;
                 }
@@ -342,7 +344,13 @@ impl Backlash {
                 for &k in &tca.teeth {
                     let offset = tca.sigma * k as f64 * tau;
                     for p in &wf.nodes {
-                        best = best.min(ev.angular(p.r, p.theta + offset, p.z, pos.theta2, pos.theta1));
+                        best = best.min(ev.angular(
+                            p.r,
+                            p.theta + offset,
+                            p.z,
+                            pos.theta2,
+                            pos.theta1,
+                        ));
                     }
                 }
                 best
@@ -508,15 +516,11 @@ pub fn simulate(
     on_state: &mut dyn FnMut(&StepView) -> Result<(), WearError>,
 ) -> Result<WearState, WearError> {
     let wf = geo.wheel_flank(tca.loaded_flank);
-    if state.removal.values.len() != wf.nodes.len()
-        || state.removal.cells_height != wf.cells_height
+    if state.removal.values.len() != wf.nodes.len() || state.removal.cells_height != wf.cells_height
     {
         return Err(WearError::Checkpoint(format!(
             "{} x {} cells, the gear has {} x {}",
-            state.removal.cells_height,
-            state.removal.cells_face,
-            wf.cells_height,
-            wf.cells_face
+            state.removal.cells_height, state.removal.cells_face, wf.cells_height, wf.cells_face
         )));
     }
     let backlash = Backlash::new(gear, geo, tca);

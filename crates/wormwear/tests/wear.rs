@@ -31,9 +31,26 @@ fn per_cycle_wear_converges_with_the_positions() {
     let (_, _, w40) = cycle(&g);
     let wf = geo.wheel_flank(tca.loaded_flank);
     let swept = w20.depth.values.iter().filter(|v| **v > 0.0).count();
-    let lmin = w20.lambda.values.iter().copied().filter(|v| v.is_finite()).fold(f64::INFINITY, f64::min);
-    let lmax = w20.lambda.values.iter().copied().filter(|v| v.is_finite()).fold(0.0, f64::max);
-    let u2: Vec<f64> = tca.node_contact.iter().filter(|c| c.reachable && c.u2.is_finite()).map(|c| c.u2.abs()).collect();
+    let lmin = w20
+        .lambda
+        .values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let lmax = w20
+        .lambda
+        .values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let u2: Vec<f64> = tca
+        .node_contact
+        .iter()
+        .filter(|c| c.reachable && c.u2.is_finite())
+        .map(|c| c.u2.abs())
+        .collect();
     eprintln!(
         "max per-cycle wear: 20 positions {:.4e} m, 40 positions {:.4e} m; nodes worn {swept} of {}; lambda {lmin:.3}..{lmax:.3}; |u2| {:.3}..{:.3} m/s; volume {:.3e} m^3",
         w20.depth.max(), w40.depth.max(), wf.nodes.len(),
@@ -41,5 +58,243 @@ fn per_cycle_wear_converges_with_the_positions() {
         w20.depth.integral(wf)
     );
     let d = (w40.depth.max() / w20.depth.max() - 1.0).abs();
-    assert!(d < 0.05, "20 -> 40 positions changes the max per-cycle wear by {:.2} %", 100.0 * d);
+    assert!(
+        d < 0.05,
+        "20 -> 40 positions changes the max per-cycle wear by {:.2} %",
+        100.0 * d
+    );
+}
+
+#[test]
+fn archard_wear_is_linear_in_k_and_in_one_over_h() {
+    // Geometry frozen (one loaded analysis): k(lambda) is proportional to K and the depth to
+    // 1/H, everywhere on the flank.
+    let g = example("gear-1x40-design.toml");
+    let (_, _, base) = cycle(&g);
+    let mut g2 = g.clone();
+    g2.wheel_material.wear_coefficient *= 2.0;
+    g2.wheel_material.hardness *= 4.0;
+    let (_, _, scaled) = cycle(&g2);
+    let mut worst: f64 = 0.0;
+    for (a, b) in base.depth.values.iter().zip(&scaled.depth.values) {
+        worst = worst.max((b - 0.5 * a).abs());
+    }
+    assert!(base.depth.max() > 0.0);
+    assert!(
+        worst <= 1e-12 * base.depth.max(),
+        "K x2, H x4 must halve the wear: {worst:e}"
+    );
+}
+
+fn life(
+    g: &GearSet,
+    cycles: f64,
+    step: wear::StepControl,
+    guard: f64,
+) -> (Geometry, kinematics::Tca, wear::WearState) {
+    let geo = Geometry::build(g).unwrap();
+    let tca = kinematics::analyse(g, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let settings = ltca::LtcaSettings::from_gear(g);
+    let plan = wear::LifeSettings {
+        cycles,
+        step,
+        max_substep_removal: guard,
+    };
+    let end = wear::simulate(
+        g,
+        &geo,
+        &tca,
+        &settings,
+        None,
+        &plan,
+        wear::WearState::new(wf),
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    (geo, tca, end)
+}
+
+#[test]
+fn with_the_geometry_frozen_wear_is_linear_in_cycles() {
+    // One step of C and one of 2C cycles from the unworn gear (no guard): the depth doubles.
+    let g = example("gear-1x40-design.toml");
+    let (_, _, a) = life(&g, 1000.0, wear::StepControl::Cycles(1000.0), 0.0);
+    let (_, _, b) = life(&g, 2000.0, wear::StepControl::Cycles(2000.0), 0.0);
+    for (x, y) in a.removal.values.iter().zip(&b.removal.values) {
+        assert!((y - 2.0 * x).abs() <= 1e-12 * a.removal.max());
+    }
+    // The records: the start and one step.
+    assert_eq!(b.records.len(), 2);
+    assert_eq!(b.records[1].cycles, 2000.0);
+}
+
+#[test]
+fn life_results_do_not_depend_on_the_wear_step() {
+    // Design case, 180 000 cycles: fixed steps of 30 000, 15 000, 10 000 cycles and adaptive
+    // 4 um steps (MODEL §7.3), with the default stability guard (5 um per sub-step).
+    let g = example("gear-1x40-design.toml");
+    let runs = [
+        ("30 000", wear::StepControl::Cycles(30_000.0)),
+        ("15 000", wear::StepControl::Cycles(15_000.0)),
+        ("10 000", wear::StepControl::Cycles(10_000.0)),
+        ("4 um", wear::StepControl::MaxRemoval(4e-6)),
+    ];
+    let results: Vec<(f64, f64, usize)> = runs
+        .iter()
+        .map(|(name, step)| {
+            let (_, _, end) = life(&g, 180_000.0, *step, 5e-6);
+            let last = end.records.last().unwrap();
+            let solves: usize = end.records.iter().map(|r| r.substeps).sum::<usize>() + 1;
+            eprintln!(
+                "steps {name}: {} steps, {solves} loaded analyses; max wear {:.3} um, backlash +{:.3} um, volume {:.4} mm^3",
+                last.step,
+                last.max_wear_m * 1e6,
+                last.backlash_increase_m * 1e6,
+                last.worn_volume_m3 * 1e9
+            );
+            (last.max_wear_m, last.backlash_increase_m, last.step)
+        })
+        .collect();
+    let (lo, hi) = results.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
+        (a.min(r.0), b.max(r.0))
+    });
+    assert!(
+        hi / lo - 1.0 < 0.03,
+        "max wear spread {:.2} %",
+        100.0 * (hi / lo - 1.0)
+    );
+    let (lo, hi) = results.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
+        (a.min(r.1), b.max(r.1))
+    });
+    assert!(
+        hi / lo - 1.0 < 0.03,
+        "backlash spread {:.2} %",
+        100.0 * (hi / lo - 1.0)
+    );
+}
+
+#[test]
+fn uniform_removal_raises_the_tangential_backlash_by_the_normal_depth_over_cos_an_cos_gamma() {
+    // A uniform normal removal d on the loaded flank opens the backlash at r2 by
+    // d / (cos(alpha_n) cos(gamma)) (tangential vs normal backlash of a worm gear); with
+    // tan(alpha_n) = tan(alpha_x) cos(gamma).
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let b = wear::Backlash::new(&g, &geo, &tca);
+    let zero = wormwear::geometry::FlankField::zeros(wf);
+    let mut uniform = zero.clone();
+    let d = 10e-6;
+    uniform.values.fill(d);
+    let j0 = b.stats(&zero);
+    let j1 = b.stats(&uniform);
+    let gamma = (g.worm.lead() / (2.0 * std::f64::consts::PI * g.worm.reference_radius)).atan();
+    let alpha_n = (21.81f64.to_radians().tan() * gamma.cos()).atan();
+    let expected = d / (alpha_n.cos() * gamma.cos());
+    let got = j1.linear_mean_m - j0.linear_mean_m;
+    eprintln!(
+        "backlash unworn {:.2} um (min {:.2e} max {:.2e} rad); +{:.3} um for 10 um normal, expected {:.3} um",
+        j0.linear_mean_m * 1e6,
+        j0.min_rad,
+        j0.max_rad,
+        got * 1e6,
+        expected * 1e6
+    );
+    assert!(j0.min_rad >= -1e-9, "negative backlash {:e}", j0.min_rad);
+    assert!((got / expected - 1.0).abs() < 0.02);
+}
+
+#[test]
+fn more_torque_wears_faster_and_higher_speed_wears_less() {
+    // Trends of MODEL §7 / REFERENCE_GEARS: per-cycle wear (worn volume of one cycle).
+    let g = example("gear-1x40-design.toml");
+    let volume = |g: &GearSet| {
+        let (geo, tca, w) = cycle(g);
+        w.depth.integral(geo.wheel_flank(tca.loaded_flank))
+    };
+    let base = volume(&g);
+    let mut heavy = g.clone();
+    heavy.conditions.torque = wormwear::input::Torque::Worm(90.0);
+    let mut fast = g.clone();
+    fast.conditions.worm_speed *= 3.0;
+    let (v_heavy, v_fast) = (volume(&heavy), volume(&fast));
+    eprintln!("per-cycle worn volume: 60 N m {base:.4e}, 90 N m {v_heavy:.4e}, 60 N m at 3x speed {v_fast:.4e} m^3");
+    assert!(v_heavy > 1.2 * base);
+    assert!(v_fast < base);
+}
+
+#[test]
+fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
+    // Run with the files written after every state; stop after the second record (an error
+    // from the writer, as an interruption); resume from the checkpoint on disk; compare with
+    // an uninterrupted run, record by record and the final wear map, exactly.
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let settings = ltca::LtcaSettings::from_gear(&g);
+    let plan = wormwear::input::WearPlan {
+        life_cycles: 40_000.0,
+        step: wear::StepControl::Cycles(10_000.0),
+        max_substep_removal: 5e-6,
+        phases: Vec::new(),
+        endurance: wormwear::input::Endurance::DEFAULT,
+    };
+    let life = wear::LifeSettings {
+        cycles: plan.life_cycles,
+        step: plan.step,
+        max_substep_removal: plan.max_substep_removal,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut written = 0;
+    let interrupted = wear::simulate(
+        &g,
+        &geo,
+        &tca,
+        &settings,
+        None,
+        &life,
+        wear::WearState::new(wf),
+        &mut |view| {
+            wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir.path())
+                .map_err(|e| wear::WearError::Output(e.to_string()))?;
+            written += 1;
+            if written == 2 {
+                return Err(wear::WearError::Output("interrupted".into()));
+            }
+            Ok(())
+        },
+    );
+    assert!(interrupted.is_err());
+    let saved = wormwear::output::wear::read_checkpoint(dir.path())
+        .unwrap()
+        .unwrap();
+    assert_eq!(saved.step, 1);
+    let resumed = wear::simulate(&g, &geo, &tca, &settings, None, &life, saved, &mut |view| {
+        wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir.path())
+            .map(|_| ())
+            .map_err(|e| wear::WearError::Output(e.to_string()))
+    })
+    .unwrap();
+    let straight = wear::simulate(
+        &g,
+        &geo,
+        &tca,
+        &settings,
+        None,
+        &life,
+        wear::WearState::new(wf),
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    assert_eq!(resumed.records.len(), 5);
+    assert_eq!(resumed.records, straight.records);
+    assert_eq!(resumed.removal, straight.removal);
+    // The summary on disk holds every state.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["wear"]["steps"].as_array().unwrap().len(), 5);
 }

@@ -1075,7 +1075,11 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             ok = false;
         }
         previous = until;
-        let kind = ck.choice(&field("kind"), &p.kind, &[("wear", false), ("pitting", true)]);
+        let kind = ck.choice(
+            &field("kind"),
+            &p.kind,
+            &[("wear", false), ("pitting", true)],
+        );
         match kind {
             Some(false) => {
                 if p.pressure_limit_mpa.is_some() || p.margin.is_some() {

@@ -153,7 +153,13 @@ impl Problem {
         let work_total: usize = self
             .blocks
             .iter()
-            .map(|b| b.size * x[b.start..b.start + b.size].iter().filter(|v| **v != 0.0).count())
+            .map(|b| {
+                b.size
+                    * x[b.start..b.start + b.size]
+                        .iter()
+                        .filter(|v| **v != 0.0)
+                        .count()
+            })
             .sum();
         if work_total > 60_000 {
             jobs.into_par_iter().for_each(work);
