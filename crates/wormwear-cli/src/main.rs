@@ -257,6 +257,7 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
     wormwear::output::tca::write_tca(&geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
     let files = wormwear::output::ltca::write_ltca(&geo, &tca, &result, dir, map_position)
         .map_err(|e| Failure::Run(e.into()))?;
+    wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
     for w in &tca.warnings {
         eprintln!("warning: {w}");
     }
@@ -354,6 +355,7 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
     };
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
+    let rating = wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
     let progress = if quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -381,11 +383,6 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
         ));
         Ok(())
     };
-    let life = wormwear::wear::LifeSettings {
-        cycles: plan.life_cycles,
-        step: plan.step,
-        max_substep_removal: plan.max_substep_removal,
-    };
     let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
     let end = wormwear::wear::simulate(
         &gear,
@@ -393,7 +390,7 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
         &tca,
         &settings,
         None,
-        &life,
+        &plan,
         state,
         &mut on_state,
     )
@@ -415,6 +412,10 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
             first.contact_area_fraction,
             last.contact_area_fraction,
             dir.display()
+        );
+        println!(
+            "rating (ISO/TR 14521): efficiency {:.3}, worm torque {:.2} N m, sigma_Hm {:.0} MPa, N_LI {:.3e} cycles",
+            rating.efficiency, rating.worm_torque_nm, rating.sigma_hm_mpa, rating.n_li_cycles
         );
     }
     Ok(())

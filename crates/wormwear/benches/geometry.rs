@@ -86,6 +86,43 @@ fn bench(c: &mut Criterion) {
         },
     );
     group.finish();
+    // One wear step of the design case (target 0.5 s): loaded analysis on a worn flank, wear of
+    // one cycle, backlash, geometry update.
+    let mut group = c.benchmark_group("wear");
+    group.sample_size(10);
+    let tca = wormwear::kinematics::analyse(&g140, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let backlash = wormwear::wear::Backlash::new(&g140, &geo, &tca);
+    let settings = wormwear::ltca::LtcaSettings::from_gear(&g140);
+    let mut removal = wormwear::geometry::FlankField::zeros(wf);
+    let l = wormwear::ltca::analyse(&g140, &geo, &tca).unwrap();
+    let first = wormwear::wear::per_cycle(&g140, &geo, &tca, &l);
+    for (h, d) in removal.values.iter_mut().zip(&first.depth.values) {
+        *h = 5000.0 * d;
+    }
+    group.bench_function(
+        "1x40 one wear step (LTCA on the worn flank + wear + backlash)",
+        |b| {
+            b.iter(|| {
+                let l = wormwear::ltca::analyse_worn(
+                    black_box(&g140),
+                    &geo,
+                    &tca,
+                    &settings,
+                    None,
+                    Some(&removal),
+                )
+                .unwrap();
+                let w = wormwear::wear::per_cycle(&g140, &geo, &tca, &l);
+                let mut next = removal.clone();
+                for (h, d) in next.values.iter_mut().zip(&w.depth.values) {
+                    *h += 1000.0 * d;
+                }
+                backlash.stats(&next)
+            })
+        },
+    );
+    group.finish();
 }
 
 criterion_group!(benches, bench);

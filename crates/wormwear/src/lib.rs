@@ -23,4 +23,5 @@ pub mod ltca;
 pub mod lubrication;
 pub mod output;
 pub mod plot;
+pub mod rating;
 pub mod wear;

@@ -34,6 +34,8 @@ pub struct CycleWear {
     pub film: FlankField,
     /// Line load at the passage, N/m (0 where not swept).
     pub line_load: FlankField,
+    /// Half-width of the loaded band when it passes (the largest), m (0 where not swept).
+    pub half_width: FlankField,
 }
 
 /// One instant of the contact band's passage over a node column: the pressure profile across
@@ -54,6 +56,8 @@ struct Sample {
     line_load: f64,
     pressure: f64,
     radius: f64,
+    /// Half of the loaded width across the line (cells with pressure), m.
+    half_width: f64,
 }
 
 impl Sample {
@@ -163,7 +167,10 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
             }
             _ => (0.0, 0.0, 0.0),
         };
+        let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
+        let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
         columns[line.slice].push(Sample {
+            half_width,
             time: tca.sigma * theta2,
             centre,
             extend_low,
@@ -186,6 +193,7 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
     let mut lambda = FlankField::zeros(wf);
     let mut film = FlankField::zeros(wf);
     let mut line_load = FlankField::zeros(wf);
+    let mut half_width = FlankField::zeros(wf);
     lambda.values.fill(f64::NAN);
     film.values.fill(f64::NAN);
     // Rolling velocities per node; where the TCA has none (nodes at the border of the region
@@ -281,6 +289,7 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
                     film.values[k] = fl.h_min * fl.thermal_factor;
                 }
                 line_load.values[k] = line_load.values[k].max(w);
+                half_width.values[k] = half_width.values[k].max(a.half_width.max(b.half_width));
             }
         }
     }
@@ -289,6 +298,7 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
         lambda,
         film,
         line_load,
+        half_width,
     }
 }
 
@@ -401,17 +411,7 @@ impl Backlash {
 
 pub use crate::input::StepControl;
 
-/// Life to simulate.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct LifeSettings {
-    /// Total wheel cycles (revolutions).
-    pub cycles: f64,
-    pub step: StepControl,
-    /// Stability guard: a step that would remove more than this depth somewhere is split into
-    /// equal sub-steps, each with the pressures recomputed (explicit wear steps of about 10 um
-    /// go unstable, MODEL §7.3); 0 disables. m.
-    pub max_substep_removal: f64,
-}
+pub use crate::input::{Phase, WearPlan};
 
 /// State of a life run after a completed step: what a checkpoint holds.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -424,6 +424,12 @@ pub struct WearState {
     pub removal: FlankField,
     /// Records of the states so far (the initial one and one per completed step).
     pub records: Vec<StepRecord>,
+    /// Pitting phases (indices in the schedule) whose pits have been cut.
+    #[serde(default)]
+    pub pitted_phases: Vec<usize>,
+    /// Pitted nodes of the loaded flank (empty: none).
+    #[serde(default)]
+    pub pitted: Vec<bool>,
 }
 
 impl WearState {
@@ -434,6 +440,8 @@ impl WearState {
             cycles: 0.0,
             removal: FlankField::zeros(wf),
             records: Vec::new(),
+            pitted_phases: Vec::new(),
+            pitted: Vec::new(),
         }
     }
 }
@@ -449,6 +457,11 @@ pub struct StepRecord {
     pub step_cycles: f64,
     /// Sub-steps that step was split into by the stability guard (1: not split).
     pub substeps: usize,
+    /// Phase of the schedule at these cycles: "wear" or "pitting".
+    pub phase: String,
+    /// Share of the active flank area pitted so far (pits cut at the starts of pitting
+    /// phases).
+    pub pitted_area_fraction: f64,
     /// Largest depth worn, m.
     pub max_wear_m: f64,
     /// Worn volume / active flank area (mean depth over the flank), m.
@@ -499,11 +512,14 @@ pub struct StepView<'a> {
     pub cycle: &'a CycleWear,
 }
 
-/// Runs the life (MODEL §7.3-7.7) from `state` (unworn, or a checkpoint): at each state the
-/// loaded analysis on the worn geometry, the wear of one cycle, a record; then a step of
-/// C_k cycles (fixed, or removing at most the given depth) with the geometry frozen; until
-/// the life is reached. `on_state` is called after every record (checkpoint, files); an error
-/// from it stops the run.
+/// Runs the life (MODEL §7.3-7.7, §8) from `state` (unworn, or a checkpoint): at each state
+/// the loaded analysis on the worn geometry, the wear of one cycle, a record; then, in a wear
+/// phase, a step of C_k cycles (fixed, or removing at most the given depth; never across a
+/// phase end) with the geometry frozen; at the start of a pitting phase the pits are cut
+/// (every node whose loaded-pattern pressure exceeds the phase's limit loses 0.78 a, a the
+/// Hertz half-width there), then the phase passes without wear. Until the life is reached.
+/// `on_state` is called after every record (checkpoint, files); an error from it stops the
+/// run.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     gear: &GearSet,
@@ -511,7 +527,7 @@ pub fn simulate(
     tca: &Tca,
     settings: &crate::ltca::LtcaSettings,
     bending: Option<&dyn crate::ltca::BendingModel>,
-    life: &LifeSettings,
+    life: &WearPlan,
     mut state: WearState,
     on_state: &mut dyn FnMut(&StepView) -> Result<(), WearError>,
 ) -> Result<WearState, WearError> {
@@ -528,6 +544,23 @@ pub fn simulate(
     let area = wf.active_area();
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    if state.pitted.len() != wf.nodes.len() {
+        state.pitted = vec![false; wf.nodes.len()];
+    }
+    // Phase at some cycles: (index, phase, end), None after the schedule (wear).
+    let phase_at = |cycles: f64| -> Option<(usize, Phase, f64)> {
+        let mut start = 0.0;
+        for (k, p) in life.phases.iter().enumerate() {
+            let end = match *p {
+                Phase::Wear { until } | Phase::Pitting { until, .. } => until,
+            };
+            if cycles < end * (1.0 - 1e-12) && cycles >= start * (1.0 - 1e-12) {
+                return Some((k, *p, end));
+            }
+            start = end;
+        }
+        None
+    };
     let analyse = |removal: &FlankField, state: &WearState| {
         crate::ltca::analyse_worn(gear, geo, tca, settings, bending, Some(removal)).map_err(
             |source| WearError::Ltca {
@@ -544,11 +577,17 @@ pub fn simulate(
         let (te_mean, te_p2p) = l.te_stats();
         let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
         let volume = state.removal.integral(wf);
+        let phase = phase_at(state.cycles);
         let record = StepRecord {
             step: state.step,
             cycles: state.cycles,
             step_cycles,
             substeps,
+            phase: match phase {
+                Some((_, Phase::Pitting { .. }, _)) => "pitting".into(),
+                _ => "wear".into(),
+            },
+            pitted_area_fraction: pitted_fraction(wf, &state.pitted),
             max_wear_m: state.removal.max(),
             mean_wear_m: volume / area,
             worn_volume_m3: volume,
@@ -576,10 +615,47 @@ pub fn simulate(
             ltca: &l,
             cycle: &cw,
         })?;
-        let left = life.cycles - state.cycles;
-        if left <= 1e-9 * life.cycles.max(1.0) {
+        let left = life.life_cycles - state.cycles;
+        if left <= 1e-9 * life.life_cycles.max(1.0) {
             break;
         }
+        let left = match phase {
+            Some((
+                k,
+                Phase::Pitting {
+                    pressure_limit,
+                    margin,
+                    ..
+                },
+                end,
+            )) => {
+                if !state.pitted_phases.contains(&k) {
+                    // Cut the pits (same cycles; the next record shows the new pressures).
+                    let duration = end - state.cycles;
+                    let limit = pressure_limit
+                        .unwrap_or_else(|| life.endurance.pressure(duration) * (1.0 + margin));
+                    cut_pits(
+                        wf,
+                        &l.pattern,
+                        limit,
+                        &cw.half_width,
+                        &mut state.removal,
+                        &mut state.pitted,
+                    );
+                    state.pitted_phases.push(k);
+                    step_cycles = 0.0;
+                } else {
+                    // No wear while the cracks incubate.
+                    step_cycles = end - state.cycles;
+                    state.cycles = end;
+                }
+                substeps = 1;
+                state.step += 1;
+                continue;
+            }
+            Some((_, Phase::Wear { .. }, end)) => left.min(end - state.cycles),
+            None => left,
+        };
         let rate = cw.depth.max();
         step_cycles = match life.step {
             StepControl::Cycles(c) => c.min(left),
@@ -615,4 +691,58 @@ pub fn simulate(
         state.step += 1;
     }
     Ok(state)
+}
+
+/// Share of the active flank area around pitted nodes (cells with a pitted corner).
+fn pitted_fraction(wf: &WheelFlank, pitted: &[bool]) -> f64 {
+    let ni = wf.cells_height;
+    let mut area = 0.0;
+    for j in 0..wf.cells_face {
+        for i in 0..ni {
+            let corners = [
+                j * (ni + 1) + i,
+                j * (ni + 1) + i + 1,
+                (j + 1) * (ni + 1) + i,
+                (j + 1) * (ni + 1) + i + 1,
+            ];
+            if corners.iter().any(|&k| pitted[k]) {
+                area += wf.cell_area[j * ni + i];
+            }
+        }
+    }
+    area / wf.active_area()
+}
+
+/// Cuts the pits of a pitting phase (MODEL §8): every node whose loaded-pattern pressure (the
+/// largest of its cells) exceeds `limit` loses 0.78 a more, a the half-width of the loaded
+/// band there (depth of the largest shear stress under a line contact).
+fn cut_pits(
+    wf: &WheelFlank,
+    pattern: &[f64],
+    limit: f64,
+    half_width: &FlankField,
+    removal: &mut FlankField,
+    pitted: &mut [bool],
+) {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    for j in 0..=nj {
+        for i in 0..=ni {
+            let mut p: f64 = 0.0;
+            for (ci, cj) in [
+                (i, j),
+                (i.wrapping_sub(1), j),
+                (i, j.wrapping_sub(1)),
+                (i.wrapping_sub(1), j.wrapping_sub(1)),
+            ] {
+                if ci < ni && cj < nj {
+                    p = p.max(pattern[cj * ni + ci]);
+                }
+            }
+            let k = j * (ni + 1) + i;
+            if p > limit && half_width.values[k] > 0.0 {
+                removal.values[k] += 0.78 * half_width.values[k];
+                pitted[k] = true;
+            }
+        }
+    }
 }

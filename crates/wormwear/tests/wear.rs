@@ -96,10 +96,12 @@ fn life(
     let tca = kinematics::analyse(g, &geo).unwrap();
     let wf = geo.wheel_flank(tca.loaded_flank);
     let settings = ltca::LtcaSettings::from_gear(g);
-    let plan = wear::LifeSettings {
-        cycles,
+    let plan = wear::WearPlan {
+        life_cycles: cycles,
         step,
         max_substep_removal: guard,
+        phases: Vec::new(),
+        endurance: wormwear::input::Endurance::DEFAULT,
     };
     let end = wear::simulate(
         g,
@@ -242,11 +244,7 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
         phases: Vec::new(),
         endurance: wormwear::input::Endurance::DEFAULT,
     };
-    let life = wear::LifeSettings {
-        cycles: plan.life_cycles,
-        step: plan.step,
-        max_substep_removal: plan.max_substep_removal,
-    };
+    let life = plan.clone();
     let dir = tempfile::tempdir().unwrap();
     let mut written = 0;
     let interrupted = wear::simulate(

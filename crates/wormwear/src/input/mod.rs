@@ -265,6 +265,29 @@ pub struct WearPlan {
     pub endurance: Endurance,
 }
 
+/// Factors of the standard ratings (MODEL §9) the user may set.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct RatingFactors {
+    /// Product of the mesh-friction factors Y_S Y_G Y_W Y_R (size, geometry, material,
+    /// roughness).
+    pub friction_factor: f64,
+    /// Product of the pitting-limit life factors Z_h Z_v Z_s Z_u Z_oil.
+    pub pitting_life_factor: f64,
+    /// Allowable pitted flank share at the end of the growth phase A_p10,max, %.
+    pub pitted_area_max_percent: f64,
+}
+
+impl Default for RatingFactors {
+    /// All factors 1, A_p10,max 8 %.
+    fn default() -> Self {
+        Self {
+            friction_factor: 1.0,
+            pitting_life_factor: 1.0,
+            pitted_area_max_percent: 8.0,
+        }
+    }
+}
+
 /// Where the load is given.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum Torque {
@@ -334,6 +357,8 @@ pub struct GearSet {
     pub analysis: Analysis,
     /// Life to simulate, when the file asks for one.
     pub wear: Option<WearPlan>,
+    /// Factors of the standard ratings.
+    pub rating: RatingFactors,
     /// Non-fatal remarks found during validation.
     pub warnings: Vec<String>,
 }

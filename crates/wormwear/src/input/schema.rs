@@ -28,6 +28,27 @@ pub struct GearFile {
     /// Life to simulate (wear stage); absent: no life run.
     #[serde(default)]
     pub wear: Option<WearSpec>,
+    /// Factors of the standard ratings (ISO/TR 14521).
+    #[serde(default)]
+    pub rating: RatingSpec,
+}
+
+/// Factors of the standard ratings; each defaults to 1 (A_p10,max to 8 %).
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RatingSpec {
+    /// Mesh friction: size factor Y_S (standard: (100 / a_mm)^0.5).
+    pub friction_size_factor: Option<f64>,
+    /// Mesh friction: geometry factor Y_G.
+    pub friction_geometry_factor: Option<f64>,
+    /// Mesh friction: material factor Y_W.
+    pub friction_material_factor: Option<f64>,
+    /// Mesh friction: roughness factor Y_R (standard: (Ra1_um / 0.5)^0.25).
+    pub friction_roughness_factor: Option<f64>,
+    /// Product of the pitting-limit life factors Z_h Z_v Z_s Z_u Z_oil.
+    pub pitting_life_factor: Option<f64>,
+    /// Allowable pitted flank share at the end of pitting growth A_p10,max, %.
+    pub pitted_area_max_percent: Option<f64>,
 }
 
 /// Life simulation (MODEL §7.3, §8).

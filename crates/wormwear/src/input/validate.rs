@@ -275,6 +275,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let lubricant = lubricant(&mut ck, &f.lubricant);
     let conditions = conditions(&mut ck, &f.conditions);
     let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
+    let rating = rating_factors(&mut ck, &f.rating);
 
     let a = &f.analysis;
     let flank_cells_height =
@@ -565,6 +566,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             solver,
         },
         wear,
+        rating: rating.unwrap_or_default(),
         warnings,
     })
 }
@@ -1008,6 +1010,60 @@ fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant> {
         thermal_conductivity: kf?,
         temperature: t? + 273.15,
         composite_roughness: rq? * 1e-6,
+    })
+}
+
+fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
+    let mut factor = |name: &str, v: Option<f64>, d: f64, lo: f64, hi: f64| match v {
+        Some(v) => ck.range(&format!("rating.{name}"), v, lo, hi, ""),
+        None => Some(d),
+    };
+    let ys = factor(
+        "friction_size_factor",
+        r.friction_size_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yg = factor(
+        "friction_geometry_factor",
+        r.friction_geometry_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yw = factor(
+        "friction_material_factor",
+        r.friction_material_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yr = factor(
+        "friction_roughness_factor",
+        r.friction_roughness_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let z = factor(
+        "pitting_life_factor",
+        r.pitting_life_factor,
+        1.0,
+        0.01,
+        100.0,
+    );
+    let ap = factor(
+        "pitted_area_max_percent",
+        r.pitted_area_max_percent,
+        8.0,
+        2.0 + 1e-9,
+        100.0,
+    );
+    Some(RatingFactors {
+        friction_factor: ys? * yg? * yw? * yr?,
+        pitting_life_factor: z?,
+        pitted_area_max_percent: ap?,
     })
 }
 

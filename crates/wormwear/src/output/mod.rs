@@ -77,6 +77,20 @@ pub fn update_summary(
     write_atomic(&path, text.as_bytes())
 }
 
+/// Writes the `rating` section of summary.json (MODEL §9) and returns the ratings.
+pub fn write_rating(
+    gear: &crate::input::GearSet,
+    dir: &Path,
+) -> Result<crate::rating::Rating, OutputError> {
+    let r = crate::rating::rate(gear);
+    let value = serde_json::to_value(r).map_err(|e| OutputError::Encode {
+        what: "rating".into(),
+        message: e.to_string(),
+    })?;
+    update_summary(dir, "rating", value)?;
+    Ok(r)
+}
+
 /// A CSV table built in memory and written atomically.
 #[derive(Debug, Clone)]
 pub struct Csv {

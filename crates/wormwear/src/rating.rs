@@ -1,0 +1,191 @@
+//! Standard ratings beside the model (MODEL §9: ISO/TR 14521, DIN 3996, method C formulas):
+//! efficiency with its four loss terms, mean Hertz stress sigma_Hm with p_m*, pitting lives
+//! N_LI / N_LII / N_L(I+II) and Stahl's N_LI, wear limits. The formulas are written in the
+//! standard's units (N/mm^2, mm, rpm, N m); the results are SI, units in the field names.
+
+use crate::input::{GearSet, ProfileType, Torque};
+use std::f64::consts::PI;
+
+pub use crate::input::RatingFactors;
+
+/// Ratings of one operating case (units in the names).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Rating {
+    pub efficiency: f64,
+    /// Mesh efficiency eta_z alone.
+    pub mesh_efficiency: f64,
+    pub worm_torque_nm: f64,
+    pub wheel_torque_nm: f64,
+    /// Sliding speed at the reference diameter, m/s.
+    pub sliding_speed_m_s: f64,
+    /// Mean mesh friction coefficient mu_zm.
+    pub friction_coefficient: f64,
+    /// Loss terms, W: mesh, churning (idle), bearings, seals.
+    pub loss_mesh_w: f64,
+    pub loss_churning_w: f64,
+    pub loss_bearings_w: f64,
+    pub loss_seals_w: f64,
+    /// Output power, W.
+    pub output_power_w: f64,
+    /// Mean Hertz stress parameter p_m* and stress sigma_Hm.
+    pub p_m_star: f64,
+    pub sigma_hm_mpa: f64,
+    /// Pitting safety S_H = sigma_HG / sigma_Hm.
+    pub pitting_safety: f64,
+    /// Wheel cycles to first pitting (A_p10 = 2 %), to the end of the growth phase, and the
+    /// check value N_L(I+II).
+    pub n_li_cycles: f64,
+    pub n_lii_cycles: f64,
+    pub n_l_i_ii_cycles: f64,
+    /// Stahl's N_LI (CuSn12Ni2, polyglycol), valid for sigma_Hm <= 500 N/mm^2 (NaN above).
+    pub n_li_stahl_cycles: f64,
+    /// Wear limits in the normal section, m: tip not pointed, and from the maximum backlash.
+    pub wear_limit_pointed_tip_m: f64,
+    pub wear_limit_backlash_m: f64,
+    /// Profile shift coefficient x2 and the lead angle at the reference diameter used.
+    pub profile_shift: f64,
+    pub lead_angle_deg: f64,
+}
+
+/// Mesh friction of bronze against steel with polyglycol, dip lubrication (MODEL §9):
+/// mu_0T = 0.024 + 0.0032 / (v_g + 0.1)^1.71, capped at 0.094.
+pub fn base_friction(sliding_speed: f64) -> f64 {
+    (0.024 + 0.0032 / (sliding_speed + 0.1).powf(1.71)).min(0.094)
+}
+
+/// Parameter p_m* of the mean Hertz stress (method C). alpha in degrees.
+#[allow(clippy::too_many_arguments)]
+pub fn p_m_star(
+    profile: ProfileType,
+    a_mm: f64,
+    d_m1_mm: f64,
+    x2: f64,
+    q1: f64,
+    z1: f64,
+    z2: f64,
+    alpha_deg: f64,
+) -> f64 {
+    let shift = x2 * x2.abs().powf(3.18);
+    let lead = (x2 + 0.005657) / z2 * (z1 / q1).powf(2.6872);
+    match profile {
+        ProfileType::C => {
+            0.1401 + 0.1866 * a_mm / d_m1_mm + 0.0595 * shift + 0.0419 * q1
+                - 0.00288 * z2
+                - 0.0089 * alpha_deg
+                + 35.1417 * lead
+        }
+        _ => {
+            0.1794 + 0.2389 * a_mm / d_m1_mm + 0.0761 * shift + 0.0536 * q1
+                - 0.00369 * z2
+                - 0.01136 * alpha_deg
+                + 44.9814 * lead
+        }
+    }
+}
+
+/// Ratings for the gear's operating case with the file's factors. The wheel torque follows
+/// from the worm torque by the efficiency (fixed point: the losses depend on the output) or is
+/// given.
+pub fn rate(gear: &GearSet) -> Rating {
+    let factors = &gear.rating;
+    let w = &gear.worm;
+    let z1 = w.starts as f64;
+    let z2 = gear.wheel.teeth as f64;
+    let u = z2 / z1;
+    let m_x = w.axial_pitch / PI * 1e3; // mm
+    let d_m1 = 2.0 * w.reference_radius * 1e3; // mm
+    let d_m2 = 2.0 * gear.wheel_reference_radius() * 1e3; // mm
+    let a = gear.operating.centre_distance * 1e3; // mm
+    let x2 = (a - 0.5 * (d_m1 + d_m2)) / m_x;
+    let q1 = d_m1 / m_x;
+    let gamma = (w.lead() / (PI * d_m1 * 1e-3)).atan();
+    let n1 = gear.conditions.worm_speed * 60.0 / (2.0 * PI); // rpm
+    let v_g = d_m1 * n1 * PI / (60_000.0 * gamma.cos());
+    let mu = base_friction(v_g) * factors.friction_factor;
+    let eta_z = gamma.tan() / (gamma + mu.atan()).tan();
+    let losses = |t2: f64| {
+        let p2 = t2 * (n1 / u) * 2.0 * PI / 60.0;
+        let mesh = 0.1 * t2 * n1 / u * (1.0 / eta_z - 1.0);
+        let churning = 0.89e-4 * a * n1.powf(4.0 / 3.0);
+        let bearings = 0.03 * p2 * a.powf(0.44) * u / d_m2;
+        let seals = 11.78e-6 * d_m1 * d_m1 * n1;
+        (p2, mesh, churning, bearings, seals)
+    };
+    let efficiency_at = |t2: f64| {
+        let (p2, mesh, churning, bearings, seals) = losses(t2);
+        p2 / (p2 + mesh + churning + bearings + seals)
+    };
+    let (t1, t2) = match gear.conditions.torque {
+        Torque::Wheel(t2) => (t2 / (u * efficiency_at(t2)), t2),
+        Torque::Worm(t1) => {
+            // T2 = T1 u eta(T2): fixed point (the losses are nearly linear in T2).
+            let mut t2 = t1 * u * eta_z;
+            for _ in 0..100 {
+                let next = t1 * u * efficiency_at(t2);
+                if (next - t2).abs() <= 1e-12 * t2 {
+                    t2 = next;
+                    break;
+                }
+                t2 = next;
+            }
+            (t1, t2)
+        }
+    };
+    let (p2, mesh, churning, bearings, seals) = losses(t2);
+    let efficiency = p2 / (p2 + mesh + churning + bearings + seals);
+    // Mean Hertz stress (N/mm^2).
+    let e1 = gear.worm_material.youngs_modulus * 1e-6;
+    let e2 = gear.wheel_material.youngs_modulus * 1e-6;
+    let (v1, v2) = (
+        gear.worm_material.poisson_ratio,
+        gear.wheel_material.poisson_ratio,
+    );
+    let e_red = 2.0 / ((1.0 - v1 * v1) / e1 + (1.0 - v2 * v2) / e2);
+    let alpha_deg = match w.profile {
+        ProfileType::C => w.axial_pressure_angle.to_degrees(),
+        _ => w.normal_pressure_angle.to_degrees(),
+    };
+    let pm = p_m_star(w.profile, a, d_m1, x2, q1, z1, z2, alpha_deg);
+    let sigma_hm = 4.0 / PI * (pm * t2 * 1e3 * e_red / a.powi(3)).sqrt();
+    let sigma_lim = gear.wheel_material.pitting_limit * 1e-6;
+    let sigma_hg = sigma_lim * factors.pitting_life_factor;
+    let v_ref = 3.0;
+    let n_li = 1e6
+        * (1.0 + 0.860 * (3.0 * v_g / v_ref).ln())
+        * (28.078 - 4.666 * (520.0 * sigma_hm / sigma_lim).ln()).exp();
+    let n_lii = (factors.pitted_area_max_percent - 2.0) * 1e6
+        / (16.212 * (sigma_hm - 180.0) / sigma_lim
+            * (1.541 * sigma_hm / sigma_lim - 0.581 * v_g / v_ref).exp());
+    let n_l_i_ii =
+        3e6 * (v_g / v_ref) * (24.924 - 4.047 * (520.0 * sigma_hm / sigma_lim).ln()).exp();
+    let n_li_stahl = if sigma_hm <= 500.0 {
+        (2650.0 / sigma_hm).powf(7.8)
+    } else {
+        f64::NAN
+    };
+    let alpha_0 = w.normal_pressure_angle;
+    Rating {
+        efficiency,
+        mesh_efficiency: eta_z,
+        worm_torque_nm: t1,
+        wheel_torque_nm: t2,
+        sliding_speed_m_s: v_g,
+        friction_coefficient: mu,
+        loss_mesh_w: mesh,
+        loss_churning_w: churning,
+        loss_bearings_w: bearings,
+        loss_seals_w: seals,
+        output_power_w: p2,
+        p_m_star: pm,
+        sigma_hm_mpa: sigma_hm,
+        pitting_safety: sigma_hg / sigma_hm,
+        n_li_cycles: n_li,
+        n_lii_cycles: n_lii,
+        n_l_i_ii_cycles: n_l_i_ii,
+        n_li_stahl_cycles: n_li_stahl,
+        wear_limit_pointed_tip_m: m_x * 1e-3 * gamma.cos() * (PI / 2.0 - 2.0 * alpha_0.tan()),
+        wear_limit_backlash_m: 0.3 * m_x * 1e-3 * gamma.cos(),
+        profile_shift: x2,
+        lead_angle_deg: gamma.to_degrees(),
+    }
+}
