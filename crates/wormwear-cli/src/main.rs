@@ -80,6 +80,21 @@ enum Command {
         #[command(flatten)]
         life: LifeArgs,
     },
+    /// The whole pipeline the file asks for: geometry, unloaded and loaded analyses, ratings,
+    /// and the life when the file has a [wear] section (or --cycles is given).
+    #[command(
+        after_help = "Examples:\n  wormwear run examples/gear-1x40-design.toml -o out/1x40\n  \
+                      wormwear run examples/gear-1x40-case-c.toml -o out/c --no-pitting"
+    )]
+    Run {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        life: LifeArgs,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -129,6 +144,7 @@ fn main() -> ExitCode {
             map_position,
         } => ltca(file, output, *map_position, cli.quiet),
         Command::Wear { file, output, life } => wear(file, output, life, cli.quiet),
+        Command::Run { file, output, life } => run(file, output, life, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -417,6 +433,21 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
             "rating (ISO/TR 14521): efficiency {:.3}, worm torque {:.2} N m, sigma_Hm {:.0} MPa, N_LI {:.3e} cycles",
             rating.efficiency, rating.worm_torque_nm, rating.sigma_hm_mpa, rating.n_li_cycles
         );
+    }
+    Ok(())
+}
+
+fn run(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let with_life = gear.wear.is_some() || args.cycles.is_some();
+    if with_life {
+        // Check the overrides before any work.
+        life_plan(&gear, args)?;
+    }
+    geometry(file, dir, quiet)?;
+    ltca(file, dir, 0, quiet)?;
+    if with_life {
+        wear(file, dir, args, quiet)?;
     }
     Ok(())
 }

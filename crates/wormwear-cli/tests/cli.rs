@@ -247,3 +247,123 @@ fn ltca_writes_its_section_plots_and_tables() {
         assert!(r["torque_balance"].as_f64().unwrap() < 1e-6);
     }
 }
+
+#[test]
+fn run_writes_every_stage_and_the_life() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["-q", "run"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "20000", "--step-cycles", "10000"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.is_empty(), "--quiet prints nothing");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    for section in ["input", "geometry", "tca", "ltca", "rating", "wear"] {
+        assert!(summary.get(section).is_some(), "section {section} missing");
+    }
+    let steps = summary["wear"]["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 3);
+    for key in [
+        "cycles",
+        "max_wear_m",
+        "mean_wear_m",
+        "worn_volume_m3",
+        "backlash_increase_m",
+        "max_pressure_pa",
+        "mean_pressure_pa",
+        "contact_area_fraction",
+        "te_mean_rad",
+        "te_p2p_rad",
+        "mesh_stiffness_mean_nm_per_rad",
+    ] {
+        assert!(steps[2][key].as_f64().is_some(), "steps[].{key} missing");
+    }
+    assert_eq!(steps[2]["cycles"].as_f64(), Some(20000.0));
+    for key in [
+        "efficiency",
+        "worm_torque_nm",
+        "sigma_hm_mpa",
+        "n_li_cycles",
+    ] {
+        assert!(
+            summary["rating"][key].as_f64().is_some(),
+            "rating.{key} missing"
+        );
+    }
+    assert_files(
+        dir.path(),
+        &[
+            "wear_steps.csv",
+            "wear_map.csv",
+            "wear_map.svg",
+            "wear_per_cycle_map.svg",
+            "wear_film_ratio_map.svg",
+            "wear_backlash.svg",
+            "wear_transmission_error.svg",
+            "wear_pressure.svg",
+            "wear_pattern_step0.svg",
+            "wear_checkpoint.json",
+            "ltca_pattern.svg",
+        ],
+    );
+    // Resuming a finished run recomputes its last state and leaves the results unchanged.
+    let again = bin()
+        .args(["-q", "wear"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "20000", "--step-cycles", "10000", "--resume"])
+        .output()
+        .unwrap();
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    let resumed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(resumed["wear"]["steps"], summary["wear"]["steps"]);
+}
+
+#[test]
+fn wear_input_errors_exit_2_and_name_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &[&str], &str); 4] = [
+        ("gear-k-2x25.toml", &[], "[wear]"),
+        ("gear-1x40-design.toml", &["--cycles=-5"], "--cycles = -5"),
+        (
+            "gear-1x40-design.toml",
+            &["--step-wear-um", "0"],
+            "--step-wear-um = 0",
+        ),
+        (
+            "gear-1x40-design.toml",
+            &["--resume"],
+            "no wear_checkpoint.json",
+        ),
+    ];
+    for (file, extra, message) in cases {
+        let out = bin()
+            .arg("wear")
+            .arg(example(file))
+            .arg("-o")
+            .arg(dir.path())
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{file} {extra:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(message), "{file} {extra:?}: {err}");
+    }
+}
