@@ -49,6 +49,7 @@ fn problem(cells: &[ContactCell], gap: impl Fn(&Vector3<f64>) -> f64, load: f64)
         low_rank: None,
         separation: cells.iter().map(|c| gap(&c.centre)).collect(),
         load,
+        upper: None,
     }
 }
 
@@ -132,4 +133,78 @@ fn long_cylinder_on_a_plane_matches_line_contact_hertz() {
     assert!(across >= 20);
     assert!((pmax / p0c - 1.0).abs() < 0.02, "p_max {pmax:e} vs {p0c:e}");
     assert!((b_num / bc - 1.0).abs() < 0.02, "b {b_num:e} vs {bc:e}");
+}
+
+#[test]
+fn pressure_cap_gives_an_elastic_perfectly_plastic_contact() {
+    // Sphere on a plane with the pressure capped at 0.8 p0 (Hertz): the load is still carried,
+    // no cell exceeds the cap, cells at the cap penetrate (plastic flow: negative gap) while
+    // the others satisfy the elastic complementarity, the load spreads out and the approach
+    // increases. A cap above p0 changes nothing.
+    let (radius, load) = (10e-3, 100.0);
+    let e_star = pair().effective_modulus;
+    let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
+    let p0 = 3.0 * load / (2.0 * PI * a * a);
+    let n = 30;
+    let h = 1.6 * a / n as f64;
+    let cells = flat_cells(n, n, h, h);
+    let area = cells[0].area();
+    let elastic_problem = problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+    let settings = SolverSettings {
+        tolerance: 1e-9,
+        ..SolverSettings::default()
+    };
+    let elastic = solve(&elastic_problem, &settings, None).unwrap();
+    let with_cap = |cap: f64| {
+        let mut pb = elastic_problem.clone();
+        pb.upper = Some(vec![cap * area; cells.len()]);
+        solve(&pb, &settings, None).unwrap()
+    };
+    let high = with_cap(1.1 * p0);
+    let worst = elastic
+        .q
+        .iter()
+        .zip(&high.q)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-6 * load,
+        "a cap above p0 changed the solution by {worst:e} N"
+    );
+    let cap = 0.8 * p0;
+    let plastic = with_cap(cap);
+    let total: f64 = plastic.q.iter().sum();
+    assert!((total / load - 1.0).abs() < 1e-12);
+    let capped = plastic.q.iter().filter(|&&q| q >= cap * area).count();
+    let loaded = |q: &[f64]| q.iter().filter(|&&q| q > 0.0).count();
+    eprintln!(
+        "cap 0.8 p0: {capped} plastic cells, loaded cells {} (elastic {}), approach {:.4e} m (elastic {:.4e}), residuals {:?}",
+        loaded(&plastic.q),
+        loaded(&elastic.q),
+        plastic.approach,
+        elastic.approach,
+        plastic.residuals
+    );
+    assert!(capped > 0 && plastic.residuals.capped == capped);
+    for (q, y) in plastic.q.iter().zip(&plastic.gap) {
+        assert!(*q <= cap * area * (1.0 + 1e-12));
+        if *q >= cap * area {
+            assert!(
+                *y <= 1e-9 * plastic.approach,
+                "capped cell with an open gap {y:e}"
+            );
+        }
+    }
+    assert!(plastic.residuals.complementarity < 1e-8);
+    assert!(plastic.residuals.min_gap > -1e-8);
+    // The load spreads outwards (second moment of the load about the axis) and the bodies come
+    // closer.
+    let spread = |q: &[f64]| -> f64 {
+        q.iter()
+            .zip(&cells)
+            .map(|(q, c)| q * (c.centre.x.powi(2) + c.centre.y.powi(2)))
+            .sum()
+    };
+    assert!(spread(&plastic.q) > spread(&elastic.q));
+    assert!(plastic.approach > elastic.approach);
 }

@@ -332,6 +332,9 @@ pub struct Analysis {
     pub contact_slice_step: usize,
     pub contact_columns: usize,
     pub contact_band_factor: f64,
+    /// Largest contact pressure of the loaded analysis (the wheel's flow pressure; cells at it
+    /// are plastic), Pa; infinite: no cap.
+    pub contact_pressure_cap: f64,
     /// LTCA solver.
     pub solver: crate::ltca::solver::SolverKind,
 }

@@ -352,6 +352,10 @@ pub struct AnalysisSpec {
     /// line load (widened automatically when the load reaches the band edge).
     #[serde(default = "default_band_factor")]
     pub contact_band_factor: f64,
+    /// LTCA: largest contact pressure, MPa (cells at it are plastic); default the wheel's
+    /// hardness; 0 = no cap.
+    #[serde(default)]
+    pub contact_pressure_cap_mpa: Option<f64>,
     /// LTCA solver: "conjugate-gradient" (default) or "fixed-point" (the published scheme).
     #[serde(default = "default_solver")]
     pub solver: String,
@@ -406,6 +410,7 @@ impl Default for AnalysisSpec {
             contact_slice_step: default_slice_step(),
             contact_columns: default_contact_columns(),
             contact_band_factor: default_band_factor(),
+            contact_pressure_cap_mpa: None,
             solver: default_solver(),
         }
     }

@@ -295,6 +295,17 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let stl_teeth = ck.int_range("analysis.stl_wheel_teeth", a.stl_wheel_teeth, 0, 500);
     let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
     let contact_columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
+    if let Some(v) = a.contact_pressure_cap_mpa {
+        if v != 0.0 {
+            ck.range(
+                "analysis.contact_pressure_cap_mpa",
+                v,
+                10.0,
+                100_000.0,
+                "MPa (0 = no cap)",
+            );
+        }
+    }
     let band_factor = ck.range(
         "analysis.contact_band_factor",
         a.contact_band_factor,
@@ -523,6 +534,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     else {
         unreachable_input()?
     };
+    let wheel_hardness = wheel_material.hardness;
     Ok(GearSet {
         title: f.title.clone().unwrap_or_default(),
         worm,
@@ -563,6 +575,11 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             contact_slice_step: slice_step as usize,
             contact_columns: contact_columns as usize,
             contact_band_factor: band_factor,
+            contact_pressure_cap: match a.contact_pressure_cap_mpa {
+                Some(0.0) => f64::INFINITY,
+                Some(v) => v * 1e6,
+                None => wheel_hardness,
+            },
             solver,
         },
         wear,

@@ -40,6 +40,8 @@ pub struct LtcaSettings {
     pub columns: usize,
     /// Half-width of the band across the line, in Hertz half-widths at the mean line load.
     pub band_factor: f64,
+    /// Largest contact pressure (elastic-perfectly-plastic cells above it), Pa; infinite: none.
+    pub pressure_cap: f64,
     pub solver: SolverSettings,
 }
 
@@ -50,6 +52,7 @@ impl LtcaSettings {
             slice_step: a.contact_slice_step,
             columns: a.contact_columns,
             band_factor: a.contact_band_factor,
+            pressure_cap: a.contact_pressure_cap,
             solver: SolverSettings {
                 kind: a.solver,
                 ..SolverSettings::default()
@@ -378,8 +381,9 @@ fn local_mesh(
     let tau = 2.0 * PI / teeth as f64;
     let step = settings.slice_step.max(1);
     let base_dz = (wf.z[1] - wf.z[0]) * step as f64;
-    // Separation threshold for slices whose minimum is not a crossing (flank edges).
-    let edge_threshold = 50e-6;
+    // Separation threshold for slices whose minimum is not a crossing (flank edges); on a worn
+    // flank the edges left standing can be the first to touch: raised by the deepest wear.
+    let edge_threshold = 50e-6 + removal.map_or(0.0, |w| w.max());
     // Line crossings of every node column at this position, to follow the line.
     let crossings: std::collections::HashMap<(i32, usize), &crate::kinematics::SliceContact> = tca
         .contact_lines
@@ -415,14 +419,21 @@ fn local_mesh(
             continue;
         }
         let tooth_index = tca.teeth.iter().position(|&k| k == line.tooth).unwrap_or(0);
+        // On a worn flank the band goes where the worn gap is smallest on the column (the TCA
+        // node gaps plus the removal over each node's lever), which need not be the unworn line.
+        let (r_line, at_end) = match removal {
+            Some(w) => worn_minimum(tca, wf, w, n, tooth_index, line.slice)
+                .unwrap_or((line.r, line.at_end)),
+            None => (line.r, line.at_end),
+        };
         base.push(Slice {
             tooth: line.tooth,
             tooth_index,
             base: line.slice,
             z: wf.z[line.slice],
             half_dz: 0.5 * base_dz,
-            r_line: line.r,
-            line_step: if line.at_end {
+            r_line,
+            line_step: if at_end {
                 None
             } else {
                 direction(line.tooth, line.slice).map(|d| d * base_dz)
@@ -444,6 +455,42 @@ fn local_mesh(
             )
         })
         .collect()
+}
+
+/// Radius of the smallest worn angular gap on node column j of tooth index t at position n
+/// (parabola through the best node and its neighbours), and whether it is at a column end.
+fn worn_minimum(
+    tca: &Tca,
+    wf: &WheelFlank,
+    removal: &FlankField,
+    n: usize,
+    t: usize,
+    j: usize,
+) -> Option<(f64, bool)> {
+    let ni = wf.cells_height;
+    let nodes = wf.nodes.len();
+    let base = (n * tca.teeth.len() + t) * nodes;
+    let worn = |i: usize| {
+        let k = j * (ni + 1) + i;
+        let p = &wf.nodes[k];
+        let lever = GapEvaluator::lever(&p.position(), &p.normal_vec());
+        tca.node_gaps[base + k] + removal.values[k] / lever
+    };
+    let values: Vec<f64> = (0..=ni).map(worn).collect();
+    let (best, _) = values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .min_by(|a, b| a.1.total_cmp(b.1))?;
+    let r = |i: usize| wf.node(i, j).r;
+    if best == 0 || best == ni || !values[best - 1].is_finite() || !values[best + 1].is_finite() {
+        return Some((r(best), true));
+    }
+    let (a, b, c) = (values[best - 1], values[best], values[best + 1]);
+    let den = a - 2.0 * b + c;
+    let shift = if den > 0.0 { 0.5 * (a - c) / den } else { 0.0 };
+    let h = r(best + 1) - r(best);
+    Some((r(best) + shift.clamp(-0.5, 0.5) * h, false))
 }
 
 /// The cells of one slice: `columns` cells of width 2 band / columns along the flank's
@@ -621,7 +668,14 @@ fn solve_position(
             }
             s.signum()
         };
+        let upper = settings.pressure_cap.is_finite().then(|| {
+            cells
+                .iter()
+                .map(|c| settings.pressure_cap * c.cell.area() * c.lever)
+                .collect()
+        });
         let mut problem = Problem {
+            upper,
             blocks,
             low_rank,
             separation: cells.iter().map(|c| c.separation).collect(),

@@ -41,6 +41,9 @@ pub struct Problem {
     pub separation: Vec<f64>,
     /// Total load W (sum of q).
     pub load: f64,
+    /// Optional caps q_i <= upper_i (a pressure cap times area and lever: elastic-perfectly-
+    /// plastic cells); honoured by the conjugate-gradient solver only.
+    pub upper: Option<Vec<f64>>,
 }
 
 /// Which solver.
@@ -83,6 +86,8 @@ pub struct Residuals {
     /// min_i q_i / max_i q_i (must be >= 0).
     pub min_load: f64,
     pub iterations: usize,
+    /// Cells at their cap (plastic), excluded from the two gap residuals.
+    pub capped: usize,
 }
 
 /// Solution of the problem.
@@ -184,9 +189,17 @@ impl Problem {
         }
     }
 
-    /// Residuals of q with approach alpha.
+    /// Residuals of q with approach alpha (cells at their cap are in plastic flow: their
+    /// negative gap is not a penetration and their gap need not close).
     fn residuals(&self, q: &[f64], gap: &[f64], approach: f64, iterations: usize) -> Residuals {
-        residuals_at_load(self.load, q, gap, approach, iterations)
+        residuals_at_load(
+            self.load,
+            q,
+            gap,
+            approach,
+            iterations,
+            self.upper.as_deref(),
+        )
     }
 
     fn validate(&self) -> Result<(), SolverError> {
@@ -254,17 +267,115 @@ fn initial(problem: &Problem, warm: Option<&[f64]>) -> Vec<f64> {
         .collect()
 }
 
-/// Polonsky-Keer conjugate gradient with active set (Polonsky & Keer, Wear 1999), with the
-/// load constraint sum q = W and the approach as its multiplier.
+/// Polonsky-Keer conjugate gradient, with optional caps q <= c (elastic-perfectly-plastic
+/// cells: at the cap a cell carries it whatever its gap, which may then be negative — plastic
+/// flow). Caps by an outer active set: cells above their cap are fixed at it and the PK solve
+/// repeated for the others; fixed cells whose gap opens are freed.
 fn conjugate_gradient(
     problem: &Problem,
     settings: &SolverSettings,
     warm: Option<&[f64]>,
 ) -> Result<Solution, SolverError> {
     let n = problem.len();
+    let q0 = initial(problem, warm);
+    let Some(cap) = problem.upper.as_ref() else {
+        return pk_inner(problem, settings, q0, &vec![false; n]);
+    };
+    let capacity: f64 = cap
+        .iter()
+        .zip(&problem.separation)
+        .filter(|(_, e)| e.is_finite())
+        .map(|(c, _)| c)
+        .sum();
+    if capacity <= problem.load {
+        return Err(SolverError::Invalid(format!(
+            "the pressure cap lets the reachable cells carry only {capacity:e} of the load {:e}",
+            problem.load
+        )));
+    }
+    let mut fixed = vec![false; n];
+    let mut q = q0;
+    let mut iterations = 0;
+    for _ in 0..200 {
+        // Loads for this pass: fixed cells at their caps, the others scaled to the rest.
+        for i in 0..n {
+            if fixed[i] {
+                q[i] = cap[i];
+            }
+        }
+        let rest = problem.load - (0..n).filter(|&i| fixed[i]).map(|i| cap[i]).sum::<f64>();
+        let free: f64 = (0..n).filter(|&i| !fixed[i]).map(|i| q[i]).sum();
+        if rest <= 0.0 {
+            // Too many fixed: free the one with the largest gap... or all, and retry.
+            fixed.iter_mut().for_each(|f| *f = false);
+            continue;
+        }
+        if free > 0.0 {
+            for i in 0..n {
+                if !fixed[i] {
+                    q[i] *= rest / free;
+                }
+            }
+        } else {
+            let open: Vec<usize> = (0..n)
+                .filter(|&i| !fixed[i] && problem.separation[i].is_finite())
+                .collect();
+            for &i in &open {
+                q[i] = rest / open.len() as f64;
+            }
+        }
+        let mut sol = pk_inner(problem, settings, q.clone(), &fixed)?;
+        iterations += sol.residuals.iterations;
+        let tol = settings.tolerance * sol.approach.abs();
+        let mut changed = false;
+        for i in 0..n {
+            if !fixed[i] && sol.q[i] > cap[i] * (1.0 + 1e-12) {
+                fixed[i] = true;
+                changed = true;
+            } else if fixed[i] && sol.gap[i] > tol {
+                fixed[i] = false;
+                changed = true;
+            }
+        }
+        if !changed {
+            sol.residuals.iterations = iterations;
+            return Ok(sol);
+        }
+        q = sol.q;
+    }
+    Err(SolverError::Invalid(
+        "the plastic (capped) set of the contact did not settle in 200 passes".into(),
+    ))
+}
+
+/// Polonsky-Keer conjugate gradient with active set (Polonsky & Keer, Wear 1999), with the
+/// load constraint sum q = W and the approach as its multiplier. Cells marked `fixed` keep
+/// their load q0 (the caps of [`conjugate_gradient`]); the others carry the rest.
+fn pk_inner(
+    problem: &Problem,
+    settings: &SolverSettings,
+    q0: Vec<f64>,
+    fixed: &[bool],
+) -> Result<Solution, SolverError> {
+    let n = problem.len();
     let e = &problem.separation;
-    let open: Vec<bool> = e.iter().map(|v| v.is_finite()).collect();
-    let mut q = initial(problem, warm);
+    let open: Vec<bool> = e
+        .iter()
+        .zip(fixed)
+        .map(|(v, f)| v.is_finite() && !f)
+        .collect();
+    let mut q = q0;
+    // The fixed cells' displacements, once.
+    let q_fixed: Vec<f64> = (0..n).map(|i| if fixed[i] { q[i] } else { 0.0 }).collect();
+    let fixed_load: f64 = q_fixed.iter().sum();
+    let load = problem.load - fixed_load;
+    let mut u_fixed = vec![0.0; n];
+    problem.apply(&q_fixed, &mut u_fixed);
+    for i in 0..n {
+        if fixed[i] {
+            q[i] = 0.0;
+        }
+    }
     let mut g = vec![0.0; n];
     let mut t = vec![0.0; n];
     let mut r = vec![0.0; n];
@@ -288,7 +399,12 @@ fn conjugate_gradient(
             exact = true;
         }
         for i in 0..n {
-            g[i] = if open[i] { u[i] + e[i] } else { f64::INFINITY };
+            // Fixed (capped) cells keep a gap too: the outer loop frees them when it opens.
+            g[i] = if open[i] || fixed[i] {
+                u[i] + u_fixed[i] + e[i]
+            } else {
+                f64::INFINITY
+            };
         }
         let (mut sum, mut count) = (0.0, 0usize);
         for i in 0..n {
@@ -323,6 +439,9 @@ fn conjugate_gradient(
                 continue;
             }
             let gap: Vec<f64> = g.clone();
+            for i in 0..n {
+                q[i] += q_fixed[i];
+            }
             let residuals = problem.residuals(&q, &gap, approach, it);
             return Ok(Solution {
                 q,
@@ -362,12 +481,13 @@ fn conjugate_gradient(
         // Cells outside the loaded set that would penetrate join it (PK's overlap step).
         let gmax = g
             .iter()
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, |m, v| m.max(v.abs()));
+            .zip(&open)
+            .filter(|(v, o)| **o && v.is_finite())
+            .fold(0.0f64, |m, (v, _)| m.max(v.abs()));
         let tau_overlap = if tau > 0.0 {
             tau
         } else {
-            problem.load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
+            load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
         };
         let mut overlap = false;
         for i in 0..n {
@@ -382,7 +502,7 @@ fn conjugate_gradient(
         if total <= 0.0 {
             return Err(SolverError::Invalid("load vanished".into()));
         }
-        let s = problem.load / total;
+        let s = load / total;
         q.iter_mut().for_each(|v| *v *= s);
         // u <- s (u - tau K t + K c), c the projection's changes.
         problem.apply(&correction, &mut kc);
@@ -398,6 +518,9 @@ fn conjugate_gradient(
             / problem.load;
     }
     let gap = g.clone();
+    for i in 0..n {
+        q[i] += q_fixed[i];
+    }
     let res = problem.residuals(&q, &gap, approach, settings.max_iterations);
     Err(SolverError::NotConverged {
         kind: SolverKind::ConjugateGradient,
@@ -489,7 +612,14 @@ pub fn affine_load_update(
     settings: &SolverSettings,
 ) -> Option<(Solution, f64)> {
     let n = problem.len();
-    let active: Vec<bool> = solution.q.iter().map(|&q| q > 0.0).collect();
+    // The free cells (loaded, below their cap) move with the load; capped cells stay.
+    let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
+    let active: Vec<bool> = solution
+        .q
+        .iter()
+        .enumerate()
+        .map(|(i, &q)| q > 0.0 && q < cap(i))
+        .collect();
     // Conjugate gradient on the loaded set for K_AA v = 1, preconditioned by the exact
     // Cholesky factors of the contact blocks restricted to the loaded set (exact in one step
     // without bending; the bending term is low rank, so few more steps with it).
@@ -547,7 +677,11 @@ pub fn affine_load_update(
         .zip(&v)
         .map(|(q, x)| q + dw * x / sum_v)
         .collect();
-    if q.iter().zip(&active).any(|(&qi, &a)| a && qi <= 0.0) {
+    if q.iter()
+        .zip(&active)
+        .enumerate()
+        .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
+    {
         return None;
     }
     let approach = solution.approach + dw / sum_v;
@@ -557,10 +691,25 @@ pub fn affine_load_update(
         .map(|i| u[i] + problem.separation[i] - approach)
         .collect();
     let tol = settings.tolerance * approach.abs();
-    if (0..n).any(|i| !active[i] && problem.separation[i].is_finite() && gap[i] < -tol) {
+    if (0..n).any(|i| {
+        !active[i]
+            && problem.separation[i].is_finite()
+            && if q[i] >= cap(i) {
+                gap[i] > tol
+            } else {
+                gap[i] < -tol
+            }
+    }) {
         return None;
     }
-    let residuals = residuals_at_load(load, &q, &gap, approach, solution.residuals.iterations);
+    let residuals = residuals_at_load(
+        load,
+        &q,
+        &gap,
+        approach,
+        solution.residuals.iterations,
+        problem.upper.as_deref(),
+    );
     Some((
         Solution {
             q,
@@ -579,12 +728,18 @@ fn residuals_at_load(
     gap: &[f64],
     approach: f64,
     iterations: usize,
+    upper: Option<&[f64]>,
 ) -> Residuals {
     let scale = approach.abs().max(f64::MIN_POSITIVE);
     let qmax = q.iter().copied().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let mut comp: f64 = 0.0;
     let mut min_gap = f64::INFINITY;
-    for (qi, yi) in q.iter().zip(gap) {
+    let mut capped = 0;
+    for (i, (qi, yi)) in q.iter().zip(gap).enumerate() {
+        if upper.is_some_and(|u| *qi >= u[i]) {
+            capped += 1;
+            continue;
+        }
         if *qi > 0.0 {
             comp = comp.max(yi.abs() * (qi / qmax).min(1.0));
         }
@@ -598,6 +753,7 @@ fn residuals_at_load(
         min_gap: min_gap / scale,
         min_load: q.iter().copied().fold(f64::INFINITY, f64::min) / qmax,
         iterations,
+        capped,
     }
 }
 
