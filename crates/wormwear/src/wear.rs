@@ -430,6 +430,10 @@ pub struct WearState {
     /// Pitted nodes of the loaded flank (empty: none).
     #[serde(default)]
     pub pitted: Vec<bool>,
+    /// Band factor of the local contact meshes reached by the widenings so far (None: the
+    /// settings' own).
+    #[serde(default)]
+    pub band_factor: Option<f64>,
 }
 
 impl WearState {
@@ -442,6 +446,7 @@ impl WearState {
             records: Vec::new(),
             pitted_phases: Vec::new(),
             pitted: Vec::new(),
+            band_factor: None,
         }
     }
 }
@@ -510,6 +515,8 @@ pub struct StepView<'a> {
     pub state: &'a WearState,
     pub ltca: &'a Ltca,
     pub cycle: &'a CycleWear,
+    /// The last state of the run (the life is reached).
+    pub last: bool,
 }
 
 /// Runs the life (MODEL §7.3-7.7, §8) from `state` (unworn, or a checkpoint): at each state
@@ -561,17 +568,32 @@ pub fn simulate(
         }
         None
     };
-    let analyse = |removal: &FlankField, state: &WearState| {
-        crate::ltca::analyse_worn(gear, geo, tca, settings, bending, Some(removal)).map_err(
+    // The worn contact widens: the band of the local meshes starts as wide as the last
+    // analysis needed (no repeated widenings), carried in the state for an exact resume.
+    let analyse = |removal: &FlankField, state: &mut WearState| {
+        let mut local = *settings;
+        local.band_factor = state.band_factor.unwrap_or(settings.band_factor);
+        let l = crate::ltca::analyse_worn(gear, geo, tca, &local, bending, Some(removal)).map_err(
             |source| WearError::Ltca {
                 step: state.step,
                 cycles: state.cycles,
                 source,
             },
-        )
+        )?;
+        let widenings = l
+            .positions
+            .iter()
+            .map(|p| p.band_widenings)
+            .max()
+            .unwrap_or(0);
+        if widenings > 0 {
+            state.band_factor = Some((local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0));
+        }
+        Ok::<_, WearError>(l)
     };
     loop {
-        let l = analyse(&state.removal, &state)?;
+        let removal = state.removal.clone();
+        let l = analyse(&removal, &mut state)?;
         let cw = per_cycle(gear, geo, tca, &l);
         let b = backlash.stats(&state.removal);
         let (te_mean, te_p2p) = l.te_stats();
@@ -610,13 +632,15 @@ pub fn simulate(
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
         state.records.push(record);
+        let left = life.life_cycles - state.cycles;
+        let last = left <= 1e-9 * life.life_cycles.max(1.0);
         on_state(&StepView {
             state: &state,
             ltca: &l,
             cycle: &cw,
+            last,
         })?;
-        let left = life.life_cycles - state.cycles;
-        if left <= 1e-9 * life.life_cycles.max(1.0) {
+        if last {
             break;
         }
         let left = match phase {
@@ -685,7 +709,8 @@ pub fn simulate(
             if remaining <= 1e-9 * step_cycles {
                 break;
             }
-            let l = analyse(&state.removal, &state)?;
+            let removal = state.removal.clone();
+            let l = analyse(&removal, &mut state)?;
             rate_map = per_cycle(gear, geo, tca, &l);
         }
         state.step += 1;

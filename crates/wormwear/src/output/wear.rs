@@ -1,8 +1,8 @@
 //! Files of a life run, written after every completed state so an interruption loses nothing:
 //! the checkpoint `wear_checkpoint.json` (resume), `wear_steps.csv`, the `wear` section of
-//! summary.json, maps of the cumulative wear, of the wear per cycle and of the film ratio on the
-//! current geometry, curves over cycles (wear, backlash, TE, pressure), and loaded patterns at
-//! log-spaced states (0, 1, 2, 4, 8, ... and the last).
+//! summary.json and curves over cycles (wear, backlash, TE, pressure) at every state; maps of
+//! the cumulative wear, of the wear per cycle and of the film ratio, the node table and the
+//! loaded pattern at log-spaced states (0, 1, 2, 4, 8, ...) and the last.
 
 use super::tca::{flank_cells, flank_outline, tip_trace_series};
 use super::{update_summary, write_atomic, Csv, OutputError};
@@ -123,6 +123,59 @@ pub fn write_state(
             message: e.to_string(),
         })?,
     )?;
+    // Curves over cycles.
+    let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
+        label: label.to_string(),
+        points: state.records.iter().map(|r| (r.cycles, f(r))).collect(),
+        color,
+        bold: true,
+    };
+    let charts: [(&str, &str, &str, Vec<Series>); 4] = [
+        (
+            "wear_backlash.svg",
+            "Backlash increase (tangential at r2, mean over positions)",
+            "backlash increase (um)",
+            vec![curve(&|r| r.backlash_increase_m * UM, "", 0)],
+        ),
+        (
+            "wear_depth.svg",
+            "Wear depth",
+            "depth (um)",
+            vec![
+                curve(&|r| r.max_wear_m * UM, "max", 1),
+                curve(&|r| r.mean_wear_m * UM, "mean over the flank", 0),
+            ],
+        ),
+        (
+            "wear_transmission_error.svg",
+            "Loaded transmission error over life",
+            "TE (urad, wheel)",
+            vec![
+                curve(&|r| r.te_mean_rad * UM, "mean", 0),
+                curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
+            ],
+        ),
+        (
+            "wear_pressure.svg",
+            "Contact pressure over life",
+            "pressure (MPa)",
+            vec![
+                curve(&|r| r.max_pressure_pa * MPA, "P_max", 1),
+                curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
+            ],
+        ),
+    ];
+    for (name, title, y, series) in charts {
+        let path = dir.join(name);
+        line_chart(&path, title, "wheel cycles", y, &series, false)?;
+        files.push(path);
+    }
+    // Maps and the node table: at log-spaced states and the last (drawing every state would
+    // cost more than the state itself on long lives).
+    let log_spaced = state.step == 0 || state.step.is_power_of_two();
+    if !(log_spaced || view.last) {
+        return Ok(files);
+    }
     // Maps of the current state.
     let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
     let map = |path: &Path, title: &str, field: &FlankField, scale: f64, bar: &str| {
@@ -226,8 +279,8 @@ pub fn write_state(
     let path = dir.join("wear_map.csv");
     csv.write(&path)?;
     files.push(path);
-    // Loaded pattern at log-spaced states.
-    if state.step == 0 || state.step.is_power_of_two() {
+    // Loaded pattern at log-spaced states and the last.
+    {
         let path = dir.join(format!("wear_pattern_step{}.svg", state.step));
         let values: Vec<f64> = view
             .ltca
@@ -251,53 +304,6 @@ pub fn write_state(
             &overlays,
             &[],
         )?;
-        files.push(path);
-    }
-    // Curves over cycles.
-    let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
-        label: label.to_string(),
-        points: state.records.iter().map(|r| (r.cycles, f(r))).collect(),
-        color,
-        bold: true,
-    };
-    let charts: [(&str, &str, &str, Vec<Series>); 4] = [
-        (
-            "wear_backlash.svg",
-            "Backlash increase (tangential at r2, mean over positions)",
-            "backlash increase (um)",
-            vec![curve(&|r| r.backlash_increase_m * UM, "", 0)],
-        ),
-        (
-            "wear_depth.svg",
-            "Wear depth",
-            "depth (um)",
-            vec![
-                curve(&|r| r.max_wear_m * UM, "max", 1),
-                curve(&|r| r.mean_wear_m * UM, "mean over the flank", 0),
-            ],
-        ),
-        (
-            "wear_transmission_error.svg",
-            "Loaded transmission error over life",
-            "TE (urad, wheel)",
-            vec![
-                curve(&|r| r.te_mean_rad * UM, "mean", 0),
-                curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
-            ],
-        ),
-        (
-            "wear_pressure.svg",
-            "Contact pressure over life",
-            "pressure (MPa)",
-            vec![
-                curve(&|r| r.max_pressure_pa * MPA, "P_max", 1),
-                curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
-            ],
-        ),
-    ];
-    for (name, title, y, series) in charts {
-        let path = dir.join(name);
-        line_chart(&path, title, "wheel cycles", y, &series, false)?;
         files.push(path);
     }
     Ok(files)
