@@ -225,6 +225,18 @@ fn more_torque_wears_faster_and_higher_speed_wears_less() {
     eprintln!("per-cycle worn volume: 60 N m {base:.4e}, 90 N m {v_heavy:.4e}, 60 N m at 3x speed {v_fast:.4e} m^3");
     assert!(v_heavy > 1.2 * base);
     assert!(v_fast < base);
+    // Over a life: more torque opens the backlash faster.
+    let growth = |g: &GearSet| {
+        let (_, _, end) = life(g, 40_000.0, wear::StepControl::Cycles(20_000.0), 5e-6);
+        end.records.last().unwrap().backlash_increase_m
+    };
+    let (b60, b90) = (growth(&g), growth(&heavy));
+    eprintln!(
+        "backlash after 40 000 cycles: 60 N m +{:.2} um, 90 N m +{:.2} um",
+        b60 * 1e6,
+        b90 * 1e6
+    );
+    assert!(b90 > 1.2 * b60);
 }
 
 #[test]
