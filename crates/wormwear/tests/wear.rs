@@ -63,6 +63,32 @@ fn per_cycle_wear_converges_with_the_positions() {
         "20 -> 40 positions changes the max per-cycle wear by {:.2} %",
         100.0 * d
     );
+    // Same on a worn flank (the contact is wider and follows the wear): 100 000 cycles of the
+    // unworn rate removed, then the wear of one cycle with 20 and 40 positions.
+    let mut removal = wormwear::geometry::FlankField::zeros(wf);
+    for (h, dh) in removal.values.iter_mut().zip(&w20.depth.values) {
+        *h = 1e5 * dh;
+    }
+    let worn = |positions: usize| {
+        let mut g = g.clone();
+        g.analysis.positions = positions;
+        let tca = kinematics::analyse(&g, &geo).unwrap();
+        let s = ltca::LtcaSettings::from_gear(&g);
+        let l = ltca::analyse_worn(&g, &geo, &tca, &s, None, Some(&removal)).unwrap();
+        wear::per_cycle(&g, &geo, &tca, &l)
+    };
+    let (a, b) = (worn(20), worn(40));
+    let d = (b.depth.max() / a.depth.max() - 1.0).abs();
+    eprintln!(
+        "worn flank: max per-cycle wear {:.4e} m (20 positions), {:.4e} m (40)",
+        a.depth.max(),
+        b.depth.max()
+    );
+    assert!(
+        d < 0.05,
+        "worn: 20 -> 40 positions changes it by {:.2} %",
+        100.0 * d
+    );
 }
 
 #[test]
