@@ -126,7 +126,7 @@ pub fn write_state(
     // Curves over cycles.
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
-        points: state.records.iter().map(|r| (r.cycles, f(r))).collect(),
+        points: state.records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
         color,
         bold: true,
     };
@@ -167,7 +167,7 @@ pub fn write_state(
     ];
     for (name, title, y, series) in charts {
         let path = dir.join(name);
-        line_chart(&path, title, "wheel cycles", y, &series, false)?;
+        line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
         files.push(path);
     }
     // Maps and the node table: at log-spaced states and the last (drawing every state would
