@@ -10,7 +10,8 @@
 //! 4. [`bending`] and [`contact`] — influence coefficients; [`ltca`] — loaded contact, load
 //!    sharing, transmission error (MODEL §5);
 //! 5. [`lubrication`] — film thickness and local wear coefficient (MODEL §6); [`wear`] — Archard
-//!    wear over life, backlash (MODEL §7).
+//!    wear over life, backlash, pitting phases (MODEL §7-8);
+//! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9).
 //!
 //! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
 
