@@ -334,3 +334,74 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
             .unwrap();
     assert_eq!(summary["wear"]["steps"].as_array().unwrap().len(), 5);
 }
+
+#[test]
+fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
+    // Schedule: wear to 20 000 cycles, pitting to 40 000 (limit 700 MPa), wear to 60 000.
+    // At the start of the pitting phase the nodes under the loaded pattern above the limit lose
+    // 0.78 x the band half-width; through the phase nothing wears and the backlash is flat.
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let settings = ltca::LtcaSettings::from_gear(&g);
+    use wormwear::input::Phase;
+    let plan = wear::WearPlan {
+        life_cycles: 60_000.0,
+        step: wear::StepControl::Cycles(10_000.0),
+        max_substep_removal: 5e-6,
+        phases: vec![
+            Phase::Wear { until: 20_000.0 },
+            Phase::Pitting {
+                until: 40_000.0,
+                pressure_limit: Some(700e6),
+                margin: 0.0,
+            },
+            Phase::Wear { until: 60_000.0 },
+        ],
+        endurance: wormwear::input::Endurance::DEFAULT,
+    };
+    let mut removals = Vec::new();
+    let end = wear::simulate(
+        &g,
+        &geo,
+        &tca,
+        &settings,
+        None,
+        &plan,
+        wear::WearState::new(wf),
+        &mut |view| {
+            removals.push(view.state.removal.clone());
+            Ok(())
+        },
+    )
+    .unwrap();
+    let r = &end.records;
+    for x in r {
+        eprintln!(
+            "step {} cycles {:.0} {}: backlash +{:.3} um, pitted {:.3}, max wear {:.2} um",
+            x.step,
+            x.cycles,
+            x.phase,
+            x.backlash_increase_m * 1e6,
+            x.pitted_area_fraction,
+            x.max_wear_m * 1e6
+        );
+    }
+    // States: 0, 10k, 20k (pitting starts: pits cut), 20k (pitted), 40k (phase over), 50k, 60k.
+    let at = |c: f64| r.iter().filter(|x| x.cycles == c).collect::<Vec<_>>();
+    let start = at(20_000.0);
+    assert_eq!(start.len(), 2);
+    assert_eq!(start[0].phase, "pitting");
+    assert_eq!(start[0].pitted_area_fraction, 0.0);
+    assert!(start[1].pitted_area_fraction > 0.0, "no pits above 700 MPa");
+    // No wear through the phase: the state at 40 000 cycles has the pitted geometry unchanged.
+    let k20 = r.iter().position(|x| x.cycles == 20_000.0).unwrap() + 1;
+    let k40 = r.iter().position(|x| x.cycles == 40_000.0).unwrap();
+    assert_eq!(removals[k20], removals[k40]);
+    assert_eq!(r[k40].backlash_m, r[k20].backlash_m);
+    assert_eq!(r[k40].phase, "wear");
+    // Wear resumes after the phase.
+    assert!(r.last().unwrap().mean_wear_m > r[k40].mean_wear_m);
+    assert_eq!(r.last().unwrap().cycles, 60_000.0);
+}

@@ -126,7 +126,11 @@ pub fn write_state(
     // Curves over cycles.
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
-        points: state.records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
+        points: state
+            .records
+            .iter()
+            .map(|r| (r.cycles * 1e-6, f(r)))
+            .collect(),
         color,
         bold: true,
     };
