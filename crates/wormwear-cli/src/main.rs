@@ -22,8 +22,12 @@ mod geometry_cmd;
 )]
 struct Cli {
     /// Print only errors.
-    #[arg(short, long, global = true)]
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
+    /// Print progress as lines on stderr (one per wear state), also when stderr is not a
+    /// terminal (CI logs, pipes), where the progress bar stays hidden.
+    #[arg(short, long, global = true)]
+    verbose: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -143,8 +147,8 @@ fn main() -> ExitCode {
             output,
             map_position,
         } => ltca(file, output, *map_position, cli.quiet),
-        Command::Wear { file, output, life } => wear(file, output, life, cli.quiet),
-        Command::Run { file, output, life } => run(file, output, life, cli.quiet),
+        Command::Wear { file, output, life } => wear(file, output, life, cli.quiet, cli.verbose),
+        Command::Run { file, output, life } => run(file, output, life, cli.quiet, cli.verbose),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -347,7 +351,13 @@ fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPla
     Ok(plan)
 }
 
-fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Failure> {
+fn wear(
+    file: &Path,
+    dir: &Path,
+    args: &LifeArgs,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(), Failure> {
     let gear = load(file)?;
     let plan = life_plan(&gear, args)?;
     let geo = build_geometry(&gear, file)?;
@@ -372,7 +382,7 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
     let rating = wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
-    let progress = if quiet {
+    let progress = if quiet || verbose {
         indicatif::ProgressBar::hidden()
     } else {
         let bar = indicatif::ProgressBar::new(1000);
@@ -388,15 +398,20 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
         wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir)
             .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
         let r = view.state.records.last().expect("record");
-        progress.set_position((1000.0 * r.cycles / plan.life_cycles).round() as u64);
-        progress.set_message(format!(
-            "step {} at {:.3e} cycles: wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
+        let line = format!(
+            "step {} at {:.3e} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
             r.step,
             r.cycles,
+            r.phase,
             r.max_wear_m * 1e6,
             r.backlash_increase_m * 1e6,
             r.max_pressure_pa / 1e6
-        ));
+        );
+        if verbose {
+            eprintln!("{line}");
+        }
+        progress.set_position((1000.0 * r.cycles / plan.life_cycles).round() as u64);
+        progress.set_message(line);
         Ok(())
     };
     let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
@@ -437,7 +452,13 @@ fn wear(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fai
     Ok(())
 }
 
-fn run(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Failure> {
+fn run(
+    file: &Path,
+    dir: &Path,
+    args: &LifeArgs,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(), Failure> {
     let gear = load(file)?;
     let with_life = gear.wear.is_some() || args.cycles.is_some();
     if with_life {
@@ -447,7 +468,7 @@ fn run(file: &Path, dir: &Path, args: &LifeArgs, quiet: bool) -> Result<(), Fail
     geometry(file, dir, quiet)?;
     ltca(file, dir, 0, quiet)?;
     if with_life {
-        wear(file, dir, args, quiet)?;
+        wear(file, dir, args, quiet, verbose)?;
     }
     Ok(())
 }

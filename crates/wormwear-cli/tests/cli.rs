@@ -367,3 +367,29 @@ fn wear_input_errors_exit_2_and_name_the_problem() {
         assert!(err.contains(message), "{file} {extra:?}: {err}");
     }
 }
+
+#[test]
+fn verbose_wear_reports_each_state_on_stderr_even_in_a_pipe() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["--verbose", "wear"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "10000", "--step-cycles", "10000"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("step 0 at") && err.contains("step 1 at"),
+        "{err}"
+    );
+    // --quiet and --verbose exclude each other (a usage error: exit 2).
+    let both = bin()
+        .args(["-q", "-v", "check"])
+        .arg(example("gear-1x40-design.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(both.status.code(), Some(2));
+}
