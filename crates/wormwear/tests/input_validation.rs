@@ -250,6 +250,73 @@ fn bad_choices_and_exclusive_fields() {
 }
 
 #[test]
+fn wear_and_rating_sections_are_checked() {
+    // Both step controls at once.
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_wear_um = 4.0\nstep_cycles = 30000",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.step_cycles", "either wear.step_wear_um", "not both"],
+    );
+    // A negative life.
+    let text = set(&design(), "wear", "life_cycles", "life_cycles = -5");
+    assert_mentions(&error_of(&text), &["wear.life_cycles = -5", "> 0"]);
+    // Phases out of order and an unknown phase kind.
+    let text = set(
+        &design(),
+        "wear",
+        "life_cycles",
+        "life_cycles = 1e6\nphases = [ { kind = \"wear\", until_cycles = 5e5 }, \
+         { kind = \"pitting\", until_cycles = 2e5 }, { kind = \"rest\", until_cycles = 9e5 } ]",
+    );
+    let m = error_of(&text);
+    assert_mentions(
+        &m,
+        &[
+            "wear.phases[1].until_cycles",
+            "increasing order",
+            "wear.phases[2].kind",
+        ],
+    );
+    // A wear phase with a pressure limit.
+    let text = set(
+        &design(),
+        "wear",
+        "life_cycles",
+        "life_cycles = 1e6\nphases = [ { kind = \"wear\", until_cycles = 5e5, pressure_limit_mpa = 500 } ]",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.phases[0].pressure_limit_mpa", "only pitting"],
+    );
+    // Rating factors and the pressure cap out of range.
+    let text = set(
+        &design(),
+        "rating",
+        "friction_size_factor",
+        "friction_size_factor = 0.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["rating.friction_size_factor = 0", "[0.1, 10]"],
+    );
+    let text = set(
+        &design(),
+        "analysis",
+        "positions",
+        "positions = 20\ncontact_pressure_cap_mpa = 1.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["analysis.contact_pressure_cap_mpa = 1", "0 = no cap"],
+    );
+}
+
+#[test]
 fn pointed_thread_and_closed_space() {
     let text = set(&design(), "worm", "tip_radius_mm", "tip_radius_mm = 36.0");
     assert_mentions(&error_of(&text), &["worm.tip_radius_mm = 36", "pointed"]);
