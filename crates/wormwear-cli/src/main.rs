@@ -85,7 +85,7 @@ enum Command {
         life: LifeArgs,
     },
     /// The whole pipeline the file asks for: geometry, unloaded and loaded analyses, ratings,
-    /// and the life when the file has a [wear] section (or --cycles is given).
+    /// the life when the file has a [wear] section (or --cycles is given), and report.html.
     #[command(
         after_help = "Examples:\n  wormwear run examples/gear-1x40-design.toml -o out/1x40\n  \
                       wormwear run examples/gear-1x40-case-c.toml -o out/c --no-pitting"
@@ -469,6 +469,17 @@ fn run(
     ltca(file, dir, 0, quiet)?;
     if with_life {
         wear(file, dir, args, quiet, verbose)?;
+    }
+    let text = std::fs::read_to_string(file).unwrap_or_default();
+    let title = if gear.title.is_empty() {
+        file.display().to_string()
+    } else {
+        gear.title.clone()
+    };
+    let report = wormwear::output::report::write_report(dir, &title, &text)
+        .map_err(|e| Failure::Run(e.into()))?;
+    if !quiet {
+        println!("report: {}", report.display());
     }
     Ok(())
 }

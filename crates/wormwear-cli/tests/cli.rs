@@ -316,6 +316,21 @@ fn run_writes_every_stage_and_the_life() {
             "ltca_pattern.svg",
         ],
     );
+    // The self-contained report: every stage's section and its figures inline, no links out.
+    let report = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    for h in [
+        "Geometry",
+        "Unloaded meshing (TCA)",
+        "Loaded contact (LTCA)",
+        "Wear over life",
+        "Ratings (ISO/TR 14521)",
+        "Input",
+    ] {
+        assert!(report.contains(&format!("{h}</h2>")), "section {h} missing");
+    }
+    assert!(report.matches("<figure><svg").count() >= 20);
+    assert!(!report.contains("http://") || report.contains("http://www.w3.org/2000/svg"));
+    assert!(!report.contains("src=\"http"));
     // Resuming a finished run recomputes its last state and leaves the results unchanged.
     let again = bin()
         .args(["-q", "wear"])

@@ -6,6 +6,7 @@
 
 pub mod geometry;
 pub mod ltca;
+pub mod report;
 pub mod tca;
 pub mod wear;
 

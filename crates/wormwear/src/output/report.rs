@@ -1,0 +1,241 @@
+//! `report.html`: one self-contained page (inline SVG, inline CSS, no network) gathering what a
+//! run wrote into its output directory: the input file, the derived data of every stage from
+//! summary.json, the figures of each stage in order, the ratings and the warnings. First
+//! version: figures are embedded as written by the stages (issue 7 grows it).
+
+use super::{write_atomic, OutputError};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Sections of the report: title, summary.json section, figure file prefixes (in order).
+const SECTIONS: [(&str, &str, &[&str]); 5] = [
+    ("Geometry", "geometry", &["wheel_flank_outline", "section_"]),
+    (
+        "Unloaded meshing (TCA)",
+        "tca",
+        &["tca_kinematic_error", "tca_pattern", "tca_sliding_speed"],
+    ),
+    (
+        "Loaded contact (LTCA)",
+        "ltca",
+        &[
+            "ltca_load_sharing",
+            "ltca_transmission_error",
+            "ltca_mesh_stiffness",
+            "ltca_pattern",
+            "ltca_pressure_position",
+        ],
+    ),
+    (
+        "Wear over life",
+        "wear",
+        &[
+            "wear_backlash",
+            "wear_depth",
+            "wear_transmission_error",
+            "wear_pressure",
+            "wear_map",
+            "wear_per_cycle_map",
+            "wear_film_ratio_map",
+            "wear_pattern_step",
+        ],
+    ),
+    ("Ratings (ISO/TR 14521)", "rating", &[]),
+];
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A scalar of summary.json as table text (numbers to 6 significant digits).
+fn scalar(v: &serde_json::Value) -> Option<String> {
+    match v {
+        serde_json::Value::Number(n) => Some(match n.as_f64() {
+            Some(x) if n.is_f64() => format!("{x:.6e}")
+                .parse::<f64>()
+                .map(|y| format!("{y}"))
+                .unwrap_or_default(),
+            _ => n.to_string(),
+        }),
+        serde_json::Value::String(s) => Some(s.clone()),
+        serde_json::Value::Bool(b) => Some(b.to_string()),
+        serde_json::Value::Null => Some("-".into()),
+        _ => None,
+    }
+}
+
+/// The SVG files of `dir` whose names start with `prefix` (sorted by name, numbers in order).
+fn figures(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.extension().is_some_and(|x| x == "svg")
+                        && p.file_name()
+                            .and_then(|n| n.to_str())
+                            .is_some_and(|n| n.starts_with(prefix))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    // Natural order: digits compared as numbers (step2 before step16).
+    let key = |p: &PathBuf| {
+        let name = p
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("")
+            .to_string();
+        let digits: String = name.chars().filter(|c| c.is_ascii_digit()).collect();
+        let stem: String = name.chars().filter(|c| !c.is_ascii_digit()).collect();
+        (stem, digits.parse::<u64>().unwrap_or(0))
+    };
+    out.sort_by_key(key);
+    out
+}
+
+/// Writes `dir/report.html` from the files in `dir` and the input text; returns its path.
+pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf, OutputError> {
+    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(serde_json::Value::Null);
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>wormwear — {t}</title><style>\
+         body{{font-family:sans-serif;max-width:1150px;margin:2em auto;color:#222}}\
+         h1{{font-size:1.6em}} h2{{border-bottom:2px solid #1f77b4;padding-bottom:.2em;margin-top:2em}}\
+         table{{border-collapse:collapse;margin:.5em 0 1em}} td,th{{border:1px solid #ccc;padding:.2em .6em;text-align:left}}\
+         td.n{{text-align:right;font-variant-numeric:tabular-nums}} figure{{margin:1em 0}}\
+         figcaption{{color:#555;font-size:.9em}} pre{{background:#f6f6f6;padding:1em;overflow-x:auto;font-size:.85em}}\
+         .warn{{color:#a40}} nav a{{margin-right:1em}}</style></head><body>\n\
+         <h1>wormwear — {t}</h1>\n",
+        t = escape(title)
+    );
+    // Contents.
+    h.push_str("<nav>");
+    for (name, key, _) in SECTIONS {
+        if summary.get(key).is_some() {
+            let _ = write!(h, "<a href=\"#{key}\">{}</a>", escape(name));
+        }
+    }
+    h.push_str("<a href=\"#input\">Input</a></nav>\n");
+    // Warnings of every stage.
+    let mut warnings = Vec::new();
+    if let serde_json::Value::Object(m) = &summary {
+        for (stage, v) in m {
+            if let Some(serde_json::Value::Array(ws)) = v.get("warnings") {
+                for w in ws {
+                    if let Some(w) = w.as_str() {
+                        warnings.push(format!("{stage}: {w}"));
+                    }
+                }
+            }
+        }
+    }
+    h.push_str("<section id=\"warnings\"><h2>Warnings</h2>");
+    if warnings.is_empty() {
+        h.push_str("<p>None.</p>");
+    } else {
+        h.push_str("<ul>");
+        for w in &warnings {
+            let _ = write!(h, "<li class=\"warn\">{}</li>", escape(w));
+        }
+        h.push_str("</ul>");
+    }
+    h.push_str("</section>\n");
+    for (name, key, prefixes) in SECTIONS {
+        let Some(section) = summary.get(key) else {
+            continue;
+        };
+        let _ = write!(h, "<section id=\"{key}\"><h2>{}</h2>", escape(name));
+        // Scalars of the section as a table; the wear steps as their own table.
+        if let serde_json::Value::Object(m) = section {
+            h.push_str("<table>");
+            for (k, v) in m {
+                if let Some(text) = scalar(v) {
+                    let _ = write!(
+                        h,
+                        "<tr><th>{}</th><td class=\"n\">{}</td></tr>",
+                        escape(k),
+                        escape(&text)
+                    );
+                }
+            }
+            h.push_str("</table>");
+        }
+        if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
+            let columns = [
+                ("cycles", 1.0, "cycles"),
+                ("phase", 1.0, "phase"),
+                ("max_wear_m", 1e6, "max wear (um)"),
+                ("mean_wear_m", 1e6, "mean wear (um)"),
+                ("backlash_increase_m", 1e6, "backlash increase (um)"),
+                ("max_pressure_pa", 1e-6, "P_max (MPa)"),
+                ("mean_pressure_pa", 1e-6, "P_mean (MPa)"),
+                ("contact_area_fraction", 1.0, "S0"),
+                ("te_mean_rad", 1e6, "TE mean (urad)"),
+            ];
+            h.push_str("<details><summary>Wear states (table)</summary><table><tr>");
+            for (_, _, label) in columns {
+                let _ = write!(h, "<th>{label}</th>");
+            }
+            h.push_str("</tr>");
+            for s in steps {
+                h.push_str("<tr>");
+                for (k, scale, _) in columns {
+                    let cell = match &s[k] {
+                        serde_json::Value::Number(n) => {
+                            format!("{:.4}", n.as_f64().unwrap_or(f64::NAN) * scale)
+                        }
+                        other => scalar(other).unwrap_or_default(),
+                    };
+                    let _ = write!(h, "<td class=\"n\">{}</td>", escape(&cell));
+                }
+                h.push_str("</tr>");
+            }
+            h.push_str("</table></details>");
+        }
+        for prefix in prefixes {
+            for path in figures(dir, prefix) {
+                // wear_map is a prefix of wear_map... only: skip other maps matched by it.
+                let name = path
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .unwrap_or_default()
+                    .to_string();
+                if *prefix == "wear_map" && name != "wear_map.svg" {
+                    continue;
+                }
+                if *prefix == "ltca_pattern" && name != "ltca_pattern.svg" {
+                    continue;
+                }
+                let Ok(svg) = std::fs::read_to_string(&path) else {
+                    continue;
+                };
+                let body = match svg.find("<svg") {
+                    Some(k) => &svg[k..],
+                    None => continue,
+                };
+                let _ = write!(
+                    h,
+                    "<figure>{body}<figcaption>{}</figcaption></figure>\n",
+                    escape(&name)
+                );
+            }
+        }
+        h.push_str("</section>\n");
+    }
+    let _ = write!(
+        h,
+        "<section id=\"input\"><h2>Input</h2><pre>{}</pre></section>\n</body></html>\n",
+        escape(input_text)
+    );
+    let path = dir.join("report.html");
+    write_atomic(&path, h.as_bytes())?;
+    Ok(path)
+}
