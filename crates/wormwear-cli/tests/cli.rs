@@ -408,3 +408,73 @@ fn verbose_wear_reports_each_state_on_stderr_even_in_a_pipe() {
         .unwrap();
     assert_eq!(both.status.code(), Some(2));
 }
+
+/// Headless Chromium, when installed (Debian `chromium`).
+fn chromium() -> Option<PathBuf> {
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .find_map(|name| {
+            std::env::var_os("PATH").and_then(|paths| {
+                std::env::split_paths(&paths)
+                    .map(|d| d.join(name))
+                    .find(|p| p.is_file())
+            })
+        })
+}
+
+#[test]
+fn report_renders_in_a_headless_browser() {
+    let Some(browser) = chromium() else {
+        eprintln!("SKIPPED: no chromium on the PATH (apt-get install chromium)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["-q", "run"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "10000", "--step-cycles", "10000"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let url = format!("file://{}", dir.path().join("report.html").display());
+    let shot = dir.path().join("report.png");
+    let dom = Command::new(&browser)
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--dump-dom"])
+        .arg(&url)
+        .output()
+        .unwrap();
+    assert!(dom.status.success());
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    for id in ["geometry", "tca", "ltca", "wear", "rating", "input"] {
+        assert!(
+            dom.contains(&format!("id=\"{id}\"")),
+            "section {id} not in the rendered page"
+        );
+    }
+    assert!(
+        dom.matches("<svg").count() >= 20,
+        "figures missing from the rendered page"
+    );
+    let status = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--window-size=1200,2400",
+        ])
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(&url)
+        .output()
+        .unwrap();
+    assert!(status.status.success());
+    assert!(
+        std::fs::metadata(&shot).unwrap().len() > 10_000,
+        "empty screenshot"
+    );
+}

@@ -221,9 +221,9 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
                     Some(k) => &svg[k..],
                     None => continue,
                 };
-                let _ = write!(
+                let _ = writeln!(
                     h,
-                    "<figure>{body}<figcaption>{}</figcaption></figure>\n",
+                    "<figure>{body}<figcaption>{}</figcaption></figure>",
                     escape(&name)
                 );
             }
