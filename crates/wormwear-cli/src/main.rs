@@ -425,7 +425,13 @@ fn wear(
         state,
         &mut on_state,
     )
-    .map_err(|e| Failure::Run(anyhow::Error::new(e).context("wear simulation")))?;
+    .map_err(|e| match e {
+        // A checkpoint of another gear (wrong directory for --resume) is a usage problem.
+        wormwear::wear::WearError::Checkpoint(_) => {
+            Failure::Input(anyhow::Error::new(e).context("--resume"))
+        }
+        _ => Failure::Run(anyhow::Error::new(e).context("wear simulation")),
+    })?;
     progress.finish_and_clear();
     if !quiet {
         let first = end.records.first().expect("record");

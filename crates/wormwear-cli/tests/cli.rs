@@ -478,3 +478,37 @@ fn report_renders_in_a_headless_browser() {
         "empty screenshot"
     );
 }
+
+#[test]
+fn resume_with_the_checkpoint_of_another_grid_is_an_input_error() {
+    // A checkpoint written for a 40 x 60 flank grid, resumed with a file asking for 30 x 60.
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["-q", "wear"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "10000", "--step-cycles", "10000"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
+        .unwrap()
+        .replace("flank_cells_height = 40", "flank_cells_height = 30");
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, text).unwrap();
+    let out = bin()
+        .arg("wear")
+        .arg(&other)
+        .arg("-o")
+        .arg(dir.path())
+        .arg("--resume")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--resume") && err.contains("checkpoint"),
+        "{err}"
+    );
+}
