@@ -570,30 +570,29 @@ pub fn simulate(
     };
     // The worn contact widens: the band of the local meshes starts as wide as the last
     // analysis needed (no repeated widenings), carried in the state for an exact resume.
-    let analyse = |removal: &FlankField, state: &mut WearState| {
+    let analyse = |state: &WearState| -> Result<(Ltca, Option<f64>), WearError> {
         let mut local = *settings;
         local.band_factor = state.band_factor.unwrap_or(settings.band_factor);
-        let l = crate::ltca::analyse_worn(gear, geo, tca, &local, bending, Some(removal)).map_err(
-            |source| WearError::Ltca {
+        let l = crate::ltca::analyse_worn(gear, geo, tca, &local, bending, Some(&state.removal))
+            .map_err(|source| WearError::Ltca {
                 step: state.step,
                 cycles: state.cycles,
                 source,
-            },
-        )?;
+            })?;
         let widenings = l
             .positions
             .iter()
             .map(|p| p.band_widenings)
             .max()
             .unwrap_or(0);
-        if widenings > 0 {
-            state.band_factor = Some((local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0));
-        }
-        Ok::<_, WearError>(l)
+        let band = (widenings > 0)
+            .then(|| (local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0))
+            .or(state.band_factor);
+        Ok((l, band))
     };
     loop {
-        let removal = state.removal.clone();
-        let l = analyse(&removal, &mut state)?;
+        let (l, band) = analyse(&state)?;
+        state.band_factor = band;
         let cw = per_cycle(gear, geo, tca, &l);
         let b = backlash.stats(&state.removal);
         let (te_mean, te_p2p) = l.te_stats();
@@ -709,8 +708,8 @@ pub fn simulate(
             if remaining <= 1e-9 * step_cycles {
                 break;
             }
-            let removal = state.removal.clone();
-            let l = analyse(&removal, &mut state)?;
+            let (l, band) = analyse(&state)?;
+            state.band_factor = band;
             rate_map = per_cycle(gear, geo, tca, &l);
         }
         state.step += 1;

@@ -112,35 +112,67 @@ fn archard_wear_is_linear_in_k_and_in_one_over_h() {
     );
 }
 
+/// A gear ready for life runs: geometry and unloaded analysis built once.
+struct Bench {
+    g: GearSet,
+    geo: Geometry,
+    tca: kinematics::Tca,
+}
+
+impl Bench {
+    fn new(g: &GearSet) -> Self {
+        let geo = Geometry::build(g).unwrap();
+        let tca = kinematics::analyse(g, &geo).unwrap();
+        Self {
+            g: g.clone(),
+            geo,
+            tca,
+        }
+    }
+
+    /// Runs `plan` from `start` (None: unworn), calling `on_state` after every state.
+    fn simulate(
+        &self,
+        plan: &wear::WearPlan,
+        start: Option<wear::WearState>,
+        on_state: &mut dyn FnMut(&wear::StepView) -> Result<(), wear::WearError>,
+    ) -> Result<wear::WearState, wear::WearError> {
+        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
+        wear::simulate(
+            &self.g,
+            &self.geo,
+            &self.tca,
+            &ltca::LtcaSettings::from_gear(&self.g),
+            None,
+            plan,
+            start.unwrap_or_else(|| wear::WearState::new(wf)),
+            on_state,
+        )
+    }
+}
+
+/// A life plan without phases.
+fn plan(cycles: f64, step: wear::StepControl, guard: f64) -> wear::WearPlan {
+    wear::WearPlan {
+        life_cycles: cycles,
+        step,
+        max_substep_removal: guard,
+        phases: Vec::new(),
+        endurance: wormwear::input::Endurance::DEFAULT,
+    }
+}
+
 fn life(
     g: &GearSet,
     cycles: f64,
     step: wear::StepControl,
     guard: f64,
 ) -> (Geometry, kinematics::Tca, wear::WearState) {
-    let geo = Geometry::build(g).unwrap();
-    let tca = kinematics::analyse(g, &geo).unwrap();
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let settings = ltca::LtcaSettings::from_gear(g);
-    let plan = wear::WearPlan {
-        life_cycles: cycles,
-        step,
-        max_substep_removal: guard,
-        phases: Vec::new(),
-        endurance: wormwear::input::Endurance::DEFAULT,
-    };
-    let end = wear::simulate(
-        g,
-        &geo,
-        &tca,
-        &settings,
-        None,
-        &plan,
-        wear::WearState::new(wf),
-        &mut |_| Ok(()),
-    )
-    .unwrap();
-    (geo, tca, end)
+    let bench = Bench::new(g);
+    let end = bench
+        .simulate(&plan(cycles, step, guard), None, &mut |_| Ok(()))
+        .unwrap();
+    (bench.geo, bench.tca, end)
 }
 
 #[test]
@@ -270,61 +302,32 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
     // Run with the files written after every state; stop after the second record (an error
     // from the writer, as an interruption); resume from the checkpoint on disk; compare with
     // an uninterrupted run, record by record and the final wear map, exactly.
-    let g = example("gear-1x40-design.toml");
-    let geo = Geometry::build(&g).unwrap();
-    let tca = kinematics::analyse(&g, &geo).unwrap();
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let settings = ltca::LtcaSettings::from_gear(&g);
-    let plan = wormwear::input::WearPlan {
-        life_cycles: 40_000.0,
-        step: wear::StepControl::Cycles(10_000.0),
-        max_substep_removal: 5e-6,
-        phases: Vec::new(),
-        endurance: wormwear::input::Endurance::DEFAULT,
-    };
-    let life = plan.clone();
+    let bench = Bench::new(&example("gear-1x40-design.toml"));
+    let plan = plan(40_000.0, wear::StepControl::Cycles(10_000.0), 5e-6);
     let dir = tempfile::tempdir().unwrap();
+    let write = |view: &wear::StepView| {
+        wormwear::output::wear::write_state(&bench.geo, &bench.tca, &plan, view, dir.path())
+            .map(|_| ())
+            .map_err(|e| wear::WearError::Output(e.to_string()))
+    };
     let mut written = 0;
-    let interrupted = wear::simulate(
-        &g,
-        &geo,
-        &tca,
-        &settings,
-        None,
-        &life,
-        wear::WearState::new(wf),
-        &mut |view| {
-            wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir.path())
-                .map_err(|e| wear::WearError::Output(e.to_string()))?;
-            written += 1;
-            if written == 2 {
-                return Err(wear::WearError::Output("interrupted".into()));
-            }
-            Ok(())
-        },
-    );
+    let interrupted = bench.simulate(&plan, None, &mut |view| {
+        write(view)?;
+        written += 1;
+        if written == 2 {
+            return Err(wear::WearError::Output("interrupted".into()));
+        }
+        Ok(())
+    });
     assert!(interrupted.is_err());
     let saved = wormwear::output::wear::read_checkpoint(dir.path())
         .unwrap()
         .unwrap();
     assert_eq!(saved.step, 1);
-    let resumed = wear::simulate(&g, &geo, &tca, &settings, None, &life, saved, &mut |view| {
-        wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir.path())
-            .map(|_| ())
-            .map_err(|e| wear::WearError::Output(e.to_string()))
-    })
-    .unwrap();
-    let straight = wear::simulate(
-        &g,
-        &geo,
-        &tca,
-        &settings,
-        None,
-        &life,
-        wear::WearState::new(wf),
-        &mut |_| Ok(()),
-    )
-    .unwrap();
+    let resumed = bench
+        .simulate(&plan, Some(saved), &mut |view| write(view))
+        .unwrap();
+    let straight = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
     assert_eq!(resumed.records.len(), 5);
     assert_eq!(resumed.records, straight.records);
     assert_eq!(resumed.removal, straight.removal);
@@ -340,11 +343,7 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
     // Schedule: wear to 20 000 cycles, pitting to 40 000 (limit 700 MPa), wear to 60 000.
     // At the start of the pitting phase the nodes under the loaded pattern above the limit lose
     // 0.78 x the band half-width; through the phase nothing wears and the backlash is flat.
-    let g = example("gear-1x40-design.toml");
-    let geo = Geometry::build(&g).unwrap();
-    let tca = kinematics::analyse(&g, &geo).unwrap();
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let settings = ltca::LtcaSettings::from_gear(&g);
+    let bench = Bench::new(&example("gear-1x40-design.toml"));
     use wormwear::input::Phase;
     let plan = wear::WearPlan {
         life_cycles: 60_000.0,
@@ -362,20 +361,12 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
         endurance: wormwear::input::Endurance::DEFAULT,
     };
     let mut removals = Vec::new();
-    let end = wear::simulate(
-        &g,
-        &geo,
-        &tca,
-        &settings,
-        None,
-        &plan,
-        wear::WearState::new(wf),
-        &mut |view| {
+    let end = bench
+        .simulate(&plan, None, &mut |view| {
             removals.push(view.state.removal.clone());
             Ok(())
-        },
-    )
-    .unwrap();
+        })
+        .unwrap();
     let r = &end.records;
     for x in r {
         eprintln!(

@@ -409,6 +409,12 @@ fn local_mesh(
         let dz = b.z - a.z;
         (dz.abs() > 0.0).then(|| ev.placement.vector_wheel_to_worm(&((b - a) / dz)))
     };
+    // Worn material exists only where the worm flank reaches (above the worm-tip trace).
+    let tip_floor: Vec<f64> = if removal.is_some() {
+        tca.tip_trace.iter().map(|t| t.1).collect()
+    } else {
+        Vec::new()
+    };
     let mut base = Vec::new();
     for line in tca
         .contact_lines
@@ -452,6 +458,7 @@ fn local_mesh(
                 band,
                 offset_of(s.tooth),
                 removal,
+                &tip_floor,
             )
         })
         .collect()
@@ -506,17 +513,12 @@ fn slice_cells(
     band: f64,
     offset: f64,
     removal: Option<&FlankField>,
+    tip_floor: &[f64],
 ) -> Vec<LocalCell> {
     let pos = tca.positions[n];
     let nc = settings.columns.max(1);
     let ds = 2.0 * band / nc as f64;
     let z = slice.z;
-    // Worn material exists only where the worm flank reaches (above the worm-tip trace).
-    let tip_floor: Vec<f64> = if removal.is_some() {
-        tca.tip_trace.iter().map(|t| t.1).collect()
-    } else {
-        Vec::new()
-    };
     let (lo, hi) = wf.radial_range_at(z);
     let (_, slope) = wf.theta_at(slice.r_line, z);
     let drds = 1.0 / (1.0 + (slice.r_line * slope).powi(2)).sqrt();
@@ -585,7 +587,7 @@ fn slice_cells(
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error
-                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(&tip_floor)) / lever),
+                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(tip_floor)) / lever),
             relief,
         });
     }

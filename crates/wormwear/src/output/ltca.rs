@@ -2,7 +2,7 @@
 //! loaded pattern, local pressures) and SVG plots (load sharing, transmission error, mesh
 //! stiffness, pressure maps of the engaged teeth at a chosen position, loaded pattern).
 
-use super::tca::{flank_cells, flank_outline, tip_trace_series};
+use super::tca::{flank_outline, tip_trace_series};
 use super::{update_summary, Csv, OutputError};
 use crate::geometry::{Geometry, WheelFlank};
 use crate::kinematics::Tca;
@@ -127,6 +127,32 @@ fn local_cells(pr: &PositionResult, tooth: usize, wf: &WheelFlank) -> Vec<MapCel
             }
         })
         .collect()
+}
+
+/// Map of the loaded contact pattern (max pressure over the cycle per flank cell, MPa; grey
+/// where no contact) with the given title and overlays.
+pub fn pattern_map(
+    path: &Path,
+    wf: &WheelFlank,
+    ltca: &Ltca,
+    title: &str,
+    overlays: &[Series],
+) -> Result<(), OutputError> {
+    let values: Vec<f64> = ltca
+        .pattern
+        .iter()
+        .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
+        .collect();
+    super::tca::wheel_flank_map(
+        path,
+        title,
+        wf,
+        &values,
+        (0.0, ltca.max_pressure * MPA),
+        "pressure (MPa)",
+        overlays,
+        &[],
+    )
 }
 
 /// Writes every LTCA output into `dir`; `map_position` selects the position of the pressure
@@ -273,27 +299,18 @@ pub fn write_ltca(
     let path = dir.join("ltca_pattern.csv");
     csv.write(&path)?;
     files.push(path);
-    let values: Vec<f64> = ltca
-        .pattern
-        .iter()
-        .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
-        .collect();
     let trace = tip_trace_series(tca);
     let path = dir.join("ltca_pattern.svg");
-    flank_map(
+    pattern_map(
         &path,
+        wf,
+        ltca,
         &format!(
             "Loaded contact pattern: max pressure over the cycle (P_max {:.0} MPa, S0 {:.2}); grey: no contact",
             ltca.max_pressure * MPA,
             ltca.s0
         ),
-        "z2 across the face width (mm)",
-        "r wheel radius (mm)",
-        &flank_cells(wf, &values),
-        (0.0, ltca.max_pressure * MPA),
-        "pressure (MPa)",
         std::slice::from_ref(&trace),
-        &[],
     )?;
     files.push(path);
     // Pressure maps of the engaged teeth at the chosen position.

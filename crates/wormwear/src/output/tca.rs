@@ -112,6 +112,32 @@ pub fn flank_cells(wf: &WheelFlank, values: &[f64]) -> Vec<MapCell> {
     cells
 }
 
+/// Colour map of per-cell values on the wheel flank in (z, r) mm (NaN: grey), values clipped
+/// to `range`.
+#[allow(clippy::too_many_arguments)]
+pub fn wheel_flank_map(
+    path: &Path,
+    title: &str,
+    wf: &WheelFlank,
+    cell_values: &[f64],
+    range: (f64, f64),
+    bar_label: &str,
+    overlays: &[Series],
+    segments: &[crate::plot::Segment],
+) -> Result<(), OutputError> {
+    flank_map(
+        path,
+        title,
+        "z2 across the face width (mm)",
+        "r wheel radius (mm)",
+        &flank_cells(wf, cell_values),
+        range,
+        bar_label,
+        overlays,
+        segments,
+    )
+}
+
 /// Cell edges separating marked from unmarked cells (the outline of a pattern), (z, r) mm.
 pub fn pattern_outline(wf: &WheelFlank, marked: &[bool]) -> Vec<crate::plot::Segment> {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
@@ -221,16 +247,15 @@ pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, 
     let j_um = tca.marking_thickness * UM;
     let sep_um: Vec<f64> = tca.min_separation.iter().map(|s| s * UM).collect();
     let path = dir.join("tca_pattern.svg");
-    flank_map(
+    wheel_flank_map(
         &path,
         &format!(
             "No-load contact pattern, marking {j_um:.0} um: {:.1} % of the active flank ({} flank)",
             100.0 * tca.pattern_area / tca.active_area,
             tca.loaded_flank.name()
         ),
-        "z2 across the face width (mm)",
-        "r wheel radius (mm)",
-        &flank_cells(wf, &sep_um),
+        wf,
+        &sep_um,
         (0.0, 3.0 * j_um),
         "separation (um)",
         std::slice::from_ref(&trace),
@@ -310,16 +335,15 @@ pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, 
             (a.min(v), b.max(v))
         });
     let path = dir.join("tca_sliding_speed.svg");
-    flank_map(
+    wheel_flank_map(
         &path,
         &format!(
             "Sliding speed at contact (max {:.2} m/s, pitch point {:.2} m/s); grey: not reached by the worm flank",
             tca.max_sliding_speed(),
             tca.pitch_sliding_speed
         ),
-        "z2 across the face width (mm)",
-        "r wheel radius (mm)",
-        &flank_cells(wf, &speed),
+        wf,
+        &speed,
         (lo, hi),
         "|Vg| (m/s)",
         &[trace],

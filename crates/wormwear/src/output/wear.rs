@@ -4,12 +4,12 @@
 //! the cumulative wear, of the wear per cycle and of the film ratio, the node table and the
 //! loaded pattern at log-spaced states (0, 1, 2, 4, 8, ...) and the last.
 
-use super::tca::{flank_cells, flank_outline, tip_trace_series};
+use super::tca::{flank_outline, tip_trace_series, wheel_flank_map};
 use super::{update_summary, write_atomic, Csv, OutputError};
 use crate::geometry::{FlankField, Geometry};
 use crate::input::WearPlan;
 use crate::kinematics::Tca;
-use crate::plot::{flank_map, line_chart, Series};
+use crate::plot::{line_chart, Series};
 use crate::wear::{StepView, WearState};
 use std::path::{Path, PathBuf};
 
@@ -182,25 +182,28 @@ pub fn write_state(
     }
     // Maps of the current state.
     let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
-    let map = |path: &Path, title: &str, field: &FlankField, scale: f64, bar: &str| {
-        let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
-        let hi = values
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0, f64::max);
-        flank_map(
-            path,
-            title,
-            "z2 across the face width (mm)",
-            "r wheel radius (mm)",
-            &flank_cells(wf, &values),
-            (0.0, if hi > 0.0 { hi } else { 1.0 }),
-            bar,
-            &overlays,
-            &[],
-        )
-    };
+    // Map of a node field (cell means, times `scale`), over [0, top] or [0, its maximum].
+    let map =
+        |path: &Path, title: &str, field: &FlankField, scale: f64, bar: &str, top: Option<f64>| {
+            let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
+            let hi = top.unwrap_or_else(|| {
+                values
+                    .iter()
+                    .copied()
+                    .filter(|v| v.is_finite())
+                    .fold(0.0, f64::max)
+            });
+            wheel_flank_map(
+                path,
+                title,
+                wf,
+                &values,
+                (0.0, if hi > 0.0 { hi } else { 1.0 }),
+                bar,
+                &overlays,
+                &[],
+            )
+        };
     let r = state.records.last().expect("a state has a record");
     let path = dir.join("wear_map.svg");
     map(
@@ -213,6 +216,7 @@ pub fn write_state(
         &state.removal,
         UM,
         "wear depth (um)",
+        None,
     )?;
     files.push(path);
     let path = dir.join("wear_per_cycle_map.svg");
@@ -226,6 +230,7 @@ pub fn write_state(
         &view.cycle.depth,
         UM,
         "wear per cycle (um)",
+        None,
     )?;
     files.push(path);
     let lambda = FlankField {
@@ -239,19 +244,16 @@ pub fn write_state(
         ..view.cycle.lambda.clone()
     };
     let path = dir.join("wear_film_ratio_map.svg");
-    flank_map(
+    map(
         &path,
         &format!(
             "Film ratio lambda at {:.4e} cycles (clipped at 4: no wear above)",
             r.cycles
         ),
-        "z2 across the face width (mm)",
-        "r wheel radius (mm)",
-        &flank_cells(wf, &lambda.cell_means()),
-        (0.0, 4.0),
+        &lambda,
+        1.0,
         "lambda",
-        &overlays,
-        &[],
+        Some(4.0),
     )?;
     files.push(path);
     let mut csv = Csv::new(&[
@@ -286,27 +288,17 @@ pub fn write_state(
     // Loaded pattern at log-spaced states and the last.
     {
         let path = dir.join(format!("wear_pattern_step{}.svg", state.step));
-        let values: Vec<f64> = view
-            .ltca
-            .pattern
-            .iter()
-            .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
-            .collect();
-        flank_map(
+        super::ltca::pattern_map(
             &path,
+            wf,
+            view.ltca,
             &format!(
                 "Loaded pattern at {:.4e} cycles (P_max {:.0} MPa, S0 {:.2})",
                 r.cycles,
                 r.max_pressure_pa * MPA,
                 r.contact_area_fraction
             ),
-            "z2 across the face width (mm)",
-            "r wheel radius (mm)",
-            &flank_cells(wf, &values),
-            (0.0, r.max_pressure_pa * MPA),
-            "pressure (MPa)",
             &overlays,
-            &[],
         )?;
         files.push(path);
     }
