@@ -241,8 +241,8 @@ fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
-    let files =
-        wormwear::output::tca::write_tca(&geo, &result, dir).map_err(|e| Failure::Run(e.into()))?;
+    let files = wormwear::output::tca::write_tca(&gear, &geo, &result, dir)
+        .map_err(|e| Failure::Run(e.into()))?;
     for w in &result.warnings {
         eprintln!("warning: {w}");
     }
@@ -274,8 +274,8 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
     })?;
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
-    wormwear::output::tca::write_tca(&geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
-    let files = wormwear::output::ltca::write_ltca(&geo, &tca, &result, dir, map_position)
+    wormwear::output::tca::write_tca(&gear, &geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
+    let files = wormwear::output::ltca::write_ltca(&gear, &geo, &tca, &result, dir, map_position)
         .map_err(|e| Failure::Run(e.into()))?;
     wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
     for w in &tca.warnings {
@@ -395,13 +395,13 @@ fn wear(
         bar
     };
     let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
-        wormwear::output::wear::write_state(&geo, &tca, &plan, view, dir)
+        wormwear::output::wear::write_state(&gear, &geo, &tca, &plan, view, dir)
             .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
         let r = view.state.records.last().expect("record");
         let line = format!(
-            "step {} at {:.3e} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
+            "step {} at {} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
             r.step,
-            r.cycles,
+            wormwear::output::cycles_label(r.cycles),
             r.phase,
             r.max_wear_m * 1e6,
             r.backlash_increase_m * 1e6,
@@ -437,10 +437,10 @@ fn wear(
         let first = end.records.first().expect("record");
         let last = end.records.last().expect("record");
         println!(
-            "wear: {} steps to {:.4e} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
+            "wear: {} steps to {} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
              P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; results in {}",
             last.step,
-            last.cycles,
+            wormwear::output::cycles_label(last.cycles),
             last.max_wear_m * 1e6,
             last.worn_volume_m3 * 1e9,
             last.backlash_increase_m * 1e6,

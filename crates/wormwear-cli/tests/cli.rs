@@ -15,6 +15,24 @@ fn assert_files(dir: &Path, names: &[&str]) {
     }
 }
 
+/// `wormwear -q run` of the design example into `dir` with a short life; asserts success.
+fn run_design_quietly(dir: &Path, cycles: &str, step_cycles: &str) -> std::process::Output {
+    let out = bin()
+        .args(["-q", "run"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir)
+        .args(["--cycles", cycles, "--step-cycles", step_cycles])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples")
@@ -114,6 +132,8 @@ fn geometry_writes_sections_grids_stl_and_summary() {
             "wheel_flank_outline.svg",
             "worm.stl",
             "wheel.stl",
+            "worm_flanks.vtp",
+            "wheel_flanks.vtp",
         ],
     );
     // Binary STL: 84-byte header + 50 bytes per triangle.
@@ -251,19 +271,7 @@ fn ltca_writes_its_section_plots_and_tables() {
 #[test]
 fn run_writes_every_stage_and_the_life() {
     let dir = tempfile::tempdir().unwrap();
-    let out = bin()
-        .args(["-q", "run"])
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .args(["--cycles", "20000", "--step-cycles", "10000"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = run_design_quietly(dir.path(), "20000", "10000");
     assert!(out.stdout.is_empty(), "--quiet prints nothing");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
@@ -308,6 +316,10 @@ fn run_writes_every_stage_and_the_life() {
             "wear_map.svg",
             "wear_per_cycle_map.svg",
             "wear_film_ratio_map.svg",
+            "wear_film_thickness_map.svg",
+            "wheel_flank_tca.vtp",
+            "wheel_flank_ltca.vtp",
+            "wheel_flank_wear.vtp",
             "wear_backlash.svg",
             "wear_transmission_error.svg",
             "wear_pressure.svg",
@@ -324,6 +336,8 @@ fn run_writes_every_stage_and_the_life() {
         "Loaded contact (LTCA)",
         "Wear over life",
         "Ratings (ISO/TR 14521)",
+        "Key results",
+        "Files",
         "Input",
     ] {
         assert!(report.contains(&format!("{h}</h2>")), "section {h} missing");
@@ -331,6 +345,7 @@ fn run_writes_every_stage_and_the_life() {
     assert!(report.matches("<figure><svg").count() >= 20);
     assert!(!report.contains("http://") || report.contains("http://www.w3.org/2000/svg"));
     assert!(!report.contains("src=\"http"));
+    assert!(report.contains("<a href=\"wheel_flank_wear.vtp\">"));
     // Resuming a finished run recomputes its last state and leaves the results unchanged.
     let again = bin()
         .args(["-q", "wear"])
@@ -429,19 +444,7 @@ fn report_renders_in_a_headless_browser() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let out = bin()
-        .args(["-q", "run"])
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .args(["--cycles", "10000", "--step-cycles", "10000"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_design_quietly(dir.path(), "10000", "10000");
     let url = format!("file://{}", dir.path().join("report.html").display());
     let shot = dir.path().join("report.png");
     let dom = Command::new(&browser)
@@ -451,7 +454,9 @@ fn report_renders_in_a_headless_browser() {
         .unwrap();
     assert!(dom.status.success());
     let dom = String::from_utf8_lossy(&dom.stdout);
-    for id in ["geometry", "tca", "ltca", "wear", "rating", "input"] {
+    for id in [
+        "key", "geometry", "tca", "ltca", "wear", "rating", "files", "input",
+    ] {
         assert!(
             dom.contains(&format!("id=\"{id}\"")),
             "section {id} not in the rendered page"
@@ -510,5 +515,117 @@ fn resume_with_the_checkpoint_of_another_grid_is_an_input_error() {
     assert!(
         err.contains("--resume") && err.contains("checkpoint"),
         "{err}"
+    );
+}
+
+/// A Python interpreter with VTK's own bindings (Debian `python3-vtk9`), when installed.
+fn python_with_vtk() -> Option<PathBuf> {
+    ["python3", "/usr/bin/python3"].iter().find_map(|p| {
+        let ok = Command::new(p)
+            .args(["-c", "import vtk"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false);
+        ok.then(|| PathBuf::from(p))
+    })
+}
+
+/// Reads every .vtp file of a run with VTK's XML reader (an implementation independent of the
+/// writer crate) and checks the exported wear against the summary: the surface integral of
+/// `wear_um` over the exported flank must equal the worn volume the wear stage computed.
+#[test]
+fn vtk_files_load_in_vtk_and_carry_the_results() {
+    let Some(python) = python_with_vtk() else {
+        eprintln!("SKIPPED: no Python with VTK (apt-get install python3-vtk9)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    run_design_quietly(dir.path(), "20000", "20000");
+    let script = r#"
+import json, sys, vtk
+out = {}
+for name in sys.argv[2:]:
+    r = vtk.vtkXMLPolyDataReader()
+    r.SetFileName(sys.argv[1] + "/" + name)
+    r.Update()
+    pd = r.GetOutput()
+    arrays = {}
+    for kind, data in (("point", pd.GetPointData()), ("cell", pd.GetCellData())):
+        for k in range(data.GetNumberOfArrays()):
+            a = data.GetArray(k)
+            arrays[kind + ":" + a.GetName()] = a.GetNumberOfTuples()
+    entry = {"error": r.GetErrorCode(), "points": pd.GetNumberOfPoints(),
+             "polys": pd.GetNumberOfPolys(), "arrays": arrays}
+    if "wear_um" in [pd.GetPointData().GetArrayName(k)
+                     for k in range(pd.GetPointData().GetNumberOfArrays())]:
+        tri = vtk.vtkTriangleFilter(); tri.SetInputData(pd); tri.Update()
+        ia = vtk.vtkIntegrateAttributes(); ia.SetInputData(tri.GetOutput()); ia.Update()
+        o = ia.GetOutput()
+        entry["area_mm2"] = o.GetCellData().GetArray("Area").GetValue(0)
+        entry["wear_integral_mm2_um"] = o.GetPointData().GetArray("wear_um").GetValue(0)
+    out[name] = entry
+print(json.dumps(out))
+"#;
+    let files = [
+        "worm_flanks.vtp",
+        "wheel_flanks.vtp",
+        "wheel_flank_tca.vtp",
+        "wheel_flank_ltca.vtp",
+        "wheel_flank_wear.vtp",
+    ];
+    let res = Command::new(&python)
+        .arg("-c")
+        .arg(script)
+        .arg(dir.path())
+        .args(files)
+        .output()
+        .unwrap();
+    assert!(
+        res.status.success(),
+        "{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    let read: serde_json::Value = serde_json::from_slice(&res.stdout).unwrap();
+    for f in files {
+        let e = &read[f];
+        assert_eq!(e["error"], 0, "{f}: VTK reader error");
+        assert!(e["points"].as_u64().unwrap() > 100, "{f}: {e}");
+        assert!(e["polys"].as_u64().unwrap() > 100, "{f}: {e}");
+        assert_eq!(
+            e["arrays"]["point:normal"], e["points"],
+            "{f}: one normal per point"
+        );
+    }
+    let wear = &read["wheel_flank_wear.vtp"];
+    for name in [
+        "point:wear_um",
+        "point:pressure_pattern_mpa",
+        "point:no_load_gap_um",
+        "point:sliding_speed_m_s",
+        "point:film_ratio",
+        "cell:pressure_pattern_mpa",
+    ] {
+        assert!(wear["arrays"].get(name).is_some(), "wear file lacks {name}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let volume_mm2_um = summary["wear"]["steps"][1]["worn_volume_m3"]
+        .as_f64()
+        .unwrap()
+        * 1e12;
+    let integral = wear["wear_integral_mm2_um"].as_f64().unwrap();
+    assert!(volume_mm2_um > 0.0);
+    assert!(
+        (integral - volume_mm2_um).abs() < 0.005 * volume_mm2_um,
+        "VTK wear integral {integral} mm2 um vs worn volume {volume_mm2_um}"
+    );
+    let area = summary["geometry"]["active_flank_area_mm2"]
+        .as_f64()
+        .unwrap();
+    let exported = wear["area_mm2"].as_f64().unwrap();
+    assert!(
+        (exported - area).abs() < 0.01 * area,
+        "exported flank area {exported} mm2 vs active flank area {area}"
     );
 }

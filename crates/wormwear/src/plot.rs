@@ -66,6 +66,49 @@ where
     Ok(())
 }
 
+/// The chart corner whose legend box (a quarter of the width, a fifth of the height of the
+/// range `(x0, x1, y0, y1)`) covers the fewest points of the series: the legend hides no curve
+/// when some corner is free.
+fn emptiest_corner(
+    series: &[Series],
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+) -> (SeriesLabelPosition, usize) {
+    let labelled = series.iter().filter(|s| !s.label.is_empty()).count();
+    let (w, h) = (
+        0.25 * (x1 - x0),
+        (0.07 * labelled as f64 + 0.06) * (y1 - y0),
+    );
+    let corners = [
+        (SeriesLabelPosition::UpperRight, x1 - w, x1, y1 - h, y1),
+        (SeriesLabelPosition::UpperLeft, x0, x0 + w, y1 - h, y1),
+        (SeriesLabelPosition::LowerRight, x1 - w, x1, y0, y0 + h),
+        (SeriesLabelPosition::LowerLeft, x0, x0 + w, y0, y0 + h),
+    ];
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
+    for (pos, a, b, c, d) in corners {
+        // Points of each polyline densified so a segment crossing the box counts.
+        let mut hits = 0;
+        for s in series {
+            for pair in s.points.windows(2) {
+                for k in 0..=8 {
+                    let t = k as f64 / 8.0;
+                    let (x, y) = (
+                        pair[0].0 + t * (pair[1].0 - pair[0].0),
+                        pair[0].1 + t * (pair[1].1 - pair[0].1),
+                    );
+                    if x >= a && x <= b && y >= c && y <= d {
+                        hits += 1;
+                    }
+                }
+            }
+        }
+        if hits < best.0 {
+            best = (hits, pos);
+        }
+    }
+    (best.1, best.0)
+}
+
 /// Bounding box (x0, x1, y0, y1) of the finite points; the unit square when there is none.
 fn bounds(points: impl Iterator<Item = (f64, f64)>) -> (f64, f64, f64, f64) {
     let mut b = (
@@ -124,6 +167,13 @@ pub fn line_chart_spanned(
     let pad = |a: f64, b: f64| if b > a { 0.04 * (b - a) } else { 0.5 };
     let (px, py) = (pad(x0, x1), pad(y0, y1));
     (x0, x1, y0, y1) = (x0 - px, x1 + px, y0 - py, y1 + py);
+    // Legend in a free corner; if every corner has curve under it, headroom on top for it.
+    let (mut corner, hits) = emptiest_corner(series, (x0, x1, y0, y1));
+    if hits > 0 && !equal_aspect {
+        let labelled = series.iter().filter(|s| !s.label.is_empty()).count();
+        y1 += (0.07 * labelled as f64 + 0.08) * (y1 - y0);
+        corner = SeriesLabelPosition::UpperRight;
+    }
     let width = 1000u32;
     let (margin_x, margin_y) = (90u32, 110u32);
     let mut height = 560u32;
@@ -156,6 +206,8 @@ pub fn line_chart_spanned(
             .map_err(plot_err)?;
         chart
             .configure_mesh()
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
             .x_desc(x_label)
             .y_desc(y_label)
             .label_style(("sans-serif", 15))
@@ -163,7 +215,7 @@ pub fn line_chart_spanned(
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(plot_err)?;
-        draw_series_with_legend(&mut chart, series, SeriesLabelPosition::UpperRight)?;
+        draw_series_with_legend(&mut chart, series, corner)?;
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, svg.as_bytes())
@@ -203,8 +255,163 @@ pub struct MapCell {
     pub value: f64,
 }
 
+/// Short tick label: up to three decimals without trailing zeros ("800", "0.25"), scientific
+/// notation for very large or very small magnitudes.
+pub fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        return format!("{v:.2e}");
+    }
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+/// Values on a structured grid of chart points for iso-lines: `rows` x `cols` points stored
+/// column by column (index `col * rows + row`), NaN where there is no value.
+#[derive(Debug, Clone)]
+pub struct IsoGrid {
+    pub rows: usize,
+    pub cols: usize,
+    pub points: Vec<(f64, f64)>,
+    pub values: Vec<f64>,
+}
+
+impl IsoGrid {
+    /// Segments of the iso-line `value = level` by marching squares with linear interpolation
+    /// along the edges; squares with a NaN corner are skipped. Saddles are split by the mean of
+    /// the four corners.
+    pub fn iso_segments(&self, level: f64) -> Vec<Segment> {
+        let mut segments = Vec::new();
+        if self.rows < 2 || self.cols < 2 {
+            return segments;
+        }
+        let at = |row: usize, col: usize| col * self.rows + row;
+        for col in 0..self.cols - 1 {
+            for row in 0..self.rows - 1 {
+                // Corners counter-clockwise in (row, col): 0 (r, c), 1 (r+1, c), 2 (r+1, c+1),
+                // 3 (r, c+1); edge e joins corners e and e+1.
+                let idx = [
+                    at(row, col),
+                    at(row + 1, col),
+                    at(row + 1, col + 1),
+                    at(row, col + 1),
+                ];
+                let v = idx.map(|k| self.values[k]);
+                if v.iter().any(|x| !x.is_finite()) {
+                    continue;
+                }
+                let above = v.map(|x| x >= level);
+                let crossing = |e: usize| -> Option<(f64, f64)> {
+                    let (a, b) = (e, (e + 1) % 4);
+                    if above[a] == above[b] {
+                        return None;
+                    }
+                    let t = (level - v[a]) / (v[b] - v[a]);
+                    let (pa, pb) = (self.points[idx[a]], self.points[idx[b]]);
+                    Some((pa.0 + t * (pb.0 - pa.0), pa.1 + t * (pb.1 - pa.1)))
+                };
+                let cuts: Vec<(usize, (f64, f64))> =
+                    (0..4).filter_map(|e| crossing(e).map(|p| (e, p))).collect();
+                match cuts.len() {
+                    2 => segments.push((cuts[0].1, cuts[1].1)),
+                    4 => {
+                        // Saddle: corners 0 and 2 on one side, 1 and 3 on the other. If the
+                        // centre is on corner 0's side, corners 1 and 3 are cut off (edges
+                        // 0-1 and 2-3), otherwise corners 0 and 2 (edges 3-0 and 1-2).
+                        let centre_above = v.iter().sum::<f64>() / 4.0 >= level;
+                        let p = |e: usize| cuts[e].1;
+                        if centre_above == above[0] {
+                            segments.push((p(0), p(1)));
+                            segments.push((p(2), p(3)));
+                        } else {
+                            segments.push((p(3), p(0)));
+                            segments.push((p(1), p(2)));
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        segments
+    }
+}
+
+/// The segments of the connected pieces of an iso-line (segments sharing end points) whose
+/// total length is at least `min_length`: drops the small closed loops that noise of one or two
+/// cells draws around itself.
+pub fn without_short_pieces(segments: Vec<Segment>, min_length: f64) -> Vec<Segment> {
+    let n = segments.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    // End points are shared exactly by the squares that computed them (same edge, same
+    // interpolation), up to rounding: key them on a fine lattice.
+    let key = |p: (f64, f64)| ((p.0 * 1e7).round() as i64, (p.1 * 1e7).round() as i64);
+    let mut first_at: std::collections::HashMap<(i64, i64), usize> =
+        std::collections::HashMap::new();
+    for (k, (a, b)) in segments.iter().enumerate() {
+        for p in [a, b] {
+            match first_at.entry(key(*p)) {
+                std::collections::hash_map::Entry::Occupied(e) => {
+                    let (ra, rb) = (root(&mut parent, k), root(&mut parent, *e.get()));
+                    parent[ra] = rb;
+                }
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(k);
+                }
+            }
+        }
+    }
+    let length = |(a, b): &Segment| ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt();
+    let mut total = vec![0.0; n];
+    for (k, segment) in segments.iter().enumerate() {
+        let r = root(&mut parent, k);
+        total[r] += length(segment);
+    }
+    let keep: Vec<bool> = (0..n)
+        .map(|k| total[root(&mut parent, k)] >= min_length)
+        .collect();
+    segments
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(s, k)| k.then_some(s))
+        .collect()
+}
+
+/// About `target` round levels (1, 2 or 5 times a power of ten apart) strictly inside
+/// (lo, hi); empty for an empty or non-finite range.
+pub fn nice_levels(lo: f64, hi: f64, target: usize) -> Vec<f64> {
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) || target == 0 {
+        return Vec::new();
+    }
+    let raw = (hi - lo) / (target + 1) as f64;
+    let power = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * power)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * power);
+    let first = (lo / step).floor() as i64 + 1;
+    (first..)
+        .map(|k| k as f64 * step)
+        .take_while(|&x| x < hi - 1e-9 * step)
+        .filter(|&x| x > lo + 1e-9 * step)
+        .collect()
+}
+
 /// Colour map of cells (e.g. the wheel flank in (z, r) mm) with a colour bar, overlay curves
-/// and overlay segments (e.g. a pattern outline). Values are clipped to `range`.
+/// and overlay segments (e.g. a pattern outline). Values are clipped to `range`. With `iso`,
+/// iso-lines at round levels are drawn over the map and marked on the colour bar.
 #[allow(clippy::too_many_arguments)]
 pub fn flank_map(
     path: &Path,
@@ -216,6 +423,7 @@ pub fn flank_map(
     bar_label: &str,
     overlays: &[Series],
     segments: &[Segment],
+    iso: Option<&IsoGrid>,
 ) -> Result<(), OutputError> {
     let (x0, x1, y0, y1) = bounds(cells.iter().flat_map(|c| c.corners.iter().copied()));
     let (px, py) = (0.03 * (x1 - x0), 0.05 * (y1 - y0));
@@ -265,6 +473,25 @@ pub fn flank_map(
                 PathElement::new(ring, cell_color(c).stroke_width(1))
             }))
             .map_err(plot_err)?;
+        let levels = if iso.is_some() {
+            nice_levels(lo, hi, 6)
+        } else {
+            Vec::new()
+        };
+        if let Some(grid) = iso {
+            let iso_style = RGBColor(25, 25, 25).mix(0.7).stroke_width(1);
+            // Pieces shorter than 6 % of the map's diagonal are noise, not a level line.
+            let min_length = 0.06 * ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
+            for &level in &levels {
+                chart
+                    .draw_series(
+                        without_short_pieces(grid.iso_segments(level), min_length)
+                            .into_iter()
+                            .map(|(a, b)| PathElement::new(vec![a, b], iso_style)),
+                    )
+                    .map_err(plot_err)?;
+            }
+        }
         chart
             .draw_series(
                 segments
@@ -287,6 +514,7 @@ pub fn flank_map(
             .configure_mesh()
             .disable_x_axis()
             .disable_mesh()
+            .y_label_formatter(&|v| tick_label(*v))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(plot_err)?;
@@ -303,7 +531,152 @@ pub fn flank_map(
                 )
             }))
             .map_err(plot_err)?;
+        // The iso-line levels as ticks across the bar.
+        bar_chart
+            .draw_series(levels.iter().map(|&y| {
+                PathElement::new(
+                    vec![(0.0, y), (1.0, y)],
+                    RGBColor(25, 25, 25).stroke_width(1),
+                )
+            }))
+            .map_err(plot_err)?;
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, svg.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Grid of `n` x `n` points on [-1, 1]^2 with values f(x, y).
+    fn grid(n: usize, f: impl Fn(f64, f64) -> f64) -> IsoGrid {
+        let mut points = Vec::new();
+        let mut values = Vec::new();
+        for col in 0..n {
+            for row in 0..n {
+                let (x, y) = (
+                    -1.0 + 2.0 * col as f64 / (n - 1) as f64,
+                    -1.0 + 2.0 * row as f64 / (n - 1) as f64,
+                );
+                points.push((x, y));
+                values.push(f(x, y));
+            }
+        }
+        IsoGrid {
+            rows: n,
+            cols: n,
+            points,
+            values,
+        }
+    }
+
+    #[test]
+    fn iso_lines_of_a_linear_field_are_exact_straight_lines() {
+        let g = grid(9, |x, y| 2.0 * x + 0.5 * y);
+        let level = 0.3;
+        let segs = g.iso_segments(level);
+        assert!(!segs.is_empty());
+        for (a, b) in segs {
+            for p in [a, b] {
+                assert!((2.0 * p.0 + 0.5 * p.1 - level).abs() < 1e-12, "{p:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn iso_line_of_a_paraboloid_is_a_closed_circle_converging_with_the_grid() {
+        // A level no grid point sits on (a vertex on the level makes degenerate segments).
+        let level: f64 = 0.47;
+        let mut errors = Vec::new();
+        for n in [11, 21, 41] {
+            let segs = grid(n, |x, y| x * x + y * y).iso_segments(level);
+            // Closed curve: every end point is shared by exactly two segment ends.
+            let key = |p: (f64, f64)| ((p.0 * 1e9).round() as i64, (p.1 * 1e9).round() as i64);
+            let mut count = std::collections::HashMap::new();
+            for (a, b) in &segs {
+                *count.entry(key(*a)).or_insert(0) += 1;
+                *count.entry(key(*b)).or_insert(0) += 1;
+            }
+            assert!(count.values().all(|&c| c == 2), "open iso-line at n = {n}");
+            let err = segs
+                .iter()
+                .flat_map(|(a, b)| [a, b])
+                .map(|p| ((p.0 * p.0 + p.1 * p.1).sqrt() - level.sqrt()).abs())
+                .fold(0.0, f64::max);
+            errors.push(err);
+        }
+        // Linear interpolation on the edges: error O(h^2), a quarter per halving of h.
+        assert!(
+            errors[1] < 0.35 * errors[0] && errors[2] < 0.35 * errors[1],
+            "{errors:?}"
+        );
+    }
+
+    #[test]
+    fn iso_lines_skip_missing_values_and_split_saddles() {
+        // A square with NaN: nothing drawn there.
+        let mut g = grid(2, |x, _| x);
+        g.values[0] = f64::NAN;
+        assert!(g.iso_segments(0.0).is_empty());
+        // Saddle x*y on one square: two segments that do not cross the centre.
+        let g = grid(2, |x, y| x * y + 0.1);
+        let segs = g.iso_segments(0.0);
+        assert_eq!(segs.len(), 2);
+        // Centre value 0.1 is above the level: the two "below" corners (x*y = -1) are cut off,
+        // so each segment stays in one half-plane x > 0 or x < 0.
+        for (a, b) in segs {
+            assert!(a.0 * b.0 > 0.0, "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn short_iso_pieces_are_dropped_and_long_ones_kept() {
+        // A field with a small bump (a loop of one cell) and a ramp crossing the whole grid.
+        let mut g = grid(21, |x, _| x);
+        let level = 0.5;
+        let bump = 5 * 21 + 5; // point (col 5, row 5), x = -0.5: far below the level
+        g.values[bump] = 1.0;
+        let all = g.iso_segments(level);
+        let kept = without_short_pieces(all.clone(), 1.0);
+        // The ramp's line x = 0.5 (length 2) stays whole; the loop around the bump (length
+        // about 0.2) goes.
+        assert!(kept.len() < all.len());
+        assert!(kept
+            .iter()
+            .all(|(a, b)| (a.0 - 0.5).abs() < 1e-12 && (b.0 - 0.5).abs() < 1e-12));
+        let length: f64 = kept
+            .iter()
+            .map(|(a, b)| ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt())
+            .sum();
+        assert!((length - 2.0).abs() < 1e-9, "{length}");
+    }
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(800.0), "800");
+        assert_eq!(tick_label(0.25), "0.25");
+        assert_eq!(tick_label(0.0), "0");
+        assert_eq!(tick_label(-0.0001), "-1.00e-4");
+        assert_eq!(tick_label(2.5e6), "2.50e6");
+        assert_eq!(tick_label(-1.5), "-1.5");
+    }
+
+    #[test]
+    fn nice_levels_are_round_and_inside_the_range() {
+        assert_eq!(
+            nice_levels(0.0, 1000.0, 6),
+            vec![200.0, 400.0, 600.0, 800.0]
+        );
+        assert_eq!(nice_levels(0.0, 4.0, 6), vec![1.0, 2.0, 3.0]);
+        let l = nice_levels(-0.35, 0.35, 6);
+        let expected = [-0.3, -0.2, -0.1, 0.0, 0.1, 0.2, 0.3];
+        assert_eq!(l.len(), expected.len(), "{l:?}");
+        assert!(
+            l.iter().zip(expected).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{l:?}"
+        );
+        assert!(nice_levels(1.0, 1.0, 6).is_empty());
+        assert!(nice_levels(0.0, f64::NAN, 6).is_empty());
+    }
 }

@@ -306,9 +306,16 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
     let plan = plan(40_000.0, wear::StepControl::Cycles(10_000.0), 5e-6);
     let dir = tempfile::tempdir().unwrap();
     let write = |view: &wear::StepView| {
-        wormwear::output::wear::write_state(&bench.geo, &bench.tca, &plan, view, dir.path())
-            .map(|_| ())
-            .map_err(|e| wear::WearError::Output(e.to_string()))
+        wormwear::output::wear::write_state(
+            &bench.g,
+            &bench.geo,
+            &bench.tca,
+            &plan,
+            view,
+            dir.path(),
+        )
+        .map(|_| ())
+        .map_err(|e| wear::WearError::Output(e.to_string()))
     };
     let mut written = 0;
     let interrupted = bench.simulate(&plan, None, &mut |view| {

@@ -185,6 +185,22 @@ pub fn write_geometry(
         &wheel_mesh(gear, geo, gear.analysis.stl_wheel_teeth).to_binary_stl("wheel", MM),
     )?;
     files.push(path);
+    // VTK: both worm flanks, both wheel flanks of the reference tooth space.
+    let path = dir.join("worm_flanks.vtp");
+    let [left, right] = super::vtk::worm_flank_surfaces(gear, geo);
+    left.write_vtp(&path, &[&right], "worm flanks (mm)")?;
+    files.push(path);
+    let path = dir.join("wheel_flanks.vtp");
+    let [left, right] = geo
+        .wheel_flanks
+        .each_ref()
+        .map(|wf| super::vtk::wheel_flank_surface(gear, wf));
+    left.write_vtp(
+        &path,
+        &[&right],
+        "wheel flanks of the reference tooth space (mm)",
+    )?;
+    files.push(path);
     write_geometry_summary(gear, geo, input_file, dir)?;
     files.push(dir.join("summary.json"));
     Ok(files)

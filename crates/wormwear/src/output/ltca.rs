@@ -5,9 +5,10 @@
 use super::tca::{flank_outline, tip_trace_series};
 use super::{update_summary, Csv, OutputError};
 use crate::geometry::{Geometry, WheelFlank};
+use crate::input::GearSet;
 use crate::kinematics::Tca;
 use crate::ltca::{Ltca, PositionResult};
-use crate::plot::{flank_map, line_chart, line_chart_spanned, MapCell, Series};
+use crate::plot::{flank_map, line_chart, line_chart_spanned, IsoGrid, MapCell, Series};
 use std::path::{Path, PathBuf};
 
 const MM: f64 = 1e3;
@@ -129,6 +130,44 @@ fn local_cells(pr: &PositionResult, tooth: usize, wf: &WheelFlank) -> Vec<MapCel
         .collect()
 }
 
+/// The pressure of one tooth's local cells (MPa) on the (column across the line, slice) grid
+/// for iso-lines, at the cell centres in (z, r) mm; NaN where the local mesh has no cell.
+fn local_iso_grid(pr: &PositionResult, tooth: usize) -> IsoGrid {
+    let cells = || {
+        pr.cells
+            .iter()
+            .zip(&pr.pressure)
+            .filter(|(c, _)| c.tooth_index == tooth)
+    };
+    let (mut s0, mut s1, mut rows) = (usize::MAX, 0, 0);
+    for (c, _) in cells() {
+        s0 = s0.min(c.slice);
+        s1 = s1.max(c.slice);
+        rows = rows.max(c.column + 1);
+    }
+    if s0 > s1 {
+        return IsoGrid {
+            rows: 0,
+            cols: 0,
+            points: Vec::new(),
+            values: Vec::new(),
+        };
+    }
+    let cols = s1 - s0 + 1;
+    let mut grid = IsoGrid {
+        rows,
+        cols,
+        points: vec![(0.0, 0.0); rows * cols],
+        values: vec![f64::NAN; rows * cols],
+    };
+    for (c, &p) in cells() {
+        let k = (c.slice - s0) * rows + c.column;
+        grid.points[k] = (c.z * MM, c.r * MM);
+        grid.values[k] = p * MPA;
+    }
+    grid
+}
+
 /// Map of the loaded contact pattern (max pressure over the cycle per flank cell, MPa; grey
 /// where no contact) with the given title and overlays.
 pub fn pattern_map(
@@ -158,6 +197,7 @@ pub fn pattern_map(
 /// Writes every LTCA output into `dir`; `map_position` selects the position of the pressure
 /// maps. Returns the files written.
 pub fn write_ltca(
+    gear: &GearSet,
     geo: &Geometry,
     tca: &Tca,
     ltca: &Ltca,
@@ -342,6 +382,7 @@ pub fn write_ltca(
             "pressure (MPa)",
             &[flank_outline(wf, "active flank", 5), trace.clone()],
             &[],
+            Some(&local_iso_grid(pr, t)),
         )?;
         files.push(path);
     }
@@ -382,5 +423,10 @@ pub fn write_ltca(
         })?;
     update_summary(dir, "ltca", value)?;
     files.push(dir.join("summary.json"));
+    let path = dir.join("wheel_flank_ltca.vtp");
+    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
+    super::vtk::add_pressure_pattern(&mut surface, &ltca.pattern);
+    surface.write_vtp(&path, &[], "loaded wheel flank: loaded analysis (mm)")?;
+    files.push(path);
     Ok(files)
 }

@@ -8,6 +8,7 @@ pub mod geometry;
 pub mod ltca;
 pub mod report;
 pub mod tca;
+pub mod vtk;
 pub mod wear;
 
 use std::fmt::Write as _;
@@ -32,6 +33,32 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
         path: path.to_path_buf(),
         source,
     }
+}
+
+/// A number of cycles for titles and messages: "180 000" below a million (thin groups of
+/// three digits), "1.25 million" above.
+pub fn cycles_label(cycles: f64) -> String {
+    if !cycles.is_finite() {
+        return format!("{cycles}");
+    }
+    if cycles.abs() >= 1e6 {
+        let m = cycles / 1e6;
+        let s = format!("{m:.3}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        return format!("{s} million");
+    }
+    let digits = format!("{}", cycles.round().abs() as u64);
+    let mut out = String::new();
+    for (k, ch) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(ch);
+    }
+    if cycles < 0.0 {
+        out.insert(0, '-');
+    }
+    out
 }
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
@@ -138,6 +165,16 @@ impl Csv {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cycle_labels_read_easily() {
+        assert_eq!(cycles_label(180000.0), "180 000");
+        assert_eq!(cycles_label(999.0), "999");
+        assert_eq!(cycles_label(0.0), "0");
+        assert_eq!(cycles_label(19e6), "19 million");
+        assert_eq!(cycles_label(1.25e6), "1.25 million");
+        assert_eq!(cycles_label(6_812_345.0), "6.812 million");
+    }
 
     #[test]
     fn summary_sections_are_merged() {

@@ -1,7 +1,7 @@
 //! `report.html`: one self-contained page (inline SVG, inline CSS, no network) gathering what a
 //! run wrote into its output directory: the input file, the derived data of every stage from
-//! summary.json, the figures of each stage in order, the ratings and the warnings. First
-//! version: figures are embedded as written by the stages (issue 7 grows it).
+//! summary.json, the figures of each stage in order, the ratings, the warnings and links to the
+//! data files beside it (CSV tables, STL and VTK surfaces for CAD and ParaView).
 
 use super::{write_atomic, OutputError};
 use std::fmt::Write as _;
@@ -37,6 +37,7 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "wear_map",
             "wear_per_cycle_map",
             "wear_film_ratio_map",
+            "wear_film_thickness_map",
             "wear_pattern_step",
         ],
     ),
@@ -117,13 +118,13 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         t = escape(title)
     );
     // Contents.
-    h.push_str("<nav>");
+    h.push_str("<nav><a href=\"#key\">Key results</a>");
     for (name, key, _) in SECTIONS {
         if summary.get(key).is_some() {
             let _ = write!(h, "<a href=\"#{key}\">{}</a>", escape(name));
         }
     }
-    h.push_str("<a href=\"#input\">Input</a></nav>\n");
+    h.push_str("<a href=\"#files\">Files</a><a href=\"#input\">Input</a></nav>\n");
     // Warnings of every stage.
     let mut warnings = Vec::new();
     if let serde_json::Value::Object(m) = &summary {
@@ -148,6 +149,94 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         h.push_str("</ul>");
     }
     h.push_str("</section>\n");
+    // Key results first: what an engineer looks for before the details.
+    let last_step = summary["wear"]["steps"]
+        .as_array()
+        .and_then(|s| s.last())
+        .cloned()
+        .unwrap_or(serde_json::Value::Null);
+    let key_results: [(&str, &serde_json::Value, f64, &str); 13] = [
+        ("Ratio", &summary["geometry"]["ratio"], 1.0, ""),
+        (
+            "Lead angle",
+            &summary["geometry"]["lead_angle_deg"],
+            1.0,
+            "deg",
+        ),
+        (
+            "Max contact pressure (unworn)",
+            &summary["ltca"]["max_pressure_pa"],
+            1e-6,
+            "MPa",
+        ),
+        (
+            "Loaded pattern S0",
+            &summary["ltca"]["contact_area_fraction"],
+            1.0,
+            "",
+        ),
+        (
+            "Transmission error, peak to peak",
+            &summary["ltca"]["te_p2p_rad"],
+            1e6,
+            "urad",
+        ),
+        (
+            "Mesh stiffness (mean)",
+            &summary["ltca"]["mesh_stiffness_mean_nm_per_rad"],
+            1.0,
+            "N m/rad",
+        ),
+        (
+            "Efficiency (ISO/TR 14521)",
+            &summary["rating"]["efficiency"],
+            1.0,
+            "",
+        ),
+        (
+            "Worm torque",
+            &summary["rating"]["worm_torque_nm"],
+            1.0,
+            "N m",
+        ),
+        (
+            "Pitting life N_LI",
+            &summary["rating"]["n_li_cycles"],
+            1.0,
+            "cycles",
+        ),
+        ("Life simulated", &last_step["cycles"], 1.0, "cycles"),
+        ("Max wear at the end", &last_step["max_wear_m"], 1e6, "um"),
+        (
+            "Backlash increase at the end",
+            &last_step["backlash_increase_m"],
+            1e6,
+            "um",
+        ),
+        (
+            "Max contact pressure at the end",
+            &last_step["max_pressure_pa"],
+            1e-6,
+            "MPa",
+        ),
+    ];
+    h.push_str("<section id=\"key\"><h2>Key results</h2><table>");
+    for (label, value, scale, unit) in key_results {
+        if let Some(x) = value.as_f64() {
+            let text = format!("{:.4e}", x * scale)
+                .parse::<f64>()
+                .map(|y| format!("{y}"))
+                .unwrap_or_default();
+            let _ = write!(
+                h,
+                "<tr><th>{}</th><td class=\"n\">{}</td><td>{}</td></tr>",
+                escape(label),
+                escape(&text),
+                escape(unit)
+            );
+        }
+    }
+    h.push_str("</table></section>\n");
     for (name, key, prefixes) in SECTIONS {
         let Some(section) = summary.get(key) else {
             continue;
@@ -230,6 +319,29 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         }
         h.push_str("</section>\n");
     }
+    // The data files beside the report (relative links: they open from the same directory).
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().to_str().map(String::from))
+                .filter(|n| {
+                    [".vtp", ".stl", ".csv", ".json"]
+                        .iter()
+                        .any(|x| n.ends_with(x))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    h.push_str(
+        "<section id=\"files\"><h2>Files</h2><p>Beside this page: <code>.vtp</code> surfaces \
+         with their results for ParaView (File > Open; colour by an array, e.g. \
+         <code>wear_um</code>), STL for CAD, CSV tables, <code>summary.json</code>.</p><ul>",
+    );
+    for f in &files {
+        let _ = write!(h, "<li><a href=\"{f}\">{f}</a></li>", f = escape(f));
+    }
+    h.push_str("</ul></section>\n");
     let _ = write!(
         h,
         "<section id=\"input\"><h2>Input</h2><pre>{}</pre></section>\n</body></html>\n",

@@ -4,8 +4,9 @@
 
 use super::{update_summary, Csv, OutputError};
 use crate::geometry::{Geometry, WheelFlank};
+use crate::input::GearSet;
 use crate::kinematics::Tca;
-use crate::plot::{flank_map, line_chart_spanned, MapCell, Series};
+use crate::plot::{flank_map, line_chart_spanned, IsoGrid, MapCell, Series};
 use std::path::{Path, PathBuf};
 
 const MM: f64 = 1e3;
@@ -113,7 +114,7 @@ pub fn flank_cells(wf: &WheelFlank, values: &[f64]) -> Vec<MapCell> {
 }
 
 /// Colour map of per-cell values on the wheel flank in (z, r) mm (NaN: grey), values clipped
-/// to `range`.
+/// to `range`, with iso-lines through the cell centres.
 #[allow(clippy::too_many_arguments)]
 pub fn wheel_flank_map(
     path: &Path,
@@ -125,16 +126,33 @@ pub fn wheel_flank_map(
     overlays: &[Series],
     segments: &[crate::plot::Segment],
 ) -> Result<(), OutputError> {
+    let cells = flank_cells(wf, cell_values);
+    let iso = IsoGrid {
+        rows: wf.cells_height,
+        cols: wf.cells_face,
+        points: cells
+            .iter()
+            .map(|c| {
+                let (x, y) = c
+                    .corners
+                    .iter()
+                    .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+                (0.25 * x, 0.25 * y)
+            })
+            .collect(),
+        values: cell_values.to_vec(),
+    };
     flank_map(
         path,
         title,
         "z2 across the face width (mm)",
         "r wheel radius (mm)",
-        &flank_cells(wf, cell_values),
+        &cells,
         range,
         bar_label,
         overlays,
         segments,
+        Some(&iso),
     )
 }
 
@@ -171,7 +189,12 @@ pub fn pattern_outline(wf: &WheelFlank, marked: &[bool]) -> Vec<crate::plot::Seg
 }
 
 /// Writes every TCA output into `dir`; returns the files written.
-pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+pub fn write_tca(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
     // Kinematic error.
@@ -384,5 +407,12 @@ pub fn write_tca(geo: &Geometry, tca: &Tca, dir: &Path) -> Result<Vec<PathBuf>, 
     })?;
     update_summary(dir, "tca", value)?;
     files.push(dir.join("summary.json"));
+    let path = dir.join("wheel_flank_tca.vtp");
+    super::vtk::wheel_flank_tca(gear, geo, tca).write_vtp(
+        &path,
+        &[],
+        "loaded wheel flank: unloaded analysis (mm)",
+    )?;
+    files.push(path);
     Ok(files)
 }

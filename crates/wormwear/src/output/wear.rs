@@ -1,13 +1,14 @@
 //! Files of a life run, written after every completed state so an interruption loses nothing:
 //! the checkpoint `wear_checkpoint.json` (resume), `wear_steps.csv`, the `wear` section of
 //! summary.json and curves over cycles (wear, backlash, TE, pressure) at every state; maps of
-//! the cumulative wear, of the wear per cycle and of the film ratio, the node table and the
-//! loaded pattern at log-spaced states (0, 1, 2, 4, 8, ...) and the last.
+//! the cumulative wear, of the wear per cycle, of the film thickness and ratio, the node table,
+//! the loaded pattern and `wheel_flank_wear.vtp` at log-spaced states (0, 1, 2, 4, 8, ...) and
+//! the last.
 
 use super::tca::{flank_outline, tip_trace_series, wheel_flank_map};
 use super::{update_summary, write_atomic, Csv, OutputError};
 use crate::geometry::{FlankField, Geometry};
-use crate::input::WearPlan;
+use crate::input::{GearSet, WearPlan};
 use crate::kinematics::Tca;
 use crate::plot::{line_chart, Series};
 use crate::wear::{StepView, WearState};
@@ -46,6 +47,7 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
 
 /// Writes the files of one completed state (see the module doc). Returns the files written.
 pub fn write_state(
+    gear: &GearSet,
     geo: &Geometry,
     tca: &Tca,
     plan: &WearPlan,
@@ -209,8 +211,8 @@ pub fn write_state(
     map(
         &path,
         &format!(
-            "Cumulative wear after {:.4e} cycles (max {:.2} um)",
-            r.cycles,
+            "Cumulative wear after {} cycles (max {:.2} um; map: cell means)",
+            super::cycles_label(r.cycles),
             r.max_wear_m * UM
         ),
         &state.removal,
@@ -223,13 +225,13 @@ pub fn write_state(
     map(
         &path,
         &format!(
-            "Wear per cycle at {:.4e} cycles (max {:.3e} um)",
-            r.cycles,
-            r.max_wear_per_cycle_m * UM
+            "Wear per cycle at {} cycles (max {:.3} nm; map: cell means)",
+            super::cycles_label(r.cycles),
+            r.max_wear_per_cycle_m * 1e9
         ),
         &view.cycle.depth,
-        UM,
-        "wear per cycle (um)",
+        1e9,
+        "wear per cycle (nm)",
         None,
     )?;
     files.push(path);
@@ -247,13 +249,26 @@ pub fn write_state(
     map(
         &path,
         &format!(
-            "Film ratio lambda at {:.4e} cycles (clipped at 4: no wear above)",
-            r.cycles
+            "Film ratio lambda at {} cycles (clipped at 4: no wear above)",
+            super::cycles_label(r.cycles)
         ),
         &lambda,
         1.0,
         "lambda",
         Some(4.0),
+    )?;
+    files.push(path);
+    let path = dir.join("wear_film_thickness_map.svg");
+    map(
+        &path,
+        &format!(
+            "Minimum film thickness h_min at {} cycles (Moes-Venner, thermal factor)",
+            super::cycles_label(r.cycles)
+        ),
+        &view.cycle.film,
+        UM,
+        "h_min (um)",
+        None,
     )?;
     files.push(path);
     let mut csv = Csv::new(&[
@@ -293,8 +308,8 @@ pub fn write_state(
             wf,
             view.ltca,
             &format!(
-                "Loaded pattern at {:.4e} cycles (P_max {:.0} MPa, S0 {:.2})",
-                r.cycles,
+                "Loaded pattern at {} cycles (P_max {:.0} MPa, S0 {:.2})",
+                super::cycles_label(r.cycles),
                 r.max_pressure_pa * MPA,
                 r.contact_area_fraction
             ),
@@ -302,5 +317,21 @@ pub fn write_state(
         )?;
         files.push(path);
     }
+    let path = dir.join("wheel_flank_wear.vtp");
+    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
+    super::vtk::add_pressure_pattern(&mut surface, &view.ltca.pattern);
+    super::vtk::add_node_field(&mut surface, "wear_um", &state.removal, UM);
+    super::vtk::add_node_field(&mut surface, "wear_per_cycle_um", &view.cycle.depth, UM);
+    super::vtk::add_node_field(&mut surface, "film_thickness_um", &view.cycle.film, UM);
+    super::vtk::add_node_field(&mut surface, "film_ratio", &view.cycle.lambda, 1.0);
+    surface.write_vtp(
+        &path,
+        &[],
+        &format!(
+            "loaded wheel flank after {} cycles (mm)",
+            super::cycles_label(r.cycles)
+        ),
+    )?;
+    files.push(path);
     Ok(files)
 }
