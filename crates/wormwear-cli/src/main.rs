@@ -16,9 +16,13 @@ mod geometry_cmd;
     name = "wormwear",
     version,
     about = "Loaded contact and wear of steel-worm / bronze-wheel worm gears",
-    after_help = "Examples:\n  wormwear check examples/gear-1x40-design.toml\n  \
-                  wormwear geometry examples/gear-1x40-design.toml -o out/1x40\n  \
-                  wormwear tca examples/gear-1x40-design.toml -o out/1x40"
+    after_help = "Examples:\n  \
+                  wormwear run examples/gear-1x40-design.toml -o out/1x40      # everything + report.html\n  \
+                  wormwear check examples/gear-1x40-design.toml                # validate the input\n  \
+                  wormwear ltca examples/gear-k-2x25.toml -o out/k             # loaded contact only\n  \
+                  wormwear wear examples/gear-1x40-case-c.toml -o out/c -v     # a life, one line per state\n\n\
+                  Exit codes: 0 success, 1 computation or output error, 2 invalid input.\n\
+                  Outputs: summary.json, CSV, SVG, report.html, STL and VTK (.vtp) files; see the README."
 )]
 struct Cli {
     /// Print only errors.
