@@ -398,9 +398,16 @@ fn wear(
         );
         bar
     };
+    // Tables, summary and curves grow with the number of states: rewrite them at most every
+    // two seconds (and at log-spaced states and the last); the checkpoint goes out every state.
+    let mut tables_written = std::time::Instant::now();
     let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
-        wormwear::output::wear::write_state(&gear, &geo, &tca, &plan, view, dir)
+        let tables = tables_written.elapsed().as_secs_f64() >= 2.0;
+        wormwear::output::wear::write_state(&gear, &geo, &tca, &plan, view, dir, tables)
             .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
+        if tables {
+            tables_written = std::time::Instant::now();
+        }
         let r = view.state.records.last().expect("record");
         let line = format!(
             "step {} at {} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",

@@ -12,7 +12,7 @@
 
 pub mod solver;
 
-use crate::contact::{coefficient, ContactCell, ElasticPair};
+use crate::contact::{symmetric_block, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
@@ -635,17 +635,10 @@ fn solve_position(
                 // of a tooth differ only slightly (line-aligned areas vary by the line's
                 // obliquity), and the tangential term's small asymmetry on curved flanks is
                 // dropped.
-                let mut matrix = vec![0.0; size * size];
-                for a in 0..size {
-                    let ci = &cells[start + a];
-                    for b in a..size {
-                        let cj = &cells[start + b];
-                        let m = coefficient(pair, &ci.cell, &cj.cell)
-                            / (cj.cell.area() * ci.lever * cj.lever);
-                        matrix[a * size + b] = m;
-                        matrix[b * size + a] = m;
-                    }
-                }
+                let group = &cells[start..start + size];
+                let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
+                let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
+                let matrix = symmetric_block(pair, &contact, &levers);
                 Block {
                     start,
                     size,

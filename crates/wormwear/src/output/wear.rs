@@ -46,6 +46,11 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
 }
 
 /// Writes the files of one completed state (see the module doc). Returns the files written.
+///
+/// The checkpoint is written at every state (it holds every record: nothing is lost on an
+/// interruption). With `tables` false, the steps table, summary and curves (which grow with the
+/// number of states) are left for a later state; they are always written at state 0, at
+/// log-spaced states and at the last one.
 pub fn write_state(
     gear: &GearSet,
     geo: &Geometry,
@@ -53,6 +58,7 @@ pub fn write_state(
     plan: &WearPlan,
     view: &StepView,
     dir: &Path,
+    tables: bool,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let state = view.state;
     let wf = geo.wheel_flank(tca.loaded_flank);
@@ -65,6 +71,10 @@ pub fn write_state(
     let path = dir.join(CHECKPOINT);
     write_atomic(&path, text.as_bytes())?;
     files.push(path);
+    let log_spaced = state.step == 0 || state.step.is_power_of_two();
+    if !(tables || log_spaced || view.last) {
+        return Ok(files);
+    }
     // Steps table and summary.
     let mut csv = Csv::new(&[
         "step",
@@ -178,7 +188,6 @@ pub fn write_state(
     }
     // Maps and the node table: at log-spaced states and the last (drawing every state would
     // cost more than the state itself on long lives).
-    let log_spaced = state.step == 0 || state.step.is_power_of_two();
     if !(log_spaced || view.last) {
         return Ok(files);
     }
