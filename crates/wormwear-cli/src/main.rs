@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
+mod calibrate_cmd;
 mod geometry_cmd;
 
 #[derive(Parser)]
@@ -103,6 +104,35 @@ enum Command {
         #[command(flatten)]
         life: LifeArgs,
     },
+    /// Archard coefficient K (MODEL §10) from wear tests (least squares on V = (K/H) W_asp L)
+    /// or from a measured backlash-increase curve (inverse problem through the life
+    /// simulation of the file's [wear] schedule). Writes the `calibration` section.
+    #[command(after_help = "Examples:\n  \
+                      wormwear calibrate examples/gear-1x40-case-c.toml -o out/cal --backlash measured.csv\n  \
+                      wormwear calibrate examples/gear-1x40-design.toml -o out/cal --tests tests.csv\n\n\
+                      --backlash CSV columns: cycles, backlash_increase_um (tangential at r2).\n\
+                      --tests CSV columns: worn_volume_mm3, sliding_length_m, apparent_area_mm2,\n\
+                      film_thickness_um (Phi_T h_min), roughness_rq_um, slope_rdq.")]
+    Calibrate {
+        /// Gear file (TOML): materials, and for --backlash the [wear] schedule.
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Wear tests (CSV).
+        #[arg(
+            long,
+            conflicts_with = "backlash",
+            required_unless_present = "backlash"
+        )]
+        tests: Option<PathBuf>,
+        /// Measured backlash increase over cycles (CSV).
+        #[arg(long)]
+        backlash: Option<PathBuf>,
+        /// Ignore the pitting phases of the schedule.
+        #[arg(long)]
+        no_pitting: bool,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -153,6 +183,21 @@ fn main() -> ExitCode {
         } => ltca(file, output, *map_position, cli.quiet),
         Command::Wear { file, output, life } => wear(file, output, life, cli.quiet, cli.verbose),
         Command::Run { file, output, life } => run(file, output, life, cli.quiet, cli.verbose),
+        Command::Calibrate {
+            file,
+            output,
+            tests,
+            backlash,
+            no_pitting,
+        } => calibrate(
+            file,
+            output,
+            tests.as_deref(),
+            backlash.as_deref(),
+            *no_pitting,
+            cli.quiet,
+            cli.verbose,
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -498,5 +543,158 @@ fn run(
     if !quiet {
         println!("report: {}", report.display());
     }
+    Ok(())
+}
+
+fn calibrate(
+    file: &Path,
+    dir: &Path,
+    tests: Option<&Path>,
+    backlash: Option<&Path>,
+    no_pitting: bool,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(), Failure> {
+    let gear = load(file)?;
+    let hardness = gear.wheel_material.hardness;
+    let section = if let Some(path) = tests {
+        let data = calibrate_cmd::tests_from_csv(&gear, path).map_err(Failure::Input)?;
+        let fit = wormwear::calibration::fit_from_tests(&data, hardness).map_err(|e| {
+            Failure::Input(anyhow::Error::new(e).context(path.display().to_string()))
+        })?;
+        if !quiet {
+            println!(
+                "K = {:.4e} from {} wear tests (relative rms residual {:.3})",
+                fit.k, fit.points, fit.relative_rms
+            );
+        }
+        serde_json::json!({
+            "method": "wear tests",
+            "data": path.display().to_string(),
+            "k": fit.k,
+            "relative_rms": fit.relative_rms,
+            "points": fit.points,
+        })
+    } else {
+        let path = backlash.expect("clap requires --tests or --backlash");
+        let measured = calibrate_cmd::backlash_from_csv(path).map_err(Failure::Input)?;
+        let last = measured.iter().map(|m| m.0).fold(0.0, f64::max);
+        let args = LifeArgs {
+            cycles: Some(last.max(1.0)),
+            step_cycles: None,
+            step_wear_um: None,
+            no_pitting,
+            resume: false,
+        };
+        let plan = life_plan(&gear, &args)?;
+        let geo = build_geometry(&gear, file)?;
+        let tca = wormwear::kinematics::analyse(&gear, &geo).map_err(|e| {
+            Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis"))
+        })?;
+        let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
+        let k_start = gear.wheel_material.wear_coefficient;
+        let mut runs = 0;
+        let mut simulate = |k: f64| {
+            let mut g = gear.clone();
+            g.wheel_material.wear_coefficient = k;
+            runs += 1;
+            let wf = geo.wheel_flank(tca.loaded_flank);
+            let end = wormwear::wear::simulate(
+                &g,
+                &geo,
+                &tca,
+                &settings,
+                None,
+                &plan,
+                wormwear::wear::WearState::new(wf),
+                &mut |_| Ok(()),
+            )?;
+            if verbose {
+                let b = end.records.last().map_or(0.0, |r| r.backlash_increase_m);
+                eprintln!(
+                    "run {runs}: K = {k:.5e}, backlash +{:.2} um at {} cycles",
+                    b * 1e6,
+                    wormwear::output::cycles_label(last)
+                );
+            }
+            Ok(end.records)
+        };
+        let (fit, records) =
+            wormwear::calibration::fit_to_backlash(&measured, k_start, 1e-3, 10, &mut simulate)
+                .map_err(|e| match e {
+                    wormwear::calibration::CalibrationError::Simulation(_) => {
+                        Failure::Run(anyhow::Error::new(e))
+                    }
+                    _ => Failure::Input(anyhow::Error::new(e).context(path.display().to_string())),
+                })?;
+        // Measured and fitted curves side by side.
+        let mut csv = wormwear::output::Csv::new(&["cycles", "measured_um", "simulated_um"]);
+        let simulated: Vec<(f64, f64)> = records
+            .iter()
+            .map(|r| (r.cycles, r.backlash_increase_m))
+            .collect();
+        let at = |c: f64| {
+            let k = simulated
+                .iter()
+                .position(|s| s.0 >= c)
+                .unwrap_or(simulated.len() - 1);
+            if k == 0 {
+                return simulated[0].1;
+            }
+            let (a, b) = (simulated[k - 1], simulated[k]);
+            a.1 + (b.1 - a.1) * ((c - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+        };
+        for &(c, b) in &measured {
+            csv.row(&[c, b * 1e6, at(c) * 1e6]);
+        }
+        csv.write(&dir.join("calibration_backlash.csv"))
+            .map_err(|e| Failure::Run(e.into()))?;
+        let chart = |points: Vec<(f64, f64)>, label: &str, color: usize| wormwear::plot::Series {
+            label: label.into(),
+            points,
+            color,
+            bold: color == 1,
+        };
+        wormwear::plot::line_chart(
+            &dir.join("calibration_backlash.svg"),
+            &format!(
+                "Backlash increase: measured and simulated with K = {:.3e}",
+                fit.k
+            ),
+            "wheel cycles (millions)",
+            "backlash increase (um)",
+            &[
+                chart(
+                    simulated.iter().map(|s| (s.0 * 1e-6, s.1 * 1e6)).collect(),
+                    "simulated",
+                    1,
+                ),
+                chart(
+                    measured.iter().map(|s| (s.0 * 1e-6, s.1 * 1e6)).collect(),
+                    "measured",
+                    0,
+                ),
+            ],
+            false,
+        )
+        .map_err(|e| Failure::Run(e.into()))?;
+        if !quiet {
+            println!(
+                "K = {:.4e} from the backlash curve ({} points, {runs} life runs from K = {k_start:.3e}; relative rms residual {:.3})",
+                fit.k, fit.points, fit.relative_rms
+            );
+        }
+        serde_json::json!({
+            "method": "backlash curve",
+            "data": path.display().to_string(),
+            "k": fit.k,
+            "k_start": k_start,
+            "relative_rms": fit.relative_rms,
+            "points": fit.points,
+            "life_runs": runs,
+        })
+    };
+    wormwear::output::update_summary(dir, "calibration", section)
+        .map_err(|e| Failure::Run(e.into()))?;
     Ok(())
 }

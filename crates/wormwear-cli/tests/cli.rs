@@ -629,3 +629,70 @@ print(json.dumps(out))
         "exported flank area {exported} mm2 vs active flank area {area}"
     );
 }
+
+#[test]
+fn calibrate_fits_k_from_wear_tests_and_names_bad_data() {
+    let dir = tempfile::tempdir().unwrap();
+    // Three tests generated with the design file's materials (E' from 203/110 GPa, v 0.29,
+    // H 1 GPa) and K = 2e-8, no film (A_c/A_0 = 1/4), Rdq 0.1, A_0 10 mm^2: V = (K/H) W_asp L.
+    let e_prime = 2.0 / ((1.0 - 0.29f64.powi(2)) / 203e9 + (1.0 - 0.29f64.powi(2)) / 110e9);
+    let w_asp = 0.2 * e_prime * (0.01 / std::f64::consts::PI).sqrt() * 0.25 * 10e-6;
+    let mut csv = String::from(
+        "worn_volume_mm3,sliding_length_m,apparent_area_mm2,film_thickness_um,roughness_rq_um,slope_rdq\n",
+    );
+    for l in [100.0, 250.0, 400.0] {
+        let v_mm3 = 2e-8 / 1e9 * w_asp * l * 1e9;
+        csv.push_str(&format!("{v_mm3},{l},10,0,0.5,0.1\n"));
+    }
+    let tests = dir.path().join("tests.csv");
+    std::fs::write(&tests, csv).unwrap();
+    let out = bin()
+        .arg("calibrate")
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .arg("--tests")
+        .arg(&tests)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let k = summary["calibration"]["k"].as_f64().unwrap();
+    assert!((k / 2e-8 - 1.0).abs() < 1e-9, "K = {k}");
+    // A missing column and a non-number are input errors naming the file, line and column.
+    std::fs::write(&tests, "worn_volume_mm3,sliding_length_m\n1,2\n").unwrap();
+    let bad = bin()
+        .arg("calibrate")
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .arg("--tests")
+        .arg(&tests)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("no column 'apparent_area_mm2'"));
+    let curve = dir.path().join("b.csv");
+    std::fs::write(&curve, "cycles,backlash_increase_um\n1000,abc\n").unwrap();
+    let bad = bin()
+        .arg("calibrate")
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .arg("--backlash")
+        .arg(&curve)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("b.csv:2") && err.contains("backlash_increase_um"),
+        "{err}"
+    );
+}

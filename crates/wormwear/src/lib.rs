@@ -16,6 +16,7 @@
 //! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
 
 pub mod bending;
+pub mod calibration;
 pub mod contact;
 pub mod geometry;
 pub mod input;

@@ -405,3 +405,38 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
     assert!(r.last().unwrap().mean_wear_m > r[k40].mean_wear_m);
     assert_eq!(r.last().unwrap().cycles, 60_000.0);
 }
+
+/// MODEL §10 inverse problem: a backlash curve simulated with a known K (the "measurement") is
+/// fitted starting from another K through the full life simulation (geometry update, film and
+/// pressure cap make the backlash not exactly proportional to K); the fit must give K back.
+#[test]
+fn k_is_recovered_from_a_backlash_curve() {
+    let mut bench = Bench::new(&example("gear-1x40-design.toml"));
+    let k_true = 1.6e-8;
+    let life = plan(30_000.0, wear::StepControl::Cycles(10_000.0), 5e-6);
+    let run = |bench: &mut Bench, k: f64| {
+        bench.g.wheel_material.wear_coefficient = k;
+        bench
+            .simulate(&life, None, &mut |_| Ok(()))
+            .map(|s| s.records)
+    };
+    let truth = run(&mut bench, k_true).unwrap();
+    let measured: Vec<(f64, f64)> = truth
+        .iter()
+        .skip(1)
+        .map(|r| (r.cycles, r.backlash_increase_m))
+        .collect();
+    assert!(measured.iter().all(|m| m.1 > 0.0));
+    let mut runs = 0;
+    let (fit, _) = wormwear::calibration::fit_to_backlash(&measured, 2.5e-8, 1e-4, 10, &mut |k| {
+        runs += 1;
+        run(&mut bench, k)
+    })
+    .unwrap();
+    println!(
+        "K fitted {:.5e} (true {k_true:.5e}) in {runs} runs, residual {:.2e}",
+        fit.k, fit.relative_rms
+    );
+    assert!((fit.k / k_true - 1.0).abs() < 1e-3, "{}", fit.k);
+    assert!(runs <= 5, "{runs} simulations");
+}
