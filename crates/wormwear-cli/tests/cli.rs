@@ -646,15 +646,18 @@ fn calibrate_fits_k_from_wear_tests_and_names_bad_data() {
     }
     let tests = dir.path().join("tests.csv");
     std::fs::write(&tests, csv).unwrap();
-    let out = bin()
-        .arg("calibrate")
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .arg("--tests")
-        .arg(&tests)
-        .output()
-        .unwrap();
+    let calibrate = |flag: &str, data: &Path| {
+        bin()
+            .arg("calibrate")
+            .arg(example("gear-1x40-design.toml"))
+            .arg("-o")
+            .arg(dir.path())
+            .arg(flag)
+            .arg(data)
+            .output()
+            .unwrap()
+    };
+    let out = calibrate("--tests", &tests);
     assert!(
         out.status.success(),
         "{}",
@@ -667,28 +670,12 @@ fn calibrate_fits_k_from_wear_tests_and_names_bad_data() {
     assert!((k / 2e-8 - 1.0).abs() < 1e-9, "K = {k}");
     // A missing column and a non-number are input errors naming the file, line and column.
     std::fs::write(&tests, "worn_volume_mm3,sliding_length_m\n1,2\n").unwrap();
-    let bad = bin()
-        .arg("calibrate")
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .arg("--tests")
-        .arg(&tests)
-        .output()
-        .unwrap();
+    let bad = calibrate("--tests", &tests);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("no column 'apparent_area_mm2'"));
     let curve = dir.path().join("b.csv");
     std::fs::write(&curve, "cycles,backlash_increase_um\n1000,abc\n").unwrap();
-    let bad = bin()
-        .arg("calibrate")
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .arg("--backlash")
-        .arg(&curve)
-        .output()
-        .unwrap();
+    let bad = calibrate("--backlash", &curve);
     assert_eq!(bad.status.code(), Some(2));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(
