@@ -446,9 +446,11 @@ fn wear(
     // Tables, summary and curves grow with the number of states: rewrite them at most every
     // two seconds (and at log-spaced states and the last); the checkpoint goes out every state.
     let mut tables_written = std::time::Instant::now();
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir);
     let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
         let tables = tables_written.elapsed().as_secs_f64() >= 2.0;
-        wormwear::output::wear::write_state(&gear, &geo, &tca, &plan, view, dir, tables)
+        writer
+            .write_state(&gear, &geo, &tca, &plan, view, tables)
             .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
         if tables {
             tables_written = std::time::Instant::now();

@@ -325,6 +325,7 @@ fn run_writes_every_stage_and_the_life() {
             "wear_pressure.svg",
             "wear_pattern_step0.svg",
             "wear_checkpoint.json",
+            "wear_records.jsonl",
             "ltca_pattern.svg",
         ],
     );

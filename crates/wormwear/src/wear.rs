@@ -496,7 +496,8 @@ pub struct StepRecord {
 /// Why a life run stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum WearError {
-    #[error("at {cycles} cycles (step {step}): {source}")]
+    // The cause is the source (not repeated here: `{:#}` prints the chain once).
+    #[error("at {cycles} cycles (step {step})")]
     Ltca {
         step: usize,
         cycles: f64,

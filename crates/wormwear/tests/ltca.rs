@@ -185,9 +185,16 @@ fn non_convergence_is_an_error_not_a_result() {
     let geo = Geometry::build(&g).unwrap();
     let tca = kinematics::analyse(&g, &geo).unwrap();
     let err = ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap_err();
-    let text = err.to_string();
+    // The whole chain, as the CLI prints it: the position, then the cause, each once.
+    let mut text = err.to_string();
+    let mut source = std::error::Error::source(&err);
+    while let Some(e) = source {
+        text = format!("{text}: {e}");
+        source = e.source();
+    }
     assert!(
-        text.contains("did not converge") && text.contains("position"),
+        text.contains("did not converge") && text.starts_with("position"),
         "{text}"
     );
+    assert_eq!(text.matches("did not converge").count(), 1, "{text}");
 }

@@ -305,23 +305,20 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
     let bench = Bench::new(&example("gear-1x40-design.toml"));
     let plan = plan(40_000.0, wear::StepControl::Cycles(10_000.0), 5e-6);
     let dir = tempfile::tempdir().unwrap();
-    let write = |view: &wear::StepView| {
-        wormwear::output::wear::write_state(
-            &bench.g,
-            &bench.geo,
-            &bench.tca,
-            &plan,
-            view,
-            dir.path(),
-            // Checkpoints only between the log-spaced states: the resume must not need more.
-            false,
-        )
-        .map(|_| ())
-        .map_err(|e| wear::WearError::Output(e.to_string()))
+    let write = |writer: &mut wormwear::output::wear::LifeWriter, view: &wear::StepView| {
+        writer
+            .write_state(
+                &bench.g, &bench.geo, &bench.tca, &plan, view,
+                // Checkpoints only between the log-spaced states: the resume must not need more.
+                false,
+            )
+            .map(|_| ())
+            .map_err(|e| wear::WearError::Output(e.to_string()))
     };
     let mut written = 0;
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir.path());
     let interrupted = bench.simulate(&plan, None, &mut |view| {
-        write(view)?;
+        write(&mut writer, view)?;
         written += 1;
         if written == 2 {
             return Err(wear::WearError::Output("interrupted".into()));
@@ -329,12 +326,23 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
         Ok(())
     });
     assert!(interrupted.is_err());
+    // An interruption between the records and the checkpoint leaves a line (maybe torn) the
+    // checkpoint does not count: it must be ignored.
+    {
+        use std::io::Write as _;
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(dir.path().join(wormwear::output::wear::RECORDS))
+            .unwrap();
+        f.write_all(b"{\"step\": 2, \"cyc").unwrap();
+    }
     let saved = wormwear::output::wear::read_checkpoint(dir.path())
         .unwrap()
         .unwrap();
     assert_eq!(saved.step, 1);
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir.path());
     let resumed = bench
-        .simulate(&plan, Some(saved), &mut |view| write(view))
+        .simulate(&plan, Some(saved), &mut |view| write(&mut writer, view))
         .unwrap();
     let straight = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
     assert_eq!(resumed.records.len(), 5);
@@ -345,6 +353,15 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
             .unwrap();
     assert_eq!(summary["wear"]["steps"].as_array().unwrap().len(), 5);
+    // The records file was rewritten by the resumed run (torn line gone) and the final
+    // checkpoint reads back as the uninterrupted end state.
+    let lines = std::fs::read_to_string(dir.path().join(wormwear::output::wear::RECORDS)).unwrap();
+    assert_eq!(lines.lines().count(), 5);
+    let end = wormwear::output::wear::read_checkpoint(dir.path())
+        .unwrap()
+        .unwrap();
+    assert_eq!(end.records, straight.records);
+    assert_eq!(end.removal, straight.removal);
 }
 
 #[test]

@@ -178,7 +178,8 @@ fn stats(v: impl Iterator<Item = f64>) -> (f64, f64) {
 /// Why the loaded analysis failed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum LtcaError {
-    #[error("position {position}: {source}")]
+    // The cause is the source (not repeated here: `{:#}` prints the chain once).
+    #[error("position {position}")]
     Solver {
         position: usize,
         #[source]

@@ -1,6 +1,8 @@
 //! Files of a life run, written after every completed state so an interruption loses nothing:
-//! the checkpoint `wear_checkpoint.json` (resume), `wear_steps.csv`, the `wear` section of
-//! summary.json and curves over cycles (wear, backlash, TE, pressure) at every state; maps of
+//! the records `wear_records.jsonl` (one JSON line per state, appended) and the checkpoint
+//! `wear_checkpoint.json` (the worn flank and how many records belong to it: resume), both at
+//! every state; `wear_steps.csv`, the `wear` section of summary.json and curves over cycles
+//! (wear, backlash, TE, pressure) when asked (the CLI: every two seconds); maps of
 //! the cumulative wear, of the wear per cycle, of the film thickness and ratio, the node table,
 //! the loaded pattern and `wheel_flank_wear.vtp` at log-spaced states (0, 1, 2, 4, 8, ...) and
 //! the last.
@@ -19,6 +21,40 @@ const MPA: f64 = 1e-6;
 
 /// Name of the checkpoint file in the output directory.
 pub const CHECKPOINT: &str = "wear_checkpoint.json";
+/// Name of the records file (JSON lines) in the output directory.
+pub const RECORDS: &str = "wear_records.jsonl";
+
+/// The checkpoint as written: the state without its records, and their number (the records
+/// are the first `record_count` lines of [`RECORDS`]). O(1) in the number of states, so long
+/// lives do not rewrite their whole history at every state.
+#[derive(serde::Serialize)]
+struct CheckpointOut<'a> {
+    step: usize,
+    cycles: f64,
+    removal: &'a FlankField,
+    pitted_phases: &'a [usize],
+    pitted: &'a [bool],
+    band_factor: Option<f64>,
+    record_count: usize,
+}
+
+/// The checkpoint as read; `records` inline is the earlier format (still read).
+#[derive(serde::Deserialize)]
+struct CheckpointIn {
+    step: usize,
+    cycles: f64,
+    removal: FlankField,
+    #[serde(default)]
+    pitted_phases: Vec<usize>,
+    #[serde(default)]
+    pitted: Vec<bool>,
+    #[serde(default)]
+    band_factor: Option<f64>,
+    #[serde(default)]
+    record_count: Option<usize>,
+    #[serde(default)]
+    records: Option<Vec<crate::wear::StepRecord>>,
+}
 
 /// The `wear` section of summary.json.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -30,28 +66,148 @@ pub struct WearSummary<'a> {
     pub steps: &'a [crate::wear::StepRecord],
 }
 
-/// Reads a checkpoint written by [`write_state`].
+/// Reads a checkpoint written by [`LifeWriter`] with its records (lines of [`RECORDS`] beyond
+/// the checkpoint's count, e.g. from an interruption between the two writes, are ignored).
 pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
     let path = dir.join(CHECKPOINT);
-    match std::fs::read_to_string(&path) {
-        Ok(text) => serde_json::from_str(&text)
-            .map(Some)
-            .map_err(|e| OutputError::Encode {
-                what: path.display().to_string(),
-                message: e.to_string(),
-            }),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(source) => Err(OutputError::Io { path, source }),
+    let bad = |path: &Path, message: String| OutputError::Encode {
+        what: path.display().to_string(),
+        message,
+    };
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => return Err(OutputError::Io { path, source }),
+    };
+    let c: CheckpointIn = serde_json::from_str(&text).map_err(|e| bad(&path, e.to_string()))?;
+    let records = match (c.records, c.record_count) {
+        (Some(records), _) => records,
+        (None, Some(count)) => {
+            let rpath = dir.join(RECORDS);
+            let lines = std::fs::read_to_string(&rpath).map_err(|source| OutputError::Io {
+                path: rpath.clone(),
+                source,
+            })?;
+            let records: Vec<crate::wear::StepRecord> = lines
+                .lines()
+                .take(count)
+                .map(|l| serde_json::from_str(l).map_err(|e| bad(&rpath, e.to_string())))
+                .collect::<Result<_, _>>()?;
+            if records.len() < count {
+                return Err(bad(
+                    &rpath,
+                    format!("{} records, the checkpoint needs {count}", records.len()),
+                ));
+            }
+            records
+        }
+        (None, None) => return Err(bad(&path, "no records and no record count".into())),
+    };
+    Ok(Some(WearState {
+        step: c.step,
+        cycles: c.cycles,
+        removal: c.removal,
+        records,
+        pitted_phases: c.pitted_phases,
+        pitted: c.pitted,
+        band_factor: c.band_factor,
+    }))
+}
+
+/// Writes the files of a life run state by state (see the module doc), appending to the
+/// records file: one writer per run (a new one after a resume rewrites the records file from
+/// the state's records first).
+#[derive(Debug)]
+pub struct LifeWriter {
+    dir: PathBuf,
+    /// Records known to be on disk (None: none yet from this writer).
+    records_written: Option<usize>,
+}
+
+impl LifeWriter {
+    /// A writer into `dir`.
+    pub fn new(dir: &Path) -> Self {
+        Self {
+            dir: dir.to_path_buf(),
+            records_written: None,
+        }
+    }
+
+    /// Writes one completed state: records and checkpoint always, the rest as
+    /// [`write_state`] says. Returns the files written.
+    #[allow(clippy::too_many_arguments)]
+    pub fn write_state(
+        &mut self,
+        gear: &GearSet,
+        geo: &Geometry,
+        tca: &Tca,
+        plan: &WearPlan,
+        view: &StepView,
+        tables: bool,
+    ) -> Result<Vec<PathBuf>, OutputError> {
+        let state = view.state;
+        let encode = |what: &str, e: serde_json::Error| OutputError::Encode {
+            what: what.into(),
+            message: e.to_string(),
+        };
+        let line = |r: &crate::wear::StepRecord| -> Result<String, OutputError> {
+            let mut l = serde_json::to_string(r).map_err(|e| encode(RECORDS, e))?;
+            l.push('\n');
+            Ok(l)
+        };
+        // Records first, then the checkpoint that counts them.
+        let rpath = self.dir.join(RECORDS);
+        match self.records_written {
+            Some(n) if n <= state.records.len() => {
+                use std::io::Write as _;
+                let mut text = String::new();
+                for r in &state.records[n..] {
+                    text.push_str(&line(r)?);
+                }
+                let io = |source| OutputError::Io {
+                    path: rpath.clone(),
+                    source,
+                };
+                let mut f = std::fs::OpenOptions::new()
+                    .append(true)
+                    .open(&rpath)
+                    .map_err(io)?;
+                f.write_all(text.as_bytes()).map_err(io)?;
+                f.sync_data().map_err(io)?;
+            }
+            _ => {
+                let mut text = String::new();
+                for r in &state.records {
+                    text.push_str(&line(r)?);
+                }
+                write_atomic(&rpath, text.as_bytes())?;
+            }
+        }
+        self.records_written = Some(state.records.len());
+        let checkpoint = CheckpointOut {
+            step: state.step,
+            cycles: state.cycles,
+            removal: &state.removal,
+            pitted_phases: &state.pitted_phases,
+            pitted: &state.pitted,
+            band_factor: state.band_factor,
+            record_count: state.records.len(),
+        };
+        let text = serde_json::to_string(&checkpoint).map_err(|e| encode(CHECKPOINT, e))?;
+        write_atomic(&self.dir.join(CHECKPOINT), text.as_bytes())?;
+        let mut files = vec![rpath, self.dir.join(CHECKPOINT)];
+        files.extend(write_state(gear, geo, tca, plan, view, &self.dir, tables)?);
+        Ok(files)
     }
 }
 
-/// Writes the files of one completed state (see the module doc). Returns the files written.
+/// Writes the result files of one completed state except the records and the checkpoint
+/// ([`LifeWriter`] writes those first). Returns the files written.
 ///
-/// The checkpoint is written at every state (it holds every record: nothing is lost on an
-/// interruption). With `tables` false, the steps table, summary and curves (which grow with the
-/// number of states) are left for a later state; they are always written at state 0, at
-/// log-spaced states and at the last one.
-pub fn write_state(
+/// With `tables` false, the steps table, summary and curves (which grow with the number of
+/// states) are left for a later state; they are always written at state 0, at log-spaced
+/// states and at the last one.
+fn write_state(
     gear: &GearSet,
     geo: &Geometry,
     tca: &Tca,
@@ -63,14 +219,6 @@ pub fn write_state(
     let state = view.state;
     let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
-    // Checkpoint first: it is what a resume needs.
-    let text = serde_json::to_string(state).map_err(|e| OutputError::Encode {
-        what: CHECKPOINT.into(),
-        message: e.to_string(),
-    })?;
-    let path = dir.join(CHECKPOINT);
-    write_atomic(&path, text.as_bytes())?;
-    files.push(path);
     let log_spaced = state.step == 0 || state.step.is_power_of_two();
     if !(tables || log_spaced || view.last) {
         return Ok(files);
