@@ -249,10 +249,9 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
     let wide = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
     let mut matrix = vec![0.0; n * n];
     let mut dist2 = vec![0.0; n];
-    let mut row = vec![0.0; n];
     for a in 0..n {
         let scale_i = 1.0 / levers[a];
-        let out = &mut row[..n - a];
+        let out = &mut matrix[a * n + a..a * n + n];
         let dist = &mut dist2[..n - a];
         #[cfg(target_arch = "x86_64")]
         if wide {
@@ -270,7 +269,6 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
                 *o = coefficient(pair, &cells[a], &cells[a + k]) * soa.inv[a + k] * scale_i;
             }
         }
-        matrix[a * n + a..a * n + n].copy_from_slice(out);
     }
     // Mirror the upper triangle, tile by tile (cache-friendly transpose).
     const TILE: usize = 32;

@@ -18,6 +18,7 @@ use crate::input::GearSet;
 use crate::kinematics::{GapEvaluator, Tca};
 use crate::ltca::Ltca;
 use crate::lubrication::{self, LineContact};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -221,76 +222,94 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
                 .collect::<Vec<_>>()
         })
         .collect();
-    for (j, samples) in columns.iter_mut().enumerate() {
-        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
-        for pair in samples.windows(2) {
-            let (a, b) = (&pair[0], &pair[1]);
-            // Consecutive instants of the same engagement only.
-            if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
-                continue;
-            }
-            let duration = (b.time - a.time) / wheel_speed;
-            let reach = a.reach().max(b.reach());
-            let (lo, hi) = (
-                a.centre.min(b.centre) - reach,
-                a.centre.max(b.centre) + reach,
-            );
-            // Sub-steps: the band moves at most a tenth of its width per sub-step.
-            let width = (2.0 * reach).max(1e-9);
-            let steps =
-                ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
-            let w = 0.5 * (a.line_load + b.line_load);
-            let fill = |x: f64, y: f64| {
-                if !x.is_finite() {
-                    y
-                } else if !y.is_finite() {
-                    x
-                } else {
-                    0.5 * (x + y)
-                }
-            };
-            for i in 0..=ni {
-                let k = j * (ni + 1) + i;
-                let node = &wf.nodes[k];
-                if node.r < lo || node.r > hi {
+    // Node columns are independent (each writes its own nodes): in parallel, then gathered.
+    // Per node of a column: depth, lambda, film, line load, half-width.
+    let per_column: Vec<Vec<[f64; 5]>> = columns
+        .par_iter_mut()
+        .enumerate()
+        .map(|(j, samples)| {
+            let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0]; ni + 1];
+            samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+            for pair in samples.windows(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                // Consecutive instants of the same engagement only.
+                if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
                     continue;
                 }
-                let nc = &tca.node_contact[k];
-                let (u1, u2) = rolling[k];
-                let mut integral = 0.0;
-                for m in 0..steps {
-                    let s = (m as f64 + 0.5) / steps as f64;
-                    let c = a.centre + s * (b.centre - a.centre);
-                    let p = (1.0 - s) * a.pressure_at(node.r, c - a.centre)
-                        + s * b.pressure_at(node.r, c - b.centre);
-                    integral += p;
-                }
-                integral *= duration / steps as f64;
-                if integral <= 0.0 {
-                    continue;
-                }
-                // The film is that of the Hertzian line contact with the band's peak pressure
-                // (w = 2 pi R p0^2 / E'): a band cut short by an edge or concentrated on a
-                // ridge carries little load per length but is no thicker a film for that.
-                let radius = fill(a.radius, b.radius);
-                let peak = a.pressure.max(b.pressure);
-                let contact = LineContact {
-                    radius,
-                    u1,
-                    u2,
-                    line_load: w.max(2.0 * PI * radius * peak * peak / e_prime),
-                    pressure: peak,
+                let duration = (b.time - a.time) / wheel_speed;
+                let reach = a.reach().max(b.reach());
+                let (lo, hi) = (
+                    a.centre.min(b.centre) - reach,
+                    a.centre.max(b.centre) + reach,
+                );
+                // Sub-steps: the band moves at most a tenth of its width per sub-step.
+                let width = (2.0 * reach).max(1e-9);
+                let steps =
+                    ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
+                let w = 0.5 * (a.line_load + b.line_load);
+                let fill = |x: f64, y: f64| {
+                    if !x.is_finite() {
+                        y
+                    } else if !y.is_finite() {
+                        x
+                    } else {
+                        0.5 * (x + y)
+                    }
                 };
-                let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
-                let kw = lubrication::wear_coefficient(k_dry, fl.lambda);
-                depth.values[k] += kw / hardness * nc.sliding_speed * integral;
-                if lambda.values[k].is_nan() || fl.lambda < lambda.values[k] {
-                    lambda.values[k] = fl.lambda;
-                    film.values[k] = fl.h_min * fl.thermal_factor;
+                for (i, o) in out.iter_mut().enumerate() {
+                    let k = j * (ni + 1) + i;
+                    let node = &wf.nodes[k];
+                    if node.r < lo || node.r > hi {
+                        continue;
+                    }
+                    let nc = &tca.node_contact[k];
+                    let (u1, u2) = rolling[k];
+                    let mut integral = 0.0;
+                    for m in 0..steps {
+                        let s = (m as f64 + 0.5) / steps as f64;
+                        let c = a.centre + s * (b.centre - a.centre);
+                        let p = (1.0 - s) * a.pressure_at(node.r, c - a.centre)
+                            + s * b.pressure_at(node.r, c - b.centre);
+                        integral += p;
+                    }
+                    integral *= duration / steps as f64;
+                    if integral <= 0.0 {
+                        continue;
+                    }
+                    // The film is that of the Hertzian line contact with the band's peak pressure
+                    // (w = 2 pi R p0^2 / E'): a band cut short by an edge or concentrated on a
+                    // ridge carries little load per length but is no thicker a film for that.
+                    let radius = fill(a.radius, b.radius);
+                    let peak = a.pressure.max(b.pressure);
+                    let contact = LineContact {
+                        radius,
+                        u1,
+                        u2,
+                        line_load: w.max(2.0 * PI * radius * peak * peak / e_prime),
+                        pressure: peak,
+                    };
+                    let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
+                    let kw = lubrication::wear_coefficient(k_dry, fl.lambda);
+                    o[0] += kw / hardness * nc.sliding_speed * integral;
+                    if o[1].is_nan() || fl.lambda < o[1] {
+                        o[1] = fl.lambda;
+                        o[2] = fl.h_min * fl.thermal_factor;
+                    }
+                    o[3] = o[3].max(w);
+                    o[4] = o[4].max(a.half_width.max(b.half_width));
                 }
-                line_load.values[k] = line_load.values[k].max(w);
-                half_width.values[k] = half_width.values[k].max(a.half_width.max(b.half_width));
             }
+            out
+        })
+        .collect();
+    for (j, out) in per_column.iter().enumerate() {
+        for (i, o) in out.iter().enumerate() {
+            let k = j * (ni + 1) + i;
+            depth.values[k] = o[0];
+            lambda.values[k] = o[1];
+            film.values[k] = o[2];
+            line_load.values[k] = o[3];
+            half_width.values[k] = o[4];
         }
     }
     CycleWear {
@@ -338,7 +357,6 @@ pub struct BacklashStats {
 impl Backlash {
     /// Gaps of both flanks over the TCA's positions and teeth.
     pub fn new(gear: &GearSet, geo: &Geometry, tca: &Tca) -> Self {
-        use rayon::prelude::*;
         let other = match tca.loaded_flank {
             crate::geometry::Flank::Left => crate::geometry::Flank::Right,
             crate::geometry::Flank::Right => crate::geometry::Flank::Left,
