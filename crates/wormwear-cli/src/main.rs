@@ -635,19 +635,9 @@ fn calibrate(
             .iter()
             .map(|r| (r.cycles, r.backlash_increase_m))
             .collect();
-        let at = |c: f64| {
-            let k = simulated
-                .iter()
-                .position(|s| s.0 >= c)
-                .unwrap_or(simulated.len() - 1);
-            if k == 0 {
-                return simulated[0].1;
-            }
-            let (a, b) = (simulated[k - 1], simulated[k]);
-            a.1 + (b.1 - a.1) * ((c - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
-        };
         for &(c, b) in &measured {
-            csv.row(&[c, b * 1e6, at(c) * 1e6]);
+            let sim = wormwear::calibration::backlash_at(&records, c).unwrap_or(f64::NAN);
+            csv.row(&[c, b * 1e6, sim * 1e6]);
         }
         csv.write(&dir.join("calibration_backlash.csv"))
             .map_err(|e| Failure::Run(e.into()))?;

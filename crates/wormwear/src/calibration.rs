@@ -117,7 +117,7 @@ fn relative_rms(pairs: impl Iterator<Item = (f64, f64)>) -> f64 {
 }
 
 /// Backlash increase of the records at `cycles`, linear between records (m); None beyond them.
-fn backlash_at(records: &[StepRecord], cycles: f64) -> Option<f64> {
+pub fn backlash_at(records: &[StepRecord], cycles: f64) -> Option<f64> {
     let k = records.iter().position(|r| r.cycles >= cycles)?;
     if k == 0 {
         return Some(records[0].backlash_increase_m);

@@ -163,21 +163,10 @@ impl Problem {
         let work = |(b, ys): (&Block, &mut [f64])| {
             ys.iter_mut().for_each(|v| *v = 0.0);
             let size = b.size;
-            // Columns of the non-zero loads, four at a time (one pass over y per four).
-            let nonzero: Vec<(usize, f64)> = x[b.start..b.start + size]
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| **v != 0.0)
-                .map(|(j, v)| (j, *v))
-                .collect();
+            // Columns of the non-zero loads, four at a time (one pass over y per four),
+            // gathered as they come (no allocation per product).
             let column = |j: usize| &b.matrix[j * size..(j + 1) * size];
-            for group in nonzero.chunks(4) {
-                let mut cols = [column(group[0].0); 4];
-                let mut coef = [0.0; 4];
-                for (k, &(j, v)) in group.iter().enumerate() {
-                    cols[k] = column(j);
-                    coef[k] = v;
-                }
+            let flush = |ys: &mut [f64], coef: [f64; 4], cols: [&[f64]; 4]| {
                 #[cfg(target_arch = "x86_64")]
                 if wide {
                     // SAFETY: the CPU has AVX2 and FMA (checked above).
@@ -187,6 +176,29 @@ impl Problem {
                 }
                 #[cfg(not(target_arch = "x86_64"))]
                 axpy4(ys, coef, cols);
+            };
+            let mut cols = [column(0); 4];
+            let mut coef = [0.0; 4];
+            let mut filled = 0;
+            for (j, &v) in x[b.start..b.start + size].iter().enumerate() {
+                if v == 0.0 {
+                    continue;
+                }
+                cols[filled] = column(j);
+                coef[filled] = v;
+                filled += 1;
+                if filled == 4 {
+                    flush(ys, coef, cols);
+                    filled = 0;
+                }
+            }
+            if filled > 0 {
+                // Unused slots: zero coefficients on a valid column.
+                for k in filled..4 {
+                    coef[k] = 0.0;
+                    cols[k] = cols[0];
+                }
+                flush(ys, coef, cols);
             }
         };
         // Threads only when the product is worth a fork-join (the projection's correction
