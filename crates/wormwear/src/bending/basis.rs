@@ -10,11 +10,11 @@
 //! MODEL's (q - 1/2) pi approximation is allowed but the exact values make the mode shapes satisfy
 //! their end conditions exactly (tested).
 
-use faer::linalg::solvers::Solve;
+use faer::linalg::solvers::{Solve, SolveLstsq};
 use faer::Mat;
 
 /// Which width functions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum WidthFunctions {
     /// Free-free beam modes (wheel tooth across its face width).
     FreeFree,
@@ -22,8 +22,18 @@ pub enum WidthFunctions {
     Averaged,
 }
 
-/// k-th root (k >= 1) of cos(b) cosh(b) = 1, by Newton from (k + 1/2) pi.
+/// k-th root (k >= 1) of cos(b) cosh(b) = 1, by Newton from (k + 1/2) pi (the first 32 are
+/// computed once).
 pub fn beam_eigenvalue(k: usize) -> f64 {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| (0..32).map(beam_eigenvalue_newton).collect());
+    table
+        .get(k)
+        .copied()
+        .unwrap_or_else(|| beam_eigenvalue_newton(k))
+}
+
+fn beam_eigenvalue_newton(k: usize) -> f64 {
     let mut b = (k as f64 + 0.5) * std::f64::consts::PI;
     for _ in 0..50 {
         let f = b.cos() * b.cosh() - 1.0;
@@ -37,18 +47,35 @@ pub fn beam_eigenvalue(k: usize) -> f64 {
     b
 }
 
+/// The hyperbolic parts of the mode shapes in a cancellation-free form: with
+/// s = (cosh b - cos b) / (sinh b - sin b),
+///   cosh(bx) - s sinh(bx) = A + B,  sinh(bx) - s cosh(bx) = A - B,
+///   A = e^(bx) (1 - s) / 2,  B = e^(-bx) (1 + s) / 2,
+/// where 1 - s = (cos b - sin b - e^-b) / (sinh b - sin b) is formed without subtracting the
+/// two nearly equal large terms (for the 12th mode cosh b ~ 1e15: the textbook form loses every
+/// digit). Returns (A, B, s).
+fn hyperbolic_parts(b: f64, x: f64) -> (f64, f64, f64) {
+    let em = (-b).exp();
+    // sinh b - sin b = e^b (1 - e^-2b - 2 sin b e^-b) / 2.
+    let scaled = 1.0 - em * em - 2.0 * b.sin() * em;
+    let one_minus_s = 2.0 * em * (b.cos() - b.sin() - em) / scaled;
+    let s = 1.0 - one_minus_s;
+    let a = 0.5 * (b * x).exp() * one_minus_s;
+    let bb = 0.5 * (-b * x).exp() * (1.0 + s);
+    (a, bb, s)
+}
+
 /// Free-free mode k >= 1 on [0, 1] and its first three derivatives (textbook form
 /// cosh + cos - s (sinh + sin), s = (cosh b - cos b) / (sinh b - sin b)).
 pub fn free_free(k: usize, x: f64) -> [f64; 4] {
     let b = beam_eigenvalue(k);
-    let s = (b.cosh() - b.cos()) / (b.sinh() - b.sin());
-    let (bx, p) = (b * x, [1.0, b, b * b, b * b * b]);
-    let (ch, sh, c, sn) = (bx.cosh(), bx.sinh(), bx.cos(), bx.sin());
+    let (a, bb, s) = hyperbolic_parts(b, x);
+    let (c, sn) = ((b * x).cos(), (b * x).sin());
     [
-        p[0] * (ch + c - s * (sh + sn)),
-        p[1] * (sh - sn - s * (ch + c)),
-        p[2] * (ch - c - s * (sh - sn)),
-        p[3] * (sh + sn - s * (ch - c)),
+        (a + bb) + c - s * sn,
+        b * ((a - bb) - sn - s * c),
+        b * b * ((a + bb) - c + s * sn),
+        b * b * b * ((a - bb) + sn + s * c),
     ]
 }
 
@@ -56,19 +83,18 @@ pub fn free_free(k: usize, x: f64) -> [f64; 4] {
 /// (cosh - cos - s (sinh - sin), same s).
 pub fn clamped_clamped(k: usize, x: f64) -> [f64; 4] {
     let b = beam_eigenvalue(k);
-    let s = (b.cosh() - b.cos()) / (b.sinh() - b.sin());
-    let (bx, p) = (b * x, [1.0, b, b * b, b * b * b]);
-    let (ch, sh, c, sn) = (bx.cosh(), bx.sinh(), bx.cos(), bx.sin());
+    let (a, bb, s) = hyperbolic_parts(b, x);
+    let (c, sn) = ((b * x).cos(), (b * x).sin());
     [
-        p[0] * (ch - c - s * (sh - sn)),
-        p[1] * (sh + sn - s * (ch - c)),
-        p[2] * (ch + c - s * (sh + sn)),
-        p[3] * (sh - sn - s * (ch + c)),
+        (a + bb) - c + s * sn,
+        b * ((a - bb) + sn + s * c),
+        b * b * ((a + bb) + c - s * sn),
+        b * b * b * ((a - bb) - sn - s * c),
     ]
 }
 
 /// The basis: Q1 height functions x Q2 width functions.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Basis {
     pub height: usize,
     pub width: usize,
@@ -150,6 +176,21 @@ impl Basis {
         let x = lu.solve(u);
         let ct = lu.solve(x.transpose());
         ct.transpose().to_owned()
+    }
+
+    /// Core matrix fitted by least squares to displacements at n >= K points (U: n x n,
+    /// displacement at point l due to a unit load at point m): C = P U P^T with
+    /// P = (F^T F)^-1 F^T, F the n x K matrix of the functions at the points. Minimises
+    /// || F C F^T - U || (Frobenius); equals [`Self::fit_at`] when n = K.
+    pub fn fit_least_squares(&self, points: &[(f64, f64)], u: &Mat<f64>) -> Mat<f64> {
+        let k = self.len();
+        let n = points.len();
+        let f = Mat::from_fn(n, k, |l, m| self.eval(points[l].0, points[l].1)[m]);
+        let qr = f.qr();
+        // P = R^-1 Q^T through the QR factorisation's least-squares solve, column by column.
+        let p = qr.solve_lstsq(Mat::<f64>::identity(n, n));
+        let pu = &p * u;
+        &pu * p.transpose()
     }
 
     /// Coefficient between two points: f(a)^T C f(b).

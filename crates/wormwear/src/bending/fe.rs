@@ -211,12 +211,34 @@ pub type Fixed = (usize, usize, f64);
 /// Nodal force (node, direction, value N).
 pub type Load = (usize, usize, f64);
 
+/// Grounded spring on a linear combination of nodal displacements: stiffness k (N/m) times
+/// (sum_i d_i . u_(node_i))^2 / 2 is added to the energy, i.e. k v v^T to the stiffness. One
+/// term: a spring on one node along d (a bearing's radial support); many: a soft constraint on
+/// a mean displacement (the torque reaction on the mean tangential displacement of a ring,
+/// which leaves its lateral motion and tilt free).
+#[derive(Debug, Clone)]
+pub struct Spring {
+    pub terms: Vec<(usize, [f64; 3])>,
+    pub stiffness: f64,
+}
+
 /// Solves K u = f with the prescribed displacements eliminated; returns the displacement of
 /// every node (m). Several load cases share one factorisation.
 pub fn solve(
     mesh: &Mesh,
     material: &Elastic,
     fixed: &[Fixed],
+    loads: &[Vec<Load>],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    solve_with_springs(mesh, material, fixed, &[], loads)
+}
+
+/// As [`solve`], with grounded springs added to the stiffness.
+pub fn solve_with_springs(
+    mesh: &Mesh,
+    material: &Elastic,
+    fixed: &[Fixed],
+    springs: &[Spring],
     loads: &[Vec<Load>],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
     let ndof = 3 * mesh.nodes.len();
@@ -259,6 +281,37 @@ pub fn solve(
             }
             for (c, &gc) in dofs.iter().enumerate() {
                 let v = k[r * 60 + c];
+                match prescribed[gc] {
+                    Some(u) => {
+                        for case in 0..ncase {
+                            rhs[(fr, case)] -= v * u;
+                        }
+                    }
+                    None => {
+                        let fc = map[gc];
+                        if fc <= fr {
+                            triplets.push(Triplet::new(fr, fc, v));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for spring in springs {
+        let k = spring.stiffness;
+        let dofs: Vec<(usize, f64)> = spring
+            .terms
+            .iter()
+            .flat_map(|&(n, d)| (0..3).map(move |c| (3 * n + c, d[c])))
+            .filter(|&(_, w)| w != 0.0)
+            .collect();
+        for &(gr, wr) in &dofs {
+            let fr = map[gr];
+            if fr == usize::MAX {
+                continue;
+            }
+            for &(gc, wc) in &dofs {
+                let v = k * wr * wc;
                 match prescribed[gc] {
                     Some(u) => {
                         for case in 0..ncase {
@@ -438,4 +491,34 @@ pub fn element_volume(mesh: &Mesh, e: usize) -> f64 {
         }
     }
     v
+}
+
+/// Jacobian determinant of element `nodes` (20 corner/mid-side coordinates) at its centre.
+pub fn centre_jacobian(x: &[[f64; 3]; 20]) -> f64 {
+    let (_, dn) = shape([0.0, 0.0, 0.0]);
+    let mut jac = [[0.0; 3]; 3];
+    for (nd, xn) in dn.iter().zip(x) {
+        for i in 0..3 {
+            for j in 0..3 {
+                jac[i][j] += nd[i] * xn[j];
+            }
+        }
+    }
+    jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1])
+        - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
+        + jac[0][2] * (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0])
+}
+
+/// The element with its third natural coordinate reversed (mirror numbering): turns a
+/// left-handed node order into a right-handed one.
+pub fn mirrored(e: [usize; 20]) -> [usize; 20] {
+    let mut out = e;
+    for (a, c) in NATURAL.iter().enumerate() {
+        let b = NATURAL
+            .iter()
+            .position(|d| d[0] == c[0] && d[1] == c[1] && d[2] == -c[2])
+            .unwrap_or(a);
+        out[b] = e[a];
+    }
+    out
 }

@@ -14,13 +14,16 @@ use crate::ltca::{BendingModel, LocalCell};
 use faer::Mat;
 
 /// Wheel bending model.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct WheelBending {
     pub basis: Basis,
     /// Core matrices for receivers on the same tooth, the tooth before (k - 1) and after (k + 1)
     /// the loaded one, m/N.
+    #[serde(with = "super::mat_serde")]
     pub same: Mat<f64>,
+    #[serde(with = "super::mat_serde")]
     pub before: Mat<f64>,
+    #[serde(with = "super::mat_serde")]
     pub after: Mat<f64>,
     /// Root radius and blank top as functions of z are needed to map r to r~.
     root_centre_distance: f64,
@@ -194,45 +197,17 @@ impl BendingModel for WheelBending {
     }
 
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
-        // Teeth present, in cell order; one block of K basis functions per tooth.
-        let mut teeth: Vec<i32> = cells.iter().map(|c| c.tooth).collect();
-        teeth.sort_unstable();
-        teeth.dedup();
-        let k = self.basis.len();
-        let rank = k * teeth.len();
-        let mut f = vec![0.0; cells.len() * rank];
-        for (i, c) in cells.iter().enumerate() {
-            let t = teeth.iter().position(|&x| x == c.tooth).unwrap_or(0);
-            let (r, w) = self.coordinates(c.r, c.z);
-            let values = self.basis.eval(r, w);
-            f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
-        }
-        let mut core = vec![0.0; rank * rank];
-        for (a, &ta) in teeth.iter().enumerate() {
-            for (b, &tb) in teeth.iter().enumerate() {
-                // Receiver tooth ta, loaded tooth tb.
-                let m = match ta - tb {
-                    0 => &self.same,
-                    -1 => &self.before,
-                    1 => &self.after,
-                    _ => continue,
-                };
-                for l in 0..k {
-                    for c in 0..k {
-                        core[(a * k + l) * rank + b * k + c] = m[(l, c)];
-                    }
-                }
-            }
-        }
-        // Symmetrise the core (reciprocity; the before/after fits are each other's transposes
-        // up to the sector's end effects).
-        for i in 0..rank {
-            for j in 0..i {
-                let v = 0.5 * (core[i * rank + j] + core[j * rank + i]);
-                core[i * rank + j] = v;
-                core[j * rank + i] = v;
-            }
-        }
-        LowRank { rank, f, core }
+        let groups: Vec<i64> = cells.iter().map(|c| c.tooth as i64).collect();
+        let coords: Vec<(f64, f64)> = cells.iter().map(|c| self.coordinates(c.r, c.z)).collect();
+        // Symmetrised core (reciprocity; the before/after fits are each other's transposes up to
+        // the sector's end effects).
+        super::worm_model::relation_low_rank(
+            &self.basis,
+            &self.same,
+            &self.before,
+            &self.after,
+            &groups,
+            &coords,
+        )
     }
 }

@@ -1,0 +1,440 @@
+//! Worm bending coefficients for the LTCA (MODEL §5.5): FE of the worm (three threads on the
+//! core, shaft to the bearings), unit normal loads at a K = Q1 x Q2 grid of the central
+//! thread's loaded flank (radius from r_f1 + 0.1 H to r_a1 - 0.1 H, polar angle from -theta_m
+//! to theta_m, theta_m = atan(0.5 b2 / (a - r_e2)), §12f), bending = opposite flank free minus
+//! blocked, projected on the normals; three thread relations fitted on the averaged
+//! free-free / clamped-clamped basis.
+//!
+//! Supports: both bearings hold the shaft laterally (stiff springs on the mean lateral
+//! displacement of a ring of the shaft surface; rotation, tilt and axial sliding free there); the torque and the thrust are reacted at the
+//! coupling, a ring of the shaft half a lead beyond the drive-side bearing (axial displacement
+//! fixed, stiff tangential springs).
+
+use super::basis::{Basis, WidthFunctions};
+use super::fe::{solve_with_springs, Elastic, FeError, Fixed, Load, Spring};
+use super::worm_mesh::{worm_mesh_on, WormBody, WormLattice, WormMesh, WormMeshSettings};
+use crate::geometry::{Flank, Geometry};
+use crate::input::GearSet;
+use crate::ltca::solver::LowRank;
+use crate::ltca::{BendingModel, LocalCell};
+use faer::Mat;
+use nalgebra::Vector3;
+
+/// Worm bending model (coefficients in m/N).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct WormBending {
+    pub basis: Basis,
+    /// Core matrices for receivers on the same thread, the thread at -p_x and at +p_x from
+    /// the loaded one, m/N.
+    #[serde(with = "super::mat_serde")]
+    pub same: Mat<f64>,
+    #[serde(with = "super::mat_serde")]
+    pub before: Mat<f64>,
+    #[serde(with = "super::mat_serde")]
+    pub after: Mat<f64>,
+    pub root_radius: f64,
+    pub tip_radius: f64,
+    /// Half angle of the zone the wheel reaches, rad.
+    pub theta_m: f64,
+    /// Axial pitch p_x and signed lead per radian (hand x h), m and m/rad.
+    pub pitch: f64,
+    pub signed_lead_per_rad: f64,
+    /// Axial profile of the loaded flank, (rho, X) pairs at equal steps, m.
+    pub profile: Vec<(f64, f64)>,
+}
+
+/// The zone half angle theta_m = atan(0.5 b2 / (a - r_e2)) (MODEL §5.5, §12f), rad; pi/2 when
+/// the blank reaches past the worm axis; kept within [0.05, 0.45 pi].
+pub fn zone_half_angle(gear: &GearSet) -> f64 {
+    let d = gear.operating.centre_distance - gear.wheel.outer_radius;
+    let theta = if d <= 0.0 {
+        0.5 * std::f64::consts::PI
+    } else {
+        (0.5 * gear.wheel.face_width / d).atan()
+    };
+    theta.clamp(0.05, 0.45 * std::f64::consts::PI)
+}
+
+impl WormBending {
+    /// Builds the model: FE of the worm (`settings`, `body`) with `height` x `width` fit points.
+    pub fn build(
+        gear: &GearSet,
+        geo: &Geometry,
+        body: &WormBody,
+        settings: &WormMeshSettings,
+        height: usize,
+        width: usize,
+    ) -> Result<Self, FeError> {
+        let flank = crate::kinematics::loaded_flank(gear);
+        let theta_m = zone_half_angle(gear);
+        let lattice = WormLattice::aligned(settings, theta_m, height, width);
+        let m = worm_mesh_on(&geo.worm, flank, body, settings, &lattice);
+        let (rf, ra) = (body.root_radius, body.tip_radius);
+        let thread_height = ra - rf;
+        let basis = Basis {
+            height,
+            width,
+            kind: WidthFunctions::Averaged,
+        };
+        // Data points: every corner node of the central thread's flank in the fit zone (the
+        // lattice puts the fit grid and the points midway between its points there), about
+        // four per basis function. The worm's kernel is peaked (local bending of the thread
+        // under a point load, over about the thread thickness), and interpolating it through
+        // exactly K points oscillates between them (Runge: 36 % error at 5 x 7, worse with
+        // more points); least squares on the denser set does not.
+        let data: Vec<(usize, usize, (f64, f64))> = m.loaded[1]
+            .iter()
+            .filter(|f| f.0 % 2 == 0 && f.1 % 2 == 0)
+            .filter_map(|&(li, hi, n)| {
+                let x = m.mesh.nodes[n];
+                let rho = (x[1] * x[1] + x[2] * x[2]).sqrt();
+                let r = (rho - rf) / thread_height;
+                let w = x[2].atan2(x[1]) / (2.0 * theta_m) + 0.5;
+                let inside =
+                    (0.1 - 1e-9..=0.9 + 1e-9).contains(&r) && (-1e-9..=1.0 + 1e-9).contains(&w);
+                inside.then_some((li, hi, (r, w)))
+            })
+            .collect();
+        let k = basis.len();
+        if data.len() < k {
+            return Err(FeError::Factorisation(format!(
+                "the worm mesh has {} flank points in the fit zone, fewer than the {k} basis functions",
+                data.len()
+            )));
+        }
+        let node = |thread: usize, li: usize, hi: usize| {
+            m.loaded[thread]
+                .iter()
+                .find(|f| f.0 == li && f.1 == hi)
+                .map(|f| f.2)
+        };
+        let ids: Vec<Vec<usize>> = (0..3)
+            .map(|t| {
+                data.iter()
+                    .map(|&(li, hi, _)| node(t, li, hi).unwrap_or(usize::MAX))
+                    .collect()
+            })
+            .collect();
+        if ids.iter().flatten().any(|&n| n == usize::MAX) {
+            return Err(FeError::Factorisation(
+                "a worm data point has no node on a neighbouring thread".into(),
+            ));
+        }
+        // Outward normals at the central thread's points (the same on the neighbours: a thread
+        // is its neighbour translated by one pitch).
+        let normals: Vec<Vector3<f64>> = ids[1]
+            .iter()
+            .map(|&n| {
+                let x = m.mesh.nodes[n];
+                geo.worm.outward_normal(flank, x[1], x[2])
+            })
+            .collect();
+        let material = Elastic {
+            youngs_modulus: gear.worm_material.youngs_modulus,
+            poisson_ratio: gear.worm_material.poisson_ratio,
+        };
+        let loads: Vec<(usize, Vector3<f64>)> = ids[1]
+            .iter()
+            .copied()
+            .zip(normals.iter().copied())
+            .collect();
+        let bending = worm_bending_displacements(&m, body, &material, &loads)?;
+        let n = data.len();
+        let relation = |t: usize| {
+            Mat::from_fn(n, n, |l, c| {
+                let d = bending[c][ids[t][l]];
+                let nn = normals[l];
+                -(d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2])
+            })
+        };
+        let coords: Vec<(f64, f64)> = data.iter().map(|d| d.2).collect();
+        let steps = 32;
+        let (lo, hi) = (rf - 0.2 * thread_height, ra + 0.2 * thread_height);
+        let profile = (0..=steps)
+            .map(|i| {
+                let rho = lo + (hi - lo) * i as f64 / steps as f64;
+                (rho, geo.worm.axial_profile(flank, rho).0)
+            })
+            .collect();
+        Ok(Self {
+            basis,
+            same: basis.fit_least_squares(&coords, &relation(1)),
+            before: basis.fit_least_squares(&coords, &relation(0)),
+            after: basis.fit_least_squares(&coords, &relation(2)),
+            root_radius: rf,
+            tip_radius: ra,
+            theta_m,
+            pitch: geo.worm.axial_pitch(),
+            signed_lead_per_rad: geo.worm.hand_sign() * geo.worm.lead()
+                / (2.0 * std::f64::consts::PI),
+            profile,
+        })
+    }
+
+    /// Basis coordinates (r~, theta~) of a worm-frame point: r~ = (rho - r_f1)/(r_a1 - r_f1),
+    /// theta~ = theta/(2 theta_m) + 1/2 with theta the polar angle from y1 (towards the wheel).
+    pub fn coordinates(&self, p: &Vector3<f64>) -> (f64, f64) {
+        let rho = (p.y * p.y + p.z * p.z).sqrt();
+        let phi = p.z.atan2(p.y);
+        (
+            (rho - self.root_radius) / (self.tip_radius - self.root_radius),
+            phi / (2.0 * self.theta_m) + 0.5,
+        )
+    }
+
+    /// Helical coordinate of the thread through a worm-frame point, in axial pitches: points
+    /// on one thread differ by less than a half, on neighbouring threads by about one.
+    pub fn thread_coordinate(&self, p: &Vector3<f64>) -> f64 {
+        let rho = (p.y * p.y + p.z * p.z).sqrt();
+        let phi = p.z.atan2(p.y);
+        let x = interpolate(&self.profile, rho);
+        (p.x - x - self.signed_lead_per_rad * phi) / self.pitch
+    }
+}
+
+fn interpolate(table: &[(f64, f64)], x: f64) -> f64 {
+    let n = table.len();
+    if n == 0 {
+        return 0.0;
+    }
+    if n == 1 {
+        return table[0].1;
+    }
+    let (x0, x1) = (table[0].0, table[n - 1].0);
+    let t = ((x - x0) / (x1 - x0) * (n - 1) as f64).clamp(0.0, (n - 1) as f64);
+    let i = (t.floor() as usize).min(n - 2);
+    let f = t - i as f64;
+    table[i].1 + (table[i + 1].1 - table[i].1) * f
+}
+
+/// Angular weights of a ring's nodes (in order around the axis): half the angle between each
+/// node's two neighbours, so sums over the ring are integrals over the circle.
+fn ring_weights(m: &WormMesh, ring: &[usize]) -> Vec<(f64, f64)> {
+    let phi: Vec<f64> = ring
+        .iter()
+        .map(|&n| m.mesh.nodes[n][2].atan2(m.mesh.nodes[n][1]))
+        .collect();
+    let count = phi.len();
+    let tau = 2.0 * std::f64::consts::PI;
+    (0..count)
+        .map(|i| {
+            let (a, b) = (phi[(i + count - 1) % count], phi[(i + 1) % count]);
+            let span = (b - a).rem_euclid(tau);
+            let span = if span == 0.0 { tau } else { span };
+            (phi[i], 0.5 * span)
+        })
+        .collect()
+}
+
+/// Supports of the worm model (see the module doc). Bearings: stiff springs on the ring's
+/// lateral translation, read from the radial displacements as sum w u_r cos(phi) /
+/// sum w cos^2(phi) (and sin): a rotation about the axis gives no radial displacement, so
+/// torsion is free; springs on each node would also resist the tilt, a ring of the helical
+/// lattice not being exactly plane. Coupling: stiff springs on the ring's mean tangential and
+/// axial displacements (torque and thrust), leaving its lateral motion and tilt free.
+fn supports(m: &WormMesh, body: &WormBody, material: &Elastic) -> (Vec<Fixed>, Vec<Spring>) {
+    // Stiff: 100 E r_shaft per support (rigid bearings and coupling).
+    let total = 100.0 * material.youngs_modulus * body.shaft_radius;
+    let mut springs = Vec::new();
+    for ring in &m.bearing_rings {
+        let w = ring_weights(m, ring);
+        for trig in [f64::cos, f64::sin] {
+            let norm: f64 = w.iter().map(|&(phi, wi)| wi * trig(phi).powi(2)).sum();
+            springs.push(Spring {
+                terms: ring
+                    .iter()
+                    .zip(&w)
+                    .map(|(&n, &(phi, wi))| {
+                        let c = wi * trig(phi) / norm;
+                        (n, [0.0, c * phi.cos(), c * phi.sin()])
+                    })
+                    .collect(),
+                stiffness: total,
+            });
+        }
+    }
+    let w = ring_weights(m, &m.drive_ring);
+    let sum: f64 = w.iter().map(|x| x.1).sum();
+    springs.push(Spring {
+        terms: m
+            .drive_ring
+            .iter()
+            .zip(&w)
+            .map(|(&n, &(phi, wi))| (n, [0.0, -phi.sin() * wi / sum, phi.cos() * wi / sum]))
+            .collect(),
+        stiffness: total,
+    });
+    springs.push(Spring {
+        terms: m
+            .drive_ring
+            .iter()
+            .zip(&w)
+            .map(|(&n, &(_, wi))| (n, [wi / sum, 0.0, 0.0]))
+            .collect(),
+        stiffness: total,
+    });
+    (Vec::new(), springs)
+}
+
+/// Bending displacements of the worm (MODEL §5.5 step 2): for each load case a unit force
+/// into the central thread (along -n) at the given node, FE displacement of every node with
+/// the thread's opposite flank free minus blocked. Index: [case][node], m/N.
+pub fn worm_bending_displacements(
+    m: &WormMesh,
+    body: &WormBody,
+    material: &Elastic,
+    loads: &[(usize, Vector3<f64>)],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let cases: Vec<Vec<Load>> = loads
+        .iter()
+        .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
+        .collect();
+    let (fixed, springs) = supports(m, body, material);
+    let free = solve_with_springs(&m.mesh, material, &fixed, &springs, &cases)?;
+    let mut blocked_fixed = fixed;
+    blocked_fixed.extend(
+        m.opposite[1]
+            .iter()
+            .flat_map(|f| (0..3).map(move |d| (f.2, d, 0.0))),
+    );
+    let blocked = solve_with_springs(&m.mesh, material, &blocked_fixed, &springs, &cases)?;
+    Ok(free
+        .iter()
+        .zip(&blocked)
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+                .collect()
+        })
+        .collect())
+}
+
+/// Displacements of the worm model under arbitrary nodal loads with its supports (no
+/// blocking), for checks. Index: [case][node], m.
+pub fn worm_displacements(
+    m: &WormMesh,
+    body: &WormBody,
+    material: &Elastic,
+    loads: &[Vec<Load>],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let (fixed, springs) = supports(m, body, material);
+    solve_with_springs(&m.mesh, material, &fixed, &springs, loads)
+}
+
+/// Thread-relation low-rank term shared by both members: cells grouped by `group` (tooth or
+/// thread index), core blocks same / before (receiver one group lower) / after, symmetrised.
+pub(crate) fn relation_low_rank(
+    basis: &Basis,
+    same: &Mat<f64>,
+    before: &Mat<f64>,
+    after: &Mat<f64>,
+    groups: &[i64],
+    coords: &[(f64, f64)],
+) -> LowRank {
+    let mut present: Vec<i64> = groups.to_vec();
+    present.sort_unstable();
+    present.dedup();
+    let k = basis.len();
+    let rank = k * present.len();
+    let mut f = vec![0.0; groups.len() * rank];
+    for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
+        let t = present.iter().position(|&x| x == g).unwrap_or(0);
+        let values = basis.eval(r, w);
+        f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
+    }
+    let mut core = vec![0.0; rank * rank];
+    for (a, &ta) in present.iter().enumerate() {
+        for (b, &tb) in present.iter().enumerate() {
+            let m = match ta - tb {
+                0 => same,
+                -1 => before,
+                1 => after,
+                _ => continue,
+            };
+            for l in 0..k {
+                for c in 0..k {
+                    core[(a * k + l) * rank + b * k + c] = m[(l, c)];
+                }
+            }
+        }
+    }
+    for i in 0..rank {
+        for j in 0..i {
+            let v = 0.5 * (core[i * rank + j] + core[j * rank + i]);
+            core[i * rank + j] = v;
+            core[j * rank + i] = v;
+        }
+    }
+    LowRank { rank, f, core }
+}
+
+impl BendingModel for WormBending {
+    fn name(&self) -> &'static str {
+        "fe-worm"
+    }
+
+    fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
+        let first = cells
+            .first()
+            .map(|c| self.thread_coordinate(&c.cell.centre))
+            .unwrap_or(0.0);
+        let groups: Vec<i64> = cells
+            .iter()
+            .map(|c| (self.thread_coordinate(&c.cell.centre) - first).round() as i64)
+            .collect();
+        let coords: Vec<(f64, f64)> = cells
+            .iter()
+            .map(|c| self.coordinates(&c.cell.centre))
+            .collect();
+        relation_low_rank(
+            &self.basis,
+            &self.same,
+            &self.before,
+            &self.after,
+            &groups,
+            &coords,
+        )
+    }
+}
+
+/// Both members: the finite-element bending of MODEL §5.5 (wheel sector and worm). The LTCA
+/// reports it as "fe".
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct FeBending {
+    pub wheel: super::wheel_model::WheelBending,
+    pub worm: WormBending,
+}
+
+impl BendingModel for FeBending {
+    fn name(&self) -> &'static str {
+        "fe"
+    }
+
+    fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
+        let a = self.wheel.coefficients(cells);
+        let b = self.worm.coefficients(cells);
+        let rank = a.rank + b.rank;
+        let mut f = vec![0.0; cells.len() * rank];
+        for i in 0..cells.len() {
+            f[i * rank..i * rank + a.rank].copy_from_slice(&a.f[i * a.rank..(i + 1) * a.rank]);
+            f[i * rank + a.rank..(i + 1) * rank]
+                .copy_from_slice(&b.f[i * b.rank..(i + 1) * b.rank]);
+        }
+        let mut core = vec![0.0; rank * rank];
+        for i in 0..a.rank {
+            core[i * rank..i * rank + a.rank]
+                .copy_from_slice(&a.core[i * a.rank..(i + 1) * a.rank]);
+        }
+        for i in 0..b.rank {
+            let row = (a.rank + i) * rank + a.rank;
+            core[row..row + b.rank].copy_from_slice(&b.core[i * b.rank..(i + 1) * b.rank]);
+        }
+        LowRank { rank, f, core }
+    }
+}
+
+/// Which flank of the worm the wheel loads (for callers building meshes by hand).
+pub fn worm_loaded_flank(gear: &GearSet) -> Flank {
+    crate::kinematics::loaded_flank(gear)
+}
