@@ -313,14 +313,55 @@ fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The bending model the file asks for (`[bending] model`), from the cache or the FE build.
+fn bending_model(
+    gear: &wormwear::input::GearSet,
+    geo: &wormwear::geometry::Geometry,
+    quiet: bool,
+) -> Result<Option<wormwear::bending::worm_model::FeBending>, Failure> {
+    let (built, warnings) = wormwear::bending::model::build(gear, geo).map_err(|e| {
+        Failure::Run(anyhow::Error::new(e).context("bending influence coefficients"))
+    })?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(built.map(|b| {
+        if !quiet {
+            let place = b
+                .cache_file
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default();
+            match b.origin {
+                wormwear::bending::model::Origin::Cache => {
+                    println!("bending (fe): read in {:.3} s from {place}", b.seconds)
+                }
+                wormwear::bending::model::Origin::Computed => println!(
+                    "bending (fe): worm and wheel FE models computed in {:.1} s, cached in {place}",
+                    b.seconds
+                ),
+            }
+        }
+        b.model
+    }))
+}
+
 fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
     let geo = build_geometry(&gear, file)?;
     let tca = wormwear::kinematics::analyse(&gear, &geo)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
-    let result = wormwear::ltca::analyse(&gear, &geo, &tca).map_err(|e| {
-        Failure::Run(anyhow::Error::new(e).context("loaded tooth contact analysis"))
-    })?;
+    let bending = bending_model(&gear, &geo, quiet)?;
+    let result = wormwear::ltca::analyse_with(
+        &gear,
+        &geo,
+        &tca,
+        &wormwear::ltca::LtcaSettings::from_gear(&gear),
+        bending
+            .as_ref()
+            .map(|b| b as &dyn wormwear::ltca::BendingModel),
+    )
+    .map_err(|e| Failure::Run(anyhow::Error::new(e).context("loaded tooth contact analysis")))?;
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
     wormwear::output::tca::write_tca(&gear, &geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
@@ -412,6 +453,7 @@ fn wear(
     let geo = build_geometry(&gear, file)?;
     let tca = wormwear::kinematics::analyse(&gear, &geo)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
+    let bending = bending_model(&gear, &geo, quiet)?;
     let wf = geo.wheel_flank(tca.loaded_flank);
     let state = if args.resume {
         match wormwear::output::wear::read_checkpoint(dir) {
@@ -478,7 +520,9 @@ fn wear(
         &geo,
         &tca,
         &settings,
-        None,
+        bending
+            .as_ref()
+            .map(|b| b as &dyn wormwear::ltca::BendingModel),
         &plan,
         state,
         &mut on_state,
@@ -594,6 +638,7 @@ fn calibrate(
             Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis"))
         })?;
         let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
+        let bending = bending_model(&gear, &geo, quiet)?;
         let k_start = gear.wheel_material.wear_coefficient;
         let mut runs = 0;
         let mut simulate = |k: f64| {
@@ -606,7 +651,9 @@ fn calibrate(
                 &geo,
                 &tca,
                 &settings,
-                None,
+                bending
+                    .as_ref()
+                    .map(|b| b as &dyn wormwear::ltca::BendingModel),
                 &plan,
                 wormwear::wear::WearState::new(wf),
                 &mut |_| Ok(()),

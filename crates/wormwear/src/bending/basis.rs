@@ -179,16 +179,32 @@ impl Basis {
     }
 
     /// Core matrix fitted by least squares to displacements at n >= K points (U: n x n,
-    /// displacement at point l due to a unit load at point m): C = P U P^T with
-    /// P = (F^T F)^-1 F^T, F the n x K matrix of the functions at the points. Minimises
-    /// || F C F^T - U || (Frobenius); equals [`Self::fit_at`] when n = K.
+    /// displacement at point l due to a unit load at point m): C = P U P^T with P the
+    /// pseudo-inverse of F (n x K, the functions at the points), from its singular value
+    /// decomposition with singular values below 1e-6 of the largest dropped. The beam modes
+    /// and monomials are far from orthogonal (condition ~1e9 at 5 x 13): without the
+    /// truncation, C picks up huge components along directions F nearly annihilates, which
+    /// cancel at the data points but turn the LTCA's compliance matrix numerically indefinite.
     pub fn fit_least_squares(&self, points: &[(f64, f64)], u: &Mat<f64>) -> Mat<f64> {
         let k = self.len();
         let n = points.len();
         let f = Mat::from_fn(n, k, |l, m| self.eval(points[l].0, points[l].1)[m]);
-        let qr = f.qr();
-        // P = R^-1 Q^T through the QR factorisation's least-squares solve, column by column.
-        let p = qr.solve_lstsq(Mat::<f64>::identity(n, n));
+        let p = match f.thin_svd() {
+            Ok(svd) => {
+                let s = svd.S().column_vector();
+                let smax = (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
+                // P = V S^+ U^T.
+                let vs = Mat::from_fn(k, s.nrows(), |i, j| {
+                    if s[j] > 1e-6 * smax {
+                        svd.V()[(i, j)] / s[j]
+                    } else {
+                        0.0
+                    }
+                });
+                &vs * svd.U().transpose()
+            }
+            Err(_) => f.qr().solve_lstsq(Mat::<f64>::identity(n, n)),
+        };
         let pu = &p * u;
         &pu * p.transpose()
     }

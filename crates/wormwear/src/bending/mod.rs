@@ -4,6 +4,7 @@
 
 pub mod basis;
 pub mod fe;
+pub mod model;
 pub mod wheel_mesh;
 pub mod wheel_model;
 pub mod worm_mesh;

@@ -340,7 +340,9 @@ pub(crate) fn relation_low_rank(
     let mut f = vec![0.0; groups.len() * rank];
     for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
         let t = present.iter().position(|&x| x == g).unwrap_or(0);
-        let values = basis.eval(r, w);
+        // Points outside the fitted zone take the value at its edge: the beam modes grow
+        // exponentially outside [0, 1].
+        let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
         f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
     }
     let mut core = vec![0.0; rank * rank];

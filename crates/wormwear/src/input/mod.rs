@@ -339,6 +339,29 @@ pub struct Analysis {
     pub solver: crate::ltca::solver::SolverKind,
 }
 
+/// Which bending model the loaded analysis uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum BendingKind {
+    /// Contact (Boussinesq) only.
+    None,
+    /// Finite-element models of worm and wheel (MODEL §5.5).
+    Fe,
+}
+
+/// Validated bending settings, SI.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BendingPlan {
+    pub kind: BendingKind,
+    pub height_points: usize,
+    pub width_points: usize,
+    pub worm_width_points: usize,
+    pub mesh_refinement: usize,
+    /// Worm shaft radius, body length and bearing positions (x1), m.
+    pub worm_shaft_radius: f64,
+    pub worm_body_length: f64,
+    pub worm_bearings: [f64; 2],
+}
+
 /// A validated gear set: everything the pipeline needs, SI units.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct GearSet {
@@ -362,6 +385,8 @@ pub struct GearSet {
     pub wear: Option<WearPlan>,
     /// Factors of the standard ratings.
     pub rating: RatingFactors,
+    /// Bending model (MODEL §5.5).
+    pub bending: BendingPlan,
     /// Non-fatal remarks found during validation.
     pub warnings: Vec<String>,
 }

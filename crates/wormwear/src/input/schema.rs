@@ -31,6 +31,43 @@ pub struct GearFile {
     /// Factors of the standard ratings (ISO/TR 14521).
     #[serde(default)]
     pub rating: RatingSpec,
+    /// Bending of the teeth and their environment (MODEL §5.5); absent: no bending.
+    #[serde(default)]
+    pub bending: BendingSpec,
+}
+
+/// Bending model of worm and wheel (MODEL §5.5).
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BendingSpec {
+    /// "none" (default) or "fe": finite-element models of both members, expanded on the
+    /// function basis, cached on disk.
+    #[serde(default)]
+    pub model: Option<String>,
+    /// Fit points along the tooth / thread height (default 5).
+    #[serde(default)]
+    pub height_points: Option<i64>,
+    /// Fit points across the wheel's face width (default 7).
+    #[serde(default)]
+    pub width_points: Option<i64>,
+    /// Fit points along the worm thread, across the zone the wheel reaches (default 13: the
+    /// worm's influence is more peaked than the wheel's).
+    #[serde(default)]
+    pub worm_width_points: Option<i64>,
+    /// Mesh refinement of both FE models, 1 (default) to 3.
+    #[serde(default)]
+    pub mesh_refinement: Option<i64>,
+    /// Worm shaft radius beyond the threaded body, mm (default 0.75 x root radius).
+    #[serde(default)]
+    pub worm_shaft_radius_mm: Option<f64>,
+    /// Length of the worm body at root radius, mm (default: the length the wheel blank can
+    /// reach, 2 sqrt(r_e2^2 - (a - r_a1)^2)).
+    #[serde(default)]
+    pub worm_body_length_mm: Option<f64>,
+    /// Worm bearing positions along the worm axis, mm; the first is on the drive side
+    /// (default: +/- (body length / 2 + 2 x root radius)).
+    #[serde(default)]
+    pub worm_bearing_positions_mm: Option<Vec<f64>>,
 }
 
 /// Factors of the standard ratings; each defaults to 1 (A_p10,max to 8 %).

@@ -276,6 +276,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let conditions = conditions(&mut ck, &f.conditions);
     let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
     let rating = rating_factors(&mut ck, &f.rating);
+    let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
 
     let a = &f.analysis;
     let flank_cells_height =
@@ -584,7 +585,101 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         },
         wear,
         rating: rating.unwrap_or_default(),
+        bending: match bending {
+            Some(b) => b,
+            None => unreachable_input()?,
+        },
         warnings,
+    })
+}
+
+/// Bending settings with their defaults (see [`BendingSpec`]).
+fn bending_plan(
+    ck: &mut Checker,
+    b: &BendingSpec,
+    worm: &ThreadSpec,
+    wheel: &WheelSpec,
+    operating: &OperatingSpec,
+) -> Option<BendingPlan> {
+    let kind = ck.choice(
+        "bending.model",
+        b.model.as_deref().unwrap_or("none"),
+        &[("none", BendingKind::None), ("fe", BendingKind::Fe)],
+    );
+    let height = ck.int_range("bending.height_points", b.height_points.unwrap_or(5), 2, 9);
+    let width = ck.int_range("bending.width_points", b.width_points.unwrap_or(7), 2, 17);
+    let worm_width = ck.int_range(
+        "bending.worm_width_points",
+        b.worm_width_points.unwrap_or(13),
+        2,
+        21,
+    );
+    let refinement = ck.int_range(
+        "bending.mesh_refinement",
+        b.mesh_refinement.unwrap_or(1),
+        1,
+        3,
+    );
+    let rf = worm.root_radius_mm;
+    let shaft = match b.worm_shaft_radius_mm {
+        Some(v) => ck.positive(
+            "bending.worm_shaft_radius_mm",
+            v,
+            rf.max(1e-9),
+            "mm (at most the worm root radius)",
+        ),
+        None => Some(0.75 * rf),
+    };
+    let reach = operating.centre_distance_mm - worm.tip_radius_mm;
+    let default_body = 2.0
+        * (wheel.outer_radius_mm.powi(2) - reach.powi(2))
+            .max(0.0)
+            .sqrt();
+    let default_body = default_body.max(2.0 * wheel.face_width_mm);
+    let body = match b.worm_body_length_mm {
+        Some(v) => ck.positive("bending.worm_body_length_mm", v, 10_000.0, "mm"),
+        None => Some(default_body),
+    };
+    let bearings = match (&b.worm_bearing_positions_mm, body) {
+        (Some(v), _) if v.len() != 2 => {
+            ck.fail(
+                "bending.worm_bearing_positions_mm",
+                format!("{v:?}"),
+                "must hold two positions (drive side first)",
+            );
+            None
+        }
+        (Some(v), Some(body)) => {
+            let (lo, hi) = (v[0].min(v[1]), v[0].max(v[1]));
+            if !(lo.is_finite() && hi.is_finite()) || lo > -0.5 * body || hi < 0.5 * body {
+                ck.fail(
+                    "bending.worm_bearing_positions_mm",
+                    format!("{v:?}"),
+                    format!(
+                        "the bearings must lie outside the worm body, beyond +/- {:.1} mm",
+                        0.5 * body
+                    ),
+                );
+                None
+            } else {
+                Some([v[0] * MM, v[1] * MM])
+            }
+        }
+        (None, Some(body)) => {
+            let x = 0.5 * body + 2.0 * rf;
+            Some([-x * MM, x * MM])
+        }
+        _ => None,
+    };
+    Some(BendingPlan {
+        kind: kind?,
+        height_points: height? as usize,
+        width_points: width? as usize,
+        worm_width_points: worm_width? as usize,
+        mesh_refinement: refinement? as usize,
+        worm_shaft_radius: shaft? * MM,
+        worm_body_length: body? * MM,
+        worm_bearings: bearings?,
     })
 }
 

@@ -1,0 +1,241 @@
+//! The bending stage's entry point: builds the finite-element bending models of both members
+//! from the gear's [`BendingPlan`] (MODEL §5.5) or reads them from the disk cache.
+//!
+//! Cache: one JSON file per model in the directory `WORMWEAR_CACHE_DIR` (default:
+//! `$XDG_CACHE_HOME/wormwear`, else `$HOME/.cache/wormwear`, else the system temporary
+//! directory). The file name is a hash of a key that holds everything the coefficients depend
+//! on (thread, hob, cutting, wheel blank and body, operating placement and rotation, elastic
+//! constants, flank grid, bending settings and the model version); the file stores the full key
+//! and is used only when it matches exactly, so a cached model is never stale. Files are
+//! written atomically (temporary file, then rename); a cache that cannot be written only costs
+//! the next run the FE time.
+
+use super::fe::FeError;
+use super::wheel_mesh::SectorMeshSettings;
+use super::wheel_model::WheelBending;
+use super::worm_mesh::{WormBody, WormMeshSettings};
+use super::worm_model::{FeBending, WormBending};
+use crate::geometry::Geometry;
+use crate::input::{BendingKind, GearSet};
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+
+/// Version of the FE models and their fit: bump when a change alters the coefficients.
+const MODEL_VERSION: &str = "fe-bending-1";
+
+/// Why the bending stage failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BendingError {
+    #[error("wheel finite-element model")]
+    Wheel(#[source] FeError),
+    #[error("worm finite-element model")]
+    Worm(#[source] FeError),
+}
+
+/// Where the model came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Origin {
+    Computed,
+    Cache,
+}
+
+/// The built model with its provenance.
+#[derive(Debug, Clone)]
+pub struct BuiltBending {
+    pub model: FeBending,
+    pub origin: Origin,
+    /// Cache file (read or written), if any.
+    pub cache_file: Option<PathBuf>,
+    /// Wall time of the build or the read, s.
+    pub seconds: f64,
+}
+
+/// Mesh settings of the wheel sector at a refinement level (1..3) for `width` fit points
+/// across the face: layers every `face_step`-th node column, at least two per fit interval.
+pub fn wheel_mesh_settings(gear: &GearSet, refinement: usize, width: usize) -> SectorMeshSettings {
+    let s = refinement.max(1);
+    let intervals = 2 * (width.max(2) - 1) * s;
+    let face_step = (gear.analysis.flank_cells_face / intervals).max(1);
+    let tooth_height =
+        gear.wheel.throat_radius - (gear.cutting.centre_distance - gear.hob.tip_radius);
+    SectorMeshSettings {
+        across: 2 * s,
+        height: 3 * s,
+        rim: s,
+        space: s,
+        face_step,
+        rim_thickness: gear
+            .wheel
+            .rim_thickness
+            .unwrap_or(2.0 * tooth_height.max(1e-4)),
+    }
+}
+
+/// Mesh settings of the worm at a refinement level (1..3).
+pub fn worm_mesh_settings(refinement: usize) -> WormMeshSettings {
+    let s = refinement.max(1);
+    WormMeshSettings {
+        layers: 24 * s,
+        across: 2 * s,
+        height: 4 * s,
+        space: s,
+        core: s,
+        inner: 2 * s,
+    }
+}
+
+/// The worm body of the gear's bending plan.
+pub fn worm_body(gear: &GearSet) -> WormBody {
+    let b = &gear.bending;
+    WormBody {
+        root_radius: gear.worm.root_radius,
+        tip_radius: gear.worm.tip_radius,
+        shaft_radius: b.worm_shaft_radius.min(gear.worm.root_radius),
+        body_half_length: 0.5 * b.worm_body_length,
+        bearings: b.worm_bearings,
+    }
+}
+
+/// Builds both members' bending models (no cache).
+pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<FeBending, BendingError> {
+    let b = &gear.bending;
+    let wheel_settings = wheel_mesh_settings(gear, b.mesh_refinement, b.width_points);
+    let worm_settings = worm_mesh_settings(b.mesh_refinement);
+    let body = worm_body(gear);
+    // The two members are independent: build them side by side.
+    let (wheel, worm) = rayon::join(
+        || WheelBending::build(gear, geo, &wheel_settings, b.height_points, b.width_points),
+        || {
+            WormBending::build(
+                gear,
+                geo,
+                &body,
+                &worm_settings,
+                b.height_points,
+                b.worm_width_points,
+            )
+        },
+    );
+    Ok(FeBending {
+        wheel: wheel.map_err(BendingError::Wheel)?,
+        worm: worm.map_err(BendingError::Worm)?,
+    })
+}
+
+/// The cache key: everything the coefficients depend on, as JSON text.
+pub fn cache_key(gear: &GearSet) -> String {
+    let key = serde_json::json!({
+        "version": MODEL_VERSION,
+        "worm": gear.worm,
+        "hob": gear.hob,
+        "cutting": gear.cutting,
+        "wheel": gear.wheel,
+        "operating": gear.operating,
+        "rotation": gear.rotation,
+        "worm_elastic": [gear.worm_material.youngs_modulus, gear.worm_material.poisson_ratio],
+        "wheel_elastic": [gear.wheel_material.youngs_modulus, gear.wheel_material.poisson_ratio],
+        "grid": [gear.analysis.flank_cells_height, gear.analysis.flank_cells_face],
+        "bending": gear.bending,
+    });
+    key.to_string()
+}
+
+/// The cache directory (see the module doc).
+pub fn cache_dir() -> PathBuf {
+    if let Some(d) = std::env::var_os("WORMWEAR_CACHE_DIR").filter(|d| !d.is_empty()) {
+        return PathBuf::from(d);
+    }
+    if let Some(d) = std::env::var_os("XDG_CACHE_HOME").filter(|d| !d.is_empty()) {
+        return PathBuf::from(d).join("wormwear");
+    }
+    if let Some(d) = std::env::var_os("HOME").filter(|d| !d.is_empty()) {
+        return PathBuf::from(d).join(".cache").join("wormwear");
+    }
+    std::env::temp_dir().join("wormwear-cache")
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct CacheFile {
+    key: String,
+    model: FeBending,
+}
+
+fn cache_path(dir: &Path, key: &str) -> PathBuf {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    dir.join(format!("bending-{:016x}.json", h.finish()))
+}
+
+fn read_cache(path: &Path, key: &str) -> Option<FeBending> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let file: CacheFile = serde_json::from_str(&text).ok()?;
+    (file.key == key).then_some(file.model)
+}
+
+fn write_cache(path: &Path, key: &str, model: &FeBending) -> std::io::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let text = serde_json::to_string(&CacheFile {
+        key: key.to_string(),
+        model: model.clone(),
+    })
+    .map_err(std::io::Error::other)?;
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}
+
+/// The bending model the gear asks for: None for `model = "none"`; for "fe" the cached
+/// models when the key matches, else the FE build (then cached). Cache problems never fail
+/// the run: they are returned as a warning beside the model.
+pub fn build(
+    gear: &GearSet,
+    geo: &Geometry,
+) -> Result<(Option<BuiltBending>, Vec<String>), BendingError> {
+    if gear.bending.kind == BendingKind::None {
+        return Ok((None, Vec::new()));
+    }
+    build_in(gear, geo, Some(&cache_dir())).map(|(b, w)| (Some(b), w))
+}
+
+/// As [`build`] for "fe" with an explicit cache directory (None: no cache).
+pub fn build_in(
+    gear: &GearSet,
+    geo: &Geometry,
+    dir: Option<&Path>,
+) -> Result<(BuiltBending, Vec<String>), BendingError> {
+    let start = std::time::Instant::now();
+    let key = cache_key(gear);
+    let path = dir.map(|d| cache_path(d, &key));
+    if let Some(model) = path.as_deref().and_then(|p| read_cache(p, &key)) {
+        return Ok((
+            BuiltBending {
+                model,
+                origin: Origin::Cache,
+                cache_file: path,
+                seconds: start.elapsed().as_secs_f64(),
+            },
+            Vec::new(),
+        ));
+    }
+    let model = compute(gear, geo)?;
+    let mut warnings = Vec::new();
+    if let Some(p) = &path {
+        if let Err(e) = write_cache(p, &key, &model) {
+            warnings.push(format!(
+                "bending coefficients not cached in {}: {e}",
+                p.display()
+            ));
+        }
+    }
+    Ok((
+        BuiltBending {
+            model,
+            origin: Origin::Computed,
+            cache_file: path,
+            seconds: start.elapsed().as_secs_f64(),
+        },
+        warnings,
+    ))
+}

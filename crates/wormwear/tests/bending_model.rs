@@ -1,0 +1,192 @@
+//! The bending stage end to end (MODEL §5.5): both members' FE models for the K 2/25 example,
+//! the disk cache (reused when unchanged, never stale), the LTCA with bending against the LTCA
+//! without it; heavier studies (1/40, 7 vs 13 width points) are ignored tests, run by hand.
+
+use std::path::Path;
+use wormwear::bending::model::{build_in, cache_key, Origin};
+use wormwear::geometry::Geometry;
+use wormwear::input::{self, BendingKind, GearSet};
+use wormwear::ltca::{self, BendingModel, Ltca, LtcaSettings};
+
+fn example(name: &str) -> GearSet {
+    input::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn summary(name: &str, r: &Ltca) -> (f64, f64, f64) {
+    let (te, p2p) = r.te_stats();
+    let loads: Vec<String> = r
+        .positions
+        .iter()
+        .map(|p| {
+            let total: f64 = p.tooth_load.iter().sum();
+            let max = p.tooth_load.iter().cloned().fold(0.0, f64::max);
+            format!("{:.0}", 100.0 * max / total)
+        })
+        .collect();
+    eprintln!(
+        "{name}: TE mean {te:.4e} rad, p2p {p2p:.4e} rad, stiffness {:.4e} N m/rad, P_max {:.0} MPa, \
+         largest tooth share per position [%]: {}",
+        r.stiffness_mean(),
+        r.max_pressure / 1e6,
+        loads.join(" ")
+    );
+    (te, p2p, r.stiffness_mean())
+}
+
+/// Largest share of the load carried by one tooth, mean over positions.
+fn peak_share(r: &Ltca) -> f64 {
+    r.positions
+        .iter()
+        .map(|p| {
+            let total: f64 = p.tooth_load.iter().sum();
+            p.tooth_load.iter().cloned().fold(0.0, f64::max) / total
+        })
+        .sum::<f64>()
+        / r.positions.len() as f64
+}
+
+fn compare(g: &GearSet, geo: &Geometry, model: &dyn BendingModel) -> (Ltca, Ltca) {
+    let tca = wormwear::kinematics::analyse(g, geo).unwrap();
+    let s = LtcaSettings::from_gear(g);
+    let rigid = ltca::analyse_with(g, geo, &tca, &s, None).unwrap();
+    let bent = ltca::analyse_with(g, geo, &tca, &s, Some(model)).unwrap();
+    (rigid, bent)
+}
+
+#[test]
+fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
+    let g = example("gear-k-2x25.toml");
+    assert_eq!(
+        g.bending.kind,
+        BendingKind::Fe,
+        "the K 2/25 example uses bending"
+    );
+    let geo = Geometry::build(&g).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (cold, warnings) = build_in(&g, &geo, Some(dir.path())).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(cold.origin, Origin::Computed);
+    let file = cold.cache_file.clone().unwrap();
+    assert!(file.exists());
+    let (warm, _) = build_in(&g, &geo, Some(dir.path())).unwrap();
+    eprintln!(
+        "bending K 2/25: computed in {:.1} s, read back in {:.4} s",
+        cold.seconds, warm.seconds
+    );
+    assert_eq!(warm.origin, Origin::Cache);
+    // The cache holds the coefficients exactly (JSON with round-trip floats).
+    for (a, b) in [
+        (&cold.model.wheel.same, &warm.model.wheel.same),
+        (&cold.model.wheel.before, &warm.model.wheel.before),
+        (&cold.model.worm.same, &warm.model.worm.same),
+        (&cold.model.worm.after, &warm.model.worm.after),
+    ] {
+        assert_eq!((a.nrows(), a.ncols()), (b.nrows(), b.ncols()));
+        for i in 0..a.nrows() {
+            for j in 0..a.ncols() {
+                assert_eq!(a[(i, j)].to_bits(), b[(i, j)].to_bits());
+            }
+        }
+    }
+    // Never stale: every input the coefficients depend on is in the key.
+    let key = cache_key(&g);
+    let mut changed = Vec::new();
+    let mut h = g.clone();
+    h.wheel_material.youngs_modulus *= 1.01;
+    changed.push(h);
+    let mut h = g.clone();
+    h.wheel.rim_thickness = Some(h.wheel.rim_thickness.unwrap_or(0.02) * 1.1);
+    changed.push(h);
+    let mut h = g.clone();
+    h.bending.width_points += 2;
+    changed.push(h);
+    let mut h = g.clone();
+    h.bending.worm_shaft_radius *= 0.9;
+    changed.push(h);
+    let mut h = g.clone();
+    h.worm.tip_radius += 1e-4;
+    changed.push(h);
+    for h in &changed {
+        assert_ne!(cache_key(h), key);
+    }
+    // A file whose stored key does not match (a hash collision, a hand edit) is not used.
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, text.replacen("fe-bending", "fe-bendinh", 1)).unwrap();
+    let (again, _) = build_in(&g, &geo, Some(dir.path())).unwrap();
+    assert_eq!(again.origin, Origin::Computed);
+    // LTCA with bending: reported "fe", in equilibrium, more compliant than without.
+    let (rigid, bent) = compare(&g, &geo, &warm.model);
+    assert_eq!(bent.bending_model, "fe");
+    assert_eq!(rigid.bending_model, "none");
+    for p in &bent.positions {
+        assert!(p.torque_residual < 1e-6);
+        assert!(
+            p.residuals.complementarity < 1e-7 && p.residuals.min_gap > -1e-7,
+            "{:?}",
+            p.residuals
+        );
+    }
+    let (te0, _, k0) = summary("K 2/25 without bending", &rigid);
+    let (te1, _, k1) = summary("K 2/25 with FE bending", &bent);
+    assert!(te1 < te0 && k1 < k0);
+    eprintln!(
+        "largest tooth share: {:.1} % without, {:.1} % with bending",
+        100.0 * peak_share(&rigid),
+        100.0 * peak_share(&bent)
+    );
+}
+
+/// The 1/40 design case with and without bending (figures for the record).
+#[test]
+#[ignore = "builds the 1/40 FE models (~30 s); figures for the notes"]
+fn bending_figures_for_the_1x40_design_case() {
+    let mut g = example("gear-1x40-design.toml");
+    g.bending.kind = BendingKind::Fe;
+    let geo = Geometry::build(&g).unwrap();
+    let (built, _) = build_in(&g, &geo, None).unwrap();
+    eprintln!("bending 1/40: computed in {:.1} s", built.seconds);
+    let (rigid, bent) = compare(&g, &geo, &built.model);
+    summary("1/40 without bending", &rigid);
+    summary("1/40 with FE bending", &bent);
+    eprintln!(
+        "largest tooth share: {:.1} % without, {:.1} % with bending",
+        100.0 * peak_share(&rigid),
+        100.0 * peak_share(&bent)
+    );
+}
+
+/// MODEL §5.5 step 5: 7 vs 13 points across the wheel's face width (and 9 vs 13 along the
+/// worm thread) change the LTCA's TE and stiffness by less than 1 %.
+#[test]
+#[ignore = "builds four FE model pairs (minutes); run by hand"]
+fn width_points_do_not_change_the_ltca() {
+    let g = example("gear-k-2x25.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let s = LtcaSettings::from_gear(&g);
+    let run = |wheel: usize, worm: usize| {
+        let mut h = g.clone();
+        h.bending.width_points = wheel;
+        h.bending.worm_width_points = worm;
+        let (b, _) = build_in(&h, &geo, None).unwrap();
+        let r = ltca::analyse_with(&h, &geo, &tca, &s, Some(&b.model)).unwrap();
+        summary(&format!("wheel {wheel} / worm {worm} width points"), &r)
+    };
+    let base = run(7, 13);
+    for (wheel, worm) in [(13, 13), (7, 9)] {
+        let r = run(wheel, worm);
+        let dte = (r.0 / base.0 - 1.0).abs();
+        let dk = (r.2 / base.2 - 1.0).abs();
+        eprintln!(
+            "wheel {wheel} / worm {worm}: TE mean {:+.2} %, stiffness {:+.2} %",
+            100.0 * (r.0 / base.0 - 1.0),
+            100.0 * (r.2 / base.2 - 1.0)
+        );
+        assert!(dte < 0.01 && dk < 0.01);
+    }
+}
