@@ -684,3 +684,43 @@ fn calibrate_fits_k_from_wear_tests_and_names_bad_data() {
         "{err}"
     );
 }
+
+/// `wormwear ltca` of the K 2/25 example (FE bending): reports "fe", builds the models once
+/// into the cache directory and reads them back on the second run with the same results.
+#[test]
+fn ltca_with_fe_bending_uses_the_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let run = |out: &str| {
+        let o = bin()
+            .env("WORMWEAR_CACHE_DIR", &cache)
+            .arg("ltca")
+            .arg(example("gear-k-2x25.toml"))
+            .arg("-o")
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).to_string()
+    };
+    let first = run("a");
+    assert!(first.contains("models computed in"), "{first}");
+    assert!(first.contains("ltca (fe)"), "{first}");
+    let files: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
+    assert_eq!(files.len(), 1, "one cache file");
+    let second = run("b");
+    assert!(second.contains("bending (fe): read in"), "{second}");
+    let summary = |out: &str| -> serde_json::Value {
+        serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(out).join("summary.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let (a, b) = (summary("a"), summary("b"));
+    assert_eq!(a["ltca"]["bending_model"], "fe");
+    assert_eq!(a["ltca"]["te_mean_rad"], b["ltca"]["te_mean_rad"]);
+    assert_eq!(
+        a["ltca"]["mesh_stiffness_mean_nm_per_rad"],
+        b["ltca"]["mesh_stiffness_mean_nm_per_rad"]
+    );
+}

@@ -442,3 +442,42 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn bending_section_is_checked() {
+    let k = example_text("gear-k-2x25.toml");
+    let text = set(&k, "bending", "model", "model = \"beam\"");
+    assert_mentions(
+        &error_of(&text),
+        &["bending.model = \"beam\"", "must be one of none, fe"],
+    );
+    let text = set(&k, "bending", "model", "model = \"fe\"\nwidth_points = 40");
+    assert_mentions(&error_of(&text), &["bending.width_points = 40", "[2, 17]"]);
+    let text = set(
+        &k,
+        "bending",
+        "model",
+        "model = \"fe\"\nworm_shaft_radius_mm = 30.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["bending.worm_shaft_radius_mm = 30", "root radius"],
+    );
+    let text = set(
+        &k,
+        "bending",
+        "model",
+        "model = \"fe\"\nworm_bearing_positions_mm = [-10.0, 10.0]",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["bending.worm_bearing_positions_mm", "outside the worm body"],
+    );
+    let text = set(
+        &k,
+        "bending",
+        "model",
+        "model = \"fe\"\nworm_bearing_positions_mm = [-200.0]",
+    );
+    assert_mentions(&error_of(&text), &["two positions"]);
+}

@@ -171,14 +171,18 @@ pub fn bending_displacements(
         .iter()
         .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
         .collect();
-    let free = solve(&m.mesh, material, &fixed, &cases)?;
-    let mut blocked_fixed = fixed;
+    let mut blocked_fixed = fixed.clone();
     blocked_fixed.extend(
         m.right_flank[1]
             .iter()
             .flat_map(|f| (0..3).map(move |d| (f.2, d, 0.0))),
     );
-    let blocked = solve(&m.mesh, material, &blocked_fixed, &cases)?;
+    // The two runs are independent: factorise side by side.
+    let (free, blocked) = rayon::join(
+        || solve(&m.mesh, material, &fixed, &cases),
+        || solve(&m.mesh, material, &blocked_fixed, &cases),
+    );
+    let (free, blocked) = (free?, blocked?);
     Ok(free
         .iter()
         .zip(&blocked)
