@@ -342,8 +342,10 @@ pub(crate) fn relation_low_rank(
     let k = basis.len();
     let rank = k * present.len();
     let mut f = vec![0.0; groups.len() * rank];
+    let mut ranges = Vec::with_capacity(groups.len());
     for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
         let t = present.iter().position(|&x| x == g).unwrap_or(0);
+        ranges.push([(t * k, (t + 1) * k), (0, 0)]);
         // Points outside the fitted zone take the value at its edge: the beam modes grow
         // exponentially outside [0, 1].
         let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
@@ -372,7 +374,12 @@ pub(crate) fn relation_low_rank(
             core[j * rank + i] = v;
         }
     }
-    LowRank { rank, f, core }
+    LowRank {
+        rank,
+        f,
+        core,
+        ranges,
+    }
 }
 
 impl BendingModel for WormBending {
@@ -436,7 +443,19 @@ impl BendingModel for FeBending {
             let row = (a.rank + i) * rank + a.rank;
             core[row..row + b.rank].copy_from_slice(&b.core[i * b.rank..(i + 1) * b.rank]);
         }
-        LowRank { rank, f, core }
+        let ranges = (0..cells.len())
+            .map(|i| {
+                let ra = a.ranges.get(i).map_or((0, a.rank), |r| r[0]);
+                let rb = b.ranges.get(i).map_or((0, b.rank), |r| r[0]);
+                [ra, (a.rank + rb.0, a.rank + rb.1)]
+            })
+            .collect();
+        LowRank {
+            rank,
+            f,
+            core,
+            ranges,
+        }
     }
 }
 
