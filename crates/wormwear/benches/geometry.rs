@@ -69,6 +69,7 @@ fn bench(c: &mut Criterion) {
         space: 2,
         face_step: 6,
         rim_thickness: 0.02,
+        web: None,
     };
     group.bench_function(
         "1x40 wheel bending model (sector FE 6117 nodes, 2 x 30 load cases, 5 x 6 basis)",

@@ -34,6 +34,22 @@ pub struct SectorMeshSettings {
     pub face_step: usize,
     /// Rim thickness below the root at the median plane, m.
     pub rim_thickness: f64,
+    /// Web from the rim down to the hub (clamped there); None: the rim's inner surface is
+    /// clamped.
+    pub web: Option<WebSettings>,
+}
+
+/// The wheel's web: a disk of the given thickness, centred on the median plane, from the rim's
+/// inner surface down to the hub radius, where it is clamped (the hub and the shaft are stiff
+/// beside it; the shaft's torsion is a rigid rotation of the whole wheel, common to all teeth).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WebSettings {
+    /// Thickness along the wheel axis, m (rounded to the layers of the mesh).
+    pub thickness: f64,
+    /// Hub radius, m.
+    pub hub_radius: f64,
+    /// Elements from the rim to the hub.
+    pub elements: usize,
 }
 
 /// The sector mesh and what the bending stage needs to know about it.
@@ -95,6 +111,14 @@ pub fn sector_mesh(
     let mut elements = Vec::new();
     let mut inner = Vec::new();
     let mut sides = Vec::new();
+    // Layers in the web: those whose middle lies within half its thickness of the median plane
+    // (the web's faces snap to layer boundaries).
+    let web = settings
+        .web
+        .filter(|w| w.hub_radius < r_in && w.thickness > 0.0);
+    let in_web = |j0: usize, j1: usize| {
+        web.is_some_and(|w| (0.5 * (l.z[j0] + l.z[j1])).abs() < 0.5 * w.thickness)
+    };
     let mut left_flank = vec![Vec::new(); 3];
     let mut right_flank = vec![Vec::new(); 3];
     // Section point of a block at parameters (u across in [0, 1], v radial in [0, 1]) in layer
@@ -143,16 +167,35 @@ pub fn sector_mesh(
             }
         }
     };
+    let dims_rim = |block: usize| -> (usize, usize) {
+        if block < 6 {
+            (settings.across, settings.rim)
+        } else {
+            (settings.space, settings.rim)
+        }
+    };
+    // Web blocks 10..17 lie under the rim blocks 3..10, with their theta nodes.
+    let section = |j: usize, block: usize, u: f64, v: f64| -> (f64, f64) {
+        match (block, web) {
+            (b, Some(w)) if b >= 10 => {
+                let (_, th) = section(j, b - 7, u, 0.0);
+                (w.hub_radius + (r_in - w.hub_radius) * v, th)
+            }
+            (b, _) => section(j, b, u, v),
+        }
+    };
     let dims = |block: usize| -> (usize, usize) {
         match block {
             b if b < 3 => (settings.across, settings.height),
             b if b < 6 => (settings.across, settings.rim),
-            _ => (settings.space, settings.rim),
+            b if b < 10 => (settings.space, settings.rim),
+            b => (dims_rim(b - 7).0, web.map_or(1, |w| w.elements.max(1))),
         }
     };
     for (li, win) in layers.windows(2).enumerate() {
         let (j0, j1) = (win[0], win[1]);
-        for block in 0..10 {
+        let blocks = if in_web(j0, j1) { 17 } else { 10 };
+        for block in 0..blocks {
             let (nu, nv) = dims(block);
             for iv in 0..nv {
                 for iu in 0..nu {
@@ -180,10 +223,18 @@ pub fn sector_mesh(
                         let id = node_at(p);
                         e[a] = id;
                         // Bookkeeping: inner surface, side cuts, left flank of each tooth.
-                        if block >= 3 && v == 0.0 {
+                        // Clamped: the hub (web bottom) with a web, else the rim's inner
+                        // surface.
+                        let clamped = match web {
+                            Some(_) => block >= 10,
+                            None => block >= 3,
+                        };
+                        if clamped && v == 0.0 {
                             inner.push(id);
                         }
-                        if (block == 6 && u == 0.0) || (block == 9 && u == 1.0) {
+                        if ((block == 6 || block == 13) && u == 0.0)
+                            || ((block == 9 || block == 16) && u == 1.0)
+                        {
                             sides.push(id);
                         }
                         if c[2] < 0.0 {
