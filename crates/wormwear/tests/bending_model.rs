@@ -2,20 +2,12 @@
 //! the disk cache (reused when unchanged, never stale), the LTCA with bending against the LTCA
 //! without it; heavier studies (1/40, 7 vs 13 width points) are ignored tests, run by hand.
 
-use std::path::Path;
+mod common;
+use common::example;
 use wormwear::bending::model::{build_in, cache_key, Origin};
 use wormwear::geometry::Geometry;
-use wormwear::input::{self, BendingKind, GearSet};
+use wormwear::input::{BendingKind, GearSet};
 use wormwear::ltca::{self, BendingModel, Ltca, LtcaSettings};
-
-fn example(name: &str) -> GearSet {
-    input::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn summary(name: &str, r: &Ltca) -> (f64, f64, f64) {
     let (te, p2p) = r.te_stats();

@@ -1,26 +1,18 @@
 //! Finite-element model of the wheel sector built from the generated flanks: geometry
 //! (volume), convergence of the tooth compliance, CalculiX on the same mesh.
 
+mod common;
+use common::example;
 use std::f64::consts::PI;
-use std::path::Path;
 use wormwear::bending::fe::{element_volume, solve, Elastic, Load};
 use wormwear::bending::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
 use wormwear::geometry::{Flank, Geometry};
-use wormwear::input::{self, GearSet};
+use wormwear::input::GearSet;
 
 const BRONZE: Elastic = Elastic {
     youngs_modulus: 110e9,
     poisson_ratio: 0.29,
 };
-
-fn example(name: &str) -> GearSet {
-    input::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn settings(scale: usize) -> SectorMeshSettings {
     SectorMeshSettings {
@@ -150,64 +142,62 @@ fn tooth_compliance_converges_under_refinement() {
 #[test]
 #[ignore = "needs CalculiX (ccx) on the PATH"]
 fn calculix_agrees_on_the_wheel_sector() {
-    use wormwear::bending::fe::{calculix_deck, read_calculix_displacements};
     let g = example("gear-1x40-design.toml");
     let geo = Geometry::build(&g).unwrap();
-    let m = mesh(&g, &geo, 1);
-    let (c, loads, fixed) = tooth_compliance(&g, &geo, &m);
     let dir = std::env::temp_dir().join(format!("wormwear-ccx-sector-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("sector.inp"),
-        calculix_deck(&m.mesh, &BRONZE, &fixed, &loads),
-    )
-    .unwrap();
-    let out = std::process::Command::new("ccx")
-        .arg("sector")
-        .current_dir(&dir)
-        .output()
-        .expect("ccx runs");
-    assert!(out.status.success());
-    let dat = std::fs::read_to_string(dir.join("sector.dat")).unwrap();
-    let u = read_calculix_displacements(&dat, m.mesh.nodes.len()).expect("displacements");
-    let flank = &m.left_flank[1];
-    let max_h = flank.iter().map(|f| f.1).max().unwrap();
-    let tip: Vec<usize> = flank.iter().filter(|f| f.1 == max_h).map(|f| f.2).collect();
-    let total = g.wheel.face_width * 1e3;
-    let theirs = tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64 / total;
+    // Same mesh (scale 1): the element and the solver.
+    let m = mesh(&g, &geo, 1);
+    let c = tooth_compliance(&g, &geo, &m).0;
+    let theirs = calculix_tooth_compliance(&g, &geo, &m, &dir, "sector");
     eprintln!("wheel tooth tip compliance: ours {c:.6e} m/N, CalculiX {theirs:.6e} m/N");
     assert!((theirs / c - 1.0).abs() < 1e-5);
     // Our default bending mesh (scale 2) against CalculiX on a finer mesh of the same sector
     // (scale 3): the same geometry and load, a different discretisation, within 3 %.
-    let ours2 = tooth_compliance(&g, &geo, &mesh(&g, &geo, 2)).0;
+    let m2 = mesh(&g, &geo, 2);
+    let ours2 = tooth_compliance(&g, &geo, &m2).0;
     let m3 = mesh(&g, &geo, 3);
-    let (_, loads3, fixed3) = tooth_compliance(&g, &geo, &m3);
-    std::fs::write(
-        dir.join("fine.inp"),
-        calculix_deck(&m3.mesh, &BRONZE, &fixed3, &loads3),
-    )
-    .unwrap();
-    let out = std::process::Command::new("ccx")
-        .arg("fine")
-        .current_dir(&dir)
-        .output()
-        .expect("ccx runs");
-    assert!(out.status.success());
-    let dat = std::fs::read_to_string(dir.join("fine.dat")).unwrap();
-    let u = read_calculix_displacements(&dat, m3.mesh.nodes.len()).expect("displacements");
-    let flank = &m3.left_flank[1];
-    let max_h = flank.iter().map(|f| f.1).max().unwrap();
-    let tip: Vec<usize> = flank.iter().filter(|f| f.1 == max_h).map(|f| f.2).collect();
-    let fine = tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64 / total;
+    let fine = calculix_tooth_compliance(&g, &geo, &m3, &dir, "fine");
     eprintln!(
         "tooth tip compliance: ours (scale 2, {} nodes) {ours2:.6e} m/N, CalculiX (scale 3, {} nodes) \
          {fine:.6e} m/N ({:+.2} %)",
-        mesh(&g, &geo, 2).mesh.nodes.len(),
+        m2.mesh.nodes.len(),
         m3.mesh.nodes.len(),
         100.0 * (ours2 / fine - 1.0)
     );
     assert!((ours2 / fine - 1.0).abs() < 0.03);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The tooth tip compliance of [`tooth_compliance`]'s load case computed by CalculiX (C3D20)
+/// on mesh `m`, m/N.
+fn calculix_tooth_compliance(
+    g: &GearSet,
+    geo: &Geometry,
+    m: &SectorMesh,
+    dir: &std::path::Path,
+    name: &str,
+) -> f64 {
+    use wormwear::bending::fe::{calculix_deck, read_calculix_displacements};
+    let (_, loads, fixed) = tooth_compliance(g, geo, m);
+    std::fs::write(
+        dir.join(format!("{name}.inp")),
+        calculix_deck(&m.mesh, &BRONZE, &fixed, &loads),
+    )
+    .unwrap();
+    let out = std::process::Command::new("ccx")
+        .arg(name)
+        .current_dir(dir)
+        .output()
+        .expect("ccx runs");
+    assert!(out.status.success());
+    let dat = std::fs::read_to_string(dir.join(format!("{name}.dat"))).unwrap();
+    let u = read_calculix_displacements(&dat, m.mesh.nodes.len()).expect("displacements");
+    let flank = &m.left_flank[1];
+    let max_h = flank.iter().map(|f| f.1).max().unwrap();
+    let tip: Vec<usize> = flank.iter().filter(|f| f.1 == max_h).map(|f| f.2).collect();
+    let total = g.wheel.face_width * 1e3;
+    tip.iter().map(|&n| -u[n][0]).sum::<f64>() / tip.len() as f64 / total
 }
 
 #[test]

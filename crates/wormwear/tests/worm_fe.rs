@@ -2,29 +2,21 @@
 //! (volume), shaft bending against Timoshenko beam theory, the glued seam, interpolation of the
 //! bending coefficients off the fit grid, reciprocity.
 
+mod common;
+use common::example;
 use std::f64::consts::PI;
-use std::path::Path;
 use wormwear::bending::fe::{element_volume, Elastic, Load};
 use wormwear::bending::worm_mesh::{
     worm_mesh, worm_mesh_on, WormBody, WormLattice, WormMeshSettings,
 };
 use wormwear::bending::worm_model::{worm_bending_displacements, worm_displacements, WormBending};
 use wormwear::geometry::{Flank, Geometry};
-use wormwear::input::{self, GearSet};
+use wormwear::input::GearSet;
 
 const STEEL: Elastic = Elastic {
     youngs_modulus: 203e9,
     poisson_ratio: 0.29,
 };
-
-fn example(name: &str) -> GearSet {
-    input::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn settings(scale: usize) -> WormMeshSettings {
     WormMeshSettings {

@@ -522,3 +522,43 @@ pub fn mirrored(e: [usize; 20]) -> [usize; 20] {
     }
     out
 }
+
+/// Bending displacements by the free / blocked technique (MODEL §5.5 step 2): for each load
+/// case a unit force into the member (along -n) at a node; the displacement of every node with
+/// the loaded tooth's opposite flank free minus that with its `blocked` nodes fixed (removes
+/// the local contact deformation, keeps the bending). The two runs are independent and are
+/// factorised side by side. Index: [case][node], m/N.
+pub fn free_minus_blocked(
+    mesh: &Mesh,
+    material: &Elastic,
+    fixed: &[Fixed],
+    springs: &[Spring],
+    blocked: &[usize],
+    loads: &[(usize, nalgebra::Vector3<f64>)],
+) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let cases: Vec<Vec<Load>> = loads
+        .iter()
+        .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
+        .collect();
+    let mut blocked_fixed = fixed.to_vec();
+    blocked_fixed.extend(
+        blocked
+            .iter()
+            .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0))),
+    );
+    let (free, held) = rayon::join(
+        || solve_with_springs(mesh, material, fixed, springs, &cases),
+        || solve_with_springs(mesh, material, &blocked_fixed, springs, &cases),
+    );
+    let (free, held) = (free?, held?);
+    Ok(free
+        .iter()
+        .zip(&held)
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+                .collect()
+        })
+        .collect())
+}

@@ -5,7 +5,7 @@
 //! the model reports itself as "fe-wheel".
 
 use super::basis::{Basis, WidthFunctions};
-use super::fe::{solve, Elastic, FeError, Load};
+use super::fe::{free_minus_blocked, Elastic, FeError};
 use super::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
 use crate::geometry::{Flank, Geometry};
 use crate::input::GearSet;
@@ -162,37 +162,13 @@ pub fn bending_displacements(
     material: &Elastic,
     loads: &[(usize, nalgebra::Vector3<f64>)],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
-    let cases: Vec<Vec<Load>> = loads
-        .iter()
-        .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
-        .collect();
     let fixed: Vec<(usize, usize, f64)> = m
         .inner
         .iter()
         .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
         .collect();
-    let mut blocked_fixed = fixed.clone();
-    blocked_fixed.extend(
-        m.right_flank[1]
-            .iter()
-            .flat_map(|f| (0..3).map(move |d| (f.2, d, 0.0))),
-    );
-    // The two runs are independent: factorise side by side.
-    let (free, blocked) = rayon::join(
-        || solve(&m.mesh, material, &fixed, &cases),
-        || solve(&m.mesh, material, &blocked_fixed, &cases),
-    );
-    let (free, blocked) = (free?, blocked?);
-    Ok(free
-        .iter()
-        .zip(&blocked)
-        .map(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
-                .collect()
-        })
-        .collect())
+    let blocked: Vec<usize> = m.right_flank[1].iter().map(|f| f.2).collect();
+    free_minus_blocked(&m.mesh, material, &fixed, &[], &blocked, loads)
 }
 
 impl BendingModel for WheelBending {

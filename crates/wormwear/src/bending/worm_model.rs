@@ -11,7 +11,7 @@
 //! fixed, stiff tangential springs).
 
 use super::basis::{Basis, WidthFunctions};
-use super::fe::{solve_with_springs, Elastic, FeError, Fixed, Load, Spring};
+use super::fe::{free_minus_blocked, solve_with_springs, Elastic, FeError, Fixed, Load, Spring};
 use super::worm_mesh::{worm_mesh_on, WormBody, WormLattice, WormMesh, WormMeshSettings};
 use crate::geometry::{Flank, Geometry};
 use crate::input::GearSet;
@@ -285,33 +285,9 @@ pub fn worm_bending_displacements(
     material: &Elastic,
     loads: &[(usize, Vector3<f64>)],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
-    let cases: Vec<Vec<Load>> = loads
-        .iter()
-        .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
-        .collect();
     let (fixed, springs) = supports(m, body, material);
-    let mut blocked_fixed = fixed.clone();
-    blocked_fixed.extend(
-        m.opposite[1]
-            .iter()
-            .flat_map(|f| (0..3).map(move |d| (f.2, d, 0.0))),
-    );
-    // The two runs are independent: factorise side by side.
-    let (free, blocked) = rayon::join(
-        || solve_with_springs(&m.mesh, material, &fixed, &springs, &cases),
-        || solve_with_springs(&m.mesh, material, &blocked_fixed, &springs, &cases),
-    );
-    let (free, blocked) = (free?, blocked?);
-    Ok(free
-        .iter()
-        .zip(&blocked)
-        .map(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
-                .collect()
-        })
-        .collect())
+    let blocked: Vec<usize> = m.opposite[1].iter().map(|f| f.2).collect();
+    free_minus_blocked(&m.mesh, material, &fixed, &springs, &blocked, loads)
 }
 
 /// Displacements of the worm model under arbitrary nodal loads with its supports (no
