@@ -269,6 +269,21 @@ pub fn solve_with_springs(
             }
         }
     }
+    // Stiffness entry (free row fr, global column gc): into the matrix (lower triangle) when
+    // the column is free, onto the right-hand sides when it is prescribed.
+    let mut scatter = |fr: usize, gc: usize, v: f64| match prescribed[gc] {
+        Some(u) => {
+            for case in 0..ncase {
+                rhs[(fr, case)] -= v * u;
+            }
+        }
+        None => {
+            let fc = map[gc];
+            if fc <= fr {
+                triplets.push(Triplet::new(fr, fc, v));
+            }
+        }
+    };
     for (e, k) in mesh.elements.iter().zip(&elements) {
         let dofs: Vec<usize> = e
             .iter()
@@ -280,25 +295,11 @@ pub fn solve_with_springs(
                 continue;
             }
             for (c, &gc) in dofs.iter().enumerate() {
-                let v = k[r * 60 + c];
-                match prescribed[gc] {
-                    Some(u) => {
-                        for case in 0..ncase {
-                            rhs[(fr, case)] -= v * u;
-                        }
-                    }
-                    None => {
-                        let fc = map[gc];
-                        if fc <= fr {
-                            triplets.push(Triplet::new(fr, fc, v));
-                        }
-                    }
-                }
+                scatter(fr, gc, k[r * 60 + c]);
             }
         }
     }
     for spring in springs {
-        let k = spring.stiffness;
         let dofs: Vec<(usize, f64)> = spring
             .terms
             .iter()
@@ -311,20 +312,7 @@ pub fn solve_with_springs(
                 continue;
             }
             for &(gc, wc) in &dofs {
-                let v = k * wr * wc;
-                match prescribed[gc] {
-                    Some(u) => {
-                        for case in 0..ncase {
-                            rhs[(fr, case)] -= v * u;
-                        }
-                    }
-                    None => {
-                        let fc = map[gc];
-                        if fc <= fr {
-                            triplets.push(Triplet::new(fr, fc, v));
-                        }
-                    }
-                }
+                scatter(fr, gc, spring.stiffness * wr * wc);
             }
         }
     }
