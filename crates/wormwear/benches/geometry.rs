@@ -79,6 +79,7 @@ fn bench(c: &mut Criterion) {
                     black_box(&g140),
                     black_box(&geo),
                     &mesh,
+                    None,
                     5,
                     6,
                 )

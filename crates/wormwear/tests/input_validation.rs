@@ -481,3 +481,49 @@ fn bending_section_is_checked() {
     );
     assert_mentions(&error_of(&text), &["two positions"]);
 }
+
+#[test]
+fn wheel_body_is_checked_when_bending_is_on() {
+    // The K 2/25 example has bending on and a full wheel body.
+    let k = example_text("gear-k-2x25.toml");
+    let text = set(&k, "wheel", "hub_radius_mm", "hub_radius_mm = 95.0");
+    assert_mentions(
+        &error_of(&text),
+        &["wheel.hub_radius_mm = 95.0000 mm", "rim's inner radius"],
+    );
+    let text = set(&k, "wheel", "shaft_radius_mm", "shaft_radius_mm = 36.0");
+    assert_mentions(
+        &error_of(&text),
+        &["wheel.shaft_radius_mm", "must be < wheel.hub_radius_mm"],
+    );
+    let text = set(
+        &k,
+        "wheel",
+        "bearing_positions_mm",
+        "bearing_positions_mm = [10.0, 65.0]",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "wheel.bearing_positions_mm",
+            "each side of the hub",
+            "25.4000",
+        ],
+    );
+    let text = set(
+        &k,
+        "wheel",
+        "bearing_positions_mm",
+        "bearing_positions_mm = [65.0]",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wheel.bearing_positions_mm", "two positions"],
+    );
+    let text = set(&k, "wheel", "web_thickness_mm", "web_thickness_mm = 60.0");
+    assert_mentions(&error_of(&text), &["wheel.web_thickness_mm", "face width"]);
+    // Without bending the body is not used and not checked.
+    let off = set(&k, "bending", "model", "model = \"none\"");
+    let off = set(&off, "wheel", "hub_radius_mm", "hub_radius_mm = 95.0");
+    assert!(wormwear::input::load_from_str(&off).is_ok());
+}

@@ -7,6 +7,7 @@ pub mod fe;
 pub mod model;
 pub mod wheel_mesh;
 pub mod wheel_model;
+pub mod wheel_shaft;
 pub mod worm_mesh;
 pub mod worm_model;
 

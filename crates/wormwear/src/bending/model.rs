@@ -11,8 +11,9 @@
 //! the next run the FE time.
 
 use super::fe::FeError;
-use super::wheel_mesh::SectorMeshSettings;
+use super::wheel_mesh::{SectorMeshSettings, WebSettings};
 use super::wheel_model::WheelBending;
+use super::wheel_shaft::WheelShaft;
 use super::worm_mesh::{WormBody, WormMeshSettings};
 use super::worm_model::{FeBending, WormBending};
 use crate::geometry::Geometry;
@@ -21,7 +22,7 @@ use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 
 /// Version of the FE models and their fit: bump when a change alters the coefficients.
-const MODEL_VERSION: &str = "fe-bending-2";
+const MODEL_VERSION: &str = "fe-bending-3";
 
 /// Why the bending stage failed.
 #[derive(Debug, thiserror::Error)]
@@ -50,32 +51,44 @@ pub struct BuiltBending {
     pub seconds: f64,
 }
 
-/// Mesh settings of the wheel sector at a refinement level (1..3) for `width` fit points
-/// across the face: layers every `face_step`-th node column, at least two per fit interval.
-/// Level 1 is the sector's scale 2 (4 elements across a tooth, 6 along its height): the tooth
-/// compliance changes by 6.5 % from scale 1 to 2 and by 1.7 % from 2 to 3 (wheel_fe tests).
+/// Mesh settings of the wheel at a refinement level (1..3) for `width` fit points across the
+/// face: layers every `face_step`-th node column, at least two per fit interval. Level 1 is the
+/// sector's scale 2 (4 elements across a tooth, 6 along its height): the tooth compliance
+/// changes by 6.5 % from scale 1 to 2 and by 1.7 % from 2 to 3 (wheel_fe tests). Below the
+/// three teeth: the rim all round the wheel and the web down to the hub (MODEL §5.5: "rim,
+/// web, hub, shaft and bearings"), clamped there; the hub's motion on the shaft is
+/// [`wheel_shaft`].
 pub fn wheel_mesh_settings(gear: &GearSet, refinement: usize, width: usize) -> SectorMeshSettings {
     let s = 2 * refinement.max(1);
     let intervals = (width.max(2) - 1) * s;
     let face_step = (gear.analysis.flank_cells_face / intervals).max(1);
-    let tooth_height =
-        gear.wheel.throat_radius - (gear.cutting.centre_distance - gear.hob.tip_radius);
-    // No web: with a web down to the hub, a three-tooth sector is a wedge whose side cuts are
-    // free, and it came out 37 times more compliant than the rim-clamped tooth (the real web is
-    // a whole disk, continuous around the wheel). Until the model carries the whole ring, the
-    // rim's inner surface is clamped (MODEL §5.5's sector; the [wheel] web and hub fields are
-    // read but not used).
+    let body = gear.wheel_body();
     SectorMeshSettings {
         across: 2 * s,
         height: 3 * s,
         rim: s,
         space: s,
         face_step,
-        rim_thickness: gear
-            .wheel
-            .rim_thickness
-            .unwrap_or(2.0 * tooth_height.max(1e-4)),
-        web: None,
+        rim_thickness: body.rim_thickness,
+        web: Some(WebSettings {
+            thickness: body.web_thickness,
+            hub_radius: body.hub_radius,
+            elements: s + 1,
+            rest_elements: (gear.wheel.teeth as usize).saturating_sub(3).clamp(8, 48) * s / 2,
+        }),
+    }
+}
+
+/// The wheel's shaft under the hub ([`GearSet::wheel_body`]: radius, hub width, bearings), steel
+/// with the worm's elastic constants.
+pub fn wheel_shaft(gear: &GearSet) -> WheelShaft {
+    let body = gear.wheel_body();
+    WheelShaft {
+        radius: body.shaft_radius,
+        hub_half_width: body.hub_half_width,
+        bearings: body.bearings,
+        youngs_modulus: gear.worm_material.youngs_modulus,
+        poisson_ratio: gear.worm_material.poisson_ratio,
     }
 }
 
@@ -112,7 +125,16 @@ pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<FeBending, BendingError
     let body = worm_body(gear);
     // The two members are independent: build them side by side.
     let (wheel, worm) = rayon::join(
-        || WheelBending::build(gear, geo, &wheel_settings, b.height_points, b.width_points),
+        || {
+            WheelBending::build(
+                gear,
+                geo,
+                &wheel_settings,
+                Some(&wheel_shaft(gear)),
+                b.height_points,
+                b.width_points,
+            )
+        },
         || {
             WormBending::build(
                 gear,

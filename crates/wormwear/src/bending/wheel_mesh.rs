@@ -34,14 +34,15 @@ pub struct SectorMeshSettings {
     pub face_step: usize,
     /// Rim thickness below the root at the median plane, m.
     pub rim_thickness: f64,
-    /// Web from the rim down to the hub (clamped there); None: the rim's inner surface is
-    /// clamped.
+    /// The whole ring (rim all round, web down to the hub, clamped there); None: a three-tooth
+    /// sector clamped at the rim's inner surface, side cuts free.
     pub web: Option<WebSettings>,
 }
 
-/// The wheel's web: a disk of the given thickness, centred on the median plane, from the rim's
-/// inner surface down to the hub radius, where it is clamped (the hub and the shaft are stiff
-/// beside it; the shaft's torsion is a rigid rotation of the whole wheel, common to all teeth).
+/// The wheel's body below the three teeth: the rim continued all round the wheel (no teeth
+/// there) and the web, a disk of the given thickness centred on the median plane, from the
+/// rim's inner surface down to the hub radius, where it is clamped (the hub is thick and taken
+/// as rigid; its motion on the shaft is added by [`super::wheel_shaft`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WebSettings {
     /// Thickness along the wheel axis, m (rounded to the layers of the mesh).
@@ -50,15 +51,18 @@ pub struct WebSettings {
     pub hub_radius: f64,
     /// Elements from the rim to the hub.
     pub elements: usize,
+    /// Elements around the rest of the ring (the 2 pi - 3 tau outside the three teeth), graded:
+    /// a quarter of the mean size next to the teeth, 1.75 times it opposite them.
+    pub rest_elements: usize,
 }
 
 /// The sector mesh and what the bending stage needs to know about it.
 #[derive(Debug, Clone)]
 pub struct SectorMesh {
     pub mesh: Mesh,
-    /// Nodes on the rim's inner surface (to clamp).
+    /// Nodes to clamp: the rim's inner surface, or the hub surface of the web (whole ring).
     pub inner: Vec<usize>,
-    /// Nodes on the two side cuts of the sector.
+    /// Nodes on the two side cuts of the sector (none for the whole ring).
     pub sides: Vec<usize>,
     /// Per tooth (-1, 0, 1): flank nodes of the left-mating flank as (layer, height index, node).
     pub left_flank: Vec<Vec<(usize, usize, usize)>>,
@@ -167,34 +171,59 @@ pub fn sector_mesh(
             }
         }
     };
-    let dims_rim = |block: usize| -> (usize, usize) {
-        if block < 6 {
-            (settings.across, settings.rim)
-        } else {
-            (settings.space, settings.rim)
+    // Whole ring: block REST is the rim from the right side cut (mid space 1/2) round to the
+    // left one (mid space -2/-1) plus 2 pi, graded (u -> u - A sin(2 pi u) / (2 pi)); web
+    // blocks REST + 1 .. lie under the rim blocks 3 ..= REST, with their theta nodes.
+    const REST: usize = 10;
+    const WEB_SHIFT: usize = REST - 2;
+    let section = |j: usize, block: usize, u: f64, v: f64| -> (f64, f64) {
+        match block {
+            REST => {
+                let z = l.z[j];
+                let root = root_at(z);
+                let rr = r_in + (root - r_in) * v;
+                let a = 0.5 * (th_right(j, root, 1) + th_left(j, root, 2));
+                let c = 0.5 * (th_right(j, root, -2) + th_left(j, root, -1));
+                let th = if u >= 1.0 {
+                    c
+                } else {
+                    let g = u - 0.75 * (2.0 * PI * u).sin() / (2.0 * PI);
+                    a + (c + 2.0 * PI - a) * g
+                };
+                (rr, th)
+            }
+            b => section(j, b, u, v),
         }
     };
-    // Web blocks 10..17 lie under the rim blocks 3..10, with their theta nodes.
     let section = |j: usize, block: usize, u: f64, v: f64| -> (f64, f64) {
         match (block, web) {
-            (b, Some(w)) if b >= 10 => {
-                let (_, th) = section(j, b - 7, u, 0.0);
+            (b, Some(w)) if b > REST => {
+                let (_, th) = section(j, b - WEB_SHIFT, u, 0.0);
                 (w.hub_radius + (r_in - w.hub_radius) * v, th)
             }
             (b, _) => section(j, b, u, v),
         }
     };
     let dims = |block: usize| -> (usize, usize) {
+        let rest = web.map_or(1, |w| w.rest_elements.max(2));
+        let around = |b: usize| match b {
+            b if b < 6 => settings.across,
+            REST => rest,
+            _ => settings.space,
+        };
         match block {
             b if b < 3 => (settings.across, settings.height),
-            b if b < 6 => (settings.across, settings.rim),
-            b if b < 10 => (settings.space, settings.rim),
-            b => (dims_rim(b - 7).0, web.map_or(1, |w| w.elements.max(1))),
+            b if b <= REST => (around(b), settings.rim),
+            b => (around(b - WEB_SHIFT), web.map_or(1, |w| w.elements.max(1))),
         }
     };
     for (li, win) in layers.windows(2).enumerate() {
         let (j0, j1) = (win[0], win[1]);
-        let blocks = if in_web(j0, j1) { 17 } else { 10 };
+        let blocks = match (web, in_web(j0, j1)) {
+            (None, _) => REST,
+            (Some(_), false) => REST + 1,
+            (Some(_), true) => 2 * REST - 1,
+        };
         for block in 0..blocks {
             let (nu, nv) = dims(block);
             for iv in 0..nv {
@@ -226,15 +255,13 @@ pub fn sector_mesh(
                         // Clamped: the hub (web bottom) with a web, else the rim's inner
                         // surface.
                         let clamped = match web {
-                            Some(_) => block >= 10,
+                            Some(_) => block > REST,
                             None => block >= 3,
                         };
                         if clamped && v == 0.0 {
                             inner.push(id);
                         }
-                        if ((block == 6 || block == 13) && u == 0.0)
-                            || ((block == 9 || block == 16) && u == 1.0)
-                        {
+                        if web.is_none() && ((block == 6 && u == 0.0) || (block == 9 && u == 1.0)) {
                             sides.push(id);
                         }
                         if c[2] < 0.0 {

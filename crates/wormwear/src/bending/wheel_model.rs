@@ -1,12 +1,15 @@
 //! Wheel bending coefficients for the LTCA (MODEL §5.5): FE of the wheel sector, unit normal
 //! loads at a K = Q1 x Q2 grid of the central tooth's loaded flank, bending = opposite flank free
 //! minus blocked, projected on the normals; three tooth relations (same tooth, the tooth before,
-//! the tooth after) fitted on the free-free function basis. The worm's bending is not included:
+//! the tooth after) fitted on the free-free function basis; plus, when the model has the whole
+//! ring with its web clamped at the hub, the hub's rigid-body motion on the shaft
+//! ([`super::wheel_shaft`]) as six more low-rank terms. The worm's bending is not included:
 //! the model reports itself as "fe-wheel".
 
 use super::basis::{Basis, WidthFunctions};
 use super::fe::{free_minus_blocked, Elastic, FeError};
 use super::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
+use super::wheel_shaft::{wrench, WheelShaft};
 use crate::geometry::{Flank, Geometry};
 use crate::input::GearSet;
 use crate::ltca::solver::LowRank;
@@ -30,14 +33,20 @@ pub struct WheelBending {
     hob_tip: f64,
     face_width: f64,
     top: Vec<(f64, f64)>,
+    /// Compliance of the hub's rigid-body motion on the shaft at the wheel centre (6 x 6,
+    /// row-major, (m, rad) per (N, N m), fixed wheel frame); None: the hub does not move
+    /// (sector clamped at the rim or at the hub).
+    pub shaft_compliance: Option<Vec<f64>>,
 }
 
 impl WheelBending {
-    /// Builds the model: FE of the sector (`mesh` settings) with `height` x `width` fit points.
+    /// Builds the model: FE of the sector (`mesh` settings) with `height` x `width` fit points,
+    /// and the shaft under the hub when given.
     pub fn build(
         gear: &GearSet,
         geo: &Geometry,
         mesh_settings: &SectorMeshSettings,
+        shaft: Option<&WheelShaft>,
         height: usize,
         width: usize,
     ) -> Result<Self, FeError> {
@@ -133,6 +142,10 @@ impl WheelBending {
             hob_tip: gear.hob.tip_radius,
             face_width: gear.wheel.face_width,
             top,
+            shaft_compliance: shaft.map(|s| {
+                let c = s.compliance();
+                (0..36).map(|i| c[(i / 6, i % 6)]).collect()
+            }),
         })
     }
 
@@ -156,7 +169,8 @@ impl WheelBending {
 /// Bending displacements of the sector (MODEL §5.5 step 2): for each load case, a unit force
 /// into the central tooth (along -n) at the given node, the FE displacement of every node with
 /// the tooth's opposite flank free minus that with it blocked (removes the local contact and
-/// keeps the bending). Rim inner surface clamped. Index: [case][node], m/N.
+/// keeps the bending). The mesh's `inner` nodes are clamped (the hub surface of the whole
+/// ring, or the rim's inner surface of a bare sector). Index: [case][node], m/N.
 pub fn bending_displacements(
     m: &SectorMesh,
     material: &Elastic,
@@ -181,13 +195,52 @@ impl BendingModel for WheelBending {
         let coords: Vec<(f64, f64)> = cells.iter().map(|c| self.coordinates(c.r, c.z)).collect();
         // Symmetrised core (reciprocity; the before/after fits are each other's transposes up to
         // the sector's end effects).
-        super::worm_model::relation_low_rank(
+        let teeth = super::worm_model::relation_low_rank(
             &self.basis,
             &self.same,
             &self.before,
             &self.after,
             &groups,
             &coords,
-        )
+        );
+        match &self.shaft_compliance {
+            Some(s) if s.len() == 36 => with_rigid_body(teeth, s, cells),
+            _ => teeth,
+        }
+    }
+}
+
+/// Appends the hub's rigid-body motion to the teeth's low-rank term: six more columns, row i
+/// the wrench g_i = (n_i, M_i x n_i) of cell i in the fixed wheel frame, core the shaft
+/// compliance S, so C_ij += g_i^T S g_j (MODEL §5.5: bending of the wheel's environment).
+pub fn with_rigid_body(teeth: LowRank, compliance: &[f64], cells: &[LocalCell]) -> LowRank {
+    let (k0, rank) = (teeth.rank, teeth.rank + 6);
+    let mut f = vec![0.0; cells.len() * rank];
+    let mut ranges = Vec::with_capacity(cells.len());
+    for (i, c) in cells.iter().enumerate() {
+        f[i * rank..i * rank + k0].copy_from_slice(&teeth.f[i * k0..(i + 1) * k0]);
+        let g = wrench(&c.wheel_centre, &c.wheel_normal);
+        f[i * rank + k0..(i + 1) * rank].copy_from_slice(g.as_slice());
+        let [r0, _, _] = teeth
+            .ranges
+            .get(i)
+            .copied()
+            .unwrap_or([(0, k0), (0, 0), (0, 0)]);
+        ranges.push([r0, (k0, rank), (0, 0)]);
+    }
+    let mut core = vec![0.0; rank * rank];
+    for r in 0..k0 {
+        core[r * rank..r * rank + k0].copy_from_slice(&teeth.core[r * k0..(r + 1) * k0]);
+    }
+    for r in 0..6 {
+        for c in 0..6 {
+            core[(k0 + r) * rank + k0 + c] = compliance[r * 6 + c];
+        }
+    }
+    LowRank {
+        rank,
+        f,
+        core,
+        ranges,
     }
 }

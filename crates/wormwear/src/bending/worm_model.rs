@@ -321,7 +321,7 @@ pub(crate) fn relation_low_rank(
     let mut ranges = Vec::with_capacity(groups.len());
     for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
         let t = present.iter().position(|&x| x == g).unwrap_or(0);
-        ranges.push([(t * k, (t + 1) * k), (0, 0)]);
+        ranges.push([(t * k, (t + 1) * k), (0, 0), (0, 0)]);
         // Points outside the fitted zone take the value at its edge: the beam modes grow
         // exponentially outside [0, 1].
         let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
@@ -419,11 +419,17 @@ impl BendingModel for FeBending {
             let row = (a.rank + i) * rank + a.rank;
             core[row..row + b.rank].copy_from_slice(&b.core[i * b.rank..(i + 1) * b.rank]);
         }
+        // Wheel rows: the tooth's functions and the shaft's rigid-body terms; worm rows: the
+        // thread's functions, shifted past the wheel's columns.
         let ranges = (0..cells.len())
             .map(|i| {
-                let ra = a.ranges.get(i).map_or((0, a.rank), |r| r[0]);
+                let [ra, rs, _] = a
+                    .ranges
+                    .get(i)
+                    .copied()
+                    .unwrap_or([(0, a.rank), (0, 0), (0, 0)]);
                 let rb = b.ranges.get(i).map_or((0, b.rank), |r| r[0]);
-                [ra, (a.rank + rb.0, a.rank + rb.1)]
+                [ra, rs, (a.rank + rb.0, a.rank + rb.1)]
             })
             .collect();
         LowRank {

@@ -391,7 +391,56 @@ pub struct GearSet {
     pub warnings: Vec<String>,
 }
 
+/// The wheel's body under its teeth with the defaults filled in (MODEL §5.5, REFERENCE_GEARS:
+/// "the wheel is bronze on a steel shaft, rim thickness twice the tooth height, wheel shaft
+/// fixed at one end"), SI, m.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WheelBody {
+    /// Root radius at the median plane (cutting centre distance - hob tip radius).
+    pub root_radius: f64,
+    /// Rim thickness under the root (default: twice the tooth height).
+    pub rim_thickness: f64,
+    /// Web thickness along the axis (default: a third of the face width).
+    pub web_thickness: f64,
+    /// Hub outer radius (default: 0.35 r2).
+    pub hub_radius: f64,
+    /// Half the hub's width (the face width's half: the hub is as wide as the rim).
+    pub hub_half_width: f64,
+    /// Shaft radius (default: 0.2 r2).
+    pub shaft_radius: f64,
+    /// Bearing positions along z2 [laterally holding, fixed end] (default: -b2, +b2).
+    pub bearings: [f64; 2],
+}
+
+impl WheelBody {
+    /// Inner radius of the rim (where the web starts), m.
+    pub fn rim_inner_radius(&self) -> f64 {
+        self.root_radius - self.rim_thickness
+    }
+}
+
 impl GearSet {
+    /// The wheel's body with its defaults (see [`WheelBody`]).
+    pub fn wheel_body(&self) -> WheelBody {
+        let w = &self.wheel;
+        let r2 = self.wheel_reference_radius();
+        let root_radius = self.cutting.centre_distance - self.hob.tip_radius;
+        let tooth_height = w.throat_radius - root_radius;
+        let bearings = match w.bearing_positions.as_deref() {
+            Some([a, b]) => [*a, *b],
+            _ => [-w.face_width, w.face_width],
+        };
+        WheelBody {
+            root_radius,
+            rim_thickness: w.rim_thickness.unwrap_or(2.0 * tooth_height.max(1e-4)),
+            web_thickness: w.web_thickness.unwrap_or(w.face_width / 3.0),
+            hub_radius: w.hub_radius.unwrap_or(0.35 * r2),
+            hub_half_width: 0.5 * w.face_width,
+            shaft_radius: w.shaft_radius.unwrap_or(0.2 * r2),
+            bearings,
+        }
+    }
+
     /// Wheel reference radius r2 = z2 p_x / (2 pi), m.
     pub fn wheel_reference_radius(&self) -> f64 {
         self.wheel.teeth as f64 * self.worm.axial_pitch / (2.0 * PI)

@@ -536,7 +536,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         unreachable_input()?
     };
     let wheel_hardness = wheel_material.hardness;
-    Ok(GearSet {
+    let gear = GearSet {
         title: f.title.clone().unwrap_or_default(),
         worm,
         hob,
@@ -590,7 +590,87 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             None => unreachable_input()?,
         },
         warnings,
-    })
+    };
+    if gear.bending.kind == BendingKind::Fe {
+        check_wheel_body(&gear)?;
+    }
+    Ok(gear)
+}
+
+/// The wheel body the bending model builds (rim, web, hub, shaft and its bearings), checked
+/// with its defaults filled in: each part must fit inside the one around it.
+fn check_wheel_body(gear: &GearSet) -> Result<(), InputError> {
+    let b = gear.wheel_body();
+    let mut errors = Vec::new();
+    let mut fail = |field: &str, value: f64, problem: String| {
+        errors.push(FieldError {
+            field: field.into(),
+            value: format!("{:.4} mm", value / MM),
+            problem,
+        })
+    };
+    let r_in = b.rim_inner_radius();
+    if r_in <= 0.0 {
+        fail(
+            "wheel.rim_thickness_mm",
+            b.rim_thickness,
+            format!("must be < the root radius {:.4} mm", b.root_radius / MM),
+        );
+    } else if b.hub_radius >= r_in {
+        fail(
+            "wheel.hub_radius_mm",
+            b.hub_radius,
+            format!(
+                "must be < the rim's inner radius (root radius - rim thickness) = {:.4} mm",
+                r_in / MM
+            ),
+        );
+    }
+    if b.shaft_radius >= b.hub_radius {
+        fail(
+            "wheel.shaft_radius_mm",
+            b.shaft_radius,
+            format!("must be < the hub radius {:.4} mm", b.hub_radius / MM),
+        );
+    }
+    if b.web_thickness > gear.wheel.face_width {
+        fail(
+            "wheel.web_thickness_mm",
+            b.web_thickness,
+            format!(
+                "must be <= the face width {:.4} mm",
+                gear.wheel.face_width / MM
+            ),
+        );
+    }
+    match gear.wheel.bearing_positions.as_deref() {
+        Some(v) if v.len() != 2 => errors.push(FieldError {
+            field: "wheel.bearing_positions_mm".into(),
+            value: format!("{:?}", v.iter().map(|x| x / MM).collect::<Vec<_>>()),
+            problem: "must hold two positions (the laterally holding bearing, then the fixed end)"
+                .into(),
+        }),
+        _ => {
+            let [a, c] = b.bearings;
+            let h = b.hub_half_width;
+            if !(a.min(c) < -h && a.max(c) > h) {
+                errors.push(FieldError {
+                    field: "wheel.bearing_positions_mm".into(),
+                    value: format!("[{:.4}, {:.4}]", a / MM, c / MM),
+                    problem: format!(
+                        "need one bearing on each side of the hub, beyond +/- {:.4} mm (half the \
+                         face width)",
+                        h / MM
+                    ),
+                });
+            }
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(InputError::Invalid(errors))
+    }
 }
 
 /// Bending settings with their defaults (see [`BendingSpec`]).

@@ -78,6 +78,10 @@ pub struct LocalCell {
     pub half_dz: f64,
     /// Lever of the normal about the wheel axis |(P x n)_z|, m.
     pub lever: f64,
+    /// Cell centre and flank normal in the fixed wheel frame (origin at the wheel centre, z
+    /// along the wheel axis; MODEL §1), m and unit.
+    pub wheel_centre: Vector3<f64>,
+    pub wheel_normal: Vector3<f64>,
     /// Moment of a unit normal force on the worm about its axis (M x n)_x, m.
     pub worm_lever: f64,
     /// Initial angular separation (after the kinematic error), rad.
@@ -585,6 +589,8 @@ fn slice_cells(
             z,
             half_dz: slice.half_dz,
             lever,
+            wheel_centre: stat,
+            wheel_normal: n_stat,
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error

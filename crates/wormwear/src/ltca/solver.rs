@@ -48,19 +48,20 @@ pub struct LowRank {
     pub f: Vec<f64>,
     /// Row-major rank x rank, symmetric.
     pub core: Vec<f64>,
-    /// Column ranges [start, end) outside which row i of f is zero (up to two per row: a
-    /// member's functions live on the row's tooth or thread only); empty: rows are dense.
-    pub ranges: Vec<[(usize, usize); 2]>,
+    /// Column ranges [start, end) outside which row i of f is zero (up to three per row: a
+    /// member's functions live on the row's tooth or thread only, plus the wheel shaft's rigid
+    /// body terms); unused entries are (0, 0); empty: rows are dense.
+    pub ranges: Vec<[(usize, usize); 3]>,
 }
 
 impl LowRank {
     /// The column ranges of row i (the whole row when no ranges are given).
     #[inline]
-    fn row_ranges(&self, i: usize) -> [(usize, usize); 2] {
+    fn row_ranges(&self, i: usize) -> [(usize, usize); 3] {
         self.ranges
             .get(i)
             .copied()
-            .unwrap_or([(0, self.rank), (0, 0)])
+            .unwrap_or([(0, self.rank), (0, 0), (0, 0)])
     }
 }
 
