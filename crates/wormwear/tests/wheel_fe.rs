@@ -251,10 +251,10 @@ fn bending_coefficients_interpolate_the_fe_off_the_fit_grid() {
     let loads: Vec<(usize, nalgebra::Vector3<f64>)> =
         ids.iter().copied().zip(normals.iter().copied()).collect();
     let bending =
-        wormwear::bending::wheel_model::bending_displacements(&m, &BRONZE, &loads).unwrap();
+        wormwear::bending::wheel_model::bending_displacements(&m, &BRONZE, &loads, &ids).unwrap();
     // Bending displacement at point l (into the tooth) due to a unit load at point c.
     let bend = |l: usize, c: usize| {
-        let d = bending[c][ids[l]];
+        let d = bending[c][l];
         -(d[0] * normals[l][0] + d[1] * normals[l][1] + d[2] * normals[l][2])
     };
     let k = fit_points.len();

@@ -231,7 +231,7 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
         })
         .collect();
     let loads: Vec<_> = picks.iter().copied().zip(normals.iter().copied()).collect();
-    let bend = worm_bending_displacements(&m, &b, &STEEL, &loads).unwrap();
+    let bend = worm_bending_displacements(&m, &b, &STEEL, &loads, &picks).unwrap();
     let point = |n: usize| {
         let x = m.mesh.nodes[n];
         nalgebra::Vector3::new(x[0], x[1], x[2])
@@ -240,7 +240,7 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
     let mut umax = 0.0f64;
     for (a, &na) in picks.iter().enumerate() {
         for (c, _) in picks.iter().enumerate() {
-            let d = bend[c][na];
+            let d = bend[c][a];
             let fe = -(d[0] * normals[a][0] + d[1] * normals[a][1] + d[2] * normals[a][2]);
             let fit = model.basis.coefficient(
                 &model.same,

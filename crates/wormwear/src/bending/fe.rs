@@ -2,7 +2,7 @@
 //! sparse direct solve (faer Cholesky). SI units: m, Pa, N.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
@@ -241,6 +241,87 @@ pub fn solve_with_springs(
     springs: &[Spring],
     loads: &[Vec<Load>],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    let elements = element_stiffnesses(mesh, material)?;
+    let solution = solve_assembled(mesh, &elements, fixed, springs, loads)?;
+    Ok((0..loads.len())
+        .map(|c| (0..mesh.nodes.len()).map(|n| solution.at(c, n)).collect())
+        .collect())
+}
+
+/// Stiffness matrices of all elements (row-major 60 x 60 each), computed in parallel.
+pub fn element_stiffnesses(mesh: &Mesh, material: &Elastic) -> Result<Vec<Vec<f64>>, FeError> {
+    (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|e| element_stiffness(mesh, e, material))
+        .collect()
+}
+
+/// Lower triangle of the free-free stiffness in compressed columns, assembled in place: the
+/// pattern comes from the node graph (nodes sharing an element or a spring), so no triplet list
+/// is built or sorted. Rows of each column are sorted; `position` finds an entry.
+struct LowerPattern {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+}
+
+impl LowerPattern {
+    fn new(mesh: &Mesh, springs: &[Spring], map: &[usize], free: usize) -> Self {
+        let nn = mesh.nodes.len();
+        let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); nn];
+        for e in &mesh.elements {
+            for &a in e {
+                adjacent[a].extend(e.iter().map(|&b| b as u32));
+            }
+        }
+        for spring in springs {
+            for &(a, _) in &spring.terms {
+                adjacent[a].extend(spring.terms.iter().map(|&(b, _)| b as u32));
+            }
+        }
+        adjacent.par_iter_mut().for_each(|list| {
+            list.sort_unstable();
+            list.dedup();
+        });
+        let mut col_ptr = Vec::with_capacity(free + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for (n, list) in adjacent.iter().enumerate() {
+            for d in 0..3 {
+                let g = 3 * n + d;
+                if map[g] == usize::MAX {
+                    continue;
+                }
+                for &m in list {
+                    for dd in 0..3 {
+                        let gr = 3 * m as usize + dd;
+                        if gr >= g && map[gr] != usize::MAX {
+                            row_idx.push(map[gr]);
+                        }
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        Self { col_ptr, row_idx }
+    }
+
+    #[inline]
+    fn position(&self, row: usize, col: usize) -> usize {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let p = a + self.row_idx[a..b].partition_point(|&r| r < row);
+        debug_assert!(p < b && self.row_idx[p] == row, "entry outside the pattern");
+        p
+    }
+}
+
+/// Solves with element stiffnesses already computed (shared by runs on the same mesh).
+fn solve_assembled(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    fixed: &[Fixed],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+) -> Result<Solution, FeError> {
     let ndof = 3 * mesh.nodes.len();
     let mut prescribed = vec![None; ndof];
     for &(n, d, v) in fixed {
@@ -254,11 +335,8 @@ pub fn solve_with_springs(
             free += 1;
         }
     }
-    let elements: Vec<Vec<f64>> = (0..mesh.elements.len())
-        .into_par_iter()
-        .map(|e| element_stiffness(mesh, e, material))
-        .collect::<Result<_, _>>()?;
-    let mut triplets = Vec::new();
+    let pattern = LowerPattern::new(mesh, springs, &map, free);
+    let mut values = vec![0.0; pattern.row_idx.len()];
     let ncase = loads.len();
     let mut rhs = Mat::<f64>::zeros(free, ncase);
     for (c, case) in loads.iter().enumerate() {
@@ -280,11 +358,11 @@ pub fn solve_with_springs(
         None => {
             let fc = map[gc];
             if fc <= fr {
-                triplets.push(Triplet::new(fr, fc, v));
+                values[pattern.position(fr, fc)] += v;
             }
         }
     };
-    for (e, k) in mesh.elements.iter().zip(&elements) {
+    for (e, k) in mesh.elements.iter().zip(elements) {
         let dofs: Vec<usize> = e
             .iter()
             .flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2])
@@ -316,29 +394,40 @@ pub fn solve_with_springs(
             }
         }
     }
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
-        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let symbolic =
+        SymbolicSparseColMat::new_checked(free, free, pattern.col_ptr, None, pattern.row_idx);
+    let a = SparseColMat::<usize, f64>::new(symbolic, values);
     let llt = a
         .sp_cholesky(Side::Lower)
         .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
-    let x = llt.solve(&rhs);
-    Ok((0..ncase)
-        .map(|c| {
-            (0..mesh.nodes.len())
-                .map(|n| {
-                    let mut u = [0.0; 3];
-                    for (d, ud) in u.iter_mut().enumerate() {
-                        let g = 3 * n + d;
-                        *ud = match prescribed[g] {
-                            Some(v) => v,
-                            None => x[(map[g], c)],
-                        };
-                    }
-                    u
-                })
-                .collect()
-        })
-        .collect())
+    Ok(Solution {
+        x: llt.solve(&rhs),
+        map,
+        prescribed,
+    })
+}
+
+/// Displacements of every load case in the free-DOF numbering of one run.
+struct Solution {
+    /// free DOFs x cases, m.
+    x: Mat<f64>,
+    map: Vec<usize>,
+    prescribed: Vec<Option<f64>>,
+}
+
+impl Solution {
+    /// Displacement of a node under case c, m.
+    fn at(&self, c: usize, n: usize) -> [f64; 3] {
+        let mut u = [0.0; 3];
+        for (d, ud) in u.iter_mut().enumerate() {
+            let g = 3 * n + d;
+            *ud = match self.prescribed[g] {
+                Some(v) => v,
+                None => self.x[(self.map[g], c)],
+            };
+        }
+        u
+    }
 }
 
 /// Structured mesh of the box [0, lx] x [0, ly] x [0, lz] with nx x ny x nz elements; `map`
@@ -512,10 +601,10 @@ pub fn mirrored(e: [usize; 20]) -> [usize; 20] {
 }
 
 /// Bending displacements by the free / blocked technique (MODEL §5.5 step 2): for each load
-/// case a unit force into the member (along -n) at a node; the displacement of every node with
-/// the loaded tooth's opposite flank free minus that with its `blocked` nodes fixed (removes
-/// the local contact deformation, keeps the bending). The two runs are independent and are
-/// factorised side by side. Index: [case][node], m/N.
+/// case a unit force into the member (along -n) at a node; the displacement with the loaded
+/// tooth's opposite flank free minus that with its `blocked` nodes fixed (removes the local
+/// contact deformation, keeps the bending), at the `observed` nodes. The two runs share the
+/// element matrices and are factorised side by side. Index: [case][observed k], m/N.
 pub fn free_minus_blocked(
     mesh: &Mesh,
     material: &Elastic,
@@ -523,6 +612,7 @@ pub fn free_minus_blocked(
     springs: &[Spring],
     blocked: &[usize],
     loads: &[(usize, nalgebra::Vector3<f64>)],
+    observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
     let cases: Vec<Vec<Load>> = loads
         .iter()
@@ -534,18 +624,20 @@ pub fn free_minus_blocked(
             .iter()
             .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0))),
     );
+    let elements = element_stiffnesses(mesh, material)?;
     let (free, held) = rayon::join(
-        || solve_with_springs(mesh, material, fixed, springs, &cases),
-        || solve_with_springs(mesh, material, &blocked_fixed, springs, &cases),
+        || solve_assembled(mesh, &elements, fixed, springs, &cases),
+        || solve_assembled(mesh, &elements, &blocked_fixed, springs, &cases),
     );
     let (free, held) = (free?, held?);
-    Ok(free
-        .iter()
-        .zip(&held)
-        .map(|(a, b)| {
-            a.iter()
-                .zip(b)
-                .map(|(x, y)| [x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+    Ok((0..cases.len())
+        .map(|c| {
+            observed
+                .iter()
+                .map(|&n| {
+                    let (a, b) = (free.at(c, n), held.at(c, n));
+                    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+                })
                 .collect()
         })
         .collect())

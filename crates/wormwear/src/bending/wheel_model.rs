@@ -112,11 +112,13 @@ impl WheelBending {
             .copied()
             .zip(normals[1].iter().copied())
             .collect();
-        let bending = bending_displacements(&m, &material, &loads)?;
+        // Observed: the fit points on the three teeth (ids[t][l] is observed[t * k + l]).
+        let observed: Vec<usize> = ids.iter().flatten().copied().collect();
+        let bending = bending_displacements(&m, &material, &loads, &observed)?;
         let k = basis.len();
         let relation = |t: usize| {
             Mat::from_fn(k, k, |l, c| {
-                let d = bending[c][ids[t][l]];
+                let d = bending[c][t * k + l];
                 let n = normals[t][l];
                 -(d[0] * n[0] + d[1] * n[1] + d[2] * n[2])
             })
@@ -166,15 +168,17 @@ impl WheelBending {
     }
 }
 
-/// Bending displacements of the sector (MODEL §5.5 step 2): for each load case, a unit force
-/// into the central tooth (along -n) at the given node, the FE displacement of every node with
-/// the tooth's opposite flank free minus that with it blocked (removes the local contact and
-/// keeps the bending). The mesh's `inner` nodes are clamped (the hub surface of the whole
-/// ring, or the rim's inner surface of a bare sector). Index: [case][node], m/N.
+/// Bending displacements of the wheel model (MODEL §5.5 step 2): for each load case, a unit
+/// force into the central tooth (along -n) at the given node, the FE displacement of the
+/// `observed` nodes with the tooth's opposite flank free minus that with it blocked (removes
+/// the local contact and keeps the bending). The mesh's `inner` nodes are clamped (the hub
+/// surface of the whole ring, or the rim's inner surface of a bare sector). Index:
+/// [case][observed k], m/N.
 pub fn bending_displacements(
     m: &SectorMesh,
     material: &Elastic,
     loads: &[(usize, nalgebra::Vector3<f64>)],
+    observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
     let fixed: Vec<(usize, usize, f64)> = m
         .inner
@@ -182,7 +186,7 @@ pub fn bending_displacements(
         .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
         .collect();
     let blocked: Vec<usize> = m.right_flank[1].iter().map(|f| f.2).collect();
-    free_minus_blocked(&m.mesh, material, &fixed, &[], &blocked, loads)
+    free_minus_blocked(&m.mesh, material, &fixed, &[], &blocked, loads, observed)
 }
 
 impl BendingModel for WheelBending {

@@ -138,11 +138,13 @@ impl WormBending {
             .copied()
             .zip(normals.iter().copied())
             .collect();
-        let bending = worm_bending_displacements(&m, body, &material, &loads)?;
+        // Observed: the data points on the three threads (ids[t][l] is observed[t * n + l]).
+        let observed: Vec<usize> = ids.iter().flatten().copied().collect();
+        let bending = worm_bending_displacements(&m, body, &material, &loads, &observed)?;
         let n = data.len();
         let relation = |t: usize| {
             Mat::from_fn(n, n, |l, c| {
-                let d = bending[c][ids[t][l]];
+                let d = bending[c][t * n + l];
                 let nn = normals[l];
                 -(d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2])
             })
@@ -277,17 +279,20 @@ fn supports(m: &WormMesh, body: &WormBody, material: &Elastic) -> (Vec<Fixed>, V
 }
 
 /// Bending displacements of the worm (MODEL §5.5 step 2): for each load case a unit force
-/// into the central thread (along -n) at the given node, FE displacement of every node with
-/// the thread's opposite flank free minus blocked. Index: [case][node], m/N.
+/// into the central thread (along -n) at the given node, FE displacement of the `observed`
+/// nodes with the thread's opposite flank free minus blocked. Index: [case][observed k], m/N.
 pub fn worm_bending_displacements(
     m: &WormMesh,
     body: &WormBody,
     material: &Elastic,
     loads: &[(usize, Vector3<f64>)],
+    observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
     let (fixed, springs) = supports(m, body, material);
     let blocked: Vec<usize> = m.opposite[1].iter().map(|f| f.2).collect();
-    free_minus_blocked(&m.mesh, material, &fixed, &springs, &blocked, loads)
+    free_minus_blocked(
+        &m.mesh, material, &fixed, &springs, &blocked, loads, observed,
+    )
 }
 
 /// Displacements of the worm model under arbitrary nodal loads with its supports (no
