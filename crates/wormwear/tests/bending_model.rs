@@ -131,6 +131,16 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
         100.0 * peak_share(&rigid),
         100.0 * peak_share(&bent)
     );
+    let work = |r: &Ltca| {
+        let it: usize = r.positions.iter().map(|p| p.residuals.iterations).sum();
+        let cells: usize = r.positions.iter().map(|p| p.cells.len()).sum();
+        (it, cells / r.positions.len())
+    };
+    eprintln!(
+        "solver iterations over the positions / cells per position: {:?} without, {:?} with bending",
+        work(&rigid),
+        work(&bent)
+    );
 }
 
 /// The 1/40 design case with and without bending (figures for the record).
@@ -149,6 +159,16 @@ fn bending_figures_for_the_1x40_design_case() {
         "largest tooth share: {:.1} % without, {:.1} % with bending",
         100.0 * peak_share(&rigid),
         100.0 * peak_share(&bent)
+    );
+    let work = |r: &Ltca| {
+        let it: usize = r.positions.iter().map(|p| p.residuals.iterations).sum();
+        let cells: usize = r.positions.iter().map(|p| p.cells.len()).sum();
+        (it, cells / r.positions.len())
+    };
+    eprintln!(
+        "solver iterations over the positions / cells per position: {:?} without, {:?} with bending",
+        work(&rigid),
+        work(&bent)
     );
 }
 

@@ -103,12 +103,7 @@ impl wormwear::ltca::BendingModel for ShaftOnly {
         "shaft"
     }
     fn coefficients(&self, cells: &[wormwear::ltca::LocalCell]) -> wormwear::ltca::solver::LowRank {
-        let empty = wormwear::ltca::solver::LowRank {
-            rank: 0,
-            f: Vec::new(),
-            core: Vec::new(),
-            ranges: Vec::new(),
-        };
+        let empty = wormwear::ltca::solver::LowRank::new(0, Vec::new(), Vec::new(), Vec::new());
         wormwear::bending::wheel_model::with_rigid_body(empty, &self.0, cells)
     }
 }

@@ -241,10 +241,5 @@ pub fn with_rigid_body(teeth: LowRank, compliance: &[f64], cells: &[LocalCell]) 
             core[(k0 + r) * rank + k0 + c] = compliance[r * 6 + c];
         }
     }
-    LowRank {
-        rank,
-        f,
-        core,
-        ranges,
-    }
+    LowRank::new(rank, f, core, ranges)
 }

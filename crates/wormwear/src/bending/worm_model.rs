@@ -355,12 +355,7 @@ pub(crate) fn relation_low_rank(
             core[j * rank + i] = v;
         }
     }
-    LowRank {
-        rank,
-        f,
-        core,
-        ranges,
-    }
+    LowRank::new(rank, f, core, ranges)
 }
 
 impl BendingModel for WormBending {
@@ -437,12 +432,7 @@ impl BendingModel for FeBending {
                 [ra, rs, (a.rank + rb.0, a.rank + rb.1)]
             })
             .collect();
-        LowRank {
-            rank,
-            f,
-            core,
-            ranges,
-        }
+        LowRank::new(rank, f, core, ranges)
     }
 }
 

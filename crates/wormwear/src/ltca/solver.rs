@@ -52,9 +52,43 @@ pub struct LowRank {
     /// member's functions live on the row's tooth or thread only, plus the wheel shaft's rigid
     /// body terms); unused entries are (0, 0); empty: rows are dense.
     pub ranges: Vec<[(usize, usize); 3]>,
+    /// Per row of the core: its runs of non-zero columns [start, end) (the core is block
+    /// sparse: tooth relations reach the neighbours only, the members do not couple).
+    core_runs: Vec<Vec<(usize, usize)>>,
 }
 
 impl LowRank {
+    /// The term F C F^T with F (n x rank, row-major), C (rank x rank, row-major, symmetric) and
+    /// the rows' non-zero column ranges (see [`LowRank::ranges`]).
+    pub fn new(rank: usize, f: Vec<f64>, core: Vec<f64>, ranges: Vec<[(usize, usize); 3]>) -> Self {
+        let core_runs = (0..rank)
+            .map(|r| {
+                let row = &core[r * rank..(r + 1) * rank];
+                let mut runs = Vec::new();
+                let mut c = 0;
+                while c < rank {
+                    if row[c] == 0.0 {
+                        c += 1;
+                        continue;
+                    }
+                    let start = c;
+                    while c < rank && row[c] != 0.0 {
+                        c += 1;
+                    }
+                    runs.push((start, c));
+                }
+                runs
+            })
+            .collect();
+        Self {
+            rank,
+            f,
+            core,
+            ranges,
+            core_runs,
+        }
+    }
+
     /// The column ranges of row i (the whole row when no ranges are given).
     #[inline]
     fn row_ranges(&self, i: usize) -> [(usize, usize); 3] {
@@ -250,11 +284,19 @@ impl Problem {
                     }
                 }
             }
-            let nonzero: Vec<usize> = (0..k).filter(|&c| ft[c] != 0.0).collect();
             let cft: Vec<f64> = (0..k)
                 .map(|r| {
                     let core = &lr.core[r * k..(r + 1) * k];
-                    nonzero.iter().map(|&c| core[c] * ft[c]).sum()
+                    lr.core_runs[r]
+                        .iter()
+                        .map(|&(a, b)| {
+                            core[a..b]
+                                .iter()
+                                .zip(&ft[a..b])
+                                .map(|(c, f)| c * f)
+                                .sum::<f64>()
+                        })
+                        .sum()
                 })
                 .collect();
             for (i, yi) in y.iter_mut().enumerate() {
