@@ -388,6 +388,13 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
             result.stiffness_mean(),
             result.max_teeth_in_contact()
         );
+        if result.shaft_torsion_compliance > 0.0 {
+            println!(
+                "  of which the wheel shaft's torsion: TE {:.3e} rad; stiffness without it {:.3e} N m/rad",
+                -result.shaft_torsion_compliance * result.wheel_torque,
+                result.stiffness_without_shaft_torsion_mean()
+            );
+        }
     }
     Ok(())
 }

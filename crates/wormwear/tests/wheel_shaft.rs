@@ -106,6 +106,9 @@ impl wormwear::ltca::BendingModel for ShaftOnly {
         let empty = wormwear::ltca::solver::LowRank::new(0, Vec::new(), Vec::new(), Vec::new());
         wormwear::bending::wheel_model::with_rigid_body(empty, &self.0, cells)
     }
+    fn rigid_rotation_compliance(&self) -> f64 {
+        self.0[35]
+    }
 }
 
 #[test]
@@ -139,6 +142,14 @@ fn shaft_torsion_shifts_the_te_and_leaves_the_load_sharing() {
         "TE shift vs -c_t C2: worst {worst_te:.2e}; pressures: worst change {worst_p:.2e} of P_max"
     );
     assert!(worst_te < 1e-6 && worst_p < 1e-6);
+    // The stiffness reported without the shaft's torsion is the one without the shaft.
+    let k0 = rigid.stiffness_mean();
+    let k1 = twisted.stiffness_without_shaft_torsion_mean();
+    eprintln!(
+        "mesh stiffness {k0:.6e}, with the torsion {:.6e}, taken out again {k1:.6e} N m/rad",
+        twisted.stiffness_mean()
+    );
+    assert!((k1 / k0 - 1.0).abs() < 1e-6 && twisted.stiffness_mean() < 0.9 * k0);
     // Lateral compliance along the line of centres: more approach, different pressures.
     let mut lateral = vec![0.0; 36];
     lateral[0] = 1e-8;

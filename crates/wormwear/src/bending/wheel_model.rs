@@ -194,6 +194,14 @@ impl BendingModel for WheelBending {
         "fe-wheel"
     }
 
+    fn rigid_rotation_compliance(&self) -> f64 {
+        // Torsion about the axis: the (theta_z, M_z) entry of the shaft compliance.
+        self.shaft_compliance
+            .as_ref()
+            .and_then(|s| s.get(35).copied())
+            .unwrap_or(0.0)
+    }
+
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
         let groups: Vec<i64> = cells.iter().map(|c| c.tooth as i64).collect();
         let coords: Vec<(f64, f64)> = cells.iter().map(|c| self.coordinates(c.r, c.z)).collect();

@@ -400,6 +400,10 @@ impl BendingModel for FeBending {
         "fe"
     }
 
+    fn rigid_rotation_compliance(&self) -> f64 {
+        self.wheel.rigid_rotation_compliance()
+    }
+
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
         let a = self.wheel.coefficients(cells);
         let b = self.worm.coefficients(cells);

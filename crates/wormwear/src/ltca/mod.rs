@@ -29,6 +29,12 @@ pub trait BendingModel: Sync {
     /// Low-rank term (in force units: normal displacement at i per unit normal force at j,
     /// m/N) for the given cells (worm frame) and their teeth.
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank;
+    /// Part of [`BendingModel::coefficients`] that is a rigid rotation of the whole wheel
+    /// about its axis (the torsion of its shaft), per unit wheel torque, rad/(N m): it adds
+    /// -c_t C2 to the TE at every position and changes no pressure; reported separately.
+    fn rigid_rotation_compliance(&self) -> f64 {
+        0.0
+    }
 }
 
 /// Settings of the local contact mesh and the solver.
@@ -126,6 +132,9 @@ pub struct PositionResult {
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Ltca {
     pub bending_model: String,
+    /// Torsional compliance of the wheel shaft included in the bending model, rad/(N m)
+    /// (0: none; see [`BendingModel::rigid_rotation_compliance`]).
+    pub shaft_torsion_compliance: f64,
     pub solver: SolverKind,
     pub positions: Vec<PositionResult>,
     /// Loaded contact pattern: max pressure over all positions and teeth per global cell of the
@@ -152,6 +161,17 @@ impl Ltca {
     /// Mean angular mesh stiffness, N m/rad.
     pub fn stiffness_mean(&self) -> f64 {
         stats(self.positions.iter().map(|p| p.stiffness_angular)).0
+    }
+    /// Mean angular mesh stiffness without the wheel shaft's torsion: C2 / (alpha - c_t C2),
+    /// N m/rad (equal to [`Ltca::stiffness_mean`] when the model has no shaft torsion).
+    pub fn stiffness_without_shaft_torsion_mean(&self) -> f64 {
+        let c_t = self.shaft_torsion_compliance;
+        stats(
+            self.positions
+                .iter()
+                .map(|p| p.wheel_torque / (p.approach - c_t * p.wheel_torque)),
+        )
+        .0
     }
     /// Most teeth carrying load at one position.
     pub fn max_teeth_in_contact(&self) -> usize {
@@ -336,6 +356,7 @@ pub fn analyse_worn(
     let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
     Ok(Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
+        shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
         solver: settings.solver.kind,
         positions,
         pattern,

@@ -32,6 +32,11 @@ pub struct LtcaSummary {
     pub te_mean_rad: f64,
     pub te_p2p_rad: f64,
     pub mesh_stiffness_mean_nm_per_rad: f64,
+    /// The wheel shaft's torsional compliance in the bending model (0: none), rad/(N m); its
+    /// share of the TE is -c_t C2 at every position.
+    pub wheel_shaft_torsion_rad_per_nm: f64,
+    /// Mean mesh stiffness with the shaft's torsion taken out, N m/rad.
+    pub mesh_stiffness_without_shaft_torsion_nm_per_rad: f64,
     pub mesh_stiffness_linear_mean_n_per_m: f64,
     pub max_teeth_in_contact: usize,
     /// Normal force per tooth (TCA tooth order) at each position, N.
@@ -76,6 +81,9 @@ impl LtcaSummary {
             te_mean_rad: te_mean,
             te_p2p_rad: te_p2p,
             mesh_stiffness_mean_nm_per_rad: ltca.stiffness_mean(),
+            wheel_shaft_torsion_rad_per_nm: ltca.shaft_torsion_compliance,
+            mesh_stiffness_without_shaft_torsion_nm_per_rad: ltca
+                .stiffness_without_shaft_torsion_mean(),
             mesh_stiffness_linear_mean_n_per_m: ltca
                 .positions
                 .iter()
