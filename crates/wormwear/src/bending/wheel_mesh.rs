@@ -1,5 +1,6 @@
-//! Finite-element mesh of a wheel sector: three teeth (the reference tooth and its two
-//! neighbours) standing on a rim, built from the generated flank grids (MODEL §5.5 step 1).
+//! Finite-element mesh of the wheel: three teeth (the reference tooth and its two neighbours)
+//! standing on a rim, built from the generated flank grids (MODEL §5.5 step 1), optionally with
+//! the rest of the ring and the web down to the hub.
 //!
 //! Layers along the face width are node columns of the global flank grid (every `face_step`-th,
 //! plus the last), so the flanks are exact there (Hermite theta_w along the column). In each
@@ -7,7 +8,10 @@
 //! - the rim, from its inner radius up to the root circle (cut by the hob tip), across the whole
 //!   sector, with theta nodes that match the teeth above them;
 //! - each tooth, from the root circle to the blank top, between its two flanks; below the flank
-//!   bottom (the fillet, not resolved) the boundary continues radially to the root.
+//!   bottom (the fillet, not resolved) the boundary continues radially to the root;
+//! - with [`WebSettings`] (the bending stage's default), the whole ring: the rim continued round
+//!   the wheel from one side cut of the three teeth to the other (graded elements), and the
+//!   web under every rim block down to the hub radius, in the layers within the web thickness.
 //!
 //! Nodes are placed on a half-step lattice of each block's mapping (mid-side nodes follow the
 //! curved flanks), and coincident nodes of neighbouring blocks are merged.
