@@ -687,7 +687,9 @@ pub fn simulate(
                     state.pitted_phases.push(k);
                     step_cycles = 0.0;
                 } else {
-                    // No wear while the cracks incubate.
+                    // No wear while the cracks incubate (up to the phase end, or the life if it
+                    // ends first).
+                    let end = end.min(life.life_cycles);
                     step_cycles = end - state.cycles;
                     state.cycles = end;
                 }

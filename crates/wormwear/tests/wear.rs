@@ -421,6 +421,17 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
     // Wear resumes after the phase.
     assert!(r.last().unwrap().mean_wear_m > r[k40].mean_wear_m);
     assert_eq!(r.last().unwrap().cycles, 60_000.0);
+
+    // A life that ends inside the pitting phase stops at the life, not at the phase end.
+    let short = wear::WearPlan {
+        life_cycles: 30_000.0,
+        ..plan.clone()
+    };
+    let end = bench.simulate(&short, None, &mut |_| Ok(())).unwrap();
+    let last = end.records.last().unwrap();
+    assert_eq!(last.cycles, 30_000.0);
+    assert_eq!(last.phase, "pitting");
+    assert_eq!(end.records.len(), 5, "0, 10k, 20k, 20k pitted, 30k");
 }
 
 /// MODEL §10 inverse problem: a backlash curve simulated with a known K (the "measurement") is
