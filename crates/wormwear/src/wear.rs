@@ -84,6 +84,10 @@ impl Sample {
                 0.0
             };
         }
+        if p.len() == 1 {
+            // x is the one cell's centre.
+            return first.1;
+        }
         let k = p.partition_point(|q| q.0 <= x).clamp(1, p.len() - 1);
         let (a, b) = (p[k - 1], p[k]);
         if b.0 == a.0 {
@@ -789,5 +793,38 @@ fn cut_pits(
                 pitted[k] = true;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(profile: Vec<(f64, f64)>) -> Sample {
+        Sample {
+            time: 0.0,
+            centre: 0.1,
+            profile,
+            extend_low: 1e-4,
+            extend_high: 1e-4,
+            line_load: 0.0,
+            pressure: 0.0,
+            radius: 0.01,
+            half_width: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_band_profile_of_one_cell_holds_its_pressure_over_the_cell() {
+        // A slice cut to a single cell by the flank's edges (it happens on worn flanks): its
+        // pressure over its extent, zero beyond, and no panic at the centre.
+        let s = sample(vec![(0.1, 5e8)]);
+        assert_eq!(s.pressure_at(0.1, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 - 0.5e-4, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 + 0.5e-4, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 + 2e-4, 0.0), 0.0);
+        // Two cells: linear between their centres.
+        let s = sample(vec![(0.1, 4e8), (0.1002, 6e8)]);
+        assert!((s.pressure_at(0.1001, 0.0) - 5e8).abs() < 1e-3);
     }
 }
