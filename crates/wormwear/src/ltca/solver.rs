@@ -519,6 +519,7 @@ fn pk_inner(
     let mut last_change = f64::INFINITY;
     let mut correction = vec![0.0; n];
     let mut kc = vec![0.0; n];
+    let mut q_old = vec![0.0; n];
     // u = K q is carried from one iteration to the next (one product K t per iteration, plus
     // a product with the few entries the projection changed) and recomputed exactly every
     // REFRESH iterations and before convergence is accepted (the drift between refreshes is
@@ -532,6 +533,9 @@ fn pk_inner(
             problem.apply(&q, &mut u);
             exact = true;
         }
+        // (Loops fused where they can be: every sum keeps its order over i, so the results
+        // are those of the separate passes, bit for bit.)
+        let (mut sum, mut count) = (0.0, 0usize);
         for i in 0..n {
             // Fixed (capped) cells keep a gap too: the outer loop frees them when it opens.
             g[i] = if open[i] || fixed[i] {
@@ -539,9 +543,6 @@ fn pk_inner(
             } else {
                 f64::INFINITY
             };
-        }
-        let (mut sum, mut count) = (0.0, 0usize);
-        for i in 0..n {
             if q[i] > 0.0 {
                 sum += g[i];
                 count += 1;
@@ -552,16 +553,22 @@ fn pk_inner(
         }
         let gbar = sum / count as f64;
         approach = gbar;
-        for gi in g.iter_mut() {
-            *gi -= gbar;
-        }
-        // Convergence: loaded cells touch, others do not penetrate, q settled.
+        // Convergence measure (loaded cells touch, others do not penetrate), the squared
+        // gradient on the loaded set and the largest open gap, in one pass.
         let mut worst: f64 = 0.0;
+        let mut gsum = 0.0;
+        let mut gmax = 0.0f64;
         for i in 0..n {
+            g[i] -= gbar;
+            let gi = g[i];
             if q[i] > 0.0 {
-                worst = worst.max(g[i].abs());
-            } else if open[i] && g[i] < 0.0 {
-                worst = worst.max(-g[i]);
+                worst = worst.max(gi.abs());
+                gsum += gi * gi;
+            } else if open[i] && gi < 0.0 {
+                worst = worst.max(-gi);
+            }
+            if open[i] && gi.is_finite() {
+                gmax = gmax.max(gi.abs());
             }
         }
         let scale = approach.abs().max(f64::MIN_POSITIVE);
@@ -584,7 +591,6 @@ fn pk_inner(
                 residuals,
             });
         }
-        let gsum: f64 = (0..n).filter(|&i| q[i] > 0.0).map(|i| g[i] * g[i]).sum();
         for i in 0..n {
             t[i] = if q[i] > 0.0 {
                 g[i] + delta * (gsum / g_old) * t[i]
@@ -603,36 +609,30 @@ fn pk_inner(
             }
         }
         let tau = if den > 0.0 { num / den } else { 0.0 };
-        let q_old = q.clone();
+        let tau_overlap = if tau > 0.0 {
+            tau
+        } else {
+            load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
+        };
+        // Projected step on the loaded set; cells outside it that would penetrate join it
+        // (PK's overlap step); the new total load.
+        q_old.copy_from_slice(&q);
+        let mut overlap = false;
+        let mut total = 0.0;
         for i in 0..n {
             correction[i] = 0.0;
             if q[i] > 0.0 {
                 let linear = q[i] - tau * t[i];
                 q[i] = linear.max(0.0);
                 correction[i] = q[i] - linear;
-            }
-        }
-        // Cells outside the loaded set that would penetrate join it (PK's overlap step).
-        let gmax = g
-            .iter()
-            .zip(&open)
-            .filter(|(v, o)| **o && v.is_finite())
-            .fold(0.0f64, |m, (v, _)| m.max(v.abs()));
-        let tau_overlap = if tau > 0.0 {
-            tau
-        } else {
-            load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
-        };
-        let mut overlap = false;
-        for i in 0..n {
-            if q_old[i] == 0.0 && open[i] && g[i] < 0.0 {
+            } else if open[i] && g[i] < 0.0 {
                 q[i] = -tau_overlap * g[i];
                 correction[i] = q[i];
                 overlap = true;
             }
+            total += q[i];
         }
         delta = if overlap { 0.0 } else { 1.0 };
-        let total: f64 = q.iter().sum();
         if total <= 0.0 {
             return Err(SolverError::Invalid("load vanished".into()));
         }
@@ -640,16 +640,13 @@ fn pk_inner(
         q.iter_mut().for_each(|v| *v *= s);
         // u <- s (u - tau K t + K c), c the projection's changes.
         problem.apply(&correction, &mut kc);
+        let mut change = 0.0;
         for i in 0..n {
             u[i] = s * (u[i] - tau * r[i] + kc[i]);
+            change += (q[i] - q_old[i]).abs();
         }
         exact = false;
-        last_change = q
-            .iter()
-            .zip(&q_old)
-            .map(|(a, b)| (a - b).abs())
-            .sum::<f64>()
-            / problem.load;
+        last_change = change / problem.load;
     }
     let gap = g.clone();
     for i in 0..n {
