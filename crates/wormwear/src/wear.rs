@@ -19,7 +19,6 @@ use crate::kinematics::{GapEvaluator, Tca};
 use crate::ltca::Ltca;
 use crate::lubrication::{self, LineContact};
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::f64::consts::PI;
 
 /// Wear of one mesh cycle (one passage of the contact over every point of the reference
@@ -124,27 +123,72 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
     let dt = tau / np as f64;
     // Wheel speed, rad/s: converts wheel rotation into time.
     let wheel_speed = gear.conditions.worm_speed / gear.ratio();
-    // Pressure profiles per (position, tooth, slice) from the local cells.
-    // (r, p, width across the line, column) of the cells, per (position, tooth, slice).
+    // Pressure profiles per (position, tooth, slice) from the local cells: (r, p, width across
+    // the line, column) of the cells. A slice's cells are consecutive in a position's list, so
+    // each (position, tooth, slice) is a list of runs of cells (one, in practice), kept in
+    // order in a table indexed by position, tooth index and node column (no hashing: this
+    // part runs on one thread between two parallel analyses).
     type Profile = Vec<(f64, f64, f64, usize)>;
-    let mut profiles: HashMap<(usize, i32, usize), Profile> = HashMap::new();
+    let teeth = tca.teeth.len();
+    let table = |position: usize, tooth_index: usize, slice: usize| {
+        (position * teeth + tooth_index) * (nj + 1) + slice
+    };
+    const NONE: usize = usize::MAX;
+    // Runs: (index in ltca.positions, first cell, end, next run of the same key).
+    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
+    let mut head = vec![NONE; np * teeth * (nj + 1)];
+    let mut tail = vec![NONE; np * teeth * (nj + 1)];
     let mut last_column = 0;
-    for pr in &ltca.positions {
-        for (c, &p) in pr.cells.iter().zip(&pr.pressure) {
-            last_column = last_column.max(c.column);
-            profiles
-                .entry((pr.position, c.tooth, c.slice))
-                .or_default()
-                .push((c.r, p, 2.0 * c.cell.half_nu, c.column));
+    for (at, pr) in ltca.positions.iter().enumerate() {
+        let cells = &pr.cells;
+        let mut k = 0;
+        while k < cells.len() {
+            let c = &cells[k];
+            let mut end = k + 1;
+            while end < cells.len()
+                && cells[end].tooth_index == c.tooth_index
+                && cells[end].slice == c.slice
+            {
+                end += 1;
+            }
+            last_column = cells[k..end]
+                .iter()
+                .map(|c| c.column)
+                .fold(last_column, usize::max);
+            let key = table(pr.position, c.tooth_index, c.slice);
+            runs.push((at, k, end, NONE));
+            let run = runs.len() - 1;
+            match tail[key] {
+                NONE => head[key] = run,
+                t => runs[t].3 = run,
+            }
+            tail[key] = run;
+            k = end;
         }
     }
+    // The profile of a key, once (a second line with the same key gets none).
+    let mut take = |position: usize, tooth: i32, slice: usize| -> Profile {
+        let Some(t) = tca.teeth.iter().position(|&k| k == tooth) else {
+            return Vec::new();
+        };
+        let key = table(position, t, slice);
+        let mut profile = Vec::new();
+        let mut run = std::mem::replace(&mut head[key], NONE);
+        while run != NONE {
+            let (at, start, end, next) = runs[run];
+            let pr = &ltca.positions[at];
+            for (c, &p) in pr.cells[start..end].iter().zip(&pr.pressure[start..end]) {
+                profile.push((c.r, p, 2.0 * c.cell.half_nu, c.column));
+            }
+            run = next;
+        }
+        profile
+    };
     // Samples per node column.
     let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); nj + 1];
     for line in &tca.contact_lines {
         let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
-        let mut cells = profiles
-            .remove(&(line.position, line.tooth, line.slice))
-            .unwrap_or_default();
+        let mut cells = take(line.position, line.tooth, line.slice);
         cells.sort_by(|a, b| a.0.total_cmp(&b.0));
         let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
         let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();

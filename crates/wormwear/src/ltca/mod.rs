@@ -321,7 +321,13 @@ pub fn analyse_worn(
             // one holding its centre (sub-slices are narrower than global cells).
             let holding =
                 (((c.z - wf.z[0]) / (wf.z[1] - wf.z[0])).floor().max(0.0) as usize).min(nj - 1);
-            for j in 0..nj {
+            // The global cells' centres increase with j: those in the extent are a run, found
+            // by bisection (the same test then decides, so the same cells as a full scan).
+            let first = partition_point(nj, |j| cell_z(j) < c.z - c.half_dz);
+            let last = partition_point(nj, |j| cell_z(j) <= c.z + c.half_dz);
+            let run = first..last.max(first);
+            let extra = (!run.contains(&holding)).then_some(holding);
+            for j in run.chain(extra) {
                 let zc = cell_z(j);
                 if j != holding && (zc < c.z - c.half_dz || zc > c.z + c.half_dz) {
                     continue;
@@ -372,6 +378,20 @@ pub fn analyse_worn(
         worm_torque,
         wheel_torque,
     })
+}
+
+/// First j in 0..n for which `below(j)` is false (`below` true on a prefix of 0..n).
+fn partition_point(n: usize, below: impl Fn(usize) -> bool) -> usize {
+    let (mut lo, mut hi) = (0, n);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if below(mid) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }
 
 /// One slice of a local mesh: a strip across the contact line of one tooth at face position
