@@ -42,7 +42,7 @@ pub struct Block {
 
 /// Dot product with four independent partial sums (lets the compiler vectorise the
 /// reduction; the summation order differs from a plain left-to-right sum by round-off).
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -115,6 +115,51 @@ impl LowRank {
             .copied()
             .unwrap_or([(0, self.rank), (0, 0), (0, 0)])
     }
+}
+
+/// y += F C F^T x (the low-rank bending term) over the non-zero column ranges of each row,
+/// skipping zero x.
+#[inline(always)]
+fn low_rank_add(lr: &LowRank, x: &[f64], y: &mut [f64]) {
+    // y += F C F^T x over the non-zero column ranges of each row (a row's functions
+    // live on its own tooth and thread: ~1/5 of the columns), skipping zero x.
+    let k = lr.rank;
+    let mut ft = vec![0.0; k];
+    for (i, &xi) in x.iter().enumerate() {
+        if xi == 0.0 {
+            continue;
+        }
+        let row = &lr.f[i * k..(i + 1) * k];
+        for (a, b) in lr.row_ranges(i) {
+            for (v, f) in ft[a..b].iter_mut().zip(&row[a..b]) {
+                *v += f * xi;
+            }
+        }
+    }
+    let cft: Vec<f64> = (0..k)
+        .map(|r| {
+            let core = &lr.core[r * k..(r + 1) * k];
+            lr.core_runs[r]
+                .iter()
+                .map(|&(a, b)| dot(&core[a..b], &ft[a..b]))
+                .sum()
+        })
+        .collect();
+    for (i, yi) in y.iter_mut().enumerate() {
+        let row = &lr.f[i * k..(i + 1) * k];
+        let mut sum = 0.0;
+        for (a, b) in lr.row_ranges(i) {
+            sum += dot(&row[a..b], &cft[a..b]);
+        }
+        *yi += sum;
+    }
+}
+
+/// [`low_rank_add`] compiled for AVX2 + FMA; chosen at run time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn low_rank_add_avx2(lr: &LowRank, x: &[f64], y: &mut [f64]) {
+    low_rank_add(lr, x, y)
 }
 
 /// The complementarity problem.
@@ -287,38 +332,15 @@ impl Problem {
             jobs.into_iter().for_each(work);
         }
         if let Some(lr) = &self.low_rank {
-            // y += F C F^T x over the non-zero column ranges of each row (a row's functions
-            // live on its own tooth and thread: ~1/5 of the columns), skipping zero x.
-            let k = lr.rank;
-            let mut ft = vec![0.0; k];
-            for (i, &xi) in x.iter().enumerate() {
-                if xi == 0.0 {
-                    continue;
-                }
-                let row = &lr.f[i * k..(i + 1) * k];
-                for (a, b) in lr.row_ranges(i) {
-                    for (v, f) in ft[a..b].iter_mut().zip(&row[a..b]) {
-                        *v += f * xi;
-                    }
-                }
+            #[cfg(target_arch = "x86_64")]
+            if wide {
+                // SAFETY: the CPU has AVX2 and FMA (checked above).
+                unsafe { low_rank_add_avx2(lr, x, y) };
+            } else {
+                low_rank_add(lr, x, y);
             }
-            let cft: Vec<f64> = (0..k)
-                .map(|r| {
-                    let core = &lr.core[r * k..(r + 1) * k];
-                    lr.core_runs[r]
-                        .iter()
-                        .map(|&(a, b)| dot(&core[a..b], &ft[a..b]))
-                        .sum()
-                })
-                .collect();
-            for (i, yi) in y.iter_mut().enumerate() {
-                let row = &lr.f[i * k..(i + 1) * k];
-                let mut sum = 0.0;
-                for (a, b) in lr.row_ranges(i) {
-                    sum += dot(&row[a..b], &cft[a..b]);
-                }
-                *yi += sum;
-            }
+            #[cfg(not(target_arch = "x86_64"))]
+            low_rank_add(lr, x, y);
         }
     }
 
