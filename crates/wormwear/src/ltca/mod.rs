@@ -830,3 +830,39 @@ fn solve_position(
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::partition_point;
+
+    #[test]
+    fn partition_point_finds_the_run_a_full_scan_finds() {
+        // Increasing centres as the loaded pattern's global cells; every extent [lo, hi] gives
+        // the same cells as testing all of them.
+        let centres: Vec<f64> = (0..60)
+            .map(|j| -22.5 + 0.75 * j as f64 + 0.01 * j as f64)
+            .collect();
+        let n = centres.len();
+        for &(lo, hi) in &[
+            (-30.0, -25.0),
+            (-30.0, -22.0),
+            (-5.0, -4.9),
+            (-5.0, 5.0),
+            (22.0, 30.0),
+            (40.0, 50.0),
+            (0.0, 0.0),
+            (centres[10], centres[12]),
+        ] {
+            let scan: Vec<usize> = (0..n)
+                .filter(|&j| centres[j] >= lo && centres[j] <= hi)
+                .collect();
+            let first = partition_point(n, |j| centres[j] < lo);
+            let last = partition_point(n, |j| centres[j] <= hi);
+            let run: Vec<usize> = (first..last.max(first)).collect();
+            assert_eq!(run, scan, "[{lo}, {hi}]");
+        }
+        assert_eq!(partition_point(0, |_| true), 0);
+        assert_eq!(partition_point(5, |_| true), 5);
+        assert_eq!(partition_point(5, |_| false), 0);
+    }
+}
