@@ -131,6 +131,12 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
         100.0 * peak_share(&rigid),
         100.0 * peak_share(&bent)
     );
+    print_solver_work(&rigid, &bent);
+}
+
+/// Prints the PK iterations summed over the positions and the cells per position, without and
+/// with bending.
+fn print_solver_work(rigid: &Ltca, bent: &Ltca) {
     let work = |r: &Ltca| {
         let it: usize = r.positions.iter().map(|p| p.residuals.iterations).sum();
         let cells: usize = r.positions.iter().map(|p| p.cells.len()).sum();
@@ -138,8 +144,8 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
     };
     eprintln!(
         "solver iterations over the positions / cells per position: {:?} without, {:?} with bending",
-        work(&rigid),
-        work(&bent)
+        work(rigid),
+        work(bent)
     );
 }
 
@@ -160,16 +166,7 @@ fn bending_figures_for_the_1x40_design_case() {
         100.0 * peak_share(&rigid),
         100.0 * peak_share(&bent)
     );
-    let work = |r: &Ltca| {
-        let it: usize = r.positions.iter().map(|p| p.residuals.iterations).sum();
-        let cells: usize = r.positions.iter().map(|p| p.cells.len()).sum();
-        (it, cells / r.positions.len())
-    };
-    eprintln!(
-        "solver iterations over the positions / cells per position: {:?} without, {:?} with bending",
-        work(&rigid),
-        work(&bent)
-    );
+    print_solver_work(&rigid, &bent);
 }
 
 /// MODEL §5.5 step 5: 7 vs 13 points across the wheel's face width (and 9 vs 13 along the
