@@ -401,17 +401,11 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
 
 /// The file's life plan with the command-line overrides applied.
 fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPlan, Failure> {
-    use wormwear::input::{Endurance, Phase, StepControl, WearPlan};
+    use wormwear::input::{Phase, StepControl, WearPlan};
     let bad = |m: String| Failure::Input(anyhow::anyhow!(m));
     let mut plan = match (&gear.wear, args.cycles) {
         (Some(p), _) => p.clone(),
-        (None, Some(_)) => WearPlan {
-            life_cycles: 0.0,
-            step: StepControl::MaxRemoval(4e-6),
-            max_substep_removal: 5e-6,
-            phases: Vec::new(),
-            endurance: Endurance::DEFAULT,
-        },
+        (None, Some(_)) => WearPlan::with_life(0.0),
         (None, None) => {
             return Err(bad(
                 "the file has no [wear] section: add one (life_cycles, step_wear_um or step_cycles) or give --cycles".into(),

@@ -98,7 +98,13 @@ fn bench(c: &mut Criterion) {
     let settings = wormwear::ltca::LtcaSettings::from_gear(&g140);
     let mut removal = wormwear::geometry::FlankField::zeros(wf);
     let l = wormwear::ltca::analyse(&g140, &geo, &tca).unwrap();
-    let first = wormwear::wear::per_cycle(&g140, &geo, &tca, &l);
+    let first = wormwear::wear::per_cycle(
+        &g140,
+        &geo,
+        &tca,
+        &l,
+        wormwear::input::FilmLoad::LoadedAnalysis,
+    );
     for (h, d) in removal.values.iter_mut().zip(&first.depth.values) {
         *h = 5000.0 * d;
     }
@@ -113,9 +119,16 @@ fn bench(c: &mut Criterion) {
                     &settings,
                     None,
                     Some(&removal),
+                    None,
                 )
                 .unwrap();
-                let w = wormwear::wear::per_cycle(&g140, &geo, &tca, &l);
+                let w = wormwear::wear::per_cycle(
+                    &g140,
+                    &geo,
+                    &tca,
+                    &l,
+                    wormwear::input::FilmLoad::LoadedAnalysis,
+                );
                 let mut next = removal.clone();
                 for (h, d) in next.values.iter_mut().zip(&w.depth.values) {
                     *h += 1000.0 * d;

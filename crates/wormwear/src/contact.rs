@@ -34,6 +34,16 @@ impl ElasticPair {
     }
 }
 
+/// Hertz half-width of a line contact, cylinder on plane (MODEL §12 g): a = sqrt(4 w R /
+/// (pi E*)) for the line load w (N/m), relative radius R (m) and effective modulus E* (Pa) of
+/// [`ElasticPair`]; m. Zero when w <= 0 or R is not a positive finite radius.
+pub fn hertz_half_width(line_load: f64, radius: f64, effective_modulus: f64) -> f64 {
+    if line_load <= 0.0 || !(radius > 0.0 && radius.is_finite()) {
+        return 0.0;
+    }
+    (4.0 * line_load * radius / (PI * effective_modulus)).sqrt()
+}
+
 /// Love's integral of 1/r over the rectangle [-a, a] x [-b, b] seen from (x, y) (in-plane
 /// offsets from the rectangle centre), m. Times `ElasticPair::normal` it is the normal
 /// displacement per unit uniform pressure.

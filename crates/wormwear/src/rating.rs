@@ -53,6 +53,25 @@ pub fn base_friction(sliding_speed: f64) -> f64 {
     (0.024 + 0.0032 / (sliding_speed + 0.1).powf(1.71)).min(0.094)
 }
 
+/// Rank's wheel cycles to first pitting (A_p10 = 2 %, MODEL §9):
+/// N_LI = 1e6 (1 + 0.860 ln(3 v_gm / v_ref)) exp[28.078 - 4.666 ln(520 sigma_Hm / sigma_Hlim)],
+/// v_gm the sliding speed at the reference diameter (m/s), v_ref = 3 m/s, stresses in MPa.
+/// None outside the formula's range: a speed factor <= 0 (v_gm below 0.31 m/s, where it
+/// would give a negative life) or a stress that is not positive.
+pub fn rank_first_pitting_cycles(
+    sliding_speed: f64,
+    sigma_hm_mpa: f64,
+    sigma_hlim_mpa: f64,
+) -> Option<f64> {
+    let v_ref = 3.0;
+    let speed = 1.0 + 0.860 * (3.0 * sliding_speed / v_ref).ln();
+    if !(speed > 0.0 && sigma_hm_mpa > 0.0 && sigma_hlim_mpa > 0.0) {
+        return None;
+    }
+    let n = 1e6 * speed * (28.078 - 4.666 * (520.0 * sigma_hm_mpa / sigma_hlim_mpa).ln()).exp();
+    n.is_finite().then_some(n)
+}
+
 /// Parameter p_m* of the mean Hertz stress (method C). alpha in degrees.
 #[allow(clippy::too_many_arguments)]
 pub fn p_m_star(
@@ -150,9 +169,7 @@ pub fn rate(gear: &GearSet) -> Rating {
     let sigma_lim = gear.wheel_material.pitting_limit * 1e-6;
     let sigma_hg = sigma_lim * factors.pitting_life_factor;
     let v_ref = 3.0;
-    let n_li = 1e6
-        * (1.0 + 0.860 * (3.0 * v_g / v_ref).ln())
-        * (28.078 - 4.666 * (520.0 * sigma_hm / sigma_lim).ln()).exp();
+    let n_li = rank_first_pitting_cycles(v_g, sigma_hm, sigma_lim).unwrap_or(f64::NAN);
     let n_lii = (factors.pitted_area_max_percent - 2.0) * 1e6
         / (16.212 * (sigma_hm - 180.0) / sigma_lim
             * (1.541 * sigma_hm / sigma_lim - 0.581 * v_g / v_ref).exp());

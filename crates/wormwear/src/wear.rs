@@ -14,9 +14,9 @@
 //! (TCA), the film and k(lambda) come from [`crate::lubrication`].
 
 use crate::geometry::{FlankField, Geometry, WheelFlank};
-use crate::input::GearSet;
+use crate::input::{FilmLoad, GearSet, PitDepth};
 use crate::kinematics::{GapEvaluator, Tca};
-use crate::ltca::Ltca;
+use crate::ltca::{stats, Ltca};
 use crate::lubrication::{self, LineContact};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -32,10 +32,16 @@ pub struct CycleWear {
     pub lambda: FlankField,
     /// Film thickness h_min Phi_T at the passage, m (NaN where not swept).
     pub film: FlankField,
-    /// Line load at the passage, N/m (0 where not swept).
+    /// Line load at the passage, N/m (the largest if swept more than once; 0 where not
+    /// swept).
     pub line_load: FlankField,
+    /// Relative radius of curvature across the line at that passage, m (0 where not swept).
+    pub contact_radius: FlankField,
     /// Half-width of the loaded band when it passes (the largest), m (0 where not swept).
     pub half_width: FlankField,
+    /// Hertz half-width of the line contact at that passage, a = sqrt(4 w R / (pi E*)) with
+    /// its line load w and relative radius R (MODEL §12 g), m (0 where not swept).
+    pub hertz_half_width: FlankField,
 }
 
 /// One instant of the contact band's passage over a node column: the pressure profile across
@@ -114,8 +120,15 @@ impl Sample {
 /// interval (sub-steps of at most a tenth of the band width). The passage is thus resolved
 /// whatever the number of positions (no aliasing), and the band follows the worn geometry
 /// (the profiles are the loaded analysis on it). Depth = (k(lambda)/H) |vg| integral(p dt),
-/// |vg| of the node at its contact moment, lambda from the interpolated line load.
-pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> CycleWear {
+/// |vg| of the node at its contact moment, lambda from the interpolated line load (floored at
+/// the Hertz load of the peak pressure with [`FilmLoad::HertzPeakFloor`]).
+pub fn per_cycle(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    ltca: &Ltca,
+    film_load: FilmLoad,
+) -> CycleWear {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let tau = 2.0 * PI / geo.teeth as f64;
@@ -236,6 +249,8 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
         gear.wheel_material.youngs_modulus,
         gear.wheel_material.poisson_ratio,
     );
+    // E* of the Hertz half-width: 1/E* = (1-v1^2)/E1 + (1-v2^2)/E2 = 2/E'.
+    let e_star = 0.5 * e_prime;
     let k_dry = gear.wheel_material.wear_coefficient;
     let hardness = gear.wheel_material.hardness;
     let mut depth = FlankField::zeros(wf);
@@ -243,6 +258,8 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
     let mut film = FlankField::zeros(wf);
     let mut line_load = FlankField::zeros(wf);
     let mut half_width = FlankField::zeros(wf);
+    let mut hertz_half_width = FlankField::zeros(wf);
+    let mut contact_radius = FlankField::zeros(wf);
     lambda.values.fill(f64::NAN);
     film.values.fill(f64::NAN);
     // Rolling velocities per node; where the TCA has none (nodes at the border of the region
@@ -271,12 +288,13 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
         })
         .collect();
     // Node columns are independent (each writes its own nodes): in parallel, then gathered.
-    // Per node of a column: depth, lambda, film, line load, half-width.
-    let per_column: Vec<Vec<[f64; 5]>> = columns
+    // Per node of a column: depth, lambda, film, line load, band half-width, and the relative
+    // radius at the passage of the largest line load.
+    let per_column: Vec<Vec<[f64; 6]>> = columns
         .par_iter_mut()
         .enumerate()
         .map(|(j, samples)| {
-            let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0]; ni + 1];
+            let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
             samples.sort_by(|a, b| a.time.total_cmp(&b.time));
             for pair in samples.windows(2) {
                 let (a, b) = (&pair[0], &pair[1]);
@@ -324,16 +342,22 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
                     if integral <= 0.0 {
                         continue;
                     }
-                    // The film is that of the Hertzian line contact with the band's peak pressure
-                    // (w = 2 pi R p0^2 / E'): a band cut short by an edge or concentrated on a
-                    // ridge carries little load per length but is no thicker a film for that.
+                    // The film of the line contact with the local line load (MODEL §6, §12 h),
+                    // or, as a refinement, with at least the Hertz load of the band's peak
+                    // pressure (w = 2 pi R p0^2 / E').
                     let radius = fill(a.radius, b.radius);
                     let peak = a.pressure.max(b.pressure);
+                    let film_line_load = match film_load {
+                        FilmLoad::LoadedAnalysis => w,
+                        FilmLoad::HertzPeakFloor => {
+                            w.max(2.0 * PI * radius * peak * peak / e_prime)
+                        }
+                    };
                     let contact = LineContact {
                         radius,
                         u1,
                         u2,
-                        line_load: w.max(2.0 * PI * radius * peak * peak / e_prime),
+                        line_load: film_line_load,
                         pressure: peak,
                     };
                     let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
@@ -343,7 +367,10 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
                         o[1] = fl.lambda;
                         o[2] = fl.h_min * fl.thermal_factor;
                     }
-                    o[3] = o[3].max(w);
+                    if w > o[3] {
+                        o[3] = w;
+                        o[5] = radius;
+                    }
                     o[4] = o[4].max(a.half_width.max(b.half_width));
                 }
             }
@@ -358,6 +385,8 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
             film.values[k] = o[2];
             line_load.values[k] = o[3];
             half_width.values[k] = o[4];
+            contact_radius.values[k] = o[5];
+            hertz_half_width.values[k] = crate::contact::hertz_half_width(o[3], o[5], e_star);
         }
     }
     CycleWear {
@@ -366,6 +395,8 @@ pub fn per_cycle(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Cycl
         film,
         line_load,
         half_width,
+        contact_radius,
+        hertz_half_width,
     }
 }
 
@@ -496,10 +527,14 @@ pub struct WearState {
     /// Pitted nodes of the loaded flank (empty: none).
     #[serde(default)]
     pub pitted: Vec<bool>,
-    /// Band factor of the local contact meshes reached by the widenings so far (None: the
-    /// settings' own).
+    /// Band factor of the local contact meshes for this state's loaded analysis, reached by
+    /// the widenings so far (None: the settings' own).
     #[serde(default)]
     pub band_factor: Option<f64>,
+    /// Loads the solver of this state's loaded analysis starts from (the previous analysis';
+    /// None: a cold start). Kept with the state so a resumed run repeats the analysis exactly.
+    #[serde(default)]
+    pub warm: Option<crate::ltca::WarmStart>,
 }
 
 impl WearState {
@@ -513,6 +548,7 @@ impl WearState {
             pitted_phases: Vec::new(),
             pitted: Vec::new(),
             band_factor: None,
+            warm: None,
         }
     }
 }
@@ -557,6 +593,47 @@ pub struct StepRecord {
     /// Film ratio range over the swept nodes.
     pub lambda_min: f64,
     pub lambda_max: f64,
+    /// Largest mean pressure over a patch of stated size (`[analysis] pressure_patch_*`,
+    /// default 0.5 mm across the line by 1 mm along the face), Pa: unlike the maximum
+    /// (`max_pressure_pa`, one cell, grows with refinement at a sharp edge) it converges with
+    /// the mesh.
+    #[serde(default)]
+    pub pressure_patch_max_pa: f64,
+    /// Rigid lag that the wear adds, mean over positions: the growth of the loaded flank's
+    /// smallest angular gap (the worn flank's kinematic lag, part of the backlash), rad
+    /// (MODEL §12 j).
+    #[serde(default)]
+    pub rigid_lag_rad: f64,
+    /// Loaded TE relative to the rigid lag (TE + lag at each position): mean and
+    /// peak-to-peak, rad.
+    #[serde(default)]
+    pub te_mean_relative_rad: f64,
+    #[serde(default)]
+    pub te_p2p_relative_rad: f64,
+    /// Rank's cycles to first pitting N_LI with the model's mean pressure of the loaded
+    /// pattern in place of sigma_Hm (MODEL §12 k); None where the formula is out of range.
+    #[serde(default)]
+    pub n_li_model_cycles: Option<f64>,
+    /// Loaded analyses run so far (this state's included): a step split by the stability
+    /// guard costs one per sub-step (MODEL §7.3: the geometry is frozen within one).
+    #[serde(default)]
+    pub loaded_analyses: usize,
+    /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
+    /// `wear_positions.csv`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub positions: Vec<PositionState>,
+}
+
+/// One position of a state's loaded analysis (MODEL §7.7: load sharing and TE over life).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PositionState {
+    /// Loaded transmission error, rad (negative = lag).
+    pub te_rad: f64,
+    /// TE + the rigid lag of the wear at this position, rad.
+    pub te_relative_rad: f64,
+    /// Normal force per studied tooth (TCA tooth order), N.
+    pub tooth_load_n: Vec<f64>,
+    pub max_pressure_pa: f64,
 }
 
 /// Why a life run stopped.
@@ -584,16 +661,18 @@ pub struct StepView<'a> {
     pub cycle: &'a CycleWear,
     /// The last state of the run (the life is reached).
     pub last: bool,
+    /// A state whose maps are written (`map_cycles`, or 0, 1, 2, 4, ... by default).
+    pub map: bool,
 }
 
 /// Runs the life (MODEL §7.3-7.7, §8) from `state` (unworn, or a checkpoint): at each state
 /// the loaded analysis on the worn geometry, the wear of one cycle, a record; then, in a wear
 /// phase, a step of C_k cycles (fixed, or removing at most the given depth; never across a
-/// phase end) with the geometry frozen; at the start of a pitting phase the pits are cut
-/// (every node whose loaded-pattern pressure exceeds the phase's limit loses 0.78 a, a the
-/// Hertz half-width there), then the phase passes without wear. Until the life is reached.
-/// `on_state` is called after every record (checkpoint, files); an error from it stops the
-/// run.
+/// phase end or a map cycle) with the geometry frozen; at the start of a pitting phase the
+/// pits are cut (every node whose loaded-pattern pressure exceeds the phase's limit loses
+/// 0.78 a, a the local Hertz half-width there, MODEL §12 g), then the phase passes without
+/// wear. Until the life is reached. `on_state` is called after every record (checkpoint,
+/// files); an error from it stops the run.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     gear: &GearSet,
@@ -613,18 +692,112 @@ pub fn simulate(
             state.removal.cells_height, state.removal.cells_face, wf.cells_height, wf.cells_face
         )));
     }
-    let backlash = Backlash::new(gear, geo, tca);
-    let initial = backlash.stats(&FlankField::zeros(wf)).linear_mean_m;
-    let area = wf.active_area();
-    let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
-    let mut substeps = state.records.last().map_or(0, |r| r.substeps);
     if state.pitted.len() != wf.nodes.len() {
         state.pitted = vec![false; wf.nodes.len()];
     }
-    // Phase at some cycles: (index, phase, end), None after the schedule (wear).
-    let phase_at = |cycles: f64| -> Option<(usize, Phase, f64)> {
+    let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
+    let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
+    let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    loop {
+        let (l, band) = life_loop.analyse(&state)?;
+        let cw = per_cycle(gear, geo, tca, &l, life.film_load);
+        let phase = life_loop.phase_at(state.cycles);
+        let record = life_loop.record(&state, &l, &cw, phase, step_cycles, substeps);
+        // A resumed run recomputes the state it stopped at: keep one record per step.
+        state.records.retain(|r| r.step < state.step);
+        state.records.push(record);
+        let left = life.life_cycles - state.cycles;
+        let last = left <= 1e-9 * life.life_cycles.max(1.0);
+        on_state(&StepView {
+            state: &state,
+            ltca: &l,
+            cycle: &cw,
+            last,
+            map: life_loop.is_map_state(&state),
+        })?;
+        if last {
+            break;
+        }
+        // What the next analysis starts from (after the checkpoint, which keeps what this
+        // state's analysis used).
+        state.band_factor = band;
+        state.warm = Some(l.warm_start());
+        let end = match phase {
+            Some((k, Phase::Pitting { .. }, end)) => {
+                step_cycles = life_loop.pitting_step(&mut state, &l, &cw, k, end);
+                substeps = 1;
+                state.step += 1;
+                continue;
+            }
+            Some((_, Phase::Wear { .. }, end)) => end,
+            None => life.life_cycles,
+        };
+        let left = left
+            .min(end - state.cycles)
+            .min(life_loop.next_map_cycles(state.cycles) - state.cycles);
+        let rate = cw.depth.max();
+        step_cycles = match life.step {
+            StepControl::Cycles(c) => c.min(left),
+            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
+            StepControl::MaxRemoval(_) => left,
+        };
+        substeps = life_loop.wear_step(&mut state, cw, step_cycles)?;
+        state.step += 1;
+    }
+    Ok(state)
+}
+
+/// What the life loop of [`simulate`] works with, and its named steps.
+struct LifeLoop<'a> {
+    gear: &'a GearSet,
+    geo: &'a Geometry,
+    tca: &'a Tca,
+    settings: &'a crate::ltca::LtcaSettings,
+    bending: Option<&'a dyn crate::ltca::BendingModel>,
+    life: &'a WearPlan,
+    wf: &'a WheelFlank,
+    backlash: Backlash,
+    /// Backlash per position of the unworn flank, rad.
+    initial_backlash: Vec<f64>,
+    active_area: f64,
+    /// Sliding speed at the reference diameter (the standard's v_gm) and sigma_Hlim, for
+    /// Rank's N_LI from the model's mean pressure.
+    sliding_speed: f64,
+    pitting_limit: f64,
+}
+
+impl<'a> LifeLoop<'a> {
+    fn new(
+        gear: &'a GearSet,
+        geo: &'a Geometry,
+        tca: &'a Tca,
+        settings: &'a crate::ltca::LtcaSettings,
+        bending: Option<&'a dyn crate::ltca::BendingModel>,
+        life: &'a WearPlan,
+    ) -> Self {
+        let wf = geo.wheel_flank(tca.loaded_flank);
+        let backlash = Backlash::new(gear, geo, tca);
+        let initial_backlash = backlash.per_position(&FlankField::zeros(wf));
+        Self {
+            gear,
+            geo,
+            tca,
+            settings,
+            bending,
+            life,
+            wf,
+            backlash,
+            initial_backlash,
+            active_area: wf.active_area(),
+            sliding_speed: crate::rating::rate(gear).sliding_speed_m_s,
+            pitting_limit: gear.wheel_material.pitting_limit,
+        }
+    }
+
+    /// Phase at some cycles: (index, phase, end); None after the schedule (wear).
+    fn phase_at(&self, cycles: f64) -> Option<(usize, Phase, f64)> {
         let mut start = 0.0;
-        for (k, p) in life.phases.iter().enumerate() {
+        for (k, p) in self.life.phases.iter().enumerate() {
             let end = match *p {
                 Phase::Wear { until } | Phase::Pitting { until, .. } => until,
             };
@@ -634,18 +807,51 @@ pub fn simulate(
             start = end;
         }
         None
-    };
-    // The worn contact widens: the band of the local meshes starts as wide as the last
-    // analysis needed (no repeated widenings), carried in the state for an exact resume.
-    let analyse = |state: &WearState| -> Result<(Ltca, Option<f64>), WearError> {
-        let mut local = *settings;
-        local.band_factor = state.band_factor.unwrap_or(settings.band_factor);
-        let l = crate::ltca::analyse_worn(gear, geo, tca, &local, bending, Some(&state.removal))
-            .map_err(|source| WearError::Ltca {
-                step: state.step,
-                cycles: state.cycles,
-                source,
-            })?;
+    }
+
+    /// The first map cycle beyond `cycles` (infinite: none).
+    fn next_map_cycles(&self, cycles: f64) -> f64 {
+        self.life
+            .map_cycles
+            .iter()
+            .flatten()
+            .copied()
+            .find(|&c| c > cycles * (1.0 + 1e-12) + 1e-9)
+            .unwrap_or(f64::INFINITY)
+    }
+
+    /// Whether the maps of this state are written: at the map cycles, or by default at the
+    /// states 0, 1, 2, 4, 8, ...
+    fn is_map_state(&self, state: &WearState) -> bool {
+        match &self.life.map_cycles {
+            None => state.step == 0 || state.step.is_power_of_two(),
+            Some(list) => list
+                .iter()
+                .any(|&c| (c - state.cycles).abs() <= 1e-9 * c.max(1.0)),
+        }
+    }
+
+    /// Loaded analysis on the worn geometry. The worn contact widens: the band of the local
+    /// meshes starts as wide as the last analysis needed (no repeated widenings), carried in
+    /// the state for an exact resume. An unworn flank is analysed as the LTCA stage does.
+    fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
+        let mut local = *self.settings;
+        local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
+        let worn = state.removal.values.iter().any(|&h| h != 0.0);
+        let l = crate::ltca::analyse_worn(
+            self.gear,
+            self.geo,
+            self.tca,
+            &local,
+            self.bending,
+            worn.then_some(&state.removal),
+            state.warm.as_ref(),
+        )
+        .map_err(|source| WearError::Ltca {
+            step: state.step,
+            cycles: state.cycles,
+            source,
+        })?;
         let widenings = l
             .positions
             .iter()
@@ -656,17 +862,50 @@ pub fn simulate(
             .then(|| (local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0))
             .or(state.band_factor);
         Ok((l, band))
-    };
-    loop {
-        let (l, band) = analyse(&state)?;
-        state.band_factor = band;
-        let cw = per_cycle(gear, geo, tca, &l);
-        let b = backlash.stats(&state.removal);
+    }
+
+    /// The record of a state (MODEL §7.7, §12 j, §12 k).
+    fn record(
+        &self,
+        state: &WearState,
+        l: &Ltca,
+        cw: &CycleWear,
+        phase: Option<(usize, Phase, f64)>,
+        step_cycles: f64,
+        substeps: usize,
+    ) -> StepRecord {
+        let wf = self.wf;
+        let per_position = self.backlash.per_position(&state.removal);
+        let lag: Vec<f64> = per_position
+            .iter()
+            .zip(&self.initial_backlash)
+            .map(|(b, b0)| b - b0)
+            .collect();
+        let positions: Vec<PositionState> = l
+            .positions
+            .iter()
+            .map(|p| PositionState {
+                te_rad: p.transmission_error,
+                te_relative_rad: p.transmission_error + lag[p.position],
+                tooth_load_n: p.tooth_load.clone(),
+                max_pressure_pa: p.max_pressure,
+            })
+            .collect();
+        let b = self.backlash.stats(&state.removal);
+        let initial = self.initial_backlash.iter().sum::<f64>()
+            / self.initial_backlash.len().max(1) as f64
+            * self.backlash.reference_radius;
         let (te_mean, te_p2p) = l.te_stats();
+        let (te_rel_mean, te_rel_p2p) = stats(positions.iter().map(|p| p.te_relative_rad));
         let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
         let volume = state.removal.integral(wf);
-        let phase = phase_at(state.cycles);
-        let record = StepRecord {
+        let previous = state
+            .records
+            .iter()
+            .rev()
+            .find(|r| r.step < state.step)
+            .map_or(0, |r| r.loaded_analyses);
+        StepRecord {
             step: state.step,
             cycles: state.cycles,
             step_cycles,
@@ -677,7 +916,7 @@ pub fn simulate(
             },
             pitted_area_fraction: pitted_fraction(wf, &state.pitted),
             max_wear_m: state.removal.max(),
-            mean_wear_m: volume / area,
+            mean_wear_m: volume / self.active_area,
             worn_volume_m3: volume,
             backlash_m: b.linear_mean_m,
             backlash_increase_m: b.linear_mean_m - initial,
@@ -694,73 +933,75 @@ pub fn simulate(
             max_wear_per_cycle_m: cw.depth.max(),
             lambda_min: lambdas.clone().fold(f64::INFINITY, f64::min),
             lambda_max: lambdas.fold(0.0, f64::max),
-        };
-        // A resumed run recomputes the state it stopped at: keep one record per step.
-        state.records.retain(|r| r.step < state.step);
-        state.records.push(record);
-        let left = life.life_cycles - state.cycles;
-        let last = left <= 1e-9 * life.life_cycles.max(1.0);
-        on_state(&StepView {
-            state: &state,
-            ltca: &l,
-            cycle: &cw,
-            last,
-        })?;
-        if last {
-            break;
+            pressure_patch_max_pa: l.pressure_patch_max,
+            rigid_lag_rad: lag.iter().sum::<f64>() / lag.len().max(1) as f64,
+            te_mean_relative_rad: te_rel_mean,
+            te_p2p_relative_rad: te_rel_p2p,
+            n_li_model_cycles: crate::rating::rank_first_pitting_cycles(
+                self.sliding_speed,
+                l.mean_pressure * 1e-6,
+                self.pitting_limit * 1e-6,
+            ),
+            loaded_analyses: previous + substeps.max(1),
+            positions,
         }
-        let left = match phase {
-            Some((
-                k,
-                Phase::Pitting {
-                    pressure_limit,
-                    margin,
-                    ..
-                },
-                end,
-            )) => {
-                if !state.pitted_phases.contains(&k) {
-                    // Cut the pits (same cycles; the next record shows the new pressures).
-                    let duration = end - state.cycles;
-                    let limit = pressure_limit
-                        .unwrap_or_else(|| life.endurance.pressure(duration) * (1.0 + margin));
-                    cut_pits(
-                        wf,
-                        &l.pattern,
-                        limit,
-                        &cw.half_width,
-                        &mut state.removal,
-                        &mut state.pitted,
-                    );
-                    state.pitted_phases.push(k);
-                    step_cycles = 0.0;
-                } else {
-                    // No wear while the cracks incubate (up to the phase end, or the life if it
-                    // ends first).
-                    let end = end.min(life.life_cycles);
-                    step_cycles = end - state.cycles;
-                    state.cycles = end;
-                }
-                substeps = 1;
-                state.step += 1;
-                continue;
-            }
-            Some((_, Phase::Wear { .. }, end)) => left.min(end - state.cycles),
-            None => left,
+    }
+
+    /// A state in pitting phase k (ending at `end`): at its start the pits are cut (same
+    /// cycles; the next record shows the new pressures), then the phase passes without wear
+    /// up to its end (or the life's, if first). Returns the cycles advanced.
+    fn pitting_step(
+        &self,
+        state: &mut WearState,
+        l: &Ltca,
+        cw: &CycleWear,
+        k: usize,
+        end: f64,
+    ) -> f64 {
+        let Phase::Pitting {
+            pressure_limit,
+            margin,
+            ..
+        } = self.life.phases[k]
+        else {
+            return 0.0;
         };
-        let rate = cw.depth.max();
-        step_cycles = match life.step {
-            StepControl::Cycles(c) => c.min(left),
-            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
-            StepControl::MaxRemoval(_) => left,
-        };
-        // Advance by step_cycles, in sub-steps when the guard asks for them.
+        if !state.pitted_phases.contains(&k) {
+            let duration = end - state.cycles;
+            let limit = pressure_limit
+                .unwrap_or_else(|| self.life.endurance.pressure(duration) * (1.0 + margin));
+            let depth = pit_depths(cw, self.life.pit_depth);
+            cut_pits(
+                self.wf,
+                &l.pattern,
+                limit,
+                &depth,
+                &mut state.removal,
+                &mut state.pitted,
+            );
+            state.pitted_phases.push(k);
+            return 0.0;
+        }
+        let end = end.min(self.life.life_cycles);
+        let advanced = end - state.cycles;
+        state.cycles = end;
+        advanced
+    }
+
+    /// Advances the state by `step_cycles` of wear at the rates of `rate_map`, in equal
+    /// sub-steps with the pressures recomputed when the stability guard asks for them
+    /// (MODEL §7.3). Returns the number of sub-steps.
+    fn wear_step(
+        &self,
+        state: &mut WearState,
+        mut rate_map: CycleWear,
+        step_cycles: f64,
+    ) -> Result<usize, WearError> {
         let mut remaining = step_cycles;
-        let mut rate_map = cw;
-        substeps = 0;
+        let mut substeps = 0;
         loop {
             let rate = rate_map.depth.max();
-            let cap = life.max_substep_removal;
+            let cap = self.life.max_substep_removal;
             let dc = if cap > 0.0 && rate * remaining > cap * (1.0 + 1e-9) {
                 // Equal sub-steps over what is left of the step.
                 let n = (rate * remaining / cap).ceil();
@@ -775,15 +1016,27 @@ pub fn simulate(
             remaining -= dc;
             substeps += 1;
             if remaining <= 1e-9 * step_cycles {
-                break;
+                return Ok(substeps);
             }
-            let (l, band) = analyse(&state)?;
+            let (l, band) = self.analyse(state)?;
             state.band_factor = band;
-            rate_map = per_cycle(gear, geo, tca, &l);
+            state.warm = Some(l.warm_start());
+            rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
         }
-        state.step += 1;
     }
-    Ok(state)
+}
+
+/// Depth of the pits at every node (MODEL §8, §12 g): 0.78 a, a the local Hertz half-width
+/// (published) or the loaded band's half-width (refinement), m.
+pub fn pit_depths(cw: &CycleWear, rule: PitDepth) -> FlankField {
+    let half_width = match rule {
+        PitDepth::Hertz => &cw.hertz_half_width,
+        PitDepth::LoadedBand => &cw.half_width,
+    };
+    FlankField {
+        values: half_width.values.iter().map(|a| 0.78 * a).collect(),
+        ..half_width.clone()
+    }
 }
 
 /// Share of the active flank area around pitted nodes (cells with a pitted corner).
@@ -807,13 +1060,14 @@ fn pitted_fraction(wf: &WheelFlank, pitted: &[bool]) -> f64 {
 }
 
 /// Cuts the pits of a pitting phase (MODEL §8): every node whose loaded-pattern pressure (the
-/// largest of its cells) exceeds `limit` loses 0.78 a more, a the half-width of the loaded
-/// band there (depth of the largest shear stress under a line contact).
-fn cut_pits(
+/// largest of its cells) exceeds `limit` (Pa) and that the contact passes (depth > 0) loses
+/// `depth` more (m; [`pit_depths`]: 0.78 a, the depth of the largest shear stress under a
+/// line contact).
+pub fn cut_pits(
     wf: &WheelFlank,
     pattern: &[f64],
     limit: f64,
-    half_width: &FlankField,
+    depth: &FlankField,
     removal: &mut FlankField,
     pitted: &mut [bool],
 ) {
@@ -832,8 +1086,8 @@ fn cut_pits(
                 }
             }
             let k = j * (ni + 1) + i;
-            if p > limit && half_width.values[k] > 0.0 {
-                removal.values[k] += 0.78 * half_width.values[k];
+            if p > limit && depth.values[k] > 0.0 {
+                removal.values[k] += depth.values[k];
                 pitted[k] = true;
             }
         }

@@ -16,6 +16,19 @@ fn example(name: &str) -> GearSet {
     input::load(&path).unwrap()
 }
 
+/// The example with the 20 um parabolic tip and edge reliefs over 1 mm (an option; the
+/// default is sharp): the set-up of the tests written for it.
+fn relieved(name: &str) -> GearSet {
+    let mut g = example(name);
+    let relief = wormwear::input::EdgeRelief {
+        amount: 20e-6,
+        length: 1e-3,
+    };
+    g.worm.tip_relief = relief;
+    g.wheel.edge_relief = relief;
+    g
+}
+
 fn run(g: &GearSet, settings: &LtcaSettings) -> Ltca {
     let geo = Geometry::build(g).unwrap();
     let tca = kinematics::analyse(g, &geo).unwrap();
@@ -24,9 +37,20 @@ fn run(g: &GearSet, settings: &LtcaSettings) -> Ltca {
 
 #[test]
 fn equilibrium_and_complementarity_hold() {
-    let g = example("gear-1x40-design.toml");
-    let s = LtcaSettings::from_gear(&g);
-    let res = run(&g, &s);
+    // Sharp edges (default) and with reliefs. The meshing identity below holds at conjugate
+    // points; with sharp edges the worm's tip edge touches too (not a conjugate point), so it
+    // is checked on the relieved gear, where the edges are eased out of contact.
+    for (g, conjugate_only) in [
+        (example("gear-1x40-design.toml"), false),
+        (relieved("gear-1x40-design.toml"), true),
+    ] {
+        equilibrium_and_complementarity_of(&g, conjugate_only);
+    }
+}
+
+fn equilibrium_and_complementarity_of(g: &GearSet, identity: bool) {
+    let s = LtcaSettings::from_gear(g);
+    let res = run(g, &s);
     assert_eq!(res.bending_model, "none");
     for p in &res.positions {
         assert!(
@@ -47,7 +71,7 @@ fn equilibrium_and_complementarity_hold() {
         for c in p
             .cells
             .iter()
-            .filter(|c| c.separation.abs() < 1e-9 && c.relief == 0.0)
+            .filter(|c| identity && c.separation.abs() < 1e-9 && c.relief == 0.0)
         {
             assert!(
                 (c.lever / c.worm_lever.abs() / 40.0 - 1.0).abs() < 2e-5,
@@ -109,12 +133,15 @@ fn both_solvers_agree_on_the_1x40() {
 }
 
 /// Acceptance criterion of the LTCA issue: doubling slices and columns changes P_max by < 3 %
-/// and TE by < 2 %. The pressure peaks where a contact line runs into an edge-relief zone (worm
-/// tip, wheel face ends), a transition about a millimetre long along the line: the default
-/// mesh takes every node column as a slice (0.75 mm) to resolve it.
+/// and TE by < 2 %, with the edges relieved (the relief option). The pressure peaks where a
+/// contact line runs into an edge-relief zone (worm tip, wheel face ends), a transition about a
+/// millimetre long along the line: the default mesh takes every node column as a slice
+/// (0.75 mm) to resolve it. With sharp edges (the default) the maximum is an edge singularity
+/// and grows with refinement; the converged quantity is then the patch pressure (tests/
+/// fidelity.rs).
 #[test]
 fn refinement_changes_pmax_and_te_little() {
-    let g = example("gear-1x40-design.toml");
+    let g = relieved("gear-1x40-design.toml");
     let s = LtcaSettings::from_gear(&g);
     let coarse = run(&g, &s);
     let mut fine_g = g.clone();

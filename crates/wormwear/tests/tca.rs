@@ -461,8 +461,15 @@ fn misalignments_enter_every_gap_through_the_placement() {
 
 #[test]
 fn edge_reliefs_are_parabolic_and_vanish_inside() {
-    // Default: 20 um at the edge, C (s/L)^2 over L = 1 mm; nothing inside the flank.
-    let g = example("gear-1x40-design.toml");
+    // The option (the default is sharp, MODEL §12 i): 20 um at the edge, C (s/L)^2 over
+    // L = 1 mm; nothing inside the flank.
+    let mut g = example("gear-1x40-design.toml");
+    let relief = wormwear::input::EdgeRelief {
+        amount: 20e-6,
+        length: 1e-3,
+    };
+    g.worm.tip_relief = relief;
+    g.wheel.edge_relief = relief;
     let geo = Geometry::build(&g).unwrap();
     let ev = kinematics::GapEvaluator::new(&g, &geo);
     let ra = g.worm.tip_radius;
@@ -475,4 +482,8 @@ fn edge_reliefs_are_parabolic_and_vanish_inside() {
     assert!((ev.relief(top, 0.0, 25e-3).0 - 20e-6).abs() < 1e-15);
     assert!((ev.relief(r_mid, 0.5 * g.wheel.face_width, 25e-3).0 - 20e-6).abs() < 1e-15);
     assert_eq!(ev.relief(top - 1.5e-3, 10e-3, 25e-3).0, 0.0);
+    // Default: none anywhere.
+    let g = example("gear-1x40-design.toml");
+    let ev = kinematics::GapEvaluator::new(&g, &geo);
+    assert_eq!(ev.relief(top, 0.5 * g.wheel.face_width, ra), (0.0, 0.0));
 }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 use wormwear::geometry::Geometry;
-use wormwear::input::{self, GearSet};
+use wormwear::input::{self, FilmLoad, GearSet};
 use wormwear::kinematics;
 use wormwear::ltca;
 use wormwear::wear;
@@ -19,7 +19,7 @@ fn cycle(g: &GearSet) -> (Geometry, kinematics::Tca, wear::CycleWear) {
     let geo = Geometry::build(g).unwrap();
     let tca = kinematics::analyse(g, &geo).unwrap();
     let l = ltca::analyse(g, &geo, &tca).unwrap();
-    let w = wear::per_cycle(g, &geo, &tca, &l);
+    let w = wear::per_cycle(g, &geo, &tca, &l, FilmLoad::LoadedAnalysis);
     (geo, tca, w)
 }
 
@@ -64,30 +64,69 @@ fn per_cycle_wear_converges_with_the_positions() {
         100.0 * d
     );
     // Same on a worn flank (the contact is wider and follows the wear): 100 000 cycles of the
-    // unworn rate removed, then the wear of one cycle with 20 and 40 positions.
+    // unworn rate removed, then the wear of one cycle with 20, 40 (and 80) positions. With the
+    // edges relieved (the option) the maximum converges at 20 -> 40 as MODEL §7.2 asks. With
+    // sharp edges (the default) the maximum sits at the worm's tip edge, an edge singularity
+    // of the pressure whose passage needs 40 positions: the map converges there from 40 -> 80,
+    // and everywhere else from 20 -> 40 (the 95th percentile of the nodes' rates, the volume).
     let mut removal = wormwear::geometry::FlankField::zeros(wf);
     for (h, dh) in removal.values.iter_mut().zip(&w20.depth.values) {
         *h = 1e5 * dh;
     }
-    let worn = |positions: usize| {
+    let worn = |g: &GearSet, positions: usize| {
         let mut g = g.clone();
         g.analysis.positions = positions;
         let tca = kinematics::analyse(&g, &geo).unwrap();
         let s = ltca::LtcaSettings::from_gear(&g);
-        let l = ltca::analyse_worn(&g, &geo, &tca, &s, None, Some(&removal)).unwrap();
-        wear::per_cycle(&g, &geo, &tca, &l)
+        let l = ltca::analyse_worn(&g, &geo, &tca, &s, None, Some(&removal), None).unwrap();
+        let w = wear::per_cycle(&g, &geo, &tca, &l, FilmLoad::LoadedAnalysis);
+        let mut rates: Vec<f64> = w
+            .depth
+            .values
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0)
+            .collect();
+        rates.sort_by(|a, b| a.total_cmp(b));
+        let p95 = rates[(0.95 * (rates.len() - 1) as f64) as usize];
+        (w.depth.max(), p95, w.depth.integral(wf))
     };
-    let (a, b) = (worn(20), worn(40));
-    let d = (b.depth.max() / a.depth.max() - 1.0).abs();
+    let change = |a: f64, b: f64| (b / a - 1.0).abs();
+    let mut relieved = g.clone();
+    relieved.worm.tip_relief = wormwear::input::EdgeRelief {
+        amount: 20e-6,
+        length: 1e-3,
+    };
+    relieved.wheel.edge_relief = relieved.worm.tip_relief;
+    let (a, b) = (worn(&relieved, 20), worn(&relieved, 40));
     eprintln!(
-        "worn flank: max per-cycle wear {:.4e} m (20 positions), {:.4e} m (40)",
-        a.depth.max(),
-        b.depth.max()
+        "worn, relieved edges: max per-cycle wear {:.4e} m (20 positions), {:.4e} m (40)",
+        a.0, b.0
     );
     assert!(
-        d < 0.05,
+        change(a.0, b.0) < 0.05,
         "worn: 20 -> 40 positions changes it by {:.2} %",
-        100.0 * d
+        100.0 * change(a.0, b.0)
+    );
+    let (s20, s40, s80) = (worn(&g, 20), worn(&g, 40), worn(&g, 80));
+    eprintln!(
+        "worn, sharp edges: max {:.4e} / {:.4e} / {:.4e} m, 95th percentile {:.4e} / {:.4e} m, volume {:.4e} / {:.4e} m^3 (20 / 40 / 80 positions)",
+        s20.0, s40.0, s80.0, s20.1, s40.1, s20.2, s40.2
+    );
+    assert!(
+        change(s40.0, s80.0) < 0.05,
+        "max, 40 -> 80: {:.2} %",
+        100.0 * change(s40.0, s80.0)
+    );
+    assert!(
+        change(s20.1, s40.1) < 0.05,
+        "p95, 20 -> 40: {:.2} %",
+        100.0 * change(s20.1, s40.1)
+    );
+    assert!(
+        change(s20.2, s40.2) < 0.05,
+        "volume, 20 -> 40: {:.2} %",
+        100.0 * change(s20.2, s40.2)
     );
 }
 
@@ -154,11 +193,9 @@ impl Bench {
 /// A life plan without phases.
 fn plan(cycles: f64, step: wear::StepControl, guard: f64) -> wear::WearPlan {
     wear::WearPlan {
-        life_cycles: cycles,
         step,
         max_substep_removal: guard,
-        phases: Vec::new(),
-        endurance: wormwear::input::Endurance::DEFAULT,
+        ..wear::WearPlan::with_life(cycles)
     }
 }
 
@@ -444,7 +481,6 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
     let bench = Bench::new(&example("gear-1x40-design.toml"));
     use wormwear::input::Phase;
     let plan = wear::WearPlan {
-        life_cycles: 60_000.0,
         step: wear::StepControl::Cycles(10_000.0),
         max_substep_removal: 5e-6,
         phases: vec![
@@ -456,7 +492,7 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
             },
             Phase::Wear { until: 60_000.0 },
         ],
-        endurance: wormwear::input::Endurance::DEFAULT,
+        ..wear::WearPlan::with_life(60_000.0)
     };
     let mut removals = Vec::new();
     let end = bench

@@ -37,6 +37,8 @@ pub struct WheelBending {
     /// row-major, (m, rad) per (N, N m), fixed wheel frame); None: the hub does not move
     /// (sector clamped at the rim or at the hub).
     pub shaft_compliance: Option<Vec<f64>>,
+    #[serde(skip)]
+    cores: super::worm_model::CoreCache,
 }
 
 impl WheelBending {
@@ -148,6 +150,7 @@ impl WheelBending {
                 let c = s.compliance();
                 (0..36).map(|i| c[(i / 6, i % 6)]).collect()
             }),
+            cores: Default::default(),
         })
     }
 
@@ -214,6 +217,7 @@ impl BendingModel for WheelBending {
             &self.after,
             &groups,
             &coords,
+            &self.cores,
         );
         match &self.shaft_compliance {
             Some(s) if s.len() == 36 => with_rigid_body(teeth, s, cells),

@@ -41,6 +41,8 @@ pub struct WormBending {
     pub signed_lead_per_rad: f64,
     /// Axial profile of the loaded flank, (rho, X) pairs at equal steps, m.
     pub profile: Vec<(f64, f64)>,
+    #[serde(skip)]
+    pub(crate) cores: CoreCache,
 }
 
 /// The zone half angle theta_m = atan(0.5 b2 / (a - r_e2)) (MODEL §5.5, §12f), rad; pi/2 when
@@ -170,6 +172,7 @@ impl WormBending {
             signed_lead_per_rad: geo.worm.hand_sign() * geo.worm.lead()
                 / (2.0 * std::f64::consts::PI),
             profile,
+            cores: CoreCache::default(),
         })
     }
 
@@ -307,8 +310,66 @@ pub fn worm_displacements(
     solve_with_springs(&m.mesh, material, &fixed, &springs, loads)
 }
 
+/// The cores of [`relation_low_rank`] per pattern of groups present (their offsets from the
+/// first), computed once: a model's positions only ever see a few patterns (2-4 consecutive
+/// teeth). Not serialised; a clone starts empty.
+#[derive(Debug, Default)]
+pub(crate) struct CoreCache(
+    std::sync::Mutex<std::collections::HashMap<Vec<i64>, std::sync::Arc<Vec<f64>>>>,
+);
+
+impl Clone for CoreCache {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+/// The core of the groups `present` (sorted, distinct): blocks same / before / after between
+/// neighbours, zero beyond, symmetrised, then projected on the positive semi-definite matrices
+/// (negative eigenvalues set to zero). A compliance is positive semi-definite (the strain
+/// energy of any load is >= 0); the assembled fits of three teeth are not quite (the 1/40
+/// wheel: eigenvalues down to -0.2 % of the largest, from the fits' errors and the relations
+/// beyond a neighbour left out), and an indefinite term can stop the contact solver from
+/// converging on widened bands. The projection is the nearest PSD matrix in the Frobenius norm.
+fn relation_core(
+    same: &Mat<f64>,
+    before: &Mat<f64>,
+    after: &Mat<f64>,
+    present: &[i64],
+) -> Vec<f64> {
+    let k = same.nrows();
+    let rank = k * present.len();
+    let mut core = nalgebra::DMatrix::<f64>::zeros(rank, rank);
+    for (a, &ta) in present.iter().enumerate() {
+        for (b, &tb) in present.iter().enumerate() {
+            let m = match ta - tb {
+                0 => same,
+                -1 => before,
+                1 => after,
+                _ => continue,
+            };
+            for l in 0..k {
+                for c in 0..k {
+                    core[(a * k + l, b * k + c)] = m[(l, c)];
+                }
+            }
+        }
+    }
+    let core = (&core + core.transpose()) * 0.5;
+    let eigen = core.symmetric_eigen();
+    let clipped =
+        nalgebra::DVector::from_iterator(rank, eigen.eigenvalues.iter().map(|&v| v.max(0.0)));
+    let v = &eigen.eigenvectors;
+    let psd = v * nalgebra::DMatrix::from_diagonal(&clipped) * v.transpose();
+    let psd = (&psd + psd.transpose()) * 0.5;
+    // Row-major.
+    (0..rank * rank)
+        .map(|x| psd[(x / rank, x % rank)])
+        .collect()
+}
+
 /// Thread-relation low-rank term shared by both members: cells grouped by `group` (tooth or
-/// thread index), core blocks same / before (receiver one group lower) / after, symmetrised.
+/// thread index), the core of the groups present from `cache` ([`relation_core`]).
 pub(crate) fn relation_low_rank(
     basis: &Basis,
     same: &Mat<f64>,
@@ -316,6 +377,7 @@ pub(crate) fn relation_low_rank(
     after: &Mat<f64>,
     groups: &[i64],
     coords: &[(f64, f64)],
+    cache: &CoreCache,
 ) -> LowRank {
     let mut present: Vec<i64> = groups.to_vec();
     present.sort_unstable();
@@ -332,30 +394,19 @@ pub(crate) fn relation_low_rank(
         let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
         f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
     }
-    let mut core = vec![0.0; rank * rank];
-    for (a, &ta) in present.iter().enumerate() {
-        for (b, &tb) in present.iter().enumerate() {
-            let m = match ta - tb {
-                0 => same,
-                -1 => before,
-                1 => after,
-                _ => continue,
-            };
-            for l in 0..k {
-                for c in 0..k {
-                    core[(a * k + l) * rank + b * k + c] = m[(l, c)];
-                }
+    let pattern: Vec<i64> = present.iter().map(|g| g - present[0]).collect();
+    let cached = cache.0.lock().ok().and_then(|m| m.get(&pattern).cloned());
+    let core = match cached {
+        Some(c) => c,
+        None => {
+            let c = std::sync::Arc::new(relation_core(same, before, after, &present));
+            if let Ok(mut m) = cache.0.lock() {
+                m.insert(pattern, c.clone());
             }
+            c
         }
-    }
-    for i in 0..rank {
-        for j in 0..i {
-            let v = 0.5 * (core[i * rank + j] + core[j * rank + i]);
-            core[i * rank + j] = v;
-            core[j * rank + i] = v;
-        }
-    }
-    LowRank::new(rank, f, core, ranges)
+    };
+    LowRank::new(rank, f, core.as_ref().clone(), ranges)
 }
 
 impl BendingModel for WormBending {
@@ -383,6 +434,7 @@ impl BendingModel for WormBending {
             &self.after,
             &groups,
             &coords,
+            &self.cores,
         )
     }
 }

@@ -95,9 +95,10 @@ pub struct EdgeRelief {
 }
 
 impl EdgeRelief {
-    /// Default: 20 um over 1 mm.
-    pub const DEFAULT: EdgeRelief = EdgeRelief {
-        amount: 20e-6,
+    /// Default: a sharp edge (the published model has no relief, MODEL §12 i); the zone
+    /// length 1 mm applies when only an amount is given.
+    pub const SHARP: EdgeRelief = EdgeRelief {
+        amount: 0.0,
         length: 1e-3,
     };
 
@@ -252,6 +253,30 @@ impl Endurance {
     }
 }
 
+/// Line load w of the film-thickness formula at a passage (MODEL §6, §12 h).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FilmLoad {
+    /// The load per unit length of contact line from the loaded analysis (published model).
+    LoadedAnalysis,
+    /// Refinement: w floored at the Hertz load of the band's peak pressure, 2 pi R p0^2 / E'
+    /// (a band cut short by an edge carries little load per length but is no thicker a film
+    /// for that); thins the film where the band is cut.
+    HertzPeakFloor,
+}
+
+/// Depth of the pits cut at the start of a pitting phase (MODEL §8, §12 g).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PitDepth {
+    /// 0.78 a with a the local Hertz half-width of the line contact (local line load and
+    /// relative radius; published model).
+    Hertz,
+    /// Refinement: 0.78 times the half-width of the loaded band of the loaded analysis (on a
+    /// worn, conforming flank much wider than Hertz's).
+    LoadedBand,
+}
+
 /// Life simulation plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct WearPlan {
@@ -263,6 +288,30 @@ pub struct WearPlan {
     /// Phase schedule (empty: wear all along).
     pub phases: Vec<Phase>,
     pub endurance: Endurance,
+    /// Line load of the film formula.
+    pub film_load: FilmLoad,
+    /// Depth of the pits of a pitting phase.
+    pub pit_depth: PitDepth,
+    /// Cycles at which the life stops for a state whose maps are written (steps are cut
+    /// there); None: the states 0, 1, 2, 4, 8, ...
+    pub map_cycles: Option<Vec<f64>>,
+}
+
+impl WearPlan {
+    /// A plan of `life_cycles` with the defaults of a `[wear]` section that gives nothing
+    /// else: adaptive 4 um steps, 5 um guard, no schedule, the published model's choices.
+    pub fn with_life(life_cycles: f64) -> Self {
+        Self {
+            life_cycles,
+            step: StepControl::MaxRemoval(4e-6),
+            max_substep_removal: 5e-6,
+            phases: Vec::new(),
+            endurance: Endurance::DEFAULT,
+            film_load: FilmLoad::LoadedAnalysis,
+            pit_depth: PitDepth::Hertz,
+            map_cycles: None,
+        }
+    }
 }
 
 /// Factors of the standard ratings (MODEL §9) the user may set.
@@ -332,9 +381,13 @@ pub struct Analysis {
     pub contact_slice_step: usize,
     pub contact_columns: usize,
     pub contact_band_factor: f64,
-    /// Largest contact pressure of the loaded analysis (the wheel's flow pressure; cells at it
-    /// are plastic), Pa; infinite: no cap.
+    /// Largest contact pressure of the loaded analysis (cells at it are plastic), Pa;
+    /// infinite (default, the published model): no cap.
     pub contact_pressure_cap: f64,
+    /// Patch over which the converged pressure is reported (MODEL §12 i): across the contact
+    /// line and along the face width, m.
+    pub pressure_patch_across: f64,
+    pub pressure_patch_along: f64,
     /// LTCA solver.
     pub solver: crate::ltca::solver::SolverKind,
 }

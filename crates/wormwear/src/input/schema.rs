@@ -110,6 +110,18 @@ pub struct WearSpec {
     /// Bronze pressure-life curve p_lim(N) = p_ref (N / N_ref)^-exponent (default: MODEL §8).
     #[serde(default)]
     pub endurance: Option<EnduranceSpec>,
+    /// Line load of the film formula: "loaded-analysis" (default, MODEL §6 / §12 h) or
+    /// "hertz-peak-floor" (floored at the Hertz load of the band's peak pressure).
+    #[serde(default)]
+    pub film_load: Option<String>,
+    /// Depth of the pits: "hertz" (default, 0.78 x the local Hertz half-width, MODEL §12 g)
+    /// or "loaded-band" (0.78 x the loaded band's half-width).
+    #[serde(default)]
+    pub pit_depth: Option<String>,
+    /// Wheel cycles at which a state is computed and its maps written (increasing; default
+    /// the states 0, 1, 2, 4, 8, ...).
+    #[serde(default)]
+    pub map_cycles: Option<Vec<f64>>,
 }
 
 /// One phase of the schedule.
@@ -389,10 +401,17 @@ pub struct AnalysisSpec {
     /// line load (widened automatically when the load reaches the band edge).
     #[serde(default = "default_band_factor")]
     pub contact_band_factor: f64,
-    /// LTCA: largest contact pressure, MPa (cells at it are plastic); default the wheel's
-    /// hardness; 0 = no cap.
+    /// LTCA: largest contact pressure, MPa (cells at it are plastic); default none (the
+    /// published model, MODEL §12 i); 0 = none.
     #[serde(default)]
     pub contact_pressure_cap_mpa: Option<f64>,
+    /// Patch of the reported mesh-converged pressure: mean pressure over a patch this wide
+    /// across the contact line, mm (default 0.5) ...
+    #[serde(default = "default_patch_across")]
+    pub pressure_patch_across_mm: f64,
+    /// ... and this long along the face width, mm (default 1).
+    #[serde(default = "default_patch_along")]
+    pub pressure_patch_along_mm: f64,
     /// LTCA solver: "conjugate-gradient" (default) or "fixed-point" (the published scheme).
     #[serde(default = "default_solver")]
     pub solver: String,
@@ -406,6 +425,12 @@ fn default_contact_columns() -> i64 {
 }
 fn default_band_factor() -> f64 {
     3.0
+}
+fn default_patch_across() -> f64 {
+    0.5
+}
+fn default_patch_along() -> f64 {
+    1.0
 }
 fn default_solver() -> String {
     "conjugate-gradient".to_string()
@@ -448,6 +473,8 @@ impl Default for AnalysisSpec {
             contact_columns: default_contact_columns(),
             contact_band_factor: default_band_factor(),
             contact_pressure_cap_mpa: None,
+            pressure_patch_across_mm: default_patch_across(),
+            pressure_patch_along_mm: default_patch_along(),
             solver: default_solver(),
         }
     }

@@ -307,6 +307,20 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             );
         }
     }
+    let patch_across = ck.range(
+        "analysis.pressure_patch_across_mm",
+        a.pressure_patch_across_mm,
+        0.01,
+        100.0,
+        "mm",
+    );
+    let patch_along = ck.range(
+        "analysis.pressure_patch_along_mm",
+        a.pressure_patch_along_mm,
+        0.01,
+        1000.0,
+        "mm",
+    );
     let band_factor = ck.range(
         "analysis.contact_band_factor",
         a.contact_band_factor,
@@ -530,12 +544,24 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     else {
         unreachable_input()?
     };
-    let (Some(slice_step), Some(contact_columns), Some(band_factor), Some(solver)) =
-        (slice_step, contact_columns, band_factor, solver)
+    let (
+        Some(slice_step),
+        Some(contact_columns),
+        Some(band_factor),
+        Some(solver),
+        Some(patch_across),
+        Some(patch_along),
+    ) = (
+        slice_step,
+        contact_columns,
+        band_factor,
+        solver,
+        patch_across,
+        patch_along,
+    )
     else {
         unreachable_input()?
     };
-    let wheel_hardness = wheel_material.hardness;
     let gear = GearSet {
         title: f.title.clone().unwrap_or_default(),
         worm,
@@ -551,7 +577,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             hub_radius,
             shaft_radius,
             bearing_positions,
-            edge_relief: edge_relief.unwrap_or(EdgeRelief::DEFAULT),
+            edge_relief: edge_relief.unwrap_or(EdgeRelief::SHARP),
         },
         nominal_centre_distance: nominal_a,
         operating: Placement {
@@ -579,8 +605,10 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             contact_pressure_cap: match a.contact_pressure_cap_mpa {
                 Some(0.0) => f64::INFINITY,
                 Some(v) => v * 1e6,
-                None => wheel_hardness,
+                None => f64::INFINITY,
             },
+            pressure_patch_across: patch_across * 1e-3,
+            pressure_patch_along: patch_along * 1e-3,
             solver,
         },
         wear,
@@ -991,7 +1019,7 @@ fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<ThreadDef> {
         normal_pressure_angle: alpha_n,
         axial_thickness: s,
         grinding_wheel: None,
-        tip_relief: EdgeRelief::DEFAULT,
+        tip_relief: EdgeRelief::SHARP,
     };
     let relief = edge_relief(
         ck,
@@ -1370,12 +1398,53 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         1000.0,
         "um",
     );
+    let film_load = ck.choice(
+        "wear.film_load",
+        w.film_load.as_deref().unwrap_or("loaded-analysis"),
+        &[
+            ("loaded-analysis", FilmLoad::LoadedAnalysis),
+            ("hertz-peak-floor", FilmLoad::HertzPeakFloor),
+        ],
+    );
+    let pit_depth = ck.choice(
+        "wear.pit_depth",
+        w.pit_depth.as_deref().unwrap_or("hertz"),
+        &[
+            ("hertz", PitDepth::Hertz),
+            ("loaded-band", PitDepth::LoadedBand),
+        ],
+    );
+    let map_cycles = match &w.map_cycles {
+        None => Some(None),
+        Some(list) => {
+            let mut ok = true;
+            let mut previous = 0.0;
+            for (k, &c) in list.iter().enumerate() {
+                let field = format!("wear.map_cycles[{k}]");
+                if ck.range(&field, c, 0.0, 1e12, "cycles").is_none() {
+                    ok = false;
+                } else if k > 0 && c <= previous {
+                    ck.fail(
+                        &field,
+                        c,
+                        format!("must be larger than the one before ({previous}): give the cycles in increasing order"),
+                    );
+                    ok = false;
+                }
+                previous = c;
+            }
+            ok.then(|| Some(list.clone()))
+        }
+    };
     Some(WearPlan {
         life_cycles: life?,
         step: step?,
         max_substep_removal: guard? * 1e-6,
         phases,
         endurance: endurance?,
+        film_load: film_load?,
+        pit_depth: pit_depth?,
+        map_cycles: map_cycles?,
     })
 }
 
@@ -1416,7 +1485,7 @@ fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
     })
 }
 
-/// Edge relief from (amount um, length mm), defaults 20 um over 1 mm; the length is at most
+/// Edge relief from (amount um, length mm), defaults 0 (sharp: MODEL §12 i) over 1 mm; the length is at most
 /// `max_length` (m).
 fn edge_relief(
     ck: &mut Checker,
@@ -1428,11 +1497,11 @@ fn edge_relief(
 ) -> Option<EdgeRelief> {
     let a = match amount {
         Some(v) => ck.range(amount_field, v, 0.0, 500.0, "um")? * 1e-6,
-        None => EdgeRelief::DEFAULT.amount,
+        None => EdgeRelief::SHARP.amount,
     };
     let l = match length {
         Some(v) => ck.range(length_field, v, 0.01, max_length / MM, "mm")? * MM,
-        None => EdgeRelief::DEFAULT.length.min(max_length),
+        None => EdgeRelief::SHARP.length.min(max_length),
     };
     Some(EdgeRelief {
         amount: a,

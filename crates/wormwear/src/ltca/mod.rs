@@ -12,7 +12,7 @@
 
 pub mod solver;
 
-use crate::contact::{symmetric_block, ContactCell, ElasticPair};
+use crate::contact::{hertz_half_width, symmetric_block, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
@@ -48,6 +48,10 @@ pub struct LtcaSettings {
     pub band_factor: f64,
     /// Largest contact pressure (elastic-perfectly-plastic cells above it), Pa; infinite: none.
     pub pressure_cap: f64,
+    /// Patch of the reported converged pressure: across the contact line and along the face
+    /// width, m ([`max_patch_pressure`]).
+    pub patch_across: f64,
+    pub patch_along: f64,
     pub solver: SolverSettings,
 }
 
@@ -59,6 +63,8 @@ impl LtcaSettings {
             columns: a.contact_columns,
             band_factor: a.contact_band_factor,
             pressure_cap: a.contact_pressure_cap,
+            patch_across: a.pressure_patch_across,
+            patch_along: a.pressure_patch_along,
             solver: SolverSettings {
                 kind: a.solver,
                 ..SolverSettings::default()
@@ -149,6 +155,12 @@ pub struct Ltca {
     pub s1: f64,
     /// Area with p > P_mean / contact area.
     pub s2: f64,
+    /// Largest mean pressure over a patch of the stated size (LtcaSettings::patch_across x
+    /// patch_along; [`max_patch_pressure`]), Pa: mesh-converged where the maximum is an edge
+    /// singularity.
+    pub pressure_patch_max: f64,
+    /// That patch: across the line and along the face width, m.
+    pub pressure_patch_size: [f64; 2],
     pub worm_torque: f64,
     pub wheel_torque: f64,
 }
@@ -188,7 +200,8 @@ impl Ltca {
     }
 }
 
-fn stats(v: impl Iterator<Item = f64>) -> (f64, f64) {
+/// Mean and peak-to-peak (max - min) of a series.
+pub(crate) fn stats(v: impl Iterator<Item = f64>) -> (f64, f64) {
     let v: Vec<f64> = v.collect();
     let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
     let (lo, hi) = v
@@ -220,11 +233,6 @@ pub fn analyse(gear: &GearSet, geo: &Geometry, tca: &Tca) -> Result<Ltca, LtcaEr
     analyse_with(gear, geo, tca, &LtcaSettings::from_gear(gear), None)
 }
 
-/// Hertz half-width estimate for line load w (N/m) and relative radius R, m.
-fn hertz_half_width(w: f64, radius: f64, e_star: f64) -> f64 {
-    (4.0 * w * radius / (PI * e_star)).sqrt()
-}
-
 /// Runs the loaded analysis at every TCA position (MODEL §5).
 pub fn analyse_with(
     gear: &GearSet,
@@ -233,12 +241,69 @@ pub fn analyse_with(
     settings: &LtcaSettings,
     bending: Option<&dyn BendingModel>,
 ) -> Result<Ltca, LtcaError> {
-    analyse_worn(gear, geo, tca, settings, bending, None)
+    analyse_worn(gear, geo, tca, settings, bending, None, None)
+}
+
+/// Loads of a loaded analysis to start the next one's solver from (consecutive wear states
+/// differ by micrometres, so their solutions are close): per position, the loaded cells as
+/// (tooth, slice, column) and their unknown q = force x lever, N m. A start only: the result
+/// is the converged solution whatever the start (to the solver's tolerance).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WarmStart {
+    pub positions: Vec<Vec<(i32, u32, u32, f64)>>,
+}
+
+impl WarmStart {
+    /// The start for `cells` of position n: the load of the same (tooth, slice, column), 0 for
+    /// a cell the previous analysis did not load; None when nothing matches.
+    fn for_cells(&self, n: usize, cells: &[LocalCell]) -> Option<Vec<f64>> {
+        let known = self.positions.get(n)?;
+        let q: Vec<f64> = cells
+            .iter()
+            .map(|c| {
+                let key = (c.tooth, c.slice as u32, c.column as u32);
+                known
+                    .binary_search_by(|e| (e.0, e.1, e.2).cmp(&key))
+                    .map_or(0.0, |k| known[k].3)
+            })
+            .collect();
+        q.iter().any(|&v| v > 0.0).then_some(q)
+    }
+}
+
+impl Ltca {
+    /// The loads of this analysis as a start for the next ([`WarmStart`]).
+    pub fn warm_start(&self) -> WarmStart {
+        WarmStart {
+            positions: self
+                .positions
+                .iter()
+                .map(|p| {
+                    let mut loaded: Vec<(i32, u32, u32, f64)> = p
+                        .cells
+                        .iter()
+                        .zip(&p.pressure)
+                        .filter(|(_, &pr)| pr > 0.0)
+                        .map(|(c, &pr)| {
+                            (
+                                c.tooth,
+                                c.slice as u32,
+                                c.column as u32,
+                                pr * c.cell.area() * c.lever,
+                            )
+                        })
+                        .collect();
+                    loaded.sort_by(|a, b| (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)));
+                    loaded
+                })
+                .collect(),
+        }
+    }
 }
 
 /// [`analyse_with`] on a wheel whose loaded flank has lost `removal` (depth of material normal
 /// to the flank on the flank's node grid, m; MODEL §7.5: it adds to the initial separations,
-/// turned into an angle by each cell's lever).
+/// turned into an angle by each cell's lever), the solver started from `warm` when given.
 pub fn analyse_worn(
     gear: &GearSet,
     geo: &Geometry,
@@ -246,6 +311,7 @@ pub fn analyse_worn(
     settings: &LtcaSettings,
     bending: Option<&dyn BendingModel>,
     removal: Option<&FlankField>,
+    warm: Option<&WarmStart>,
 ) -> Result<Ltca, LtcaError> {
     let pair = ElasticPair::new(
         gear.worm_material.youngs_modulus,
@@ -304,6 +370,7 @@ pub fn analyse_worn(
                 worm_torque,
                 wheel_torque_guess,
                 removal,
+                warm,
             )
         })
         .collect::<Result<_, _>>()?;
@@ -357,6 +424,8 @@ pub fn analyse_worn(
         .filter(|&&k| pattern[k] > mean_pressure)
         .map(|&k| wf.cell_area[k])
         .sum();
+    let pressure_patch_max =
+        max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
     let wheel_torque =
         positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
     let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
@@ -375,6 +444,8 @@ pub fn analyse_worn(
         } else {
             0.0
         },
+        pressure_patch_max,
+        pressure_patch_size: [settings.patch_across, settings.patch_along],
         worm_torque,
         wheel_torque,
     })
@@ -474,8 +545,7 @@ fn local_mesh(
         // On a worn flank the band goes where the worn gap is smallest on the column (the TCA
         // node gaps plus the removal over each node's lever), which need not be the unworn line.
         let (r_line, at_end) = match removal {
-            Some(w) => worn_minimum(tca, wf, w, n, tooth_index, line.slice)
-                .unwrap_or((line.r, line.at_end)),
+            Some(w) => worn_minimum(tca, wf, w, n, tooth_index, line),
             None => (line.r, line.at_end),
         };
         base.push(Slice {
@@ -510,40 +580,65 @@ fn local_mesh(
         .collect()
 }
 
-/// Radius of the smallest worn angular gap on node column j of tooth index t at position n
-/// (parabola through the best node and its neighbours), and whether it is at a column end.
+/// Radius of the smallest worn angular gap on the node column of `line` (tooth index t,
+/// position n), and whether it is at a column end: the parabola through the best node and its
+/// neighbours, less the same fit's bias on the unworn gaps (their minimum is the TCA's exact
+/// line crossing), so that a flank worn by the same angle everywhere keeps the unworn line.
 fn worn_minimum(
     tca: &Tca,
     wf: &WheelFlank,
     removal: &FlankField,
     n: usize,
     t: usize,
-    j: usize,
-) -> Option<(f64, bool)> {
-    let ni = wf.cells_height;
+    line: &crate::kinematics::SliceContact,
+) -> (f64, bool) {
+    let (ni, j) = (wf.cells_height, line.slice);
     let nodes = wf.nodes.len();
     let base = (n * tca.teeth.len() + t) * nodes;
-    let worn = |i: usize| {
-        let k = j * (ni + 1) + i;
-        let p = &wf.nodes[k];
-        let lever = GapEvaluator::lever(&p.position(), &p.normal_vec());
-        tca.node_gaps[base + k] + removal.values[k] / lever
+    let gaps = |worn: bool| -> Vec<f64> {
+        (0..=ni)
+            .map(|i| {
+                let k = j * (ni + 1) + i;
+                let p = &wf.nodes[k];
+                let lever = GapEvaluator::lever(&p.position(), &p.normal_vec());
+                tca.node_gaps[base + k] + if worn { removal.values[k] / lever } else { 0.0 }
+            })
+            .collect()
     };
-    let values: Vec<f64> = (0..=ni).map(worn).collect();
-    let (best, _) = values
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.is_finite())
-        .min_by(|a, b| a.1.total_cmp(b.1))?;
     let r = |i: usize| wf.node(i, j).r;
-    if best == 0 || best == ni || !values[best - 1].is_finite() || !values[best + 1].is_finite() {
-        return Some((r(best), true));
+    // Parabola vertex through the smallest node and its neighbours (None at a column end).
+    let vertex = |values: &[f64]| -> Option<(usize, Option<f64>)> {
+        let (best, _) = values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .min_by(|a, b| a.1.total_cmp(b.1))?;
+        if best == 0 || best == ni || !values[best - 1].is_finite() || !values[best + 1].is_finite()
+        {
+            return Some((best, None));
+        }
+        let (a, b, c) = (values[best - 1], values[best], values[best + 1]);
+        let den = a - 2.0 * b + c;
+        let shift = if den > 0.0 { 0.5 * (a - c) / den } else { 0.0 };
+        let h = r(best + 1) - r(best);
+        Some((best, Some(r(best) + shift.clamp(-0.5, 0.5) * h)))
+    };
+    let Some((best, worn)) = vertex(&gaps(true)) else {
+        return (line.r, line.at_end);
+    };
+    let unworn = vertex(&gaps(false));
+    match (worn, unworn) {
+        // Where the wear leaves the smallest node where it was, the nodes' fit is only a
+        // correction to the TCA's exact line: its bias on the unworn gaps is taken off, and a
+        // fit cut by the column's end (the worm-tip trace, the blank top) keeps the TCA line.
+        (None, Some((b0, None))) if b0 == best => (line.r, line.at_end),
+        (None, _) => (r(best), true),
+        (Some(worn), Some((_, Some(unworn)))) if !line.at_end => {
+            let h = r(best + 1) - r(best);
+            (worn - (unworn - line.r).clamp(-h, h), false)
+        }
+        (Some(worn), _) => (worn, false),
     }
-    let (a, b, c) = (values[best - 1], values[best], values[best + 1]);
-    let den = a - 2.0 * b + c;
-    let shift = if den > 0.0 { 0.5 * (a - c) / den } else { 0.0 };
-    let h = r(best + 1) - r(best);
-    Some((r(best) + shift.clamp(-0.5, 0.5) * h, false))
 }
 
 /// The cells of one slice: `columns` cells of width 2 band / columns along the flank's
@@ -656,6 +751,7 @@ fn solve_position(
     worm_torque: Option<f64>,
     wheel_torque_guess: f64,
     removal: Option<&FlankField>,
+    seed: Option<&WarmStart>,
 ) -> Result<PositionResult, LtcaError> {
     let mut band = band0;
     let mut widenings = 0;
@@ -664,6 +760,11 @@ fn solve_position(
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
         }
+        // The previous analysis' loads on the same cells (the first mesh only: a widened band
+        // puts other points under the same indices).
+        let mut warm: Option<Vec<f64>> = seed
+            .filter(|_| widenings == 0)
+            .and_then(|s| s.for_cells(n, &cells));
         // Blocks per tooth (cells are grouped by tooth in mesh order), assembled in parallel.
         let mut ranges = Vec::new();
         let mut start = 0;
@@ -724,7 +825,6 @@ fn solve_position(
             separation: cells.iter().map(|c| c.separation).collect(),
             load: wheel_torque_guess,
         };
-        let mut warm: Option<Vec<f64>> = None;
         let mut solution = None;
         let weights: Vec<f64> = cells
             .iter()
@@ -865,4 +965,66 @@ mod tests {
         assert_eq!(partition_point(5, |_| true), 5);
         assert_eq!(partition_point(5, |_| false), 0);
     }
+}
+
+/// Largest mean pressure over a patch `across` wide across the contact line and `along` long
+/// along the face width (m), over every tooth at every position, Pa: the pressure of a "cell
+/// of stated size". At a sharp edge the local cells' own maximum grows as the mesh is refined
+/// (an integrable singularity); this mean converges. Cells are placed in (distance across the
+/// line from the band's first column, z) with their widths 2 half_nu and 2 half_dz; pressure is
+/// zero outside the cells. The largest mean has a window end on a cell boundary in each
+/// direction, which is where the candidates are taken.
+pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64) -> f64 {
+    positions
+        .par_iter()
+        .map(|p| {
+            // (across lo, across hi, z lo, z hi, pressure) of the loaded cells, per tooth.
+            let mut teeth: std::collections::BTreeMap<usize, Vec<[f64; 5]>> = Default::default();
+            for (c, &pr) in p.cells.iter().zip(&p.pressure) {
+                if pr <= 0.0 {
+                    continue;
+                }
+                let w = 2.0 * c.cell.half_nu;
+                teeth.entry(c.tooth_index).or_default().push([
+                    c.column as f64 * w,
+                    (c.column + 1) as f64 * w,
+                    c.z - c.half_dz,
+                    c.z + c.half_dz,
+                    pr,
+                ]);
+            }
+            teeth
+                .values()
+                .map(|cells| patch_mean_max(cells, across, along))
+                .fold(0.0, f64::max)
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
+/// [`max_patch_pressure`] over one tooth's loaded cells.
+fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64 {
+    // Cells sorted by their z extent's start: a window's cells are found by bisection.
+    let mut cells = cells.to_vec();
+    cells.sort_by(|a, b| a[2].total_cmp(&b[2]));
+    let longest = cells.iter().map(|c| c[3] - c[2]).fold(0.0, f64::max);
+    let mut best: f64 = 0.0;
+    for c in &cells {
+        for x0 in [c[0], c[1] - across] {
+            for z0 in [c[2], c[3] - along] {
+                let (x1, z1) = (x0 + across, z0 + along);
+                let first = cells.partition_point(|d| d[2] < z0 - longest);
+                let force: f64 = cells[first..]
+                    .iter()
+                    .take_while(|d| d[2] < z1)
+                    .map(|d| {
+                        let ox = (d[1].min(x1) - d[0].max(x0)).max(0.0);
+                        let oz = (d[3].min(z1) - d[2].max(z0)).max(0.0);
+                        d[4] * ox * oz
+                    })
+                    .sum();
+                best = best.max(force / (across * along));
+            }
+        }
+    }
+    best
 }

@@ -364,6 +364,33 @@ impl Problem {
         )
     }
 
+    /// The dense submatrix of K on the unknowns `set` (sorted): contact blocks plus the
+    /// low-rank term.
+    pub fn dense(&self, set: &[usize]) -> nalgebra::DMatrix<f64> {
+        let m = set.len();
+        let mut k = nalgebra::DMatrix::<f64>::zeros(m, m);
+        for b in &self.blocks {
+            let inside: Vec<(usize, usize)> = set
+                .iter()
+                .enumerate()
+                .filter(|(_, &i)| i >= b.start && i < b.start + b.size)
+                .map(|(a, &i)| (a, i - b.start))
+                .collect();
+            for &(a, ia) in &inside {
+                for &(c, ic) in &inside {
+                    k[(a, c)] = b.matrix[ic * b.size + ia];
+                }
+            }
+        }
+        if let Some(lr) = &self.low_rank {
+            let r = lr.rank;
+            let f = nalgebra::DMatrix::from_fn(m, r, |a, c| lr.f[set[a] * r + c]);
+            let core = nalgebra::DMatrix::from_row_slice(r, r, &lr.core);
+            k += &f * core * f.transpose();
+        }
+        k
+    }
+
     fn validate(&self) -> Result<(), SolverError> {
         if self.is_empty() {
             return Err(SolverError::Empty);
@@ -441,7 +468,15 @@ fn conjugate_gradient(
     let n = problem.len();
     let q0 = initial(problem, warm);
     let Some(cap) = problem.upper.as_ref() else {
-        return pk_inner(problem, settings, q0, &vec![false; n]);
+        // PK can cycle between active sets on badly conditioned problems (worn, pitted flanks
+        // with bending: a widened band of ~1800 cells whose bending modes are 40 times more
+        // compliant than the contact); the primal active-set method then finishes the job.
+        return match pk_inner(problem, settings, q0.clone(), &vec![false; n]) {
+            Err(e @ SolverError::NotConverged { .. }) => {
+                active_set(problem, settings, &q0).map_err(|_| e)
+            }
+            other => other,
+        };
     };
     let capacity: f64 = cap
         .iter()
@@ -688,6 +723,129 @@ fn pk_inner(
         residual: res.complementarity.max(-res.min_gap),
         tolerance: settings.tolerance,
     })
+}
+
+/// Primal active-set method for the same problem (Lawson & Hanson's NNLS with the load
+/// constraint): on the loaded set P the gaps are closed exactly, K_PP q_P - alpha = -e_P with
+/// sum q_P = W (dense Cholesky of K_PP, which is small: the loaded cells); cells whose load
+/// would turn negative leave P along the ratio test (q stays feasible), then the cells that
+/// penetrate most join it. Finite for a positive definite K; each pass costs one dense
+/// factorisation of the loaded set, so it is the fallback, not the default.
+pub fn active_set(
+    problem: &Problem,
+    settings: &SolverSettings,
+    start: &[f64],
+) -> Result<Solution, SolverError> {
+    problem.validate()?;
+    let n = problem.len();
+    let e = &problem.separation;
+    let load = problem.load;
+    // Feasible start: the given loads on open cells, else the cell of smallest separation.
+    let mut q: Vec<f64> = (0..n)
+        .map(|i| {
+            if e[i].is_finite() {
+                start.get(i).copied().unwrap_or(0.0).max(0.0)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let total: f64 = q.iter().sum();
+    if total > 0.0 {
+        q.iter_mut().for_each(|v| *v *= load / total);
+    } else {
+        let first = (0..n)
+            .filter(|&i| e[i].is_finite())
+            .min_by(|&a, &b| e[a].total_cmp(&e[b]))
+            .ok_or(SolverError::Empty)?;
+        q[first] = load;
+    }
+    let mut set: Vec<usize> = (0..n).filter(|&i| q[i] > 0.0).collect();
+    let mut y = vec![0.0; n];
+    let mut approach = 0.0;
+    let limit = settings.max_iterations.min(50 * n + 100);
+    for pass in 1..=limit {
+        // Inner loop: the equality problem on the set, stepping back while loads go negative.
+        loop {
+            let (z, alpha) = closed_gaps(problem, &set)?;
+            if z.iter().all(|&v| v > 0.0) {
+                for (&i, &v) in set.iter().zip(&z) {
+                    q[i] = v;
+                }
+                approach = alpha;
+                break;
+            }
+            let mut t: f64 = 1.0;
+            for (&i, &v) in set.iter().zip(&z) {
+                if v <= 0.0 {
+                    t = t.min(q[i] / (q[i] - v));
+                }
+            }
+            for (&i, &v) in set.iter().zip(&z) {
+                q[i] += t * (v - q[i]);
+            }
+            let qmax = q.iter().copied().fold(0.0, f64::max);
+            set.retain(|&i| q[i] > 1e-14 * qmax);
+            for i in 0..n {
+                if !set.contains(&i) {
+                    q[i] = 0.0;
+                }
+            }
+            if set.is_empty() {
+                return Err(SolverError::Invalid("active set emptied".into()));
+            }
+        }
+        // Gaps; the cells that penetrate most join the set.
+        problem.apply(&q, &mut y);
+        for i in 0..n {
+            y[i] = if e[i].is_finite() {
+                y[i] + e[i] - approach
+            } else {
+                f64::INFINITY
+            };
+        }
+        let tol = settings.tolerance * approach.abs();
+        let mut candidates: Vec<usize> = (0..n).filter(|&i| q[i] == 0.0 && y[i] < -tol).collect();
+        if candidates.is_empty() {
+            let residuals = residuals_at_load(load, &q, &y, approach, pass, None);
+            return Ok(Solution {
+                q,
+                approach,
+                gap: y,
+                residuals,
+            });
+        }
+        candidates.sort_by(|&a, &b| y[a].total_cmp(&y[b]));
+        // Several at a time while far from the solution, one at a time near it (Lawson and
+        // Hanson's rule, which guarantees the entering cell keeps a positive load).
+        let take = if pass < 20 { 8 } else { 1 };
+        set.extend(candidates.into_iter().take(take));
+        set.sort_unstable();
+    }
+    let residuals = residuals_at_load(load, &q, &y, approach, limit, None);
+    Err(SolverError::NotConverged {
+        kind: SolverKind::ConjugateGradient,
+        iterations: limit,
+        residual: residuals.complementarity.max(-residuals.min_gap),
+        tolerance: settings.tolerance,
+    })
+}
+
+/// Loads z on `set` (sorted) that close every gap of the set, K_SS z - alpha = -e_S, with
+/// sum z = W, and that alpha.
+fn closed_gaps(problem: &Problem, set: &[usize]) -> Result<(Vec<f64>, f64), SolverError> {
+    let m = set.len();
+    let k = problem.dense(set);
+    let chol = nalgebra::Cholesky::new(k).ok_or_else(|| {
+        SolverError::Invalid(
+            "the influence matrix of the loaded set is not positive definite".into(),
+        )
+    })?;
+    let rhs = nalgebra::DVector::from_iterator(m, set.iter().map(|&i| -problem.separation[i]));
+    let a = chol.solve(&rhs);
+    let b = chol.solve(&nalgebra::DVector::from_element(m, 1.0));
+    let alpha = (problem.load - a.sum()) / b.sum();
+    Ok(((a + b * alpha).iter().copied().collect(), alpha))
 }
 
 /// The published fixed point (MODEL §5.4): with y0 = K q + e,

@@ -23,7 +23,18 @@ pub struct LtcaSummary {
     pub worm_torque_nm: f64,
     /// Mean over the positions.
     pub wheel_torque_nm: f64,
+    /// Largest pressure of the loaded pattern's cells (raw maximum, see
+    /// `max_pressure_definition`) and where it sits on the flank (cell centre), mm.
     pub max_pressure_pa: f64,
+    pub max_pressure_r_mm: f64,
+    pub max_pressure_z_mm: f64,
+    /// Largest mean pressure over the stated patch (`[analysis] pressure_patch_*`;
+    /// mesh-converged at sharp edges).
+    pub pressure_patch_max_pa: f64,
+    pub pressure_patch_across_mm: f64,
+    pub pressure_patch_along_mm: f64,
+    pub max_pressure_definition: &'static str,
+    /// Mean of the loaded pattern's non-zero cells (MODEL §5.6).
     pub mean_pressure_pa: f64,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
@@ -65,8 +76,14 @@ pub struct SolverResiduals {
 }
 
 impl LtcaSummary {
-    pub fn new(tca: &Tca, ltca: &Ltca) -> Self {
+    pub fn new(tca: &Tca, wf: &crate::geometry::WheelFlank, ltca: &Ltca) -> Self {
         let (te_mean, te_p2p) = ltca.te_stats();
+        let at_max = ltca
+            .pattern
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(k, _)| &wf.cells[k]);
         let n = ltca.positions.len().max(1) as f64;
         Self {
             bending_model: ltca.bending_model.clone(),
@@ -74,6 +91,12 @@ impl LtcaSummary {
             worm_torque_nm: ltca.worm_torque,
             wheel_torque_nm: ltca.wheel_torque,
             max_pressure_pa: ltca.max_pressure,
+            max_pressure_r_mm: at_max.map_or(f64::NAN, |c| c.r * MM),
+            max_pressure_z_mm: at_max.map_or(f64::NAN, |c| c.z * MM),
+            pressure_patch_max_pa: ltca.pressure_patch_max,
+            pressure_patch_across_mm: ltca.pressure_patch_size[0] * MM,
+            pressure_patch_along_mm: ltca.pressure_patch_size[1] * MM,
+            max_pressure_definition: crate::output::wear::MAX_PRESSURE_DEFINITION,
             mean_pressure_pa: ltca.mean_pressure,
             contact_area_fraction: ltca.s0,
             s1: ltca.s1,
@@ -425,7 +448,7 @@ pub fn write_ltca(
     csv.write(&path)?;
     files.push(path);
     let value =
-        serde_json::to_value(LtcaSummary::new(tca, ltca)).map_err(|e| OutputError::Encode {
+        serde_json::to_value(LtcaSummary::new(tca, wf, ltca)).map_err(|e| OutputError::Encode {
             what: "ltca summary".into(),
             message: e.to_string(),
         })?;

@@ -135,14 +135,19 @@ impl Csv {
         }
     }
 
-    /// Appends a row of numbers (must match the header length).
+    /// Appends a row of numbers (must match the header length); whole numbers (indices,
+    /// counts) are written as integers, the rest with 11 significant digits.
     pub fn row(&mut self, values: &[f64]) {
         debug_assert_eq!(values.len(), self.columns);
         for (k, v) in values.iter().enumerate() {
             if k > 0 {
                 self.text.push(',');
             }
-            let _ = write!(self.text, "{v:.10e}");
+            if v.fract() == 0.0 && v.abs() < 1e15 {
+                let _ = write!(self.text, "{}", *v as i64);
+            } else {
+                let _ = write!(self.text, "{v:.10e}");
+            }
         }
         self.text.push('\n');
     }

@@ -7,13 +7,24 @@ use super::{write_atomic, OutputError};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Sections of the report: title, summary.json section, figure file prefixes (in order).
+/// Sections of the report: title, summary.json section, figures in order: a file stem, or a
+/// name prefix ending with `*` (all the files it starts, numbers in order).
 const SECTIONS: [(&str, &str, &[&str]); 5] = [
-    ("Geometry", "geometry", &["wheel_flank_outline", "section_"]),
+    (
+        "Geometry",
+        "geometry",
+        &["wheel_flank_outline", "section_*"],
+    ),
     (
         "Unloaded meshing (TCA)",
         "tca",
-        &["tca_kinematic_error", "tca_pattern", "tca_sliding_speed"],
+        &[
+            "tca_kinematic_error",
+            "tca_pattern",
+            "tca_sliding_speed",
+            "tca_sliding_along",
+            "tca_sliding_across",
+        ],
     ),
     (
         "Loaded contact (LTCA)",
@@ -23,7 +34,7 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "ltca_transmission_error",
             "ltca_mesh_stiffness",
             "ltca_pattern",
-            "ltca_pressure_position",
+            "ltca_pressure_position*",
         ],
     ),
     (
@@ -38,7 +49,10 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "wear_per_cycle_map",
             "wear_film_ratio_map",
             "wear_film_thickness_map",
-            "wear_pattern_step",
+            "wear_pattern",
+            "wear_map_step*",
+            "wear_film_ratio_map_step*",
+            "wear_pattern_step*",
         ],
     ),
     ("Ratings (ISO/TR 14521)", "rating", &[]),
@@ -68,16 +82,21 @@ fn scalar(v: &serde_json::Value) -> Option<String> {
     }
 }
 
-/// The SVG files of `dir` whose names start with `prefix` (sorted by name, numbers in order).
-fn figures(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+/// The SVG files of `dir` named `pattern`.svg, or, for a pattern ending with `*`, whose names
+/// start with it (sorted by name, numbers in order).
+fn figures(dir: &Path, pattern: &str) -> Vec<PathBuf> {
+    let (prefix, exact) = match pattern.strip_suffix('*') {
+        Some(p) => (p, None),
+        None => (pattern, Some(format!("{pattern}.svg"))),
+    };
     let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|rd| {
             rd.filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
                     p.extension().is_some_and(|x| x == "svg")
-                        && p.file_name()
-                            .and_then(|n| n.to_str())
-                            .is_some_and(|n| n.starts_with(prefix))
+                        && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+                            exact.as_deref().map_or(n.starts_with(prefix), |e| n == e)
+                        })
                 })
                 .collect()
         })
@@ -291,18 +310,11 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         }
         for prefix in prefixes {
             for path in figures(dir, prefix) {
-                // wear_map is a prefix of wear_map... only: skip other maps matched by it.
                 let name = path
                     .file_name()
                     .and_then(|n| n.to_str())
                     .unwrap_or_default()
                     .to_string();
-                if *prefix == "wear_map" && name != "wear_map.svg" {
-                    continue;
-                }
-                if *prefix == "ltca_pattern" && name != "ltca_pattern.svg" {
-                    continue;
-                }
                 let Ok(svg) = std::fs::read_to_string(&path) else {
                     continue;
                 };

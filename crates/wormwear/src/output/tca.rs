@@ -325,54 +325,53 @@ pub fn write_tca(
     let path = dir.join("tca_flank_map.csv");
     csv.write(&path)?;
     files.push(path);
-    // Sliding speed map: cell value = mean of its reachable corner nodes.
-    let node_value = |i: usize, j: usize| {
-        let c = &tca.node_contact[j * (wf.cells_height + 1) + i];
-        if c.reachable {
-            c.sliding_speed
-        } else {
-            f64::NAN
-        }
-    };
-    let mut speed = Vec::with_capacity(wf.cells.len());
-    for j in 0..wf.cells_face {
-        for i in 0..wf.cells_height {
-            let v = [
-                node_value(i, j),
-                node_value(i + 1, j),
-                node_value(i, j + 1),
-                node_value(i + 1, j + 1),
-            ];
-            let ok: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-            speed.push(if ok.len() >= 2 {
-                ok.iter().sum::<f64>() / ok.len() as f64
-            } else {
-                f64::NAN
-            });
-        }
-    }
-    let (lo, hi) = speed
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let path = dir.join("tca_sliding_speed.svg");
-    wheel_flank_map(
-        &path,
-        &format!(
-            "Sliding speed at contact (max {:.2} m/s, pitch point {:.2} m/s); grey: not reached by the worm flank",
-            tca.max_sliding_speed(),
-            tca.pitch_sliding_speed
+    // Sliding speed maps: magnitude, and its components along and across the contact line
+    // (MODEL §4.5; the across component drives the film's entrainment, the along one does not).
+    let maps: [(&str, String, &str, fn(&crate::kinematics::NodeContact) -> f64); 3] = [
+        (
+            "tca_sliding_speed.svg",
+            format!(
+                "Sliding speed at contact (max {:.2} m/s, pitch point {:.2} m/s); grey: not reached by the worm flank",
+                tca.max_sliding_speed(),
+                tca.pitch_sliding_speed
+            ),
+            "|Vg| (m/s)",
+            |c| c.sliding_speed,
         ),
-        wf,
-        &speed,
-        (lo, hi),
-        "|Vg| (m/s)",
-        &[trace],
-        &[],
-    )?;
-    files.push(path);
+        (
+            "tca_sliding_along.svg",
+            "Sliding speed along the contact line (signed, along the line's direction)".into(),
+            "Vg along (m/s)",
+            |c| c.sliding_along,
+        ),
+        (
+            "tca_sliding_across.svg",
+            "Sliding speed across the contact line (signed, in the tangent plane)".into(),
+            "Vg across (m/s)",
+            |c| c.sliding_across,
+        ),
+    ];
+    for (name, title, bar, component) in maps {
+        let values = reachable_cell_means(tca, wf, component);
+        let (lo, hi) = values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let path = dir.join(name);
+        wheel_flank_map(
+            &path,
+            &title,
+            wf,
+            &values,
+            (lo, hi),
+            bar,
+            &[trace.clone()],
+            &[],
+        )?;
+        files.push(path);
+    }
     // Contact lines.
     let mut csv = Csv::new(&[
         "position",
@@ -415,4 +414,41 @@ pub fn write_tca(
     )?;
     files.push(path);
     Ok(files)
+}
+
+/// Per flank cell, the mean of `value` over its corner nodes that the worm flank reaches (NaN
+/// with fewer than two).
+fn reachable_cell_means(
+    tca: &Tca,
+    wf: &crate::geometry::WheelFlank,
+    value: fn(&crate::kinematics::NodeContact) -> f64,
+) -> Vec<f64> {
+    let node_value = |i: usize, j: usize| {
+        let c = &tca.node_contact[j * (wf.cells_height + 1) + i];
+        if c.reachable {
+            value(c)
+        } else {
+            f64::NAN
+        }
+    };
+    let mut out = Vec::with_capacity(wf.cells.len());
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let ok: Vec<f64> = [
+                node_value(i, j),
+                node_value(i + 1, j),
+                node_value(i, j + 1),
+                node_value(i + 1, j + 1),
+            ]
+            .into_iter()
+            .filter(|x| x.is_finite())
+            .collect();
+            out.push(if ok.len() >= 2 {
+                ok.iter().sum::<f64>() / ok.len() as f64
+            } else {
+                f64::NAN
+            });
+        }
+    }
+    out
 }

@@ -2,10 +2,11 @@
 //! the records `wear_records.jsonl` (one JSON line per state, appended) and the checkpoint
 //! `wear_checkpoint.json` (the worn flank and how many records belong to it: resume), both at
 //! every state; `wear_steps.csv`, the `wear` section of summary.json and curves over cycles
-//! (wear, backlash, TE, pressure) when asked (the CLI: every two seconds); maps of
-//! the cumulative wear, of the wear per cycle, of the film thickness and ratio, the node table,
-//! the loaded pattern and `wheel_flank_wear.vtp` at log-spaced states (0, 1, 2, 4, 8, ...) and
-//! the last.
+//! (wear, backlash, TE, pressure) and `wear_positions.csv` (TE and load sharing per state and
+//! position) when asked (the CLI: every two seconds); maps of the cumulative wear, of the wear
+//! per cycle, of the film thickness and ratio, the loaded pattern and the node table at the map
+//! states (`[wear] map_cycles`, default 0, 1, 2, 4, 8, ...: files `*_step{N}`) and, without
+//! the suffix, the latest of them and the last; `wheel_flank_wear.vtp` with them.
 
 use super::tca::{flank_outline, tip_trace_series, wheel_flank_map};
 use super::{update_summary, write_atomic, Csv, OutputError};
@@ -35,6 +36,7 @@ struct CheckpointOut<'a> {
     pitted_phases: &'a [usize],
     pitted: &'a [bool],
     band_factor: Option<f64>,
+    warm: Option<&'a crate::ltca::WarmStart>,
     record_count: usize,
 }
 
@@ -51,6 +53,8 @@ struct CheckpointIn {
     #[serde(default)]
     band_factor: Option<f64>,
     #[serde(default)]
+    warm: Option<crate::ltca::WarmStart>,
+    #[serde(default)]
     record_count: Option<usize>,
     #[serde(default)]
     records: Option<Vec<crate::wear::StepRecord>>,
@@ -62,9 +66,25 @@ pub struct WearSummary<'a> {
     pub life_cycles: f64,
     pub step_control: &'a crate::input::StepControl,
     pub bending_model: &'a str,
-    /// One record per state: the start and after each step.
-    pub steps: &'a [crate::wear::StepRecord],
+    /// The model's choices and refinements in force (MODEL §12 g, h).
+    pub film_load: crate::input::FilmLoad,
+    pub pit_depth: crate::input::PitDepth,
+    /// States recorded (the start, one per step, one per pit cut) and loaded analyses run
+    /// (a step split by the stability guard costs one per sub-step; MODEL §7.3 counts those).
+    pub states: usize,
+    pub loaded_analyses: usize,
+    /// What `max_pressure_pa` is: the largest cell of the loaded pattern (raw, grows with
+    /// refinement at a sharp edge); `pressure_patch_max_pa` is the mesh-converged companion.
+    pub max_pressure_definition: &'static str,
+    /// One record per state: the start and after each step (per-position curves in
+    /// `wear_positions.csv`).
+    pub steps: Vec<crate::wear::StepRecord>,
 }
+
+/// What a summary's `max_pressure_pa` means.
+pub const MAX_PRESSURE_DEFINITION: &str = "largest pressure of the loaded pattern's cells \
+(raw maximum; at a sharp edge it grows with mesh refinement: see pressure_patch_max_pa, the \
+largest mean pressure over a patch of stated size, which converges)";
 
 /// Reads a checkpoint written by [`LifeWriter`] with its records (lines of [`RECORDS`] beyond
 /// the checkpoint's count, e.g. from an interruption between the two writes, are ignored).
@@ -111,6 +131,7 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
         pitted_phases: c.pitted_phases,
         pitted: c.pitted,
         band_factor: c.band_factor,
+        warm: c.warm,
     }))
 }
 
@@ -191,6 +212,7 @@ impl LifeWriter {
             pitted_phases: &state.pitted_phases,
             pitted: &state.pitted,
             band_factor: state.band_factor,
+            warm: state.warm.as_ref(),
             record_count: state.records.len(),
         };
         let text = serde_json::to_string(&checkpoint).map_err(|e| encode(CHECKPOINT, e))?;
@@ -217,12 +239,56 @@ fn write_state(
     tables: bool,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let state = view.state;
-    let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
-    let log_spaced = state.step == 0 || state.step.is_power_of_two();
-    if !(tables || log_spaced || view.last) {
+    if !(tables || view.map || view.last) {
         return Ok(files);
     }
+    files.extend(write_tables(tca, plan, view, dir)?);
+    // Maps and the node table: at the map states and the last (drawing every state would
+    // cost more than the state itself on long lives).
+    if !(view.map || view.last) {
+        return Ok(files);
+    }
+    let r = state.records.last().expect("a state has a record");
+    let maps = StateMaps {
+        geo,
+        tca,
+        view,
+        dir,
+    };
+    if view.map {
+        files.extend(maps.write(&format!("_step{}", state.step))?);
+    }
+    files.extend(maps.write("")?);
+    let path = dir.join("wheel_flank_wear.vtp");
+    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
+    super::vtk::add_pressure_pattern(&mut surface, &view.ltca.pattern);
+    super::vtk::add_node_field(&mut surface, "wear_um", &state.removal, UM);
+    super::vtk::add_node_field(&mut surface, "wear_per_cycle_um", &view.cycle.depth, UM);
+    super::vtk::add_node_field(&mut surface, "film_thickness_um", &view.cycle.film, UM);
+    super::vtk::add_node_field(&mut surface, "film_ratio", &view.cycle.lambda, 1.0);
+    surface.write_vtp(
+        &path,
+        &[],
+        &format!(
+            "loaded wheel flank after {} cycles (mm)",
+            super::cycles_label(r.cycles)
+        ),
+    )?;
+    files.push(path);
+    Ok(files)
+}
+
+/// The tables and curves over the states so far: `wear_steps.csv`, `wear_positions.csv`, the
+/// `wear` section of summary.json and the curves over cycles.
+fn write_tables(
+    tca: &Tca,
+    plan: &WearPlan,
+    view: &StepView,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let state = view.state;
+    let mut files = Vec::new();
     // Steps table and summary.
     let mut csv = Csv::new(&[
         "step",
@@ -243,6 +309,14 @@ fn write_state(
         "mesh_stiffness_mean_nm_per_rad",
         "max_wear_per_cycle_m",
         "lambda_min",
+        "substeps",
+        "loaded_analyses",
+        "pressure_patch_max_pa",
+        "rigid_lag_rad",
+        "te_mean_relative_rad",
+        "te_p2p_relative_rad",
+        "n_li_model_cycles",
+        "pitted_area_fraction",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -264,16 +338,39 @@ fn write_state(
             r.mesh_stiffness_mean_nm_per_rad,
             r.max_wear_per_cycle_m,
             r.lambda_min,
+            r.substeps as f64,
+            r.loaded_analyses as f64,
+            r.pressure_patch_max_pa,
+            r.rigid_lag_rad,
+            r.te_mean_relative_rad,
+            r.te_p2p_relative_rad,
+            r.n_li_model_cycles.unwrap_or(f64::NAN),
+            r.pitted_area_fraction,
         ]);
     }
     let path = dir.join("wear_steps.csv");
     csv.write(&path)?;
     files.push(path);
+    let path = dir.join("wear_positions.csv");
+    position_table(tca, &state.records).write(&path)?;
+    files.push(path);
     let summary = WearSummary {
         life_cycles: plan.life_cycles,
         step_control: &plan.step,
         bending_model: &view.ltca.bending_model,
-        steps: &state.records,
+        film_load: plan.film_load,
+        pit_depth: plan.pit_depth,
+        states: state.records.len(),
+        loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
+        max_pressure_definition: MAX_PRESSURE_DEFINITION,
+        steps: state
+            .records
+            .iter()
+            .map(|r| crate::wear::StepRecord {
+                positions: Vec::new(),
+                ..r.clone()
+            })
+            .collect(),
     };
     update_summary(
         dir,
@@ -317,6 +414,16 @@ fn write_state(
             vec![
                 curve(&|r| r.te_mean_rad * UM, "mean", 0),
                 curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
+                curve(
+                    &|r| r.te_mean_relative_rad * UM,
+                    "mean relative to the wear's rigid lag",
+                    3,
+                ),
+                curve(
+                    &|r| r.te_p2p_relative_rad * UM,
+                    "peak-to-peak relative to the lag",
+                    4,
+                ),
             ],
         ),
         (
@@ -324,7 +431,12 @@ fn write_state(
             "Contact pressure over life",
             "pressure (MPa)",
             vec![
-                curve(&|r| r.max_pressure_pa * MPA, "P_max", 1),
+                curve(&|r| r.max_pressure_pa * MPA, "P_max (raw)", 1),
+                curve(
+                    &|r| r.pressure_patch_max_pa * MPA,
+                    "P_99 (1 % of the area above)",
+                    2,
+                ),
                 curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
             ],
         ),
@@ -334,16 +446,71 @@ fn write_state(
         line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
         files.push(path);
     }
-    // Maps and the node table: at log-spaced states and the last (drawing every state would
-    // cost more than the state itself on long lives).
-    if !(log_spaced || view.last) {
-        return Ok(files);
+    Ok(files)
+}
+
+/// Per state and position: TE, TE relative to the wear's rigid lag, largest pressure and the
+/// normal force on each studied tooth (load sharing over life, MODEL §7.7).
+fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
+    let tooth_columns: Vec<String> = tca
+        .teeth
+        .iter()
+        .map(|k| format!("tooth{k}_load_n"))
+        .collect();
+    let mut header = vec![
+        "step",
+        "cycles",
+        "position",
+        "te_rad",
+        "te_relative_rad",
+        "max_pressure_pa",
+    ];
+    header.extend(tooth_columns.iter().map(String::as_str));
+    let mut csv = Csv::new(&header);
+    for r in records {
+        for (n, p) in r.positions.iter().enumerate() {
+            let mut row = vec![
+                r.step as f64,
+                r.cycles,
+                n as f64,
+                p.te_rad,
+                p.te_relative_rad,
+                p.max_pressure_pa,
+            ];
+            row.extend(
+                (0..tooth_columns.len()).map(|t| p.tooth_load_n.get(t).copied().unwrap_or(0.0)),
+            );
+            csv.row(&row);
+        }
     }
-    // Maps of the current state.
-    let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
-    // Map of a node field (cell means, times `scale`), over [0, top] or [0, its maximum].
-    let map =
-        |path: &Path, title: &str, field: &FlankField, scale: f64, bar: &str, top: Option<f64>| {
+    csv
+}
+
+/// The maps and node table of one state.
+struct StateMaps<'a> {
+    geo: &'a Geometry,
+    tca: &'a Tca,
+    view: &'a StepView<'a>,
+    dir: &'a Path,
+}
+
+impl StateMaps<'_> {
+    /// Writes the maps (cumulative wear, wear per cycle, film ratio and thickness, loaded
+    /// pattern) and the node table, their names ending with `suffix` before the extension.
+    fn write(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
+        let (tca, view, dir) = (self.tca, self.view, self.dir);
+        let state = view.state;
+        let wf = self.geo.wheel_flank(tca.loaded_flank);
+        let mut files = Vec::new();
+        // Maps of the current state.
+        let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
+        // Map of a node field (cell means, times `scale`), over [0, top] or [0, its maximum].
+        let map = |path: &Path,
+                   title: &str,
+                   field: &FlankField,
+                   scale: f64,
+                   bar: &str,
+                   top: Option<f64>| {
             let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
             let hi = top.unwrap_or_else(|| {
                 values
@@ -363,132 +530,117 @@ fn write_state(
                 &[],
             )
         };
-    let r = state.records.last().expect("a state has a record");
-    let path = dir.join("wear_map.svg");
-    map(
-        &path,
-        &format!(
-            "Cumulative wear after {} cycles (max {:.2} um; map: cell means)",
-            super::cycles_label(r.cycles),
-            r.max_wear_m * UM
-        ),
-        &state.removal,
-        UM,
-        "wear depth (um)",
-        None,
-    )?;
-    files.push(path);
-    let path = dir.join("wear_per_cycle_map.svg");
-    map(
-        &path,
-        &format!(
-            "Wear per cycle at {} cycles (max {:.3} nm; map: cell means)",
-            super::cycles_label(r.cycles),
-            r.max_wear_per_cycle_m * 1e9
-        ),
-        &view.cycle.depth,
-        1e9,
-        "wear per cycle (nm)",
-        None,
-    )?;
-    files.push(path);
-    let lambda = FlankField {
-        values: view
-            .cycle
-            .lambda
-            .values
-            .iter()
-            .map(|v| v.min(4.0))
-            .collect(),
-        ..view.cycle.lambda.clone()
-    };
-    let path = dir.join("wear_film_ratio_map.svg");
-    map(
-        &path,
-        &format!(
-            "Film ratio lambda at {} cycles (clipped at 4: no wear above)",
-            super::cycles_label(r.cycles)
-        ),
-        &lambda,
-        1.0,
-        "lambda",
-        Some(4.0),
-    )?;
-    files.push(path);
-    let path = dir.join("wear_film_thickness_map.svg");
-    map(
-        &path,
-        &format!(
-            "Minimum film thickness h_min at {} cycles (Moes-Venner, thermal factor)",
-            super::cycles_label(r.cycles)
-        ),
-        &view.cycle.film,
-        UM,
-        "h_min (um)",
-        None,
-    )?;
-    files.push(path);
-    let mut csv = Csv::new(&[
-        "i",
-        "j",
-        "r_mm",
-        "z_mm",
-        "wear_m",
-        "wear_per_cycle_m",
-        "lambda",
-        "film_m",
-    ]);
-    for j in 0..=wf.cells_face {
-        for i in 0..=wf.cells_height {
-            let k = j * (wf.cells_height + 1) + i;
-            let n = wf.node(i, j);
-            csv.row(&[
-                i as f64,
-                j as f64,
-                n.r * 1e3,
-                n.z * 1e3,
-                state.removal.values[k],
-                view.cycle.depth.values[k],
-                view.cycle.lambda.values[k],
-                view.cycle.film.values[k],
-            ]);
-        }
-    }
-    let path = dir.join("wear_map.csv");
-    csv.write(&path)?;
-    files.push(path);
-    // Loaded pattern at log-spaced states and the last.
-    {
-        let path = dir.join(format!("wear_pattern_step{}.svg", state.step));
-        super::ltca::pattern_map(
+        let r = state.records.last().expect("a state has a record");
+        let path = dir.join(format!("wear_map{suffix}.svg"));
+        map(
             &path,
-            wf,
-            view.ltca,
             &format!(
-                "Loaded pattern at {} cycles (P_max {:.0} MPa, S0 {:.2})",
+                "Cumulative wear after {} cycles (max {:.2} um; map: cell means)",
                 super::cycles_label(r.cycles),
-                r.max_pressure_pa * MPA,
-                r.contact_area_fraction
+                r.max_wear_m * UM
             ),
-            &overlays,
+            &state.removal,
+            UM,
+            "wear depth (um)",
+            None,
         )?;
         files.push(path);
+        let path = dir.join(format!("wear_per_cycle_map{suffix}.svg"));
+        map(
+            &path,
+            &format!(
+                "Wear per cycle at {} cycles (max {:.3} nm; map: cell means)",
+                super::cycles_label(r.cycles),
+                r.max_wear_per_cycle_m * 1e9
+            ),
+            &view.cycle.depth,
+            1e9,
+            "wear per cycle (nm)",
+            None,
+        )?;
+        files.push(path);
+        let lambda = FlankField {
+            values: view
+                .cycle
+                .lambda
+                .values
+                .iter()
+                .map(|v| v.min(4.0))
+                .collect(),
+            ..view.cycle.lambda.clone()
+        };
+        let path = dir.join(format!("wear_film_ratio_map{suffix}.svg"));
+        map(
+            &path,
+            &format!(
+                "Film ratio lambda at {} cycles (clipped at 4: no wear above)",
+                super::cycles_label(r.cycles)
+            ),
+            &lambda,
+            1.0,
+            "lambda",
+            Some(4.0),
+        )?;
+        files.push(path);
+        let path = dir.join(format!("wear_film_thickness_map{suffix}.svg"));
+        map(
+            &path,
+            &format!(
+                "Minimum film thickness h_min at {} cycles (Moes-Venner, thermal factor)",
+                super::cycles_label(r.cycles)
+            ),
+            &view.cycle.film,
+            UM,
+            "h_min (um)",
+            None,
+        )?;
+        files.push(path);
+        let mut csv = Csv::new(&[
+            "i",
+            "j",
+            "r_mm",
+            "z_mm",
+            "wear_m",
+            "wear_per_cycle_m",
+            "lambda",
+            "film_m",
+        ]);
+        for j in 0..=wf.cells_face {
+            for i in 0..=wf.cells_height {
+                let k = j * (wf.cells_height + 1) + i;
+                let n = wf.node(i, j);
+                csv.row(&[
+                    i as f64,
+                    j as f64,
+                    n.r * 1e3,
+                    n.z * 1e3,
+                    state.removal.values[k],
+                    view.cycle.depth.values[k],
+                    view.cycle.lambda.values[k],
+                    view.cycle.film.values[k],
+                ]);
+            }
+        }
+        let path = dir.join(format!("wear_map{suffix}.csv"));
+        csv.write(&path)?;
+        files.push(path);
+        // Loaded pattern (the maximum pressure over the cycle per flank cell).
+        {
+            let path = dir.join(format!("wear_pattern{suffix}.svg"));
+            super::ltca::pattern_map(
+                &path,
+                wf,
+                view.ltca,
+                &format!(
+                    "Loaded pattern at {} cycles (P_max {:.0} MPa, S0 {:.2})",
+                    super::cycles_label(r.cycles),
+                    r.max_pressure_pa * MPA,
+                    r.contact_area_fraction
+                ),
+                &overlays,
+            )?;
+            files.push(path);
+        }
+        Ok(files)
     }
-    let path = dir.join("wheel_flank_wear.vtp");
-    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
-    super::vtk::add_pressure_pattern(&mut surface, &view.ltca.pattern);
-    super::vtk::add_node_field(&mut surface, "wear_um", &state.removal, UM);
-    super::vtk::add_node_field(&mut surface, "wear_per_cycle_um", &view.cycle.depth, UM);
-    super::vtk::add_node_field(&mut surface, "film_thickness_um", &view.cycle.film, UM);
-    super::vtk::add_node_field(&mut surface, "film_ratio", &view.cycle.lambda, 1.0);
-    surface.write_vtp(
-        &path,
-        &[],
-        &format!(
-            "loaded wheel flank after {} cycles (mm)",
-            super::cycles_label(r.cycles)
-        ),
-    )?;
-    files.push(path);
-    Ok(files)
 }

@@ -12,3 +12,13 @@ pub fn example(name: &str) -> GearSet {
     )
     .unwrap()
 }
+
+/// Every reference case of `examples/`.
+#[allow(dead_code)]
+pub const EXAMPLES: [&str; 5] = [
+    "gear-1x40-design.toml",
+    "gear-1x40-case-a.toml",
+    "gear-1x40-case-b.toml",
+    "gear-1x40-case-c.toml",
+    "gear-k-2x25.toml",
+];
