@@ -206,8 +206,7 @@ impl BendingModel for WheelBending {
     }
 
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
-        let groups: Vec<i64> = cells.iter().map(|c| c.tooth as i64).collect();
-        let coords: Vec<(f64, f64)> = cells.iter().map(|c| self.coordinates(c.r, c.z)).collect();
+        let (groups, coords) = self.groups(cells);
         // Symmetrised core (reciprocity; the before/after fits are each other's transposes up to
         // the sector's end effects).
         let teeth = super::worm_model::relation_low_rank(
@@ -226,6 +225,41 @@ impl BendingModel for WheelBending {
     }
 }
 
+impl WheelBending {
+    /// Tooth groups and basis coordinates of the cells.
+    pub(crate) fn groups(&self, cells: &[LocalCell]) -> (Vec<i64>, Vec<(f64, f64)>) {
+        (
+            cells.iter().map(|c| c.tooth as i64).collect(),
+            cells.iter().map(|c| self.coordinates(c.r, c.z)).collect(),
+        )
+    }
+
+    /// The hub moves on its shaft (six rigid-body terms).
+    pub(crate) fn has_shaft(&self) -> bool {
+        self.shaft_compliance.as_ref().is_some_and(|s| s.len() == 36)
+    }
+
+    /// Core of the teeth present (cached).
+    pub(crate) fn teeth_core(&self, present: &[i64]) -> std::sync::Arc<Vec<f64>> {
+        super::worm_model::cached_core(&self.same, &self.before, &self.after, present, &self.cores)
+    }
+
+    /// Writes each cell's wrench g_i = (n_i, M_i x n_i) (fixed wheel frame) at columns
+    /// `offset..offset + 6` of its row of `f` (row length `stride`).
+    pub(crate) fn write_wrenches(
+        &self,
+        cells: &[LocalCell],
+        f: &mut [f64],
+        stride: usize,
+        offset: usize,
+    ) {
+        for (i, c) in cells.iter().enumerate() {
+            let g = wrench(&c.wheel_centre, &c.wheel_normal);
+            f[i * stride + offset..i * stride + offset + 6].copy_from_slice(g.as_slice());
+        }
+    }
+}
+
 /// Appends the hub's rigid-body motion to the teeth's low-rank term: six more columns, row i
 /// the wrench g_i = (n_i, M_i x n_i) of cell i in the fixed wheel frame, core the shaft
 /// compliance S, so C_ij += g_i^T S g_j (MODEL §5.5: bending of the wheel's environment).
@@ -234,7 +268,7 @@ pub fn with_rigid_body(teeth: LowRank, compliance: &[f64], cells: &[LocalCell]) 
     let mut f = vec![0.0; cells.len() * rank];
     let mut ranges = Vec::with_capacity(cells.len());
     for (i, c) in cells.iter().enumerate() {
-        f[i * rank..i * rank + k0].copy_from_slice(&teeth.f[i * k0..(i + 1) * k0]);
+        f[i * rank..i * rank + k0].copy_from_slice(&teeth.dense_row(i));
         let g = wrench(&c.wheel_centre, &c.wheel_normal);
         f[i * rank + k0..(i + 1) * rank].copy_from_slice(g.as_slice());
         let [r0, _, _] = teeth

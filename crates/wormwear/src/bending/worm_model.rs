@@ -368,8 +368,56 @@ fn relation_core(
         .collect()
 }
 
-/// Thread-relation low-rank term shared by both members: cells grouped by `group` (tooth or
-/// thread index), the core of the groups present from `cache` ([`relation_core`]).
+/// The rows of a thread-relation term: cells grouped by `group` (tooth or thread index), each
+/// row's basis values written at columns `offset + t k .. offset + (t + 1) k` of its row of
+/// `f` (row length `stride`; t the group's rank among those present, k the basis size).
+/// Returns the groups present (sorted) and each row's column range.
+pub(crate) fn relation_rows(
+    basis: &Basis,
+    groups: &[i64],
+    coords: &[(f64, f64)],
+    f: &mut [f64],
+    stride: usize,
+    offset: usize,
+) -> (Vec<i64>, Vec<(usize, usize)>) {
+    let mut present: Vec<i64> = groups.to_vec();
+    present.sort_unstable();
+    present.dedup();
+    let k = basis.len();
+    let mut ranges = Vec::with_capacity(groups.len());
+    for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
+        let t = present.binary_search(&g).unwrap_or(0);
+        let (a, b) = (offset + t * k, offset + (t + 1) * k);
+        ranges.push((a, b));
+        // Points outside the fitted zone take the value at its edge: the beam modes grow
+        // exponentially outside [0, 1].
+        let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
+        f[i * stride + a..i * stride + b].copy_from_slice(&values);
+    }
+    (present, ranges)
+}
+
+/// The core of `present` groups from `cache` ([`relation_core`], computed once per pattern),
+/// row-major.
+pub(crate) fn cached_core(
+    same: &Mat<f64>,
+    before: &Mat<f64>,
+    after: &Mat<f64>,
+    present: &[i64],
+    cache: &CoreCache,
+) -> std::sync::Arc<Vec<f64>> {
+    let pattern: Vec<i64> = present.iter().map(|g| g - present[0]).collect();
+    if let Some(c) = cache.0.lock().ok().and_then(|m| m.get(&pattern).cloned()) {
+        return c;
+    }
+    let c = std::sync::Arc::new(relation_core(same, before, after, present));
+    if let Ok(mut m) = cache.0.lock() {
+        m.insert(pattern, c.clone());
+    }
+    c
+}
+
+/// Thread-relation low-rank term of one member alone ([`relation_rows`], [`cached_core`]).
 pub(crate) fn relation_low_rank(
     basis: &Basis,
     same: &Mat<f64>,
@@ -382,31 +430,31 @@ pub(crate) fn relation_low_rank(
     let mut present: Vec<i64> = groups.to_vec();
     present.sort_unstable();
     present.dedup();
-    let k = basis.len();
-    let rank = k * present.len();
+    let rank = basis.len() * present.len();
     let mut f = vec![0.0; groups.len() * rank];
-    let mut ranges = Vec::with_capacity(groups.len());
-    for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
-        let t = present.iter().position(|&x| x == g).unwrap_or(0);
-        ranges.push([(t * k, (t + 1) * k), (0, 0), (0, 0)]);
-        // Points outside the fitted zone take the value at its edge: the beam modes grow
-        // exponentially outside [0, 1].
-        let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
-        f[i * rank + t * k..i * rank + (t + 1) * k].copy_from_slice(&values);
-    }
-    let pattern: Vec<i64> = present.iter().map(|g| g - present[0]).collect();
-    let cached = cache.0.lock().ok().and_then(|m| m.get(&pattern).cloned());
-    let core = match cached {
-        Some(c) => c,
-        None => {
-            let c = std::sync::Arc::new(relation_core(same, before, after, &present));
-            if let Ok(mut m) = cache.0.lock() {
-                m.insert(pattern, c.clone());
-            }
-            c
-        }
-    };
+    let (present, rows) = relation_rows(basis, groups, coords, &mut f, rank, 0);
+    let core = cached_core(same, before, after, &present, cache);
+    let ranges = rows.into_iter().map(|r| [r, (0, 0), (0, 0)]).collect();
     LowRank::new(rank, f, core.as_ref().clone(), ranges)
+}
+
+impl WormBending {
+    /// Thread groups and basis coordinates of the cells.
+    fn groups(&self, cells: &[LocalCell]) -> (Vec<i64>, Vec<(f64, f64)>) {
+        let first = cells
+            .first()
+            .map(|c| self.thread_coordinate(&c.cell.centre))
+            .unwrap_or(0.0);
+        let groups = cells
+            .iter()
+            .map(|c| (self.thread_coordinate(&c.cell.centre) - first).round() as i64)
+            .collect();
+        let coords = cells
+            .iter()
+            .map(|c| self.coordinates(&c.cell.centre))
+            .collect();
+        (groups, coords)
+    }
 }
 
 impl BendingModel for WormBending {
@@ -415,18 +463,7 @@ impl BendingModel for WormBending {
     }
 
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
-        let first = cells
-            .first()
-            .map(|c| self.thread_coordinate(&c.cell.centre))
-            .unwrap_or(0.0);
-        let groups: Vec<i64> = cells
-            .iter()
-            .map(|c| (self.thread_coordinate(&c.cell.centre) - first).round() as i64)
-            .collect();
-        let coords: Vec<(f64, f64)> = cells
-            .iter()
-            .map(|c| self.coordinates(&c.cell.centre))
-            .collect();
+        let (groups, coords) = self.groups(cells);
         relation_low_rank(
             &self.basis,
             &self.same,
@@ -456,39 +493,67 @@ impl BendingModel for FeBending {
         self.wheel.rigid_rotation_compliance()
     }
 
+    /// Both members' terms written straight into one F (wheel teeth, wheel hub's rigid body,
+    /// worm threads side by side; the cores block-diagonal): one allocation per position.
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
-        let a = self.wheel.coefficients(cells);
-        let b = self.worm.coefficients(cells);
-        let rank = a.rank + b.rank;
+        let (wheel_groups, wheel_coords) = self.wheel.groups(cells);
+        let (worm_groups, worm_coords) = self.worm.groups(cells);
+        let count = |g: &[i64]| {
+            let mut v = g.to_vec();
+            v.sort_unstable();
+            v.dedup();
+            v.len()
+        };
+        let teeth = self.wheel.basis.len() * count(&wheel_groups);
+        let hub = if self.wheel.has_shaft() { 6 } else { 0 };
+        let threads = self.worm.basis.len() * count(&worm_groups);
+        let rank = teeth + hub + threads;
         let mut f = vec![0.0; cells.len() * rank];
-        for i in 0..cells.len() {
-            f[i * rank..i * rank + a.rank].copy_from_slice(&a.f[i * a.rank..(i + 1) * a.rank]);
-            f[i * rank + a.rank..(i + 1) * rank]
-                .copy_from_slice(&b.f[i * b.rank..(i + 1) * b.rank]);
+        let (wheel_present, wheel_rows) = relation_rows(
+            &self.wheel.basis,
+            &wheel_groups,
+            &wheel_coords,
+            &mut f,
+            rank,
+            0,
+        );
+        if hub > 0 {
+            self.wheel.write_wrenches(cells, &mut f, rank, teeth);
         }
+        let (worm_present, worm_rows) = relation_rows(
+            &self.worm.basis,
+            &worm_groups,
+            &worm_coords,
+            &mut f,
+            rank,
+            teeth + hub,
+        );
         let mut core = vec![0.0; rank * rank];
-        for i in 0..a.rank {
-            core[i * rank..i * rank + a.rank]
-                .copy_from_slice(&a.core[i * a.rank..(i + 1) * a.rank]);
+        let mut place = |block: &[f64], size: usize, at: usize| {
+            for r in 0..size {
+                core[(at + r) * rank + at..(at + r) * rank + at + size]
+                    .copy_from_slice(&block[r * size..(r + 1) * size]);
+            }
+        };
+        place(&self.wheel.teeth_core(&wheel_present), teeth, 0);
+        if let Some(s) = self.wheel.shaft_compliance.as_deref().filter(|_| hub > 0) {
+            place(s, 6, teeth);
         }
-        for i in 0..b.rank {
-            let row = (a.rank + i) * rank + a.rank;
-            core[row..row + b.rank].copy_from_slice(&b.core[i * b.rank..(i + 1) * b.rank]);
-        }
-        // Wheel rows: the tooth's functions and the shaft's rigid-body terms; worm rows: the
-        // thread's functions, shifted past the wheel's columns.
+        place(&self.worm.threads_core(&worm_present), threads, teeth + hub);
         let ranges = (0..cells.len())
             .map(|i| {
-                let [ra, rs, _] = a
-                    .ranges
-                    .get(i)
-                    .copied()
-                    .unwrap_or([(0, a.rank), (0, 0), (0, 0)]);
-                let rb = b.ranges.get(i).map_or((0, b.rank), |r| r[0]);
-                [ra, rs, (a.rank + rb.0, a.rank + rb.1)]
+                let shaft = if hub > 0 { (teeth, teeth + hub) } else { (0, 0) };
+                [wheel_rows[i], shaft, worm_rows[i]]
             })
             .collect();
         LowRank::new(rank, f, core, ranges)
+    }
+}
+
+impl WormBending {
+    /// Core of the threads present (cached).
+    fn threads_core(&self, present: &[i64]) -> std::sync::Arc<Vec<f64>> {
+        cached_core(&self.same, &self.before, &self.after, present, &self.cores)
     }
 }
 

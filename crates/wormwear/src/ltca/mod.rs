@@ -798,9 +798,7 @@ fn solve_position(
         let low_rank = bending.map(|b| {
             let mut lr = b.coefficients(&cells);
             for (i, c) in cells.iter().enumerate() {
-                for v in &mut lr.f[i * lr.rank..(i + 1) * lr.rank] {
-                    *v /= c.lever;
-                }
+                lr.divide_row(i, c.lever);
             }
             lr
         });

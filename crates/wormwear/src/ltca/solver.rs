@@ -58,17 +58,22 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// Low-rank symmetric term F C F^T (rows of F per unknown, C k x k).
+/// Low-rank symmetric term F C F^T (rows of F per unknown, C k x k). F is stored packed: each
+/// row keeps only the values of its non-zero column ranges, one after the other (a row's
+/// functions live on its own tooth and thread: ~1/3 of the columns), so the products stream
+/// a third of the memory.
 #[derive(Debug, Clone)]
 pub struct LowRank {
     pub rank: usize,
-    /// Row-major n x rank.
-    pub f: Vec<f64>,
+    /// Packed rows: row i is `values[offsets[i]..offsets[i + 1]]`, the concatenation of its
+    /// ranges' columns.
+    values: Vec<f64>,
+    offsets: Vec<usize>,
     /// Row-major rank x rank, symmetric.
     pub core: Vec<f64>,
-    /// Column ranges [start, end) outside which row i of f is zero (up to three per row: a
+    /// Column ranges [start, end) outside which row i of F is zero (up to three per row: a
     /// member's functions live on the row's tooth or thread only, plus the wheel shaft's rigid
-    /// body terms); unused entries are (0, 0); empty: rows are dense.
+    /// body terms); unused entries are (0, 0).
     pub ranges: Vec<[(usize, usize); 3]>,
     /// Per row of the core: its runs of non-zero columns [start, end) (the core is block
     /// sparse: tooth relations reach the neighbours only, the members do not couple).
@@ -76,9 +81,16 @@ pub struct LowRank {
 }
 
 impl LowRank {
-    /// The term F C F^T with F (n x rank, row-major), C (rank x rank, row-major, symmetric) and
-    /// the rows' non-zero column ranges (see [`LowRank::ranges`]).
+    /// The term F C F^T with F (n x rank, row-major, dense), C (rank x rank, row-major,
+    /// symmetric) and the rows' non-zero column ranges (empty: rows are dense); F's entries
+    /// outside a row's ranges are taken as zero.
     pub fn new(rank: usize, f: Vec<f64>, core: Vec<f64>, ranges: Vec<[(usize, usize); 3]>) -> Self {
+        let n = if rank > 0 { f.len() / rank } else { ranges.len() };
+        let ranges: Vec<[(usize, usize); 3]> = if ranges.is_empty() {
+            vec![[(0, rank), (0, 0), (0, 0)]; n]
+        } else {
+            ranges
+        };
         // A row's ranges must not overlap (the products would count those columns twice).
         debug_assert!(ranges.iter().all(|r| {
             (0..3).all(|a| {
@@ -87,6 +99,17 @@ impl LowRank {
                 })
             })
         }));
+        let mut values = Vec::with_capacity(ranges.iter().flatten().map(|(a, b)| b.saturating_sub(*a)).sum());
+        let mut offsets = Vec::with_capacity(n + 1);
+        for (i, r) in ranges.iter().enumerate() {
+            offsets.push(values.len());
+            for &(a, b) in r {
+                if a < b {
+                    values.extend_from_slice(&f[i * rank + a..i * rank + b]);
+                }
+            }
+        }
+        offsets.push(values.len());
         let core_runs = (0..rank)
             .map(|r| {
                 let row = &core[r * rank..(r + 1) * rank];
@@ -108,38 +131,66 @@ impl LowRank {
             .collect();
         Self {
             rank,
-            f,
+            values,
+            offsets,
             core,
             ranges,
             core_runs,
         }
     }
 
-    /// The column ranges of row i (the whole row when no ranges are given).
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// Row i of F, dense (rank values).
+    pub fn dense_row(&self, i: usize) -> Vec<f64> {
+        let mut row = vec![0.0; self.rank];
+        let mut at = self.offsets[i];
+        for &(a, b) in &self.ranges[i] {
+            if a < b {
+                row[a..b].copy_from_slice(&self.values[at..at + b - a]);
+                at += b - a;
+            }
+        }
+        row
+    }
+
+    /// Divides row i of F by d.
+    pub fn divide_row(&mut self, i: usize, d: f64) {
+        for v in &mut self.values[self.offsets[i]..self.offsets[i + 1]] {
+            *v /= d;
+        }
+    }
+
+    /// Row i's packed values with its ranges.
     #[inline]
-    fn row_ranges(&self, i: usize) -> [(usize, usize); 3] {
-        self.ranges
-            .get(i)
-            .copied()
-            .unwrap_or([(0, self.rank), (0, 0), (0, 0)])
+    fn packed_row(&self, i: usize) -> (&[f64], &[(usize, usize); 3]) {
+        (
+            &self.values[self.offsets[i]..self.offsets[i + 1]],
+            &self.ranges[i],
+        )
     }
 }
 
-/// y += F C F^T x (the low-rank bending term) over the non-zero column ranges of each row,
-/// skipping zero x.
+/// y += F C F^T x (the low-rank bending term) over the packed rows, skipping zero x.
 #[inline(always)]
 fn low_rank_add(lr: &LowRank, x: &[f64], y: &mut [f64]) {
-    // (A row's functions live on its own tooth and thread: ~1/5 of the columns.)
     let k = lr.rank;
     let mut ft = vec![0.0; k];
     for (i, &xi) in x.iter().enumerate() {
         if xi == 0.0 {
             continue;
         }
-        let row = &lr.f[i * k..(i + 1) * k];
-        for (a, b) in lr.row_ranges(i) {
-            for (v, f) in ft[a..b].iter_mut().zip(&row[a..b]) {
-                *v += f * xi;
+        let (row, ranges) = lr.packed_row(i);
+        let mut at = 0;
+        for &(a, b) in ranges {
+            if a < b {
+                for (v, f) in ft[a..b].iter_mut().zip(&row[at..at + b - a]) {
+                    *v += f * xi;
+                }
+                at += b - a;
             }
         }
     }
@@ -153,10 +204,14 @@ fn low_rank_add(lr: &LowRank, x: &[f64], y: &mut [f64]) {
         })
         .collect();
     for (i, yi) in y.iter_mut().enumerate() {
-        let row = &lr.f[i * k..(i + 1) * k];
+        let (row, ranges) = lr.packed_row(i);
         let mut sum = 0.0;
-        for (a, b) in lr.row_ranges(i) {
-            sum += dot(&row[a..b], &cft[a..b]);
+        let mut at = 0;
+        for &(a, b) in ranges {
+            if a < b {
+                sum += dot(&row[at..at + b - a], &cft[a..b]);
+                at += b - a;
+            }
         }
         *yi += sum;
     }
@@ -384,7 +439,8 @@ impl Problem {
         }
         if let Some(lr) = &self.low_rank {
             let r = lr.rank;
-            let f = nalgebra::DMatrix::from_fn(m, r, |a, c| lr.f[set[a] * r + c]);
+            let rows: Vec<Vec<f64>> = set.iter().map(|&i| lr.dense_row(i)).collect();
+            let f = nalgebra::DMatrix::from_fn(m, r, |a, c| rows[a][c]);
             let core = nalgebra::DMatrix::from_row_slice(r, r, &lr.core);
             k += &f * core * f.transpose();
         }
@@ -469,9 +525,15 @@ fn conjugate_gradient(
     let q0 = initial(problem, warm);
     let Some(cap) = problem.upper.as_ref() else {
         // PK can cycle between active sets on badly conditioned problems (worn, pitted flanks
-        // with bending: a widened band of ~1800 cells whose bending modes are 40 times more
-        // compliant than the contact); the primal active-set method then finishes the job.
-        return match pk_inner(problem, settings, q0.clone(), &vec![false; n]) {
+        // with bending: a few cells of a ridge carrying the load, bending modes 40 times more
+        // compliant than the contact); the primal active-set method then finishes the job. PK
+        // gets a tenth of the iterations (it converges in ~100 when it does), the active set
+        // the rest.
+        let pk = SolverSettings {
+            max_iterations: (settings.max_iterations / 10).max(1),
+            ..*settings
+        };
+        return match pk_inner(problem, &pk, q0.clone(), &vec![false; n], true) {
             Err(e @ SolverError::NotConverged { .. }) => {
                 active_set(problem, settings, &q0).map_err(|_| e)
             }
@@ -521,7 +583,7 @@ fn conjugate_gradient(
                 q[i] = rest / open.len() as f64;
             }
         }
-        let mut sol = pk_inner(problem, settings, q.clone(), &fixed)?;
+        let mut sol = pk_inner(problem, settings, q.clone(), &fixed, false)?;
         iterations += sol.residuals.iterations;
         let tol = settings.tolerance * sol.approach.abs();
         let mut changed = false;
@@ -547,13 +609,18 @@ fn conjugate_gradient(
 
 /// Polonsky-Keer conjugate gradient with active set (Polonsky & Keer, Wear 1999), with the
 /// load constraint sum q = W and the approach as its multiplier. Cells marked `fixed` keep
-/// their load q0 (the caps of [`conjugate_gradient`]); the others carry the rest.
+/// their load q0 (the caps of [`conjugate_gradient`]); the others carry the rest. With
+/// `give_up_on_stall`, a residual that has not halved in STALL iterations ends the run as not
+/// converged (PK cycling between active sets; the caller has a fallback).
 fn pk_inner(
     problem: &Problem,
     settings: &SolverSettings,
     q0: Vec<f64>,
     fixed: &[bool],
+    give_up_on_stall: bool,
 ) -> Result<Solution, SolverError> {
+    const STALL: usize = 400;
+    let (mut best, mut best_at) = (f64::INFINITY, 0usize);
     let n = problem.len();
     let e = &problem.separation;
     let open: Vec<bool> = e
@@ -636,6 +703,11 @@ fn pk_inner(
             }
         }
         let scale = approach.abs().max(f64::MIN_POSITIVE);
+        if worst / scale < 0.5 * best {
+            (best, best_at) = (worst / scale, it);
+        } else if give_up_on_stall && it > best_at + STALL {
+            break;
+        }
         if worst / scale < settings.tolerance && last_change < settings.tolerance.sqrt() {
             if !exact {
                 problem.apply(&q, &mut u);
@@ -716,10 +788,10 @@ fn pk_inner(
     for i in 0..n {
         q[i] += q_fixed[i];
     }
-    let res = problem.residuals(&q, &gap, approach, settings.max_iterations);
+    let res = problem.residuals(&q, &gap, approach, it);
     Err(SolverError::NotConverged {
         kind: SolverKind::ConjugateGradient,
-        iterations: settings.max_iterations,
+        iterations: it,
         residual: res.complementarity.max(-res.min_gap),
         tolerance: settings.tolerance,
     })
