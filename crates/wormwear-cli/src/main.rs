@@ -133,6 +133,23 @@ enum Command {
         #[arg(long)]
         no_pitting: bool,
     },
+    /// The validation study behind VALIDATION.md: analytic checks, the published studies on the
+    /// reference gears, sensitivity to the unpublished inputs, our options against the default.
+    /// Resumable: finished jobs are kept in DIR/runs and reused when their inputs are the same.
+    #[command(after_help = "Example (from the repository root; about two hours on 2 cores):\n  \
+                      wormwear validate -o out/validation && cp out/validation/VALIDATION.md .\n  \
+                      wormwear validate -o out/smoke --quick      # a minute: the machinery only")]
+    Validate {
+        /// Output directory (VALIDATION.md, validation.json, runs/).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Directory of the reference cases.
+        #[arg(long, default_value = "examples")]
+        examples: PathBuf,
+        /// Smoke run: lives cut to a hundredth, no bending.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -198,6 +215,11 @@ fn main() -> ExitCode {
             cli.quiet,
             cli.verbose,
         ),
+        Command::Validate {
+            output,
+            examples,
+            quick,
+        } => validate(output, examples, *quick, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -736,5 +758,32 @@ fn calibrate(
     };
     wormwear::output::update_summary(dir, "calibration", section)
         .map_err(|e| Failure::Run(e.into()))?;
+    Ok(())
+}
+
+/// Runs the validation study into `dir` (VALIDATION.md at its root).
+fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(), Failure> {
+    if !examples.join("gear-1x40-design.toml").is_file() {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--examples = {}: no gear-1x40-design.toml there (run from the repository root or give the examples directory)",
+            examples.display()
+        )));
+    }
+    let settings = wormwear::validation::Settings {
+        examples: examples.to_path_buf(),
+        quick,
+    };
+    let path = wormwear::validation::run(&settings, dir, &mut |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    })
+    .map_err(|e| match e {
+        wormwear::validation::ValidationError::Input { .. } => Failure::Input(e.into()),
+        _ => Failure::Run(anyhow::Error::new(e).context("validation study")),
+    })?;
+    if !quiet {
+        println!("validation written to {}", path.display());
+    }
     Ok(())
 }

@@ -13,7 +13,8 @@
 //!    wear over life, backlash, pitting phases (MODEL §7-8);
 //! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9).
 //!
-//! [`output`] writes results (summary.json, CSV, SVG, STL) atomically.
+//! [`output`] writes results (summary.json, CSV, SVG, STL) atomically; [`validation`] runs the
+//! study behind VALIDATION.md.
 
 pub mod bending;
 pub mod calibration;
@@ -26,4 +27,5 @@ pub mod lubrication;
 pub mod output;
 pub mod plot;
 pub mod rating;
+pub mod validation;
 pub mod wear;

@@ -134,19 +134,9 @@ mod tests {
     #[test]
     fn rigid_isoviscous_limit_is_martins_solution() {
         // Martin (1916): h_min = 4.9 eta0 u_m R / w for a rigid cylinder on a plane with an
-        // isoviscous oil, u_m = (u1 + u2)/2. Light load, no pressure-viscosity, stiff bodies.
-        let mut lub = oil();
-        lub.pressure_viscosity = 0.0;
-        let e_prime = 1e15;
-        let c = LineContact {
-            radius: 0.02,
-            u1: 3.0,
-            u2: 1.0,
-            line_load: 50.0,
-            pressure: 0.0,
-        };
-        let h = min_film_thickness(&lub, e_prime, &c);
-        let martin = 4.9 * lub.viscosity * 2.0 * 0.02 / 50.0;
+        // isoviscous oil, u_m = (u1 + u2)/2. Light load, no pressure-viscosity, stiff bodies
+        // (validation::analytic::martin_film, the figure of VALIDATION.md).
+        let (h, martin) = crate::validation::analytic::martin_film();
         assert!((h / martin - 1.0).abs() < 1e-3, "{h} vs Martin {martin}");
     }
 

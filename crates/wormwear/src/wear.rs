@@ -569,8 +569,12 @@ pub struct StepRecord {
     /// Share of the active flank area pitted so far (pits cut at the starts of pitting
     /// phases).
     pub pitted_area_fraction: f64,
-    /// Largest depth worn, m.
+    /// Largest depth worn, m, and where on the flank (node radius and face position), m.
     pub max_wear_m: f64,
+    #[serde(default)]
+    pub max_wear_r_m: f64,
+    #[serde(default)]
+    pub max_wear_z_m: f64,
     /// Worn volume / active flank area (mean depth over the flank), m.
     pub mean_wear_m: f64,
     /// Worn volume of one tooth flank, m^3.
@@ -580,7 +584,12 @@ pub struct StepRecord {
     pub backlash_increase_m: f64,
     pub backlash_min_rad: f64,
     pub backlash_max_rad: f64,
+    /// Largest pressure of the loaded pattern and the centre of its cell, m.
     pub max_pressure_pa: f64,
+    #[serde(default)]
+    pub max_pressure_r_m: f64,
+    #[serde(default)]
+    pub max_pressure_z_m: f64,
     pub mean_pressure_pa: f64,
     pub contact_area_fraction: f64,
     pub s1: f64,
@@ -899,6 +908,8 @@ impl<'a> LifeLoop<'a> {
         let (te_rel_mean, te_rel_p2p) = stats(positions.iter().map(|p| p.te_relative_rad));
         let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
         let volume = state.removal.integral(wf);
+        let worst_node = argmax(&state.removal.values).map(|k| &wf.nodes[k]);
+        let worst_cell = argmax(&l.pattern).map(|k| &wf.cells[k]);
         let previous = state
             .records
             .iter()
@@ -916,6 +927,8 @@ impl<'a> LifeLoop<'a> {
             },
             pitted_area_fraction: pitted_fraction(wf, &state.pitted),
             max_wear_m: state.removal.max(),
+            max_wear_r_m: worst_node.map_or(f64::NAN, |n| n.r),
+            max_wear_z_m: worst_node.map_or(f64::NAN, |n| n.z),
             mean_wear_m: volume / self.active_area,
             worn_volume_m3: volume,
             backlash_m: b.linear_mean_m,
@@ -923,6 +936,8 @@ impl<'a> LifeLoop<'a> {
             backlash_min_rad: b.min_rad,
             backlash_max_rad: b.max_rad,
             max_pressure_pa: l.max_pressure,
+            max_pressure_r_m: worst_cell.map_or(f64::NAN, |c| c.r),
+            max_pressure_z_m: worst_cell.map_or(f64::NAN, |c| c.z),
             mean_pressure_pa: l.mean_pressure,
             contact_area_fraction: l.s0,
             s1: l.s1,
@@ -1024,6 +1039,16 @@ impl<'a> LifeLoop<'a> {
             rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
         }
     }
+}
+
+/// Index of the largest value (None when empty or all NaN).
+fn argmax(values: &[f64]) -> Option<usize> {
+    values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(k, _)| k)
 }
 
 /// Depth of the pits at every node (MODEL §8, §12 g): 0.78 a, a the local Hertz half-width

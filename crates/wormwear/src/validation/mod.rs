@@ -1,0 +1,426 @@
+//! The validation study behind `VALIDATION.md` (MODEL §12 g-m): the analytic checks, the
+//! studies the published work made on the reference gears, the sensitivity of the lives to the
+//! inputs the published data do not give, and each refinement of ours against the default.
+//!
+//! A study is a list of jobs: loaded analyses of an unworn gear and lives. Each job's result is
+//! written to `DIR/runs/<id>.json` with the full text of its inputs (gear, plan, code version);
+//! a later run reuses a result only when that text is the same, so an interrupted study resumes
+//! where it stopped and a changed input is always recomputed. The report is then written from
+//! the results ([`report`]).
+
+pub mod analytic;
+pub mod report;
+
+use crate::geometry::Geometry;
+use crate::input::{self, BendingKind, GearSet, Phase, StepControl, WearPlan};
+use crate::wear::{StepRecord, WearState};
+use std::path::{Path, PathBuf};
+
+/// Version of the study's jobs: part of every job's key (a change of the code that changes
+/// results bumps it, so old results are recomputed).
+pub const STUDY_VERSION: &str = "validation-1";
+
+/// Why the study stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    #[error("example {path}: {source}")]
+    Input {
+        path: String,
+        #[source]
+        source: input::InputError,
+    },
+    #[error("job {id}: {message}")]
+    Job { id: String, message: String },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+}
+
+/// What the study runs.
+#[derive(Debug, Clone)]
+pub struct Settings {
+    /// The directory of the reference cases (`examples/`).
+    pub examples: PathBuf,
+    /// Smoke run: lives cut to a hundredth, no bending, no million-cycle studies (checks the
+    /// machinery, not the model).
+    pub quick: bool,
+}
+
+/// One job: a loaded analysis of the unworn gear (no plan) or a life.
+#[derive(Debug, Clone)]
+pub struct Job {
+    pub id: String,
+    pub gear: GearSet,
+    pub plan: Option<WearPlan>,
+}
+
+/// What the study keeps of a job (units in the names).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct JobResult {
+    pub id: String,
+    /// The job's inputs as JSON text (gear, plan, study version): the result is reused only
+    /// for the same text.
+    pub key: String,
+    pub seconds: f64,
+    pub bending_model: String,
+    /// Unworn loaded analysis.
+    pub unworn: UnwornPattern,
+    /// The life's records (without the per-position curves); empty for an unworn analysis.
+    pub records: Vec<StepRecord>,
+    /// The schedule, for the phase tables: (kind, start, end) in cycles.
+    pub phases: Vec<(String, f64, f64)>,
+}
+
+/// Loaded pattern of the unworn gear (MODEL §5.6) and where its maximum sits.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct UnwornPattern {
+    pub max_pressure_pa: f64,
+    pub pressure_patch_max_pa: f64,
+    pub mean_pressure_pa: f64,
+    pub s0: f64,
+    pub s1: f64,
+    pub s2: f64,
+    /// Centre of the cell of the maximum, m; and its height above the worm-tip trace on its
+    /// face column (how far from the worm's tip edge), m.
+    pub max_r_m: f64,
+    pub max_z_m: f64,
+    pub max_above_tip_trace_m: f64,
+    pub te_mean_rad: f64,
+    pub te_p2p_rad: f64,
+    pub stiffness_nm_per_rad: f64,
+}
+
+/// Results of the study by job id.
+pub type Results = std::collections::BTreeMap<String, JobResult>;
+
+/// The reference case `name` of `examples/`, validated.
+pub fn example(settings: &Settings, name: &str) -> Result<GearSet, ValidationError> {
+    let path = settings.examples.join(name);
+    let mut g = input::load(&path).map_err(|source| ValidationError::Input {
+        path: path.display().to_string(),
+        source,
+    })?;
+    if settings.quick {
+        g.bending.kind = BendingKind::None;
+    }
+    Ok(g)
+}
+
+/// Runs every job not already in `dir/runs` (same key) and writes the report; returns the
+/// path of `dir/VALIDATION.md`. `progress` receives a line per job.
+pub fn run(
+    settings: &Settings,
+    dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<PathBuf, ValidationError> {
+    let jobs = jobs(settings)?;
+    let mut results = Results::new();
+    for (k, job) in jobs.iter().enumerate() {
+        let result = match cached(dir, job) {
+            Some(r) => {
+                progress(&format!(
+                    "[{}/{}] {}: from {}",
+                    k + 1,
+                    jobs.len(),
+                    job.id,
+                    run_path(dir, &job.id).display()
+                ));
+                r
+            }
+            None => {
+                progress(&format!("[{}/{}] {} ...", k + 1, jobs.len(), job.id));
+                let r = run_job(job)?;
+                let text = serde_json::to_string(&r).map_err(|e| ValidationError::Job {
+                    id: job.id.clone(),
+                    message: e.to_string(),
+                })?;
+                crate::output::write_atomic(&run_path(dir, &job.id), text.as_bytes())?;
+                progress(&format!("    {} done in {:.1} s", job.id, r.seconds));
+                r
+            }
+        };
+        results.insert(job.id.clone(), result);
+    }
+    let analytic = analytic::checks(&example(settings, "gear-1x40-design.toml")?);
+    let markdown = report::markdown(settings, &results, &analytic);
+    let path = dir.join("VALIDATION.md");
+    crate::output::write_atomic(&path, markdown.as_bytes())?;
+    let json = serde_json::json!({ "analytic": analytic, "jobs": results });
+    crate::output::write_atomic(
+        &dir.join("validation.json"),
+        serde_json::to_string_pretty(&json)
+            .unwrap_or_default()
+            .as_bytes(),
+    )?;
+    Ok(path)
+}
+
+fn run_path(dir: &Path, id: &str) -> PathBuf {
+    dir.join("runs").join(format!("{id}.json"))
+}
+
+/// The job's key: its inputs as JSON text.
+fn key(job: &Job) -> String {
+    serde_json::json!({
+        "version": STUDY_VERSION,
+        "gear": job.gear,
+        "plan": job.plan,
+    })
+    .to_string()
+}
+
+/// A stored result of the same job (same key), if any.
+fn cached(dir: &Path, job: &Job) -> Option<JobResult> {
+    let text = std::fs::read_to_string(run_path(dir, &job.id)).ok()?;
+    let r: JobResult = serde_json::from_str(&text).ok()?;
+    (r.key == key(job)).then_some(r)
+}
+
+/// Runs one job: geometry, TCA, bending (from the cache when built before), the unworn loaded
+/// analysis, and the life when there is a plan.
+pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
+    let fail = |message: String| ValidationError::Job {
+        id: job.id.clone(),
+        message,
+    };
+    let start = std::time::Instant::now();
+    let g = &job.gear;
+    let geo = Geometry::build(g).map_err(|e| fail(e.to_string()))?;
+    let tca = crate::kinematics::analyse(g, &geo).map_err(|e| fail(e.to_string()))?;
+    let (built, _) = crate::bending::model::build(g, &geo).map_err(|e| fail(e.to_string()))?;
+    let bending = built.map(|b| b.model);
+    let bending_ref = bending
+        .as_ref()
+        .map(|b| b as &dyn crate::ltca::BendingModel);
+    let settings = crate::ltca::LtcaSettings::from_gear(g);
+    let l = crate::ltca::analyse_with(g, &geo, &tca, &settings, bending_ref)
+        .map_err(|e| fail(format!("{e:#}")))?;
+    let unworn = unworn_pattern(&geo, &tca, &l);
+    let mut records = Vec::new();
+    if let Some(plan) = &job.plan {
+        let wf = geo.wheel_flank(tca.loaded_flank);
+        let end = crate::wear::simulate(
+            g,
+            &geo,
+            &tca,
+            &settings,
+            bending_ref,
+            plan,
+            WearState::new(wf),
+            &mut |_| Ok(()),
+        )
+        .map_err(|e| fail(format!("{e:#}")))?;
+        records = end
+            .records
+            .into_iter()
+            .map(|r| StepRecord {
+                positions: Vec::new(),
+                ..r
+            })
+            .collect();
+    }
+    Ok(JobResult {
+        id: job.id.clone(),
+        key: key(job),
+        seconds: start.elapsed().as_secs_f64(),
+        bending_model: l.bending_model.clone(),
+        unworn,
+        records,
+        phases: job.plan.as_ref().map(schedule).unwrap_or_default(),
+    })
+}
+
+/// The unworn pattern's figures (MODEL §5.6) and the place of its maximum.
+fn unworn_pattern(geo: &Geometry, tca: &crate::kinematics::Tca, l: &crate::ltca::Ltca) -> UnwornPattern {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let k = (0..l.pattern.len())
+        .max_by(|&a, &b| l.pattern[a].total_cmp(&l.pattern[b]))
+        .unwrap_or(0);
+    let cell = &wf.cells[k];
+    let j = k / wf.cells_height;
+    let trace = 0.5 * (tca.tip_trace[j].1 + tca.tip_trace[j + 1].1);
+    let (te_mean, te_p2p) = l.te_stats();
+    UnwornPattern {
+        max_pressure_pa: l.max_pressure,
+        pressure_patch_max_pa: l.pressure_patch_max,
+        mean_pressure_pa: l.mean_pressure,
+        s0: l.s0,
+        s1: l.s1,
+        s2: l.s2,
+        max_r_m: cell.r,
+        max_z_m: cell.z,
+        max_above_tip_trace_m: cell.r - trace,
+        te_mean_rad: te_mean,
+        te_p2p_rad: te_p2p,
+        stiffness_nm_per_rad: l.stiffness_mean(),
+    }
+}
+
+/// The plan's phases as (kind, start, end); one wear phase for a plan without schedule.
+fn schedule(plan: &WearPlan) -> Vec<(String, f64, f64)> {
+    let mut out = Vec::new();
+    let mut start = 0.0;
+    for p in &plan.phases {
+        let (kind, end) = match *p {
+            Phase::Wear { until } => ("wear", until),
+            Phase::Pitting { until, .. } => ("pitting", until),
+        };
+        let end = end.min(plan.life_cycles);
+        if end > start {
+            out.push((kind.to_string(), start, end));
+        }
+        start = end;
+    }
+    if start < plan.life_cycles {
+        out.push(("wear".to_string(), start, plan.life_cycles));
+    }
+    out
+}
+
+/// A variant of a gear: `id` and a change.
+fn variant(base: &GearSet, change: impl FnOnce(&mut GearSet)) -> GearSet {
+    let mut g = base.clone();
+    change(&mut g);
+    g
+}
+
+/// The study's jobs in order: (b) reference studies, (c) sensitivity, (d) options.
+pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
+    let scale = if settings.quick { 0.01 } else { 1.0 };
+    let life = |g: &GearSet| -> WearPlan {
+        let mut p = g.wear.clone().unwrap_or_else(|| WearPlan::with_life(180_000.0));
+        p.life_cycles *= scale;
+        for phase in &mut p.phases {
+            match phase {
+                Phase::Wear { until } | Phase::Pitting { until, .. } => *until *= scale,
+            }
+        }
+        p
+    };
+    let design = example(settings, "gear-1x40-design.toml")?;
+    let (a, b, c) = (
+        example(settings, "gear-1x40-case-a.toml")?,
+        example(settings, "gear-1x40-case-b.toml")?,
+        example(settings, "gear-1x40-case-c.toml")?,
+    );
+    let mut jobs = Vec::new();
+    let mut push = |id: &str, gear: GearSet, plan: Option<WearPlan>| {
+        jobs.push(Job {
+            id: id.to_string(),
+            gear,
+            plan,
+        })
+    };
+    // (b) Unworn patterns (the lives below start with them too).
+    push("unworn-design", design.clone(), None);
+    // (b) Design case: step controls over 180 000 cycles, and a million cycles.
+    let design_life = life(&design);
+    for (id, step) in [
+        ("design-30000", StepControl::Cycles(30_000.0 * scale)),
+        ("design-15000", StepControl::Cycles(15_000.0 * scale)),
+        ("design-10000", StepControl::Cycles(10_000.0 * scale)),
+        ("design-adaptive", StepControl::MaxRemoval(4e-6)),
+    ] {
+        push(
+            id,
+            design.clone(),
+            Some(WearPlan {
+                step,
+                ..design_life.clone()
+            }),
+        );
+    }
+    if !settings.quick {
+        for (id, step) in [
+            ("design-1e6-fixed", StepControl::Cycles(30_000.0)),
+            ("design-1e6-adaptive", StepControl::MaxRemoval(4e-6)),
+        ] {
+            push(
+                id,
+                design.clone(),
+                Some(WearPlan {
+                    step,
+                    ..WearPlan::with_life(1e6)
+                }),
+            );
+        }
+    }
+    // (b) The endurance cases with their schedules, and case B wear only.
+    push("case-a", a.clone(), Some(life(&a)));
+    push("case-b", b.clone(), Some(life(&b)));
+    push("case-c", c.clone(), Some(life(&c)));
+    let mut wear_only = life(&b);
+    wear_only.phases.clear();
+    push("case-b-wear-only", b.clone(), Some(wear_only));
+    // (b) Speed study: case C's torque at 100 / 600 / 1200 rpm (900 rpm is case C).
+    for rpm in [100.0, 600.0, 1200.0] {
+        let g = variant(&c, |g| {
+            g.conditions.worm_speed = rpm * 2.0 * std::f64::consts::PI / 60.0
+        });
+        push(&format!("speed-{rpm:.0}"), g, Some(life(&c)));
+    }
+    // (c) Sensitivity of case C's life to the unpublished inputs; (d) our options.
+    for (id, g, plan) in variants(&c, life(&c)) {
+        push(&id, g, Some(plan));
+    }
+    Ok(jobs)
+}
+
+/// The variants of case C for (c) and (d): id, gear, plan.
+fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
+    let relief = input::EdgeRelief {
+        amount: 20e-6,
+        length: 1e-3,
+    };
+    let mut out = Vec::new();
+    for rq in [0.2, 0.5] {
+        out.push((
+            format!("c-roughness-{rq}"),
+            variant(c, |g| g.lubricant.composite_roughness = rq * 1e-6),
+            plan.clone(),
+        ));
+    }
+    for (id, factor) in [("c-k-half", 0.5), ("c-k-double", 2.0)] {
+        out.push((
+            id.to_string(),
+            variant(c, |g| g.wheel_material.wear_coefficient *= factor),
+            plan.clone(),
+        ));
+    }
+    if c.bending.kind == BendingKind::Fe {
+        out.push((
+            "c-no-bending".to_string(),
+            variant(c, |g| g.bending.kind = BendingKind::None),
+            plan.clone(),
+        ));
+    }
+    out.push((
+        "c-reliefs".to_string(),
+        variant(c, |g| {
+            g.worm.tip_relief = relief;
+            g.wheel.edge_relief = relief;
+        }),
+        plan.clone(),
+    ));
+    out.push((
+        "c-pressure-cap".to_string(),
+        variant(c, |g| g.analysis.contact_pressure_cap = g.wheel_material.hardness),
+        plan.clone(),
+    ));
+    out.push((
+        "c-band-pits".to_string(),
+        c.clone(),
+        WearPlan {
+            pit_depth: input::PitDepth::LoadedBand,
+            ..plan.clone()
+        },
+    ));
+    out.push((
+        "c-film-floor".to_string(),
+        c.clone(),
+        WearPlan {
+            film_load: input::FilmLoad::HertzPeakFloor,
+            ..plan
+        },
+    ));
+    out
+}
