@@ -136,9 +136,11 @@ enum Command {
     /// The validation study behind VALIDATION.md: analytic checks, the published studies on the
     /// reference gears, sensitivity to the unpublished inputs, our options against the default.
     /// Resumable: finished jobs are kept in DIR/runs and reused when their inputs are the same.
-    #[command(after_help = "Example (from the repository root; about two hours on 2 cores):\n  \
+    #[command(
+        after_help = "Example (from the repository root; about two hours on 2 cores):\n  \
                       wormwear validate -o out/validation && cp out/validation/VALIDATION.md .\n  \
-                      wormwear validate -o out/smoke --quick      # a minute: the machinery only")]
+                      wormwear validate -o out/smoke --quick      # a minute: the machinery only"
+    )]
     Validate {
         /// Output directory (VALIDATION.md, validation.json, runs/).
         #[arg(short, long)]

@@ -744,3 +744,56 @@ fn ltca_with_fe_bending_uses_the_cache() {
         b["ltca"]["mesh_stiffness_mean_nm_per_rad"]
     );
 }
+
+#[test]
+fn validate_writes_every_section_and_resumes_from_its_runs() {
+    // The machinery of the validation study on its smoke run (lives / 100, no bending): every
+    // section of VALIDATION.md, one stored result per job, and a second call that reuses them
+    // all (same inputs) and writes the same document.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("v");
+    let call = || {
+        let o = bin()
+            .args(["validate", "--quick", "-o"])
+            .arg(&out)
+            .arg("--examples")
+            .arg(example("gear-1x40-design.toml").parent().unwrap())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let first = call();
+    let text = std::fs::read_to_string(out.join("VALIDATION.md")).unwrap();
+    for heading in [
+        "## (a) Analytic solutions and invariants",
+        "### Unworn loaded pattern",
+        "### Design case: wear step",
+        "### Endurance cases A, B, C with their observed schedules",
+        "### Case B, wear only, to 19e6 cycles",
+        "### Speed study",
+        "## (c) Sensitivity",
+        "## (d) Our refinements against the default",
+    ] {
+        assert!(text.contains(heading), "{heading} missing");
+    }
+    let runs = std::fs::read_dir(out.join("runs")).unwrap().count();
+    assert_eq!(runs, first.matches(" done in ").count());
+    let second = call();
+    assert_eq!(second.matches(": from ").count(), runs, "{second}");
+    assert!(!second.contains(" done in "));
+    // Same results, so the same tables (the run times are those stored with the results).
+    assert_eq!(
+        std::fs::read_to_string(out.join("VALIDATION.md")).unwrap(),
+        text
+    );
+    // A wrong examples directory is an input error.
+    let o = bin()
+        .args(["validate", "--quick", "-o"])
+        .arg(&out)
+        .args(["--examples", "/nonexistent"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--examples"));
+}

@@ -55,7 +55,8 @@ fn pressure_cap_gives_an_elastic_perfectly_plastic_contact() {
     let h = 1.6 * a / n as f64;
     let cells = analytic::flat_cells(n, n, h, h);
     let area = cells[0].area();
-    let elastic_problem = analytic::flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+    let elastic_problem =
+        analytic::flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
     let settings = SolverSettings {
         tolerance: 1e-9,
         ..SolverSettings::default()

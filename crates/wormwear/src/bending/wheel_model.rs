@@ -236,7 +236,9 @@ impl WheelBending {
 
     /// The hub moves on its shaft (six rigid-body terms).
     pub(crate) fn has_shaft(&self) -> bool {
-        self.shaft_compliance.as_ref().is_some_and(|s| s.len() == 36)
+        self.shaft_compliance
+            .as_ref()
+            .is_some_and(|s| s.len() == 36)
     }
 
     /// Core of the teeth present (cached).

@@ -542,7 +542,11 @@ impl BendingModel for FeBending {
         place(&self.worm.threads_core(&worm_present), threads, teeth + hub);
         let ranges = (0..cells.len())
             .map(|i| {
-                let shaft = if hub > 0 { (teeth, teeth + hub) } else { (0, 0) };
+                let shaft = if hub > 0 {
+                    (teeth, teeth + hub)
+                } else {
+                    (0, 0)
+                };
                 [wheel_rows[i], shaft, worm_rows[i]]
             })
             .collect();

@@ -293,7 +293,7 @@ impl Ltca {
                             )
                         })
                         .collect();
-                    loaded.sort_by(|a, b| (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)));
+                    loaded.sort_by_key(|e| (e.0, e.1, e.2));
                     loaded
                 })
                 .collect(),
@@ -929,42 +929,6 @@ fn solve_position(
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::partition_point;
-
-    #[test]
-    fn partition_point_finds_the_run_a_full_scan_finds() {
-        // Increasing centres as the loaded pattern's global cells; every extent [lo, hi] gives
-        // the same cells as testing all of them.
-        let centres: Vec<f64> = (0..60)
-            .map(|j| -22.5 + 0.75 * j as f64 + 0.01 * j as f64)
-            .collect();
-        let n = centres.len();
-        for &(lo, hi) in &[
-            (-30.0, -25.0),
-            (-30.0, -22.0),
-            (-5.0, -4.9),
-            (-5.0, 5.0),
-            (22.0, 30.0),
-            (40.0, 50.0),
-            (0.0, 0.0),
-            (centres[10], centres[12]),
-        ] {
-            let scan: Vec<usize> = (0..n)
-                .filter(|&j| centres[j] >= lo && centres[j] <= hi)
-                .collect();
-            let first = partition_point(n, |j| centres[j] < lo);
-            let last = partition_point(n, |j| centres[j] <= hi);
-            let run: Vec<usize> = (first..last.max(first)).collect();
-            assert_eq!(run, scan, "[{lo}, {hi}]");
-        }
-        assert_eq!(partition_point(0, |_| true), 0);
-        assert_eq!(partition_point(5, |_| true), 5);
-        assert_eq!(partition_point(5, |_| false), 0);
-    }
-}
-
 /// Largest mean pressure over a patch `across` wide across the contact line and `along` long
 /// along the face width (m), over every tooth at every position, Pa: the pressure of a "cell
 /// of stated size". At a sharp edge the local cells' own maximum grows as the mesh is refined
@@ -1025,4 +989,40 @@ fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64 {
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::partition_point;
+
+    #[test]
+    fn partition_point_finds_the_run_a_full_scan_finds() {
+        // Increasing centres as the loaded pattern's global cells; every extent [lo, hi] gives
+        // the same cells as testing all of them.
+        let centres: Vec<f64> = (0..60)
+            .map(|j| -22.5 + 0.75 * j as f64 + 0.01 * j as f64)
+            .collect();
+        let n = centres.len();
+        for &(lo, hi) in &[
+            (-30.0, -25.0),
+            (-30.0, -22.0),
+            (-5.0, -4.9),
+            (-5.0, 5.0),
+            (22.0, 30.0),
+            (40.0, 50.0),
+            (0.0, 0.0),
+            (centres[10], centres[12]),
+        ] {
+            let scan: Vec<usize> = (0..n)
+                .filter(|&j| centres[j] >= lo && centres[j] <= hi)
+                .collect();
+            let first = partition_point(n, |j| centres[j] < lo);
+            let last = partition_point(n, |j| centres[j] <= hi);
+            let run: Vec<usize> = (first..last.max(first)).collect();
+            assert_eq!(run, scan, "[{lo}, {hi}]");
+        }
+        assert_eq!(partition_point(0, |_| true), 0);
+        assert_eq!(partition_point(5, |_| true), 5);
+        assert_eq!(partition_point(5, |_| false), 0);
+    }
 }

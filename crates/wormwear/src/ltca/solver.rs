@@ -85,7 +85,7 @@ impl LowRank {
     /// symmetric) and the rows' non-zero column ranges (empty: rows are dense); F's entries
     /// outside a row's ranges are taken as zero.
     pub fn new(rank: usize, f: Vec<f64>, core: Vec<f64>, ranges: Vec<[(usize, usize); 3]>) -> Self {
-        let n = if rank > 0 { f.len() / rank } else { ranges.len() };
+        let n = f.len().checked_div(rank).unwrap_or(ranges.len());
         let ranges: Vec<[(usize, usize); 3]> = if ranges.is_empty() {
             vec![[(0, rank), (0, 0), (0, 0)]; n]
         } else {
@@ -99,7 +99,13 @@ impl LowRank {
                 })
             })
         }));
-        let mut values = Vec::with_capacity(ranges.iter().flatten().map(|(a, b)| b.saturating_sub(*a)).sum());
+        let mut values = Vec::with_capacity(
+            ranges
+                .iter()
+                .flatten()
+                .map(|(a, b)| b.saturating_sub(*a))
+                .sum(),
+        );
         let mut offsets = Vec::with_capacity(n + 1);
         for (i, r) in ranges.iter().enumerate() {
             offsets.push(values.len());
@@ -858,9 +864,11 @@ pub fn active_set(
             }
             let qmax = q.iter().copied().fold(0.0, f64::max);
             set.retain(|&i| q[i] > 1e-14 * qmax);
-            for i in 0..n {
-                if !set.contains(&i) {
-                    q[i] = 0.0;
+            let mut inside = vec![false; n];
+            set.iter().for_each(|&i| inside[i] = true);
+            for (qi, keep) in q.iter_mut().zip(&inside) {
+                if !keep {
+                    *qi = 0.0;
                 }
             }
             if set.is_empty() {

@@ -327,7 +327,8 @@ pub fn write_tca(
     files.push(path);
     // Sliding speed maps: magnitude, and its components along and across the contact line
     // (MODEL §4.5; the across component drives the film's entrainment, the along one does not).
-    let maps: [(&str, String, &str, fn(&crate::kinematics::NodeContact) -> f64); 3] = [
+    type Component = fn(&crate::kinematics::NodeContact) -> f64;
+    let maps: [(&str, String, &str, Component); 3] = [
         (
             "tca_sliding_speed.svg",
             format!(
@@ -367,7 +368,7 @@ pub fn write_tca(
             &values,
             (lo, hi),
             bar,
-            &[trace.clone()],
+            std::slice::from_ref(&trace),
             &[],
         )?;
         files.push(path);

@@ -356,8 +356,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
         fine.columns = 41;
         if let Ok(f) = crate::ltca::analyse_with(&g, &geo, &tca, &fine, None) {
             out.push(Check {
-                what: "Raw P_max, 11 -> 41 cells across the line (edge singularity: grows)"
-                    .into(),
+                what: "Raw P_max, 11 -> 41 cells across the line (edge singularity: grows)".into(),
                 computed: format!(
                     "{:.0} -> {:.0} MPa",
                     unworn.max_pressure * 1e-6,
@@ -382,7 +381,13 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             });
         }
         // Hertz half-width against the loaded band's on the unworn flank (the pits' depth).
-        let cw = crate::wear::per_cycle(&g, &geo, &tca, &unworn, crate::input::FilmLoad::LoadedAnalysis);
+        let cw = crate::wear::per_cycle(
+            &g,
+            &geo,
+            &tca,
+            &unworn,
+            crate::input::FilmLoad::LoadedAnalysis,
+        );
         let e_star = steel_on_bronze().effective_modulus;
         let mut worst: f64 = 0.0;
         for k in 0..wf.nodes.len() {
@@ -393,7 +398,8 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             }
         }
         out.push(Check {
-            what: "Pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node".into(),
+            what: "Pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node"
+                .into(),
             computed: format!("largest {:.1} um", cw.hertz_half_width.max() * 1e6),
             reference: "the formula with the node's line load and radius".into(),
             error: worst,

@@ -230,7 +230,11 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
 }
 
 /// The unworn pattern's figures (MODEL §5.6) and the place of its maximum.
-fn unworn_pattern(geo: &Geometry, tca: &crate::kinematics::Tca, l: &crate::ltca::Ltca) -> UnwornPattern {
+fn unworn_pattern(
+    geo: &Geometry,
+    tca: &crate::kinematics::Tca,
+    l: &crate::ltca::Ltca,
+) -> UnwornPattern {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let k = (0..l.pattern.len())
         .max_by(|&a, &b| l.pattern[a].total_cmp(&l.pattern[b]))
@@ -287,7 +291,10 @@ fn variant(base: &GearSet, change: impl FnOnce(&mut GearSet)) -> GearSet {
 pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     let scale = if settings.quick { 0.01 } else { 1.0 };
     let life = |g: &GearSet| -> WearPlan {
-        let mut p = g.wear.clone().unwrap_or_else(|| WearPlan::with_life(180_000.0));
+        let mut p = g
+            .wear
+            .clone()
+            .unwrap_or_else(|| WearPlan::with_life(180_000.0));
         p.life_cycles *= scale;
         for phase in &mut p.phases {
             match phase {
@@ -403,7 +410,9 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
     ));
     out.push((
         "c-pressure-cap".to_string(),
-        variant(c, |g| g.analysis.contact_pressure_cap = g.wheel_material.hardness),
+        variant(c, |g| {
+            g.analysis.contact_pressure_cap = g.wheel_material.hardness
+        }),
         plan.clone(),
     ));
     out.push((

@@ -40,10 +40,7 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
             ""
         }
     );
-    let bending: Vec<&str> = results
-        .values()
-        .map(|r| r.bending_model.as_str())
-        .collect();
+    let bending: Vec<&str> = results.values().map(|r| r.bending_model.as_str()).collect();
     let _ = writeln!(
         m,
         "Units: pressures in MPa, wear and backlash in um (backlash: tangential at the wheel \
@@ -226,9 +223,9 @@ fn step_tables(m: &mut String, results: &Results) {
             .iter()
             .filter_map(|(_, id)| results.get(*id).and_then(last).map(f))
             .collect();
-        let (lo, hi) = v
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| {
+            (a.0.min(x), a.1.max(x))
+        });
         100.0 * (hi / lo - 1.0)
     };
     let _ = writeln!(
@@ -256,7 +253,10 @@ fn step_tables(m: &mut String, results: &Results) {
 }
 
 fn schedule_table(m: &mut String, results: &Results) {
-    let _ = writeln!(m, "### Endurance cases A, B, C with their observed schedules\n");
+    let _ = writeln!(
+        m,
+        "### Endurance cases A, B, C with their observed schedules\n"
+    );
     let _ = writeln!(
         m,
         "Phases from REFERENCE_GEARS.md (wear: backlash rising; pitting: pits cut at the phase \
@@ -415,7 +415,10 @@ fn section_c_d(m: &mut String, results: &Results) {
         );
         let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|");
     };
-    let _ = writeln!(m, "## (c) Sensitivity to the inputs the published data do not give\n");
+    let _ = writeln!(
+        m,
+        "## (c) Sensitivity to the inputs the published data do not give\n"
+    );
     let _ = writeln!(
         m,
         "Case C's life (6.8e6 cycles with its schedule), one input changed at a time; the \
@@ -449,7 +452,11 @@ fn section_c_d(m: &mut String, results: &Results) {
         "pressure cap at the bronze's hardness: `contact_pressure_cap_mpa = 1000`",
         "c-pressure-cap",
     );
-    row(m, "pits of the loaded band: `pit_depth = \"loaded-band\"`", "c-band-pits");
+    row(
+        m,
+        "pits of the loaded band: `pit_depth = \"loaded-band\"`",
+        "c-band-pits",
+    );
     row(
         m,
         "film load floored: `film_load = \"hertz-peak-floor\"`",
