@@ -565,3 +565,54 @@ impl WormBending {
 pub fn worm_loaded_flank(gear: &GearSet) -> Flank {
     crate::kinematics::loaded_flank(gear)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relation_cores_are_positive_semi_definite_and_unchanged_when_they_are() {
+        // A PSD "same" block with neighbour blocks that make the assembled three-group matrix
+        // indefinite: the projection removes the negative part only (nearest PSD matrix); a
+        // PSD assembly (no neighbours) comes back as it was.
+        let k = 4;
+        let same = Mat::<f64>::from_fn(k, k, |i, j| if i == j { 2.0 + i as f64 } else { 0.3 });
+        let strong = Mat::<f64>::from_fn(k, k, |i, j| if i == j { 2.5 } else { 0.0 });
+        let none = Mat::<f64>::zeros(k, k);
+        let present = [0, 1, 2];
+        let eig = |c: &[f64]| {
+            let n = (c.len() as f64).sqrt() as usize;
+            nalgebra::DMatrix::from_row_slice(n, n, c).symmetric_eigenvalues()
+        };
+        let projected = relation_core(&same, &strong, &strong, &present);
+        let raw_min = {
+            let mut m = nalgebra::DMatrix::<f64>::zeros(3 * k, 3 * k);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let blk = match a as i64 - b as i64 {
+                        0 => &same,
+                        -1 | 1 => &strong,
+                        _ => continue,
+                    };
+                    for l in 0..k {
+                        for c in 0..k {
+                            m[(a * k + l, b * k + c)] = blk[(l, c)];
+                        }
+                    }
+                }
+            }
+            m.symmetric_eigenvalues().min()
+        };
+        assert!(raw_min < -0.1, "the test matrix is indefinite: {raw_min}");
+        assert!(eig(&projected).min() > -1e-12);
+        let kept = relation_core(&same, &none, &none, &present);
+        for a in 0..3 {
+            for l in 0..k {
+                for c in 0..k {
+                    let v = kept[(a * k + l) * 3 * k + a * k + c];
+                    assert!((v - same[(l, c)]).abs() < 1e-12);
+                }
+            }
+        }
+    }
+}

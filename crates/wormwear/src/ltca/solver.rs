@@ -1209,6 +1209,57 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_active_set_method_solves_hertz_and_agrees_with_pk() {
+        // Sphere on a plane (the Hertz check of VALIDATION.md) plus a low-rank term (a
+        // compliant "bending" mode): the primal active-set fallback gives the KKT point PK
+        // gives (the problem is positive definite: one solution), and without the low-rank
+        // term Hertz's peak pressure.
+        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
+        let (radius, load) = (10e-3, 100.0);
+        let e_star = steel_on_bronze().effective_modulus;
+        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
+        let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+        let n = 24;
+        let h = 1.4 * a / n as f64;
+        let cells = flat_cells(n, n, h, h);
+        let mut pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+        let settings = SolverSettings {
+            tolerance: 1e-10,
+            ..SolverSettings::default()
+        };
+        let start = vec![0.0; pb.len()];
+        let exact = active_set(&pb, &settings, &start).unwrap();
+        let pmax = exact.q.iter().copied().fold(0.0, f64::max) / cells[0].area();
+        assert!((pmax / p0 - 1.0).abs() < 0.03, "{pmax:e} vs {p0:e}");
+        // Add a rank-2 term much more compliant than the contact along two smooth modes.
+        let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
+        let scale = 50.0 * pb.blocks[0].matrix[0];
+        pb.low_rank = Some(LowRank::new(
+            2,
+            rows,
+            vec![scale, 0.0, 0.0, 0.3 * scale],
+            Vec::new(),
+        ));
+        let by_pk = solve(&pb, &settings, None).unwrap();
+        let by_active_set = active_set(&pb, &settings, &start).unwrap();
+        let worst = by_pk
+            .q
+            .iter()
+            .zip(&by_active_set.q)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "active set: {} passes, PK {} iterations; largest load difference {worst:e} N",
+            by_active_set.residuals.iterations, by_pk.residuals.iterations
+        );
+        assert!(worst < 1e-6 * load);
+        assert!((by_pk.approach / by_active_set.approach - 1.0).abs() < 1e-8);
+        assert!(by_active_set.residuals.complementarity < 1e-9);
+        assert!(by_active_set.residuals.min_gap > -1e-9);
+        assert!(by_active_set.residuals.load < 1e-12);
+    }
+
+    #[test]
     fn the_wide_low_rank_product_equals_the_portable_one() {
         // The AVX2 build of F C F^T x (chosen at run time) against the portable build and a
         // plain triple loop: same numbers to round-off, with row ranges, a block-sparse core
