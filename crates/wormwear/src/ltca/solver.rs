@@ -1240,7 +1240,9 @@ mod tests {
             vec![scale, 0.0, 0.0, 0.3 * scale],
             Vec::new(),
         ));
-        let by_pk = solve(&pb, &settings, None).unwrap();
+        // PK alone, without the fallback (the compliant modes slow it: ~470 iterations).
+        let q0 = initial(&pb, None);
+        let by_pk = pk_inner(&pb, &settings, q0, &vec![false; pb.len()], false).unwrap();
         let by_active_set = active_set(&pb, &settings, &start).unwrap();
         let worst = by_pk
             .q
