@@ -589,7 +589,8 @@ fn conjugate_gradient(
                 q[i] = rest / open.len() as f64;
             }
         }
-        let mut sol = pk_inner(problem, settings, q.clone(), &fixed, false)?;
+        let pk_budget = (settings.max_iterations / 10).max(1);
+        let mut sol = solve_with_fixed(problem, settings, q.clone(), &fixed, pk_budget)?;
         iterations += sol.residuals.iterations;
         let tol = settings.tolerance * sol.approach.abs();
         let mut changed = false;
@@ -611,6 +612,62 @@ fn conjugate_gradient(
     Err(SolverError::Invalid(
         "the plastic (capped) set of the contact did not settle in 200 passes".into(),
     ))
+}
+
+/// The problem with the cells `fixed` held at their loads in `q0` (the capped cells of
+/// [`conjugate_gradient`]): PK, and when it stalls the primal active-set method on the free
+/// cells (the fixed cells' displacements added to the free cells' separations, their loads
+/// taken off the total). PK gets `pk_iterations` at most. Gaps are returned for every cell,
+/// fixed ones included.
+fn solve_with_fixed(
+    problem: &Problem,
+    settings: &SolverSettings,
+    q0: Vec<f64>,
+    fixed: &[bool],
+    pk_iterations: usize,
+) -> Result<Solution, SolverError> {
+    let pk = SolverSettings {
+        max_iterations: pk_iterations,
+        ..*settings
+    };
+    let error = match pk_inner(problem, &pk, q0.clone(), fixed, true) {
+        Err(e @ SolverError::NotConverged { .. }) => e,
+        other => return other,
+    };
+    let n = problem.len();
+    let q_fixed: Vec<f64> = (0..n).map(|i| if fixed[i] { q0[i] } else { 0.0 }).collect();
+    let mut u_fixed = vec![0.0; n];
+    problem.apply(&q_fixed, &mut u_fixed);
+    let fixed_load: f64 = q_fixed.iter().sum();
+    let reduced = Problem {
+        separation: (0..n)
+            .map(|i| {
+                if fixed[i] {
+                    f64::INFINITY
+                } else {
+                    problem.separation[i] + u_fixed[i]
+                }
+            })
+            .collect(),
+        load: problem.load - fixed_load,
+        upper: None,
+        ..problem.clone()
+    };
+    let start: Vec<f64> = (0..n).map(|i| if fixed[i] { 0.0 } else { q0[i] }).collect();
+    let free = active_set(&reduced, settings, &start).map_err(|_| error)?;
+    let q: Vec<f64> = (0..n).map(|i| free.q[i] + q_fixed[i]).collect();
+    let mut gap = vec![0.0; n];
+    problem.apply(&q, &mut gap);
+    for i in 0..n {
+        gap[i] += problem.separation[i] - free.approach;
+    }
+    let residuals = problem.residuals(&q, &gap, free.approach, free.residuals.iterations);
+    Ok(Solution {
+        q,
+        approach: free.approach,
+        gap,
+        residuals,
+    })
 }
 
 /// Polonsky-Keer conjugate gradient with active set (Polonsky & Keer, Wear 1999), with the
@@ -1259,6 +1316,84 @@ mod tests {
         assert!(by_active_set.residuals.complementarity < 1e-9);
         assert!(by_active_set.residuals.min_gap > -1e-9);
         assert!(by_active_set.residuals.load < 1e-12);
+    }
+
+    #[test]
+    fn a_capped_problem_is_finished_by_the_active_set_when_pk_cannot() {
+        // The sphere with the compliant rank-2 term and a pressure cap at 0.8 p0: an
+        // elastic-perfectly-plastic solution (no cell above its cap, capped cells in plastic
+        // flow with a closed or negative gap, the others complementary) carrying the load.
+        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
+        let (radius, load) = (10e-3, 100.0);
+        let e_star = steel_on_bronze().effective_modulus;
+        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
+        let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+        let n = 24;
+        let h = 1.4 * a / n as f64;
+        let cells = flat_cells(n, n, h, h);
+        let mut pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+        let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
+        let scale = 50.0 * pb.blocks[0].matrix[0];
+        pb.low_rank = Some(LowRank::new(
+            2,
+            rows,
+            vec![scale, 0.0, 0.0, 0.3 * scale],
+            Vec::new(),
+        ));
+        let area = cells[0].area();
+        let cap = 0.8 * p0 * area;
+        pb.upper = Some(vec![cap; cells.len()]);
+        let settings = SolverSettings {
+            tolerance: 1e-10,
+            ..SolverSettings::default()
+        };
+        let sol = solve(&pb, &settings, None).unwrap();
+        let total: f64 = sol.q.iter().sum();
+        assert!((total / load - 1.0).abs() < 1e-12);
+        let capped = sol.q.iter().filter(|&&q| q >= cap).count();
+        assert!(capped > 0 && sol.residuals.capped == capped);
+        for (q, y) in sol.q.iter().zip(&sol.gap) {
+            assert!(*q <= cap * (1.0 + 1e-12));
+            if *q >= cap {
+                assert!(
+                    *y <= 1e-8 * sol.approach,
+                    "capped cell with an open gap {y:e}"
+                );
+            }
+        }
+        assert!(sol.residuals.complementarity < 1e-8, "{:?}", sol.residuals);
+        assert!(sol.residuals.min_gap > -1e-8, "{:?}", sol.residuals);
+        // The fallback itself: the capped cells held, PK given one iteration (it cannot
+        // finish), the active set on the free cells gives the same loads.
+        let fixed: Vec<bool> = sol.q.iter().map(|&q| q >= cap).collect();
+        // Free cells start with the rest of the load spread over those inside the contact.
+        let inside: Vec<bool> = cells
+            .iter()
+            .zip(&fixed)
+            .map(|(c, f)| !f && c.centre.x.hypot(c.centre.y) < a)
+            .collect();
+        let rest = load - cap * fixed.iter().filter(|&&f| f).count() as f64;
+        let share = rest / inside.iter().filter(|&&i| i).count() as f64;
+        let q0: Vec<f64> = (0..pb.len())
+            .map(|i| {
+                if fixed[i] {
+                    cap
+                } else if inside[i] {
+                    share
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let again = solve_with_fixed(&pb, &settings, q0, &fixed, 1).unwrap();
+        let worst = sol
+            .q
+            .iter()
+            .zip(&again.q)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-6 * load, "{worst:e}");
+        assert!((again.approach / sol.approach - 1.0).abs() < 1e-8);
     }
 
     #[test]

@@ -68,6 +68,9 @@ pub struct JobResult {
     pub records: Vec<StepRecord>,
     /// The schedule, for the phase tables: (kind, start, end) in cycles.
     pub phases: Vec<(String, f64, f64)>,
+    /// Why the job failed (then nothing else is filled in; not stored, tried again next run).
+    #[serde(default)]
+    pub error: Option<String>,
 }
 
 /// Loaded pattern of the unworn gear (MODEL §5.6) and where its maximum sits.
@@ -128,14 +131,32 @@ pub fn run(
             }
             None => {
                 progress(&format!("[{}/{}] {} ...", k + 1, jobs.len(), job.id));
-                let r = run_job(job)?;
-                let text = serde_json::to_string(&r).map_err(|e| ValidationError::Job {
-                    id: job.id.clone(),
-                    message: e.to_string(),
-                })?;
-                crate::output::write_atomic(&run_path(dir, &job.id), text.as_bytes())?;
-                progress(&format!("    {} done in {:.1} s", job.id, r.seconds));
-                r
+                match run_job(job) {
+                    Ok(r) => {
+                        let text = serde_json::to_string(&r).map_err(|e| ValidationError::Job {
+                            id: job.id.clone(),
+                            message: e.to_string(),
+                        })?;
+                        crate::output::write_atomic(&run_path(dir, &job.id), text.as_bytes())?;
+                        progress(&format!("    {} done in {:.1} s", job.id, r.seconds));
+                        r
+                    }
+                    // A job that fails is reported as failed (and tried again next time), the
+                    // study goes on.
+                    Err(e) => {
+                        progress(&format!("    {} FAILED: {e}", job.id));
+                        JobResult {
+                            id: job.id.clone(),
+                            key: key(job),
+                            seconds: 0.0,
+                            bending_model: String::new(),
+                            unworn: UnwornPattern::default(),
+                            records: Vec::new(),
+                            phases: Vec::new(),
+                            error: Some(e.to_string()),
+                        }
+                    }
+                }
             }
         };
         results.insert(job.id.clone(), result);
@@ -193,7 +214,7 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
         .map(|b| b as &dyn crate::ltca::BendingModel);
     let settings = crate::ltca::LtcaSettings::from_gear(g);
     let l = crate::ltca::analyse_with(g, &geo, &tca, &settings, bending_ref)
-        .map_err(|e| fail(format!("{e:#}")))?;
+        .map_err(|e| fail(chain(&e)))?;
     let unworn = unworn_pattern(&geo, &tca, &l);
     let mut records = Vec::new();
     if let Some(plan) = &job.plan {
@@ -208,7 +229,7 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
             WearState::new(wf),
             &mut |_| Ok(()),
         )
-        .map_err(|e| fail(format!("{e:#}")))?;
+        .map_err(|e| fail(chain(&e)))?;
         records = end
             .records
             .into_iter()
@@ -226,7 +247,20 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
         unworn,
         records,
         phases: job.plan.as_ref().map(schedule).unwrap_or_default(),
+        error: None,
     })
+}
+
+/// An error and its causes, one after the other.
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
 }
 
 /// The unworn pattern's figures (MODEL §5.6) and the place of its maximum.

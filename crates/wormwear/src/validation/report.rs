@@ -19,6 +19,7 @@ pub fn markdown(settings: &Settings, results: &Results, analytic: &[Check]) -> S
     section_a(&mut m, analytic);
     section_b(&mut m, results);
     section_c_d(&mut m, results);
+    failures(&mut m, results);
     run_times(&mut m, results);
     m
 }
@@ -574,6 +575,23 @@ fn section_c_d(m: &mut String, results: &Results) {
         "film load floored: `film_load = \"hertz-peak-floor\"`",
         "c-film-floor",
     );
+    m.push('\n');
+}
+
+/// The jobs that failed, with their errors.
+fn failures(m: &mut String, results: &Results) {
+    let failed: Vec<&JobResult> = results.values().filter(|r| r.error.is_some()).collect();
+    if failed.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "## Jobs that failed
+"
+    );
+    for r in failed {
+        let _ = writeln!(m, "- `{}`: {}", r.id, r.error.as_deref().unwrap_or(""));
+    }
     m.push('\n');
 }
 
