@@ -281,7 +281,8 @@ pub fn checks(design: &crate::input::GearSet) -> Vec<Check> {
     out
 }
 
-/// Checks on the 1/40 gear (design case, no bending): conjugacy, the uniform angular
+/// Checks on the 1/40 gear (design case without bending: these are the contact model's
+/// properties): conjugacy, the uniform angular
 /// recession (rigid lag), the backlash law of a uniform removal, the mesh-converged pressure.
 fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
     let mut out = Vec::new();
@@ -294,7 +295,8 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
         if let Ok(tca) = crate::kinematics::analyse(&conj, &geo) {
             let (_, p2p) = tca.kinematic_error_stats();
             out.push(Check {
-                what: "Conjugate pair (hob = worm): unloaded kinematic error, peak-to-peak".into(),
+                what: "1/40 conjugate pair (hob = worm): unloaded kinematic error, peak-to-peak"
+                    .into(),
                 computed: format!("{p2p:.2e} rad"),
                 reference: "0 (bound: 1e-7 rad)".into(),
                 error: p2p,
@@ -321,7 +323,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
     let alpha_n = (g.worm.axial_pressure_angle.tan() * gamma.cos()).atan();
     let expected = d / (alpha_n.cos() * gamma.cos());
     out.push(Check {
-        what: "Backlash of a uniform 10 um removal (tangential at r2)".into(),
+        what: "1/40, backlash of a uniform 10 um removal (tangential at r2)".into(),
         computed: format!("{:.4} um", got * 1e6),
         reference: format!("d / (cos an cos gamma) = {:.4} um", expected * 1e6),
         error: relative(got, expected),
@@ -344,7 +346,8 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
         let (te0, _) = unworn.te_stats();
         let (te1, _) = worn.te_stats();
         out.push(Check {
-            what: "Flank worn by a uniform angle delta = 20 urad: TE shift".into(),
+            what: "1/40 (no bending), flank worn by a uniform angle delta = 20 urad: TE shift"
+                .into(),
             computed: format!("{:.6} urad", (te0 - te1) * 1e6),
             reference: "delta = 20 urad (rigid lag)".into(),
             error: relative(te0 - te1, delta),
@@ -356,7 +359,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
         fine.columns = 41;
         if let Ok(f) = crate::ltca::analyse_with(&g, &geo, &tca, &fine, None) {
             out.push(Check {
-                what: "Raw P_max, 11 -> 41 cells across the line (edge singularity: grows)".into(),
+                what: "1/40 (no bending), raw P_max, 11 -> 41 cells across the line (edge singularity: grows)".into(),
                 computed: format!(
                     "{:.0} -> {:.0} MPa",
                     unworn.max_pressure * 1e-6,
@@ -368,7 +371,9 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
                 test: "fidelity::the_patch_pressure_converges_where_the_maximum_does_not".into(),
             });
             out.push(Check {
-                what: "P_patch (0.5 x 1 mm mean), 11 -> 41 cells across the line".into(),
+                what:
+                    "1/40 (no bending), P_patch (0.5 x 1 mm mean), 11 -> 41 cells across the line"
+                        .into(),
                 computed: format!(
                     "{:.0} -> {:.0} MPa",
                     unworn.pressure_patch_max * 1e-6,
@@ -398,7 +403,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             }
         }
         out.push(Check {
-            what: "Pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node"
+            what: "1/40 (no bending), pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node"
                 .into(),
             computed: format!("largest {:.1} um", cw.hertz_half_width.max() * 1e6),
             reference: "the formula with the node's line load and radius".into(),
