@@ -150,9 +150,12 @@ impl LowRank {
         self.offsets.len().saturating_sub(1)
     }
 
-    /// Row i of F, dense (rank values).
+    /// Row i of F, dense (rank values; empty for a rank-0 term, whatever i).
     pub fn dense_row(&self, i: usize) -> Vec<f64> {
         let mut row = vec![0.0; self.rank];
+        if self.rank == 0 {
+            return row;
+        }
         let mut at = self.offsets[i];
         for &(a, b) in &self.ranges[i] {
             if a < b {
