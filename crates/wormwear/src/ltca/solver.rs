@@ -1673,7 +1673,9 @@ mod tests {
         // K restricted to a set (here: cells of one half only, so two columns of the bending
         // term drop out, and a set across both halves) against the dense submatrix of K.
         let (cells, pb, _) = sphere_with_two_halves(8);
-        let left: Vec<usize> = (0..cells.len()).filter(|&i| cells[i].centre.x < 0.0).collect();
+        let left: Vec<usize> = (0..cells.len())
+            .filter(|&i| cells[i].centre.x < 0.0)
+            .collect();
         let across: Vec<usize> = (0..cells.len()).filter(|i| i % 5 == 1).collect();
         for (set, rank) in [(left, 2), (across, 4)] {
             let sub = pb.restrict(&set);
@@ -1717,10 +1719,7 @@ mod tests {
             screened_from(&pb, &settings, left, left_inside).unwrap(),
         ];
         for ((sol, passes), (at_least, at_most)) in runs.into_iter().zip([(1, 1), (2, 99)]) {
-            assert!(
-                (at_least..=at_most).contains(&passes),
-                "{passes} solves"
-            );
+            assert!((at_least..=at_most).contains(&passes), "{passes} solves");
             let worst = sol
                 .q
                 .iter()
