@@ -480,9 +480,13 @@ fn wear(
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
     let bending = bending_model(&gear, &geo, quiet)?;
     let wf = geo.wheel_flank(tca.loaded_flank);
+    let inputs = wormwear::output::wear::life_inputs(&gear, &plan);
     let state = if args.resume {
-        match wormwear::output::wear::read_checkpoint(dir) {
-            Ok(Some(s)) => s,
+        match wormwear::output::wear::read_resume(dir) {
+            Ok(Some((s, stored))) => {
+                check_resume(dir, &s, stored.as_ref(), &inputs, plan.life_cycles)?;
+                s
+            }
             Ok(None) => {
                 return Err(Failure::Input(anyhow::anyhow!(
                     "--resume: no {} in {}",
@@ -513,7 +517,7 @@ fn wear(
     // Tables, summary and curves grow with the number of states: rewrite them at most every
     // two seconds (and at log-spaced states and the last); the checkpoint goes out every state.
     let mut tables_written = std::time::Instant::now();
-    let mut writer = wormwear::output::wear::LifeWriter::new(dir);
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir).with_inputs(inputs);
     let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
         let tables = tables_written.elapsed().as_secs_f64() >= 2.0;
         writer
@@ -581,6 +585,54 @@ fn wear(
             "rating (ISO/TR 14521): efficiency {:.3}, worm torque {:.2} N m, sigma_Hm {:.0} MPa, N_LI {:.3e} cycles",
             rating.efficiency, rating.worm_torque_nm, rating.sigma_hm_mpa, rating.n_li_cycles
         );
+    }
+    Ok(())
+}
+
+/// A checkpoint may be resumed only with the inputs it was computed with and towards a life
+/// at least as long as the cycles it reached.
+fn check_resume(
+    dir: &Path,
+    state: &wormwear::wear::WearState,
+    stored: Option<&serde_json::Value>,
+    inputs: &serde_json::Value,
+    life_cycles: f64,
+) -> Result<(), Failure> {
+    let checkpoint = dir.join(wormwear::output::wear::CHECKPOINT);
+    let Some(stored) = stored else {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--resume: {} holds no record of the inputs it was computed with (written by an \
+             earlier version): its states cannot be checked against this input file; run \
+             without --resume into a new directory",
+            checkpoint.display()
+        )));
+    };
+    let changes = wormwear::output::wear::input_changes(stored, inputs);
+    if !changes.is_empty() {
+        let shown: Vec<&str> = changes.iter().take(12).map(String::as_str).collect();
+        let more = changes.len().saturating_sub(shown.len());
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--resume: the inputs differ from those {} was computed with ({} difference{}, \
+             checkpoint -> now):\n  {}{}\nresume with the original inputs, or run without \
+             --resume into a new directory",
+            checkpoint.display(),
+            changes.len(),
+            if changes.len() == 1 { "" } else { "s" },
+            shown.join("\n  "),
+            if more > 0 {
+                format!("\n  ... and {more} more")
+            } else {
+                String::new()
+            }
+        )));
+    }
+    if life_cycles < state.cycles {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--resume: the life asked for ({life_cycles:e} cycles) ends before the checkpoint's \
+             state ({:e} cycles, step {}); ask for at least that many cycles",
+            state.cycles,
+            state.step
+        )));
     }
     Ok(())
 }

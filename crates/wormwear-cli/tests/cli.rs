@@ -505,38 +505,63 @@ fn report_renders_in_a_headless_browser() {
     );
 }
 
-#[test]
-fn resume_with_the_checkpoint_of_another_grid_is_an_input_error() {
-    // A checkpoint written for a 40 x 60 flank grid, resumed with a file asking for 30 x 60.
-    let dir = tempfile::tempdir().unwrap();
-    let out = bin()
-        .args(["-q", "wear"])
-        .arg(example("gear-1x40-design.toml"))
+/// `wormwear wear FILE -o DIR ARGS...`.
+fn wear_into(file: &Path, dir: &Path, args: &[&str]) -> std::process::Output {
+    bin()
+        .arg("wear")
+        .arg(file)
         .arg("-o")
-        .arg(dir.path())
-        .args(["--cycles", "10000", "--step-cycles", "10000"])
+        .arg(dir)
+        .args(args)
         .output()
-        .unwrap();
-    assert!(out.status.success());
-    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
         .unwrap()
+}
+
+#[test]
+fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_difference() {
+    // A checkpoint of the design case at 60 N m, 1500 rpm on a 40 x 60 flank grid; resumed
+    // with 90 N m, 150 rpm and 30 x 60 (each named, exit 2, nothing written), then with a life
+    // shorter than the checkpoint's, then from a checkpoint without its inputs.
+    let dir = tempfile::tempdir().unwrap();
+    let design = example("gear-1x40-design.toml");
+    let life = ["-q", "--cycles", "10000", "--step-cycles", "10000"];
+    assert!(wear_into(&design, dir.path(), &life).status.success());
+    let records = std::fs::read(dir.path().join("wear_records.jsonl")).unwrap();
+    let text = std::fs::read_to_string(&design)
+        .unwrap()
+        .replace("worm_torque_nm = 60.0", "worm_torque_nm = 90.0")
+        .replace("worm_speed_rpm = 1500.0", "worm_speed_rpm = 150.0")
         .replace("flank_cells_height = 40", "flank_cells_height = 30");
     let other = dir.path().join("other.toml");
     std::fs::write(&other, text).unwrap();
-    let out = bin()
-        .arg("wear")
-        .arg(&other)
-        .arg("-o")
-        .arg(dir.path())
-        .arg("--resume")
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("--resume") && err.contains("checkpoint"),
-        "{err}"
+    let resume = [&life[..], &["--resume"]].concat();
+    let refused = |file: &Path, args: &[&str], message: &str| {
+        let out = wear_into(file, dir.path(), args);
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(err.contains(message), "{err}");
+        err
+    };
+    let err = refused(&other, &resume, "3 differences");
+    assert!(err.contains("gear.conditions.torque"), "{err}");
+    assert!(err.contains("gear.conditions.worm_speed"), "{err}");
+    assert!(err.contains("flank_cells_height: 40 -> 30"), "{err}");
+    assert_eq!(
+        std::fs::read(dir.path().join("wear_records.jsonl")).unwrap(),
+        records
     );
+    refused(
+        &design,
+        &["--cycles", "5000", "--step-cycles", "10000", "--resume"],
+        "ends before the checkpoint",
+    );
+    // A checkpoint without its inputs (an earlier version's) cannot be checked: refused.
+    let path = dir.path().join("wear_checkpoint.json");
+    let mut checkpoint: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    checkpoint.as_object_mut().unwrap().remove("inputs");
+    std::fs::write(&path, checkpoint.to_string()).unwrap();
+    refused(&design, &resume, "no record of the inputs");
 }
 
 /// A Python interpreter with VTK's own bindings (Debian `python3-vtk9`), when installed.

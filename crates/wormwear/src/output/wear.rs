@@ -38,6 +38,8 @@ struct CheckpointOut<'a> {
     band_factor: Option<f64>,
     warm: Option<&'a crate::ltca::WarmStart>,
     record_count: usize,
+    /// The inputs the states were computed with ([`life_inputs`]).
+    inputs: Option<&'a serde_json::Value>,
 }
 
 /// The checkpoint as read; `records` inline is the earlier format (still read).
@@ -58,6 +60,8 @@ struct CheckpointIn {
     record_count: Option<usize>,
     #[serde(default)]
     records: Option<Vec<crate::wear::StepRecord>>,
+    #[serde(default)]
+    inputs: Option<serde_json::Value>,
 }
 
 /// The `wear` section of summary.json.
@@ -89,6 +93,76 @@ largest mean pressure over a patch of stated size, which converges)";
 /// Reads a checkpoint written by [`LifeWriter`] with its records (lines of [`RECORDS`] beyond
 /// the checkpoint's count, e.g. from an interruption between the two writes, are ignored).
 pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
+    Ok(read_resume(dir)?.map(|(state, _)| state))
+}
+
+/// The inputs that shape a life's results: the gear set without its title, its remarks and
+/// its life plan, and the plan without the life's length (a resume may extend a life).
+/// Stored in the checkpoint, compared on resume ([`input_changes`]).
+pub fn life_inputs(gear: &GearSet, plan: &WearPlan) -> serde_json::Value {
+    let mut g = serde_json::to_value(gear).unwrap_or(serde_json::Value::Null);
+    if let Some(map) = g.as_object_mut() {
+        for key in ["title", "warnings", "wear"] {
+            map.remove(key);
+        }
+    }
+    let mut p = serde_json::to_value(plan).unwrap_or(serde_json::Value::Null);
+    if let Some(map) = p.as_object_mut() {
+        map.remove("life_cycles");
+    }
+    serde_json::json!({ "gear": g, "plan": p })
+}
+
+/// Where two [`life_inputs`] differ: one line per differing leaf, `path: old -> new` (dotted
+/// path; values cut to 60 characters), in document order.
+pub fn input_changes(old: &serde_json::Value, new: &serde_json::Value) -> Vec<String> {
+    fn cut(v: Option<&serde_json::Value>) -> String {
+        let text = v.map_or("(absent)".to_string(), |v| v.to_string());
+        if text.chars().count() > 60 {
+            format!("{}...", text.chars().take(57).collect::<String>())
+        } else {
+            text
+        }
+    }
+    fn walk(
+        path: &str,
+        a: Option<&serde_json::Value>,
+        b: Option<&serde_json::Value>,
+        out: &mut Vec<String>,
+    ) {
+        use serde_json::Value;
+        match (a, b) {
+            (Some(Value::Object(x)), Some(Value::Object(y))) => {
+                let mut keys: Vec<&String> = x.keys().collect();
+                keys.extend(y.keys().filter(|k| !x.contains_key(*k)));
+                for k in keys {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(&p, x.get(k), y.get(k), out);
+                }
+            }
+            (Some(Value::Array(x)), Some(Value::Array(y))) if x.len() == y.len() => {
+                for (i, (u, v)) in x.iter().zip(y).enumerate() {
+                    walk(&format!("{path}[{i}]"), Some(u), Some(v), out);
+                }
+            }
+            _ if a == b => {}
+            _ => out.push(format!("{path}: {} -> {}", cut(a), cut(b))),
+        }
+    }
+    let mut out = Vec::new();
+    walk("", Some(old), Some(new), &mut out);
+    out
+}
+
+/// [`read_checkpoint`], with the inputs the checkpoint was computed with (None: a checkpoint
+/// of an earlier version, which did not store them).
+pub fn read_resume(
+    dir: &Path,
+) -> Result<Option<(WearState, Option<serde_json::Value>)>, OutputError> {
     let path = dir.join(CHECKPOINT);
     let bad = |path: &Path, message: String| OutputError::Encode {
         what: path.display().to_string(),
@@ -123,16 +197,19 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
         }
         (None, None) => return Err(bad(&path, "no records and no record count".into())),
     };
-    Ok(Some(WearState {
-        step: c.step,
-        cycles: c.cycles,
-        removal: c.removal,
-        records,
-        pitted_phases: c.pitted_phases,
-        pitted: c.pitted,
-        band_factor: c.band_factor,
-        warm: c.warm,
-    }))
+    Ok(Some((
+        WearState {
+            step: c.step,
+            cycles: c.cycles,
+            removal: c.removal,
+            records,
+            pitted_phases: c.pitted_phases,
+            pitted: c.pitted,
+            band_factor: c.band_factor,
+            warm: c.warm,
+        },
+        c.inputs,
+    )))
 }
 
 /// Writes the files of a life run state by state (see the module doc), appending to the
@@ -143,6 +220,8 @@ pub struct LifeWriter {
     dir: PathBuf,
     /// Records known to be on disk (None: none yet from this writer).
     records_written: Option<usize>,
+    /// The run's [`life_inputs`], stored in every checkpoint.
+    inputs: Option<serde_json::Value>,
 }
 
 impl LifeWriter {
@@ -151,7 +230,15 @@ impl LifeWriter {
         Self {
             dir: dir.to_path_buf(),
             records_written: None,
+            inputs: None,
         }
+    }
+
+    /// The same, storing the run's inputs ([`life_inputs`]) in every checkpoint so that a
+    /// resume can check them.
+    pub fn with_inputs(mut self, inputs: serde_json::Value) -> Self {
+        self.inputs = Some(inputs);
+        self
     }
 
     /// Writes one completed state: records and checkpoint always, the rest as
@@ -214,6 +301,7 @@ impl LifeWriter {
             band_factor: state.band_factor,
             warm: state.warm.as_ref(),
             record_count: state.records.len(),
+            inputs: self.inputs.as_ref(),
         };
         let text = serde_json::to_string(&checkpoint).map_err(|e| encode(CHECKPOINT, e))?;
         write_atomic(&self.dir.join(CHECKPOINT), text.as_bytes())?;
@@ -642,5 +730,40 @@ impl StateMaps<'_> {
             files.push(path);
         }
         Ok(files)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn input_changes_name_every_differing_leaf_and_nothing_else() {
+        let old = serde_json::json!({
+            "gear": {"conditions": {"torque": {"Worm": 60.0}, "worm_speed": 157.0},
+                     "grid": [40, 60], "name": "x"},
+            "plan": {"step": {"Cycles": 10000.0}}
+        });
+        assert!(input_changes(&old, &old).is_empty());
+        let new = serde_json::json!({
+            "gear": {"conditions": {"torque": {"Wheel": 1250.0}, "worm_speed": 15.7},
+                     "grid": [30, 60], "extra": true, "name": "x"},
+            "plan": {"step": {"Cycles": 10000.0}}
+        });
+        let changes = input_changes(&old, &new);
+        assert_eq!(
+            changes,
+            vec![
+                "gear.conditions.torque.Worm: 60.0 -> (absent)",
+                "gear.conditions.torque.Wheel: (absent) -> 1250.0",
+                "gear.conditions.worm_speed: 157.0 -> 15.7",
+                "gear.grid[0]: 40 -> 30",
+                "gear.extra: (absent) -> true",
+            ]
+        );
+        // Long values are cut.
+        let long = serde_json::json!({"a": "y".repeat(200)});
+        let line = &input_changes(&serde_json::json!({"a": 1}), &long)[0];
+        assert!(line.len() < 80 && line.ends_with("..."));
     }
 }
