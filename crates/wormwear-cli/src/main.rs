@@ -191,6 +191,27 @@ enum Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // One run per output directory: the lock lives until the process ends.
+    let output = match &cli.command {
+        Command::Check { .. } => None,
+        Command::Geometry { output, .. }
+        | Command::Tca { output, .. }
+        | Command::Ltca { output, .. }
+        | Command::Wear { output, .. }
+        | Command::Run { output, .. }
+        | Command::Calibrate { output, .. }
+        | Command::Validate { output, .. } => Some(output),
+    };
+    let _lock = match output
+        .map(|dir| wormwear::output::lock_directory(dir))
+        .transpose()
+    {
+        Ok(lock) => lock,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let result = match &cli.command {
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),

@@ -564,6 +564,58 @@ fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_differenc
     refused(&design, &resume, "no record of the inputs");
 }
 
+#[test]
+fn a_second_run_into_a_busy_output_directory_fails_at_once() {
+    // A life running into DIR holds its lock: a second run into DIR exits 2 at once with a
+    // clear message and writes nothing; once the first is killed (the OS drops its lock) the
+    // directory can be used again.
+    let dir = tempfile::tempdir().unwrap();
+    let mut first = bin()
+        .args(["-q", "wear"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .args(["--cycles", "1e7", "--step-cycles", "10000"])
+        .spawn()
+        .unwrap();
+    let records = dir.path().join("wear_records.jsonl");
+    let started = std::time::Instant::now();
+    while !records.exists() && started.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert!(records.exists(), "the first run did not start");
+    let second = bin()
+        .args(["geometry"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let still_running = first.try_wait().unwrap().is_none();
+    first.kill().unwrap();
+    first.wait().unwrap();
+    assert!(still_running, "the first run ended before the check");
+    assert_eq!(second.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        err.contains("another wormwear run is writing into"),
+        "{err}"
+    );
+    assert!(!dir.path().join("axial_profiles.csv").exists());
+    let again = bin()
+        .args(["-q", "geometry"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+}
+
 /// A Python interpreter with VTK's own bindings (Debian `python3-vtk9`), when installed.
 fn python_with_vtk() -> Option<PathBuf> {
     ["python3", "/usr/bin/python3"].iter().find_map(|p| {

@@ -28,6 +28,57 @@ pub enum OutputError {
     Encode { what: String, message: String },
 }
 
+/// Name of the lock file a run holds in its output directory.
+pub const LOCK_FILE: &str = ".wormwear.lock";
+
+/// An exclusive lock on an output directory, held while the value lives. It is an OS file
+/// lock, which the system releases when the process ends: a killed run leaves no stale lock.
+#[derive(Debug)]
+pub struct DirectoryLock {
+    _file: std::fs::File,
+}
+
+/// Why an output directory could not be locked.
+#[derive(Debug, thiserror::Error)]
+pub enum LockError {
+    #[error(
+        "another wormwear run is writing into {dir} (it holds {lock}); wait for it to end or \
+         choose another output directory"
+    )]
+    Busy { dir: PathBuf, lock: PathBuf },
+    #[error("cannot lock the output directory {path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Creates `dir` if needed and takes its lock ([`LOCK_FILE`]); fails at once if another
+/// process holds it (two runs into one directory would interleave their files).
+pub fn lock_directory(dir: &Path) -> Result<DirectoryLock, LockError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| LockError::Io { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let path = dir.join(LOCK_FILE);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(io(&path))?;
+    match file.try_lock() {
+        Ok(()) => Ok(DirectoryLock { _file: file }),
+        Err(std::fs::TryLockError::WouldBlock) => Err(LockError::Busy {
+            dir: dir.to_path_buf(),
+            lock: path,
+        }),
+        Err(std::fs::TryLockError::Error(source)) => Err(LockError::Io { path, source }),
+    }
+}
+
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     move |source| OutputError::Io {
         path: path.to_path_buf(),
@@ -203,5 +254,23 @@ mod tests {
         });
         assert_eq!(leftovers.count(), 0);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[cfg(test)]
+mod lock_tests {
+    use super::*;
+
+    #[test]
+    fn a_locked_directory_refuses_a_second_lock_until_the_first_is_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("new").join("out");
+        let first = lock_directory(&out).unwrap();
+        assert!(out.is_dir());
+        let second = lock_directory(&out).unwrap_err();
+        assert!(matches!(second, LockError::Busy { .. }));
+        assert!(second.to_string().contains("another wormwear run"));
+        drop(first);
+        assert!(lock_directory(&out).is_ok());
     }
 }
