@@ -505,16 +505,16 @@ fn report_renders_in_a_headless_browser() {
     );
 }
 
-/// `wormwear wear FILE -o DIR ARGS...`.
+/// `wormwear COMMAND FILE -o DIR ARGS...`.
+fn into(command: &str, file: &Path, dir: &Path, args: &[&str]) -> Command {
+    let mut c = bin();
+    c.arg(command).arg(file).arg("-o").arg(dir).args(args);
+    c
+}
+
+/// `wormwear wear FILE -o DIR ARGS...`, run to its end.
 fn wear_into(file: &Path, dir: &Path, args: &[&str]) -> std::process::Output {
-    bin()
-        .arg("wear")
-        .arg(file)
-        .arg("-o")
-        .arg(dir)
-        .args(args)
-        .output()
-        .unwrap()
+    into("wear", file, dir, args).output().unwrap()
 }
 
 #[test]
@@ -570,27 +570,16 @@ fn a_second_run_into_a_busy_output_directory_fails_at_once() {
     // clear message and writes nothing; once the first is killed (the OS drops its lock) the
     // directory can be used again.
     let dir = tempfile::tempdir().unwrap();
-    let mut first = bin()
-        .args(["-q", "wear"])
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .args(["--cycles", "1e7", "--step-cycles", "10000"])
-        .spawn()
-        .unwrap();
+    let design = example("gear-1x40-design.toml");
+    let life = ["-q", "--cycles", "1e7", "--step-cycles", "10000"];
+    let mut first = into("wear", &design, dir.path(), &life).spawn().unwrap();
     let records = dir.path().join("wear_records.jsonl");
     let started = std::time::Instant::now();
     while !records.exists() && started.elapsed().as_secs() < 120 {
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
     assert!(records.exists(), "the first run did not start");
-    let second = bin()
-        .args(["geometry"])
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
-        .output()
-        .unwrap();
+    let second = into("geometry", &design, dir.path(), &[]).output().unwrap();
     let still_running = first.try_wait().unwrap().is_none();
     first.kill().unwrap();
     first.wait().unwrap();
@@ -602,11 +591,7 @@ fn a_second_run_into_a_busy_output_directory_fails_at_once() {
         "{err}"
     );
     assert!(!dir.path().join("axial_profiles.csv").exists());
-    let again = bin()
-        .args(["-q", "geometry"])
-        .arg(example("gear-1x40-design.toml"))
-        .arg("-o")
-        .arg(dir.path())
+    let again = into("geometry", &design, dir.path(), &["-q"])
         .output()
         .unwrap();
     assert!(
