@@ -555,13 +555,36 @@ fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_differenc
         &["--cycles", "5000", "--step-cycles", "10000", "--resume"],
         "ends before the checkpoint",
     );
-    // A checkpoint without its inputs (an earlier version's) cannot be checked: refused.
+    // A sealed checkpoint without its inputs cannot be checked: refused.
     let path = dir.path().join("wear_checkpoint.json");
-    let mut checkpoint: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    checkpoint.as_object_mut().unwrap().remove("inputs");
-    std::fs::write(&path, checkpoint.to_string()).unwrap();
+    let sound = std::fs::read_to_string(&path).unwrap();
+    let mut checkpoint: serde_json::Value = serde_json::from_str(&sound).unwrap();
+    let map = checkpoint.as_object_mut().unwrap();
+    map.remove("inputs");
+    map.remove(wormwear::integrity::CHECKSUM);
+    std::fs::write(&path, wormwear::integrity::seal(&checkpoint).unwrap()).unwrap();
     refused(&design, &resume, "no record of the inputs");
+    // A changed checkpoint (a digit of the cycles flipped, the JSON still valid), one without
+    // its checksum (an earlier version's): "cannot read", nothing written.
+    let flipped = sound.replacen("\"cycles\":10000", "\"cycles\":19000", 1);
+    assert_ne!(flipped, sound);
+    let mut unsealed: serde_json::Value = serde_json::from_str(&sound).unwrap();
+    unsealed
+        .as_object_mut()
+        .unwrap()
+        .remove(wormwear::integrity::CHECKSUM);
+    for (text, reason) in [
+        (flipped, "checksum mismatch"),
+        (unsealed.to_string(), "no checksum"),
+    ] {
+        std::fs::write(&path, text).unwrap();
+        let err = refused(&design, &resume, reason);
+        assert!(err.contains("cannot read"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read(dir.path().join("wear_records.jsonl")).unwrap(),
+        records
+    );
 }
 
 #[test]

@@ -21,6 +21,7 @@ pub mod calibration;
 pub mod contact;
 pub mod geometry;
 pub mod input;
+pub mod integrity;
 pub mod kinematics;
 pub mod ltca;
 pub mod lubrication;

@@ -106,11 +106,35 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
     for h in &changed {
         assert_ne!(cache_key(h), key);
     }
-    // A file whose stored key does not match (a hash collision, a hand edit) is not used.
+    // A changed entry (the JSON still valid) fails its checksum: not used, rebuilt with a
+    // warning that names it, and the rebuilt entry is trusted again.
     let text = std::fs::read_to_string(&file).unwrap();
-    std::fs::write(&file, text.replacen("fe-bending", "fe-bendinh", 1)).unwrap();
-    let (again, _) = build_in(&g, &geo, Some(dir.path())).unwrap();
+    let changed = text.replacen("fe-bending", "fe-bendinh", 1);
+    assert_ne!(changed, text);
+    std::fs::write(&file, changed).unwrap();
+    let (again, warnings) = build_in(&g, &geo, Some(dir.path())).unwrap();
     assert_eq!(again.origin, Origin::Computed);
+    assert!(
+        warnings.len() == 1 && warnings[0].contains("checksum") && warnings[0].contains("rebuilt"),
+        "{warnings:?}"
+    );
+    assert_eq!(
+        build_in(&g, &geo, Some(dir.path())).unwrap().0.origin,
+        Origin::Cache
+    );
+    // A sound entry whose stored key does not match (a hash collision) is not used either.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let map = doc.as_object_mut().unwrap();
+    map.remove(wormwear::integrity::CHECKSUM);
+    map.insert(
+        "key".into(),
+        serde_json::Value::String("another gear".into()),
+    );
+    std::fs::write(&file, wormwear::integrity::seal(&doc).unwrap()).unwrap();
+    let (again, warnings) = build_in(&g, &geo, Some(dir.path())).unwrap();
+    assert_eq!(again.origin, Origin::Computed);
+    assert!(warnings.is_empty(), "{warnings:?}");
     // LTCA with bending: reported "fe", in equilibrium, more compliant than without.
     let (rigid, bent) = compare(&g, &geo, &warm.model);
     assert_eq!(bent.bending_model, "fe");

@@ -196,17 +196,23 @@ fn cache_path(dir: &Path, key: &str) -> PathBuf {
     dir.join(format!("bending-{:016x}.json", h.finish()))
 }
 
-fn read_cache(path: &Path, key: &str) -> Option<FeBending> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let file: CacheFile = serde_json::from_str(&text).ok()?;
-    (file.key == key).then_some(file.model)
+/// The cached model for `key`: None when there is no entry or it is of another key; an error
+/// (the reason) when the entry cannot be trusted: unreadable, or its checksum fails.
+fn read_cache(path: &Path, key: &str) -> Result<Option<FeBending>, String> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e.to_string()),
+    };
+    let file: CacheFile = crate::integrity::open(&text).map_err(|e| e.to_string())?;
+    Ok((file.key == key).then_some(file.model))
 }
 
 fn write_cache(path: &Path, key: &str, model: &FeBending) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let text = serde_json::to_string(&CacheFile {
+    let text = crate::integrity::seal(&CacheFile {
         key: key.to_string(),
         model: model.clone(),
     })
@@ -238,7 +244,20 @@ pub fn build_in(
     let start = std::time::Instant::now();
     let key = cache_key(gear);
     let path = dir.map(|d| cache_path(d, &key));
-    if let Some(model) = path.as_deref().and_then(|p| read_cache(p, &key)) {
+    let mut warnings = Vec::new();
+    let cached = match path.as_deref().map(|p| read_cache(p, &key)) {
+        Some(Ok(model)) => model,
+        Some(Err(reason)) => {
+            warnings.push(format!(
+                "bending cache entry {} not used ({reason}): rebuilt",
+                path.as_deref()
+                    .map_or(String::new(), |p| p.display().to_string())
+            ));
+            None
+        }
+        None => None,
+    };
+    if let Some(model) = cached {
         return Ok((
             BuiltBending {
                 model,
@@ -250,7 +269,6 @@ pub fn build_in(
         ));
     }
     let model = compute(gear, geo)?;
-    let mut warnings = Vec::new();
     if let Some(p) = &path {
         if let Err(e) = write_cache(p, &key, &model) {
             warnings.push(format!(

@@ -26,6 +26,8 @@ pub enum OutputError {
     },
     #[error("cannot encode {what}: {message}")]
     Encode { what: String, message: String },
+    #[error("cannot read {path}: {message}")]
+    Read { path: PathBuf, message: String },
 }
 
 /// Name of the lock file a run holds in its output directory.

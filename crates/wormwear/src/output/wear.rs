@@ -164,24 +164,26 @@ pub fn read_resume(
     dir: &Path,
 ) -> Result<Option<(WearState, Option<serde_json::Value>)>, OutputError> {
     let path = dir.join(CHECKPOINT);
-    let bad = |path: &Path, message: String| OutputError::Encode {
-        what: path.display().to_string(),
+    let bad = |path: &Path, message: String| OutputError::Read {
+        path: path.to_path_buf(),
         message,
     };
     let text = match std::fs::read_to_string(&path) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(source) => return Err(OutputError::Io { path, source }),
+        Err(source) => {
+            return Err(OutputError::Read {
+                message: source.to_string(),
+                path,
+            })
+        }
     };
-    let c: CheckpointIn = serde_json::from_str(&text).map_err(|e| bad(&path, e.to_string()))?;
+    let c: CheckpointIn = crate::integrity::open(&text).map_err(|e| bad(&path, e.to_string()))?;
     let records = match (c.records, c.record_count) {
         (Some(records), _) => records,
         (None, Some(count)) => {
             let rpath = dir.join(RECORDS);
-            let lines = std::fs::read_to_string(&rpath).map_err(|source| OutputError::Io {
-                path: rpath.clone(),
-                source,
-            })?;
+            let lines = std::fs::read_to_string(&rpath).map_err(|e| bad(&rpath, e.to_string()))?;
             let records: Vec<crate::wear::StepRecord> = lines
                 .lines()
                 .take(count)
@@ -303,7 +305,10 @@ impl LifeWriter {
             record_count: state.records.len(),
             inputs: self.inputs.as_ref(),
         };
-        let text = serde_json::to_string(&checkpoint).map_err(|e| encode(CHECKPOINT, e))?;
+        let text = crate::integrity::seal(&checkpoint).map_err(|e| OutputError::Encode {
+            what: CHECKPOINT.into(),
+            message: e.to_string(),
+        })?;
         write_atomic(&self.dir.join(CHECKPOINT), text.as_bytes())?;
         let mut files = vec![rpath, self.dir.join(CHECKPOINT)];
         files.extend(write_state(gear, geo, tca, plan, view, &self.dir, tables)?);

@@ -133,10 +133,11 @@ pub fn run(
                 progress(&format!("[{}/{}] {} ...", k + 1, jobs.len(), job.id));
                 match run_job(job) {
                     Ok(r) => {
-                        let text = serde_json::to_string(&r).map_err(|e| ValidationError::Job {
-                            id: job.id.clone(),
-                            message: e.to_string(),
-                        })?;
+                        let text =
+                            crate::integrity::seal(&r).map_err(|e| ValidationError::Job {
+                                id: job.id.clone(),
+                                message: e.to_string(),
+                            })?;
                         crate::output::write_atomic(&run_path(dir, &job.id), text.as_bytes())?;
                         progress(&format!("    {} done in {:.1} s", job.id, r.seconds));
                         r
@@ -192,7 +193,8 @@ fn key(job: &Job) -> String {
 /// A stored result of the same job (same key), if any.
 fn cached(dir: &Path, job: &Job) -> Option<JobResult> {
     let text = std::fs::read_to_string(run_path(dir, &job.id)).ok()?;
-    let r: JobResult = serde_json::from_str(&text).ok()?;
+    // (A run that fails its checksum is run again.)
+    let r: JobResult = crate::integrity::open(&text).ok()?;
     (r.key == key(job)).then_some(r)
 }
 
