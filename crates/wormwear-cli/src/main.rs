@@ -202,7 +202,7 @@ fn main() -> ExitCode {
         | Command::Calibrate { output, .. }
         | Command::Validate { output, .. } => Some(output),
     };
-    let _lock = match output
+    let lock = match output
         .map(|dir| wormwear::output::lock_directory(dir))
         .transpose()
     {
@@ -212,6 +212,10 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let stale = lock.as_ref().map_or(0, |l| l.stale_temporaries_removed);
+    if stale > 0 && !cli.quiet {
+        eprintln!("note: removed {stale} temporary file(s) left by an interrupted run");
+    }
     let result = match &cli.command {
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),

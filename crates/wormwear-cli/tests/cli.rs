@@ -614,9 +614,13 @@ fn a_second_run_into_a_busy_output_directory_fails_at_once() {
         "{err}"
     );
     assert!(!dir.path().join("axial_profiles.csv").exists());
+    // A temporary the killed run might have left is removed by the next run.
+    let stale = dir.path().join(".summary.json.tmp999999");
+    std::fs::write(&stale, b"{").unwrap();
     let again = into("geometry", &design, dir.path(), &["-q"])
         .output()
         .unwrap();
+    assert!(!stale.exists());
     assert!(
         again.status.success(),
         "{}",

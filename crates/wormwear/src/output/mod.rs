@@ -38,6 +38,8 @@ pub const LOCK_FILE: &str = ".wormwear.lock";
 #[derive(Debug)]
 pub struct DirectoryLock {
     _file: std::fs::File,
+    /// Temporaries of an interrupted run removed when the lock was taken.
+    pub stale_temporaries_removed: usize,
 }
 
 /// Why an output directory could not be locked.
@@ -57,7 +59,8 @@ pub enum LockError {
 }
 
 /// Creates `dir` if needed and takes its lock ([`LOCK_FILE`]); fails at once if another
-/// process holds it (two runs into one directory would interleave their files).
+/// process holds it (two runs into one directory would interleave their files). With the
+/// lock, the temporaries a killed run left there are removed.
 pub fn lock_directory(dir: &Path) -> Result<DirectoryLock, LockError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -72,7 +75,10 @@ pub fn lock_directory(dir: &Path) -> Result<DirectoryLock, LockError> {
         .open(&path)
         .map_err(io(&path))?;
     match file.try_lock() {
-        Ok(()) => Ok(DirectoryLock { _file: file }),
+        Ok(()) => Ok(DirectoryLock {
+            _file: file,
+            stale_temporaries_removed: remove_stale_temporaries(dir),
+        }),
         Err(std::fs::TryLockError::WouldBlock) => Err(LockError::Busy {
             dir: dir.to_path_buf(),
             lock: path,
@@ -126,12 +132,57 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    {
+    let written = (|| {
         let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp))?;
         f.write_all(bytes).map_err(io_err(&tmp))?;
         f.sync_all().map_err(io_err(&tmp))?;
+        drop(f);
+        std::fs::rename(&tmp, path).map_err(io_err(path))
+    })();
+    if written.is_err() {
+        // Leave no partial temporary behind (best effort: the error reported is the first).
+        let _ = std::fs::remove_file(&tmp);
     }
-    std::fs::rename(&tmp, path).map_err(io_err(path))
+    written
+}
+
+/// True for the name of a temporary of [`write_atomic`]: `.NAME.tmpPID`.
+fn is_atomic_temporary(name: &str) -> bool {
+    name.starts_with('.')
+        && name.rsplit_once(".tmp").is_some_and(|(head, pid)| {
+            head.len() > 1 && !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit())
+        })
+}
+
+/// Removes the temporaries of [`write_atomic`] that a killed run left in `dir` and its
+/// immediate subdirectories; returns how many. Call it with the directory's lock held (no
+/// other run is writing there).
+fn remove_stale_temporaries(dir: &Path) -> usize {
+    let mut removed = 0;
+    let mut dirs = vec![dir.to_path_buf()];
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        dirs.extend(
+            entries
+                .flatten()
+                .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
+                .map(|e| e.path()),
+        );
+    }
+    for d in dirs {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let is_file = e.file_type().is_ok_and(|t| t.is_file());
+            if is_file
+                && is_atomic_temporary(&e.file_name().to_string_lossy())
+                && std::fs::remove_file(e.path()).is_ok()
+            {
+                removed += 1;
+            }
+        }
+    }
+    removed
 }
 
 /// Adds or replaces `section` in `dir/summary.json`, keeping the other sections.
@@ -274,5 +325,39 @@ mod lock_tests {
         assert!(second.to_string().contains("another wormwear run"));
         drop(first);
         assert!(lock_directory(&out).is_ok());
+    }
+
+    #[test]
+    fn stale_temporaries_go_when_the_lock_is_taken_and_nothing_else_does() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::create_dir_all(d.join("runs")).unwrap();
+        let stale = [".summary.json.tmp4242", "runs/.case-b.json.tmp7"];
+        let kept = [".notes.tmpx", "keep.json.tmp12", ".tmp12", "summary.json"];
+        for f in stale.iter().chain(&kept) {
+            std::fs::write(d.join(f), b"x").unwrap();
+        }
+        let lock = lock_directory(d).unwrap();
+        assert_eq!(lock.stale_temporaries_removed, 2);
+        for f in stale {
+            assert!(!d.join(f).exists(), "{f}");
+        }
+        for f in kept {
+            assert!(d.join(f).exists(), "{f}");
+        }
+    }
+
+    #[test]
+    fn a_failed_atomic_write_leaves_no_temporary() {
+        // The target is a directory: the final rename fails.
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("summary.json");
+        std::fs::create_dir(&target).unwrap();
+        assert!(write_atomic(&target, b"{}").is_err());
+        let names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, vec!["summary.json".to_string()]);
     }
 }
