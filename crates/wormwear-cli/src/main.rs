@@ -416,7 +416,7 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
     wormwear::output::tca::write_tca(&gear, &geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
     let files = wormwear::output::ltca::write_ltca(&gear, &geo, &tca, &result, dir, map_position)
         .map_err(|e| Failure::Run(e.into()))?;
-    wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
+    write_rating(&gear, dir, quiet)?;
     for w in &tca.warnings {
         eprintln!("warning: {w}");
     }
@@ -526,7 +526,7 @@ fn wear(
     };
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
-    let rating = wormwear::output::write_rating(&gear, dir).map_err(|e| Failure::Run(e.into()))?;
+    let rating = write_rating(&gear, dir, quiet)?;
     let progress = if quiet || verbose {
         indicatif::ProgressBar::hidden()
     } else {
@@ -612,6 +612,21 @@ fn wear(
         );
     }
     Ok(())
+}
+
+/// Writes the ratings and prints why any of them is null (outside its formula's range).
+fn write_rating(
+    gear: &GearSet,
+    dir: &Path,
+    quiet: bool,
+) -> Result<wormwear::rating::Rating, Failure> {
+    let rating = wormwear::output::write_rating(gear, dir).map_err(|e| Failure::Run(e.into()))?;
+    if !quiet {
+        for w in &rating.warnings {
+            eprintln!("warning: rating: {w}");
+        }
+    }
+    Ok(rating)
 }
 
 /// A checkpoint may be resumed only with the inputs it was computed with and towards a life

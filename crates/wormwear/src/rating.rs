@@ -8,8 +8,9 @@ use std::f64::consts::PI;
 
 pub use crate::input::RatingFactors;
 
-/// Ratings of one operating case (units in the names).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+/// Ratings of one operating case (units in the names). A quantity whose formula is outside
+/// its range is NaN (null in JSON) and `warnings` says why.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Rating {
     pub efficiency: f64,
     /// Mesh efficiency eta_z alone.
@@ -45,7 +46,17 @@ pub struct Rating {
     /// Profile shift coefficient x2 and the lead angle at the reference diameter used.
     pub profile_shift: f64,
     pub lead_angle_deg: f64,
+    /// Why a quantity above is null (outside its formula's range).
+    pub warnings: Vec<String>,
 }
+
+/// Pitting lives beyond this many wheel cycles are outside the data of the life formulas
+/// (endurance tests end near 1e8): reported null with a warning instead of extrapolated.
+pub const LIFE_LIMIT_CYCLES: f64 = 1e10;
+
+/// Efficiencies below this are outside the loss method's range (the no-load losses then take
+/// nearly all of the input power and the fixed point for the wheel torque collapses).
+pub const EFFICIENCY_FLOOR: f64 = 0.05;
 
 /// Mesh friction of bronze against steel with polyglycol, dip lubrication (MODEL §9):
 /// mu_0T = 0.024 + 0.0032 / (v_g + 0.1)^1.71, capped at 0.094.
@@ -169,7 +180,6 @@ pub fn rate(gear: &GearSet) -> Rating {
     let sigma_lim = gear.wheel_material.pitting_limit * 1e-6;
     let sigma_hg = sigma_lim * factors.pitting_life_factor;
     let v_ref = 3.0;
-    let n_li = rank_first_pitting_cycles(v_g, sigma_hm, sigma_lim).unwrap_or(f64::NAN);
     let n_lii = (factors.pitted_area_max_percent - 2.0) * 1e6
         / (16.212 * (sigma_hm - 180.0) / sigma_lim
             * (1.541 * sigma_hm / sigma_lim - 0.581 * v_g / v_ref).exp());
@@ -181,6 +191,46 @@ pub fn rate(gear: &GearSet) -> Rating {
         f64::NAN
     };
     let alpha_0 = w.normal_pressure_angle;
+    let mut warnings = Vec::new();
+    let efficiency = if efficiency >= EFFICIENCY_FLOOR {
+        efficiency
+    } else {
+        warnings.push(format!(
+            "efficiency {efficiency:.3e} below {EFFICIENCY_FLOOR}: the no-load losses (churning \
+             {churning:.0} W, seals {seals:.0} W) take nearly all of the input power at \
+             {t1:.3} N m, outside the loss method's range (reported null; the wheel torque and \
+             the stresses below assume it)"
+        ));
+        f64::NAN
+    };
+    let n_li = match rank_first_pitting_cycles(v_g, sigma_hm, sigma_lim) {
+        None => {
+            warnings.push(format!(
+                "N_LI: Rank's formula needs a sliding speed above 0.31 m/s (here {v_g:.3} m/s) \
+                 and a positive stress (reported null)"
+            ));
+            f64::NAN
+        }
+        Some(n) => within_life_data("N_LI", n, sigma_hm, &mut warnings),
+    };
+    let n_lii = if sigma_hm > 180.0 {
+        within_life_data("N_LII", n_lii, sigma_hm, &mut warnings)
+    } else {
+        warnings.push(format!(
+            "N_LII: Rank's growth formula needs sigma_Hm above 180 N/mm^2 (here {sigma_hm:.0}; \
+             reported null)"
+        ));
+        f64::NAN
+    };
+    let n_l_i_ii = within_life_data("N_L(I+II)", n_l_i_ii, sigma_hm, &mut warnings);
+    let n_li_stahl = if n_li_stahl.is_nan() {
+        warnings.push(format!(
+            "Stahl's N_LI holds for sigma_Hm up to 500 N/mm^2 (here {sigma_hm:.0}; reported null)"
+        ));
+        f64::NAN
+    } else {
+        within_life_data("Stahl's N_LI", n_li_stahl, sigma_hm, &mut warnings)
+    };
     Rating {
         efficiency,
         mesh_efficiency: eta_z,
@@ -204,5 +254,29 @@ pub fn rate(gear: &GearSet) -> Rating {
         wear_limit_backlash_m: 0.3 * m_x * 1e-3 * gamma.cos(),
         profile_shift: x2,
         lead_angle_deg: gamma.to_degrees(),
+        warnings,
     }
+}
+
+/// A pitting life if it is a positive number of cycles within [`LIFE_LIMIT_CYCLES`]; else NaN
+/// and a warning naming the life and the stress.
+fn within_life_data(name: &str, cycles: f64, sigma_hm: f64, warnings: &mut Vec<String>) -> f64 {
+    if cycles > 0.0 && cycles <= LIFE_LIMIT_CYCLES {
+        return cycles;
+    }
+    warnings.push(
+        if cycles > LIFE_LIMIT_CYCLES && cycles.is_finite() || cycles == f64::INFINITY {
+            format!(
+                "{name} = {cycles:.3e} cycles at sigma_Hm {sigma_hm:.0} N/mm^2 lies beyond \
+             {LIFE_LIMIT_CYCLES:e} cycles, outside the formula's data (no pitting expected; \
+             reported null)"
+            )
+        } else {
+            format!(
+                "{name}: the formula gives {cycles:.3e} cycles at sigma_Hm {sigma_hm:.0} N/mm^2, \
+             not a life (reported null)"
+            )
+        },
+    );
+    f64::NAN
 }

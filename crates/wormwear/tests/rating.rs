@@ -70,3 +70,63 @@ fn mesh_efficiency_is_the_screw_formula_and_friction_falls_with_speed() {
     // Heavier load, shorter pitting life.
     assert!(r4.n_li_cycles < r.n_li_cycles);
 }
+
+#[test]
+fn ratings_outside_their_formulas_ranges_are_null_with_a_reason() {
+    // Case C as published: every rating a number. At 100 rpm (a speed of the published study)
+    // the sliding speed is below Rank's 0.31 m/s; at 5 N m sigma_Hm is below the growth
+    // formula's 180 N/mm^2; at 1 N m the no-load losses take the input power. Each of those
+    // is null (NaN, JSON null) with a warning naming the reason; no life is negative or
+    // beyond the formulas' data, no efficiency below the method's range.
+    let c = example("gear-1x40-case-c.toml");
+    let base = rating::rate(&c);
+    assert!(base.warnings.is_empty(), "{:?}", base.warnings);
+    let rpm = |n: f64| n * 2.0 * std::f64::consts::PI / 60.0;
+    let mut slow = c.clone();
+    slow.conditions.worm_speed = rpm(100.0);
+    let mut light = c.clone();
+    light.conditions.torque = Torque::Worm(5.0);
+    let mut idle = c.clone();
+    idle.conditions.torque = Torque::Worm(1.0);
+    for (g, null, reason) in [
+        (&slow, "n_li_cycles", "0.31 m/s"),
+        (&light, "n_lii_cycles", "180 N/mm^2"),
+        (&idle, "efficiency", "no-load losses"),
+    ] {
+        let r = rating::rate(g);
+        let json = serde_json::to_value(&r).unwrap();
+        assert!(json[null].is_null(), "{null}: {}", json[null]);
+        assert!(
+            r.warnings.iter().any(|w| w.contains(reason)),
+            "{null}: {:?}",
+            r.warnings
+        );
+        for life in [
+            r.n_li_cycles,
+            r.n_lii_cycles,
+            r.n_l_i_ii_cycles,
+            r.n_li_stahl_cycles,
+        ] {
+            assert!(
+                life.is_nan() || (life > 0.0 && life <= rating::LIFE_LIMIT_CYCLES),
+                "{life:e}"
+            );
+        }
+        assert!(
+            r.efficiency.is_nan()
+                || (r.efficiency >= rating::EFFICIENCY_FLOOR && r.efficiency < 1.0)
+        );
+        // Every null has its warning.
+        let nulls = [
+            r.efficiency,
+            r.n_li_cycles,
+            r.n_lii_cycles,
+            r.n_l_i_ii_cycles,
+            r.n_li_stahl_cycles,
+        ]
+        .iter()
+        .filter(|v| v.is_nan())
+        .count();
+        assert_eq!(nulls, r.warnings.len(), "{:?}", r.warnings);
+    }
+}

@@ -215,7 +215,7 @@ pub fn write_rating(
     dir: &Path,
 ) -> Result<crate::rating::Rating, OutputError> {
     let r = crate::rating::rate(gear);
-    let value = serde_json::to_value(r).map_err(|e| OutputError::Encode {
+    let value = serde_json::to_value(&r).map_err(|e| OutputError::Encode {
         what: "rating".into(),
         message: e.to_string(),
     })?;
