@@ -68,12 +68,18 @@ pub fn base_friction(sliding_speed: f64) -> f64 {
 /// N_LI = 1e6 (1 + 0.860 ln(3 v_gm / v_ref)) exp[28.078 - 4.666 ln(520 sigma_Hm / sigma_Hlim)],
 /// v_gm the sliding speed at the reference diameter (m/s), v_ref = 3 m/s, stresses in MPa.
 /// None outside the formula's range: a speed factor <= 0 (v_gm below 0.31 m/s, where it
-/// would give a negative life) or a stress that is not positive.
+/// would give a negative life), a stress that is not positive, or a life beyond
+/// [`LIFE_LIMIT_CYCLES`] (outside the data).
 pub fn rank_first_pitting_cycles(
     sliding_speed: f64,
     sigma_hm_mpa: f64,
     sigma_hlim_mpa: f64,
 ) -> Option<f64> {
+    rank_formula(sliding_speed, sigma_hm_mpa, sigma_hlim_mpa).filter(|n| *n <= LIFE_LIMIT_CYCLES)
+}
+
+/// Rank's N_LI formula itself, None only where its speed factor or stress is not positive.
+fn rank_formula(sliding_speed: f64, sigma_hm_mpa: f64, sigma_hlim_mpa: f64) -> Option<f64> {
     let v_ref = 3.0;
     let speed = 1.0 + 0.860 * (3.0 * sliding_speed / v_ref).ln();
     if !(speed > 0.0 && sigma_hm_mpa > 0.0 && sigma_hlim_mpa > 0.0) {
@@ -203,7 +209,7 @@ pub fn rate(gear: &GearSet) -> Rating {
         ));
         f64::NAN
     };
-    let n_li = match rank_first_pitting_cycles(v_g, sigma_hm, sigma_lim) {
+    let n_li = match rank_formula(v_g, sigma_hm, sigma_lim) {
         None => {
             warnings.push(format!(
                 "N_LI: Rank's formula needs a sliding speed above 0.31 m/s (here {v_g:.3} m/s) \

@@ -78,6 +78,10 @@ fn ratings_outside_their_formulas_ranges_are_null_with_a_reason() {
     // formula's 180 N/mm^2; at 1 N m the no-load losses take the input power. Each of those
     // is null (NaN, JSON null) with a warning naming the reason; no life is negative or
     // beyond the formulas' data, no efficiency below the method's range.
+    // The model's N_LI (MODEL §12 k) uses the same bounds: 10 N/mm^2 would give ~1e16 cycles.
+    assert!(rating::rank_first_pitting_cycles(5.0, 10.0, 520.0).is_none());
+    assert!(rating::rank_first_pitting_cycles(0.2, 400.0, 520.0).is_none());
+    assert!(rating::rank_first_pitting_cycles(5.0, 400.0, 520.0).is_some());
     let c = example("gear-1x40-case-c.toml");
     let base = rating::rate(&c);
     assert!(base.warnings.is_empty(), "{:?}", base.warnings);
