@@ -500,6 +500,8 @@ fn wear(
 ) -> Result<(), Failure> {
     let gear = load(file)?;
     let plan = life_plan(&gear, args)?;
+    wormwear::wear::check_plan_can_end(&gear, &plan)
+        .map_err(|e| Failure::Input(anyhow::Error::new(e).context("life plan")))?;
     let geo = build_geometry(&gear, file)?;
     let tca = wormwear::kinematics::analyse(&gear, &geo)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
@@ -585,6 +587,9 @@ fn wear(
         // A checkpoint of another gear (wrong directory for --resume) is a usage problem.
         wormwear::wear::WearError::Checkpoint(_) => {
             Failure::Input(anyhow::Error::new(e).context("--resume"))
+        }
+        wormwear::wear::WearError::Plan(_) => {
+            Failure::Input(anyhow::Error::new(e).context("life plan"))
         }
         _ => Failure::Run(anyhow::Error::new(e).context("wear simulation")),
     })?;

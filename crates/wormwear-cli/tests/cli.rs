@@ -390,8 +390,18 @@ fn run_writes_every_stage_and_the_life() {
 #[test]
 fn wear_input_errors_exit_2_and_name_the_problem() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[&str], &str); 4] = [
+    let cases: [(&str, &[&str], &str); 6] = [
         ("gear-k-2x25.toml", &[], "[wear]"),
+        (
+            "gear-1x40-design.toml",
+            &["--step-wear-um", "1e-9"],
+            "up to 3.814e12 loaded analyses",
+        ),
+        (
+            "gear-1x40-design.toml",
+            &["--cycles", "1e12", "--step-cycles", "1"],
+            "up to 1.000e12 loaded analyses",
+        ),
         ("gear-1x40-design.toml", &["--cycles=-5"], "--cycles = -5"),
         (
             "gear-1x40-design.toml",

@@ -658,6 +658,9 @@ pub enum WearError {
     },
     #[error("the checkpoint does not match this gear's flank grid ({0})")]
     Checkpoint(String),
+    /// A plan that could not end in a practical number of loaded analyses.
+    #[error("{0}")]
+    Plan(String),
     #[error("{0}")]
     Output(String),
 }
@@ -704,6 +707,7 @@ pub fn simulate(
     if state.pitted.len() != wf.nodes.len() {
         state.pitted = vec![false; wf.nodes.len()];
     }
+    check_plan_can_end(gear, life)?;
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
@@ -754,6 +758,55 @@ pub fn simulate(
         state.step += 1;
     }
     Ok(state)
+}
+
+/// Most loaded analyses a life plan may need (a case B life needs ~2 700).
+pub const MAX_ANALYSES: f64 = 200_000.0;
+
+/// Refuses a plan whose step count has no practical bound: fixed steps of `life / step`
+/// states, or adaptive steps and sub-steps so small that wearing down to the standard's
+/// pointed-tip limit (MODEL §9 (a)), which no life passes, would take more than
+/// [`MAX_ANALYSES`] loaded analyses.
+pub fn check_plan_can_end(gear: &GearSet, life: &WearPlan) -> Result<(), WearError> {
+    let limit = crate::rating::rate(gear).wear_limit_pointed_tip_m;
+    let (what, count) = match life.step {
+        StepControl::Cycles(c) => (
+            format!(
+                "fixed steps of {c:e} cycles over {:e} cycles",
+                life.life_cycles
+            ),
+            life.life_cycles / c,
+        ),
+        StepControl::MaxRemoval(d) => (
+            format!(
+                "adaptive steps of {:e} um up to the pointed-tip wear limit of {:.3} mm",
+                d * 1e6,
+                limit * 1e3
+            ),
+            limit / d,
+        ),
+    };
+    let guard = life.max_substep_removal;
+    let (what, count) = if guard > 0.0 && limit / guard > count {
+        (
+            format!(
+                "sub-steps of at most {:e} um (max_substep_wear_um) up to the pointed-tip wear \
+                 limit of {:.3} mm",
+                guard * 1e6,
+                limit * 1e3
+            ),
+            limit / guard,
+        )
+    } else {
+        (what, count)
+    };
+    if count > MAX_ANALYSES {
+        return Err(WearError::Plan(format!(
+            "up to {count:.3e} loaded analyses could be needed ({what}), more than \
+             {MAX_ANALYSES:e}: use larger steps or a shorter life"
+        )));
+    }
+    Ok(())
 }
 
 /// What the life loop of [`simulate`] works with, and its named steps.
