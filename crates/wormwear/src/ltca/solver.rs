@@ -678,7 +678,14 @@ fn screened_from(
         }
         let sub = problem.restrict(&set);
         let start: Vec<f64> = set.iter().map(|&i| q[i]).collect();
-        let part = conjugate_gradient(&sub, settings, Some(&start))?;
+        let part = match conjugate_gradient(&sub, settings, Some(&start)) {
+            Ok(part) => part,
+            // The restriction is only a speed-up: a failure on it is the whole problem's to
+            // decide.
+            Err(_) => {
+                return conjugate_gradient(problem, settings, Some(&q)).map(|s| (s, passes + 1))
+            }
+        };
         iterations += part.residuals.iterations;
         passes += 1;
         q.iter_mut().for_each(|v| *v = 0.0);
