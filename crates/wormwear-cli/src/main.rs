@@ -397,6 +397,14 @@ fn bending_model(
 
 fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
+    let positions = gear.analysis.positions;
+    if map_position >= positions {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--map-position = {map_position}: {} analyses {positions} positions, numbered 0 to {}",
+            file.display(),
+            positions.saturating_sub(1)
+        )));
+    }
     let geo = build_geometry(&gear, file)?;
     let tca = wormwear::kinematics::analyse(&gear, &geo)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;

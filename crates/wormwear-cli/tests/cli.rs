@@ -246,6 +246,27 @@ fn ltca_writes_its_section_plots_and_tables() {
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
     assert!(summary["tca"]["kinematic_error_p2p_rad"].is_number());
+    // A position the file does not analyse is an input error, not a silent clamp.
+    let positions = summary["ltca"]["solver_residuals"]
+        .as_array()
+        .map_or(0, |p| p.len());
+    assert!(positions > 3);
+    let beyond = positions.to_string();
+    let out = into(
+        "ltca",
+        &example("gear-1x40-design.toml"),
+        &out_dir,
+        &["--map-position", &beyond],
+    )
+    .output()
+    .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&format!("--map-position = {beyond}"))
+            && err.contains(&format!("numbered 0 to {}", positions - 1)),
+        "{err}"
+    );
     let l = &summary["ltca"];
     for key in [
         "max_pressure_pa",
