@@ -527,3 +527,20 @@ fn wheel_body_is_checked_when_bending_is_on() {
     let off = set(&off, "wheel", "hub_radius_mm", "hub_radius_mm = 95.0");
     assert!(wormwear::input::load_from_str(&off).is_ok());
 }
+
+#[test]
+fn a_parse_error_on_a_huge_line_does_not_echo_it_whole() {
+    // A 100 000-element array under a wrong key: the error names the key and its line, and
+    // cuts the echoed source line instead of printing 200 KB.
+    let text = design().replacen(
+        "[worm]",
+        &format!("[worm]\nbogus = [{}]", vec!["1"; 100_000].join(",")),
+        1,
+    );
+    let message = error_of(&text);
+    assert_mentions(
+        &message,
+        &["bogus", "line 7", "characters)", "axial_module_mm"],
+    );
+    assert!(message.len() < 2_000, "{} characters", message.len());
+}

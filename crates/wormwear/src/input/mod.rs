@@ -557,9 +557,29 @@ impl InputError {
     }
 }
 
+/// A message with every line longer than 400 characters cut there (a parse error echoes the
+/// offending source line, which may be a 100 000-element array).
+fn cut_long_lines(message: &str) -> String {
+    const LONGEST: usize = 400;
+    message
+        .lines()
+        .map(|line| {
+            let count = line.chars().count();
+            if count > LONGEST {
+                let head: String = line.chars().take(LONGEST).collect();
+                format!("{head}... ({count} characters)")
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Parses and validates a gear file given as TOML text.
 pub fn load_from_str(text: &str) -> Result<GearSet, InputError> {
-    let file: GearFile = toml::from_str(text).map_err(|e| InputError::Syntax(e.to_string()))?;
+    let file: GearFile =
+        toml::from_str(text).map_err(|e| InputError::Syntax(cut_long_lines(&e.to_string())))?;
     validate::validate(&file)
 }
 
