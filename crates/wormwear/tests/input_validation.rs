@@ -543,3 +543,18 @@ fn a_parse_error_on_a_huge_line_does_not_echo_it_whole() {
     assert_mentions(&message, &["bogus", &at, "characters)", "axial_module_mm"]);
     assert!(message.len() < 2_000, "{} characters", message.len());
 }
+
+#[test]
+fn an_endurance_curve_given_in_part_takes_the_defaults_for_the_rest() {
+    // README: `[wear.endurance]` fields default to 425 MPa at 11e6 cycles, exponent 0.176.
+    let text = example_text("gear-1x40-case-c.toml").replacen(
+        "[rating]",
+        "[wear.endurance]\nexponent = 0.2\n\n[rating]",
+        1,
+    );
+    let gear = input::load_from_str(&text).unwrap();
+    let e = gear.wear.unwrap().endurance;
+    assert_eq!(e.exponent, 0.2);
+    assert_eq!(e.reference_pressure, 425e6);
+    assert_eq!(e.reference_cycles, 11e6);
+}

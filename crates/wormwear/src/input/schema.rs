@@ -141,13 +141,29 @@ pub struct PhaseSpec {
     pub margin: Option<f64>,
 }
 
-/// Power-law pressure-life curve.
+/// Power-law pressure-life curve; a field left out takes the MODEL §8 default (425 MPa at
+/// 11e6 cycles, exponent 0.176).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnduranceSpec {
+    #[serde(default = "default_reference_pressure_mpa")]
     pub reference_pressure_mpa: f64,
+    #[serde(default = "default_reference_cycles")]
     pub reference_cycles: f64,
+    #[serde(default = "default_exponent")]
     pub exponent: f64,
+}
+
+fn default_reference_pressure_mpa() -> f64 {
+    crate::input::Endurance::DEFAULT.reference_pressure * 1e-6
+}
+
+fn default_reference_cycles() -> f64 {
+    crate::input::Endurance::DEFAULT.reference_cycles
+}
+
+fn default_exponent() -> f64 {
+    crate::input::Endurance::DEFAULT.exponent
 }
 
 /// Worm or hob thread (both are helicoids; MODEL §2, §3.1).
