@@ -558,3 +558,12 @@ fn an_endurance_curve_given_in_part_takes_the_defaults_for_the_rest() {
     assert_eq!(e.reference_pressure, 425e6);
     assert_eq!(e.reference_cycles, 11e6);
 }
+
+#[test]
+fn named_choices_are_case_insensitive_as_documented() {
+    let upper = input::load_from_str(&design()).unwrap();
+    let lower =
+        input::load_from_str(&set(&design(), "worm", "profile", "profile = \"a\"")).unwrap();
+    assert_eq!(lower.worm.profile, upper.worm.profile);
+    assert!(format!("{:?}", lower.worm.profile) == "A");
+}
