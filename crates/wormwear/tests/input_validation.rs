@@ -567,3 +567,23 @@ fn named_choices_are_case_insensitive_as_documented() {
     assert_eq!(lower.worm.profile, upper.worm.profile);
     assert!(format!("{:?}", lower.worm.profile) == "A");
 }
+
+#[test]
+fn ten_thousand_sections_are_refused_at_once() {
+    let offsets = vec!["0.0"; 10_000].join(", ");
+    let text = set(
+        &design(),
+        "analysis",
+        "section_offsets_mm",
+        &format!("section_offsets_mm = [{offsets}]"),
+    );
+    let start = std::time::Instant::now();
+    let message = error_of(&text);
+    assert_mentions(
+        &message,
+        &["analysis.section_offsets_mm", "10000 offsets", "at most 50"],
+    );
+    // One message for the list, not one per offset.
+    assert!(message.len() < 2_000, "{}", message.len());
+    eprintln!("rejected in {:.3} s", start.elapsed().as_secs_f64());
+}

@@ -348,8 +348,21 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             );
         }
     }
+    // Each section is a profile computation and a plot: a few dozen is plenty.
+    const MAX_SECTIONS: usize = 50;
+    if let Some(v) = a
+        .section_offsets_mm
+        .as_ref()
+        .filter(|v| v.len() > MAX_SECTIONS)
+    {
+        ck.fail(
+            "analysis.section_offsets_mm",
+            format!("{} offsets", v.len()),
+            format!("at most {MAX_SECTIONS} sections"),
+        );
+    }
     let section_offsets = match (&a.section_offsets_mm, face_width) {
-        (Some(v), Some(b)) => v
+        (Some(v), Some(b)) if v.len() <= MAX_SECTIONS => v
             .iter()
             .enumerate()
             .filter_map(|(i, &z)| {
