@@ -921,17 +921,32 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
 #[test]
 fn a_life_killed_after_every_state_and_resumed_ends_as_the_uninterrupted_one() {
     // Fault injection (issue 16): the design case to 60 000 cycles in 10 000-cycle steps (sub-
-    // steps from the stability guard), killed as soon as each new state is on disk and resumed,
-    // until it ends. The records and the step table equal the uninterrupted run's byte for byte.
-    let design = example("gear-1x40-design.toml");
+    // steps from the stability guard) with a pitting phase from 20 000 to 30 000 cycles, killed
+    // as soon as each new state is on disk and resumed, until it ends. The records and the
+    // step table equal the uninterrupted run's byte for byte.
+    let files = tempfile::tempdir().unwrap();
+    let design = files.path().join("pitted.toml");
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
+        .unwrap()
+        .replacen(
+            "step_wear_um = 4.0",
+            "step_wear_um = 4.0\nphases = [\n    { kind = \"wear\", until_cycles = 20000 },\n    \
+             { kind = \"pitting\", until_cycles = 30000, pressure_limit_mpa = 500.0 },\n    \
+             { kind = \"wear\", until_cycles = 60000 },\n]",
+            1,
+        );
+    std::fs::write(&design, text).unwrap();
     let life = ["-q", "--cycles", "60000", "--step-cycles", "10000"];
     let whole = tempfile::tempdir().unwrap();
     assert!(wear_into(&design, whole.path(), &life).status.success());
-    let states = std::fs::read_to_string(whole.path().join("wear_records.jsonl"))
-        .unwrap()
-        .lines()
-        .count();
-    assert!(states >= 6);
+    let written = std::fs::read_to_string(whole.path().join("wear_records.jsonl")).unwrap();
+    let states = written.lines().count();
+    assert!(states >= 7);
+    assert!(
+        written.contains("\"phase\":\"pitting\""),
+        "no pitting state"
+    );
+    assert!(written.contains("\"substeps\":2") || written.contains("\"substeps\":3"));
     let dir = tempfile::tempdir().unwrap();
     let records = dir.path().join("wear_records.jsonl");
     let on_disk = || {
