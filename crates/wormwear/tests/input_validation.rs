@@ -587,3 +587,37 @@ fn ten_thousand_sections_are_refused_at_once() {
     assert!(message.len() < 2_000, "{}", message.len());
     eprintln!("rejected in {:.3} s", start.elapsed().as_secs_f64());
 }
+
+#[test]
+fn geometry_failures_name_the_inputs_to_change() {
+    // Files that validate but cannot be generated (issue 16): an involute worm whose base
+    // radius lies above its root (5 deg), a 4-start worm and hob on the 1/40 blank.
+    let involute = design()
+        .replace("profile = \"A\"", "profile = \"I\"")
+        .replace("pressure_angle_deg = 21.81", "pressure_angle_deg = 5.0");
+    let four_starts = design()
+        .replace("starts = 1", "starts = 4")
+        .replace("lead_mm = 15.551", "lead_mm = 62.204");
+    for (text, parts) in [
+        (
+            involute,
+            &[
+                "worm:",
+                "[worm] profile",
+                "pressure_angle_deg",
+                "root_radius_mm",
+            ][..],
+        ),
+        (
+            four_starts,
+            &["[hob] starts", "[wheel] teeth", "outer_radius_mm"][..],
+        ),
+    ] {
+        let gear = input::load_from_str(&text).unwrap();
+        let message = match Geometry::build(&gear) {
+            Ok(_) => panic!("generated"),
+            Err(e) => e.to_string(),
+        };
+        assert_mentions(&message, parts);
+    }
+}

@@ -55,8 +55,19 @@ impl Geometry {
         cells_height: usize,
         cells_face: usize,
     ) -> Result<Self, GeometryError> {
-        let worm = ThreadSurface::new(&gear.worm)?;
-        let hob = ThreadSurface::new(&gear.hob)?;
+        let thread_hint = |member: &'static str| {
+            move |e: GeometryError| match e {
+                GeometryError::Profile(m) => GeometryError::Profile(format!(
+                    "{member}: {m}; the inputs that shape it: [{member}] profile, \
+                     pressure_angle_deg with pressure_angle_plane, root_radius_mm and \
+                     tip_radius_mm (an involute worm's base radius must lie below its root; a \
+                     K or C worm's grinding wheel, or profile radius, must reach the root)"
+                )),
+                other => other,
+            }
+        };
+        let worm = ThreadSurface::new(&gear.worm).map_err(thread_hint("worm"))?;
+        let hob = ThreadSurface::new(&gear.hob).map_err(thread_hint("hob"))?;
         let blank = BlankLimits {
             face_width: gear.wheel.face_width,
             outer_radius: gear.wheel.outer_radius,
@@ -64,9 +75,19 @@ impl Geometry {
             centre_distance: gear.nominal_centre_distance,
         };
         let hobbing = Hobbing::new(&hob, gear.cutting, gear.wheel.teeth);
-        let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)?;
-        let right =
-            wheel::generate_flank(&hobbing, Flank::Right, &blank, cells_height, cells_face)?;
+        let wheel_hint = |e: GeometryError| match e {
+            GeometryError::Wheel(m) => GeometryError::Wheel(format!(
+                "{m}; the inputs that shape it: [hob] starts, lead_mm, tip_radius_mm and \
+                 pressure angle, [cutting] centre_distance_mm, [wheel] teeth, outer_radius_mm \
+                 and face_width_mm (the blank must lie inside the region the hob envelops: a \
+                 smaller outer radius or face width, or a hob matching the wheel's teeth)"
+            )),
+            other => other,
+        };
+        let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)
+            .map_err(wheel_hint)?;
+        let right = wheel::generate_flank(&hobbing, Flank::Right, &blank, cells_height, cells_face)
+            .map_err(wheel_hint)?;
         Ok(Self {
             worm,
             hob,
