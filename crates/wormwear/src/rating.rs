@@ -197,46 +197,7 @@ pub fn rate(gear: &GearSet) -> Rating {
         f64::NAN
     };
     let alpha_0 = w.normal_pressure_angle;
-    let mut warnings = Vec::new();
-    let efficiency = if efficiency >= EFFICIENCY_FLOOR {
-        efficiency
-    } else {
-        warnings.push(format!(
-            "efficiency {efficiency:.3e} below {EFFICIENCY_FLOOR}: the no-load losses (churning \
-             {churning:.0} W, seals {seals:.0} W) take nearly all of the input power at \
-             {t1:.3} N m, outside the loss method's range (reported null; the wheel torque and \
-             the stresses below assume it)"
-        ));
-        f64::NAN
-    };
-    let n_li = match rank_formula(v_g, sigma_hm, sigma_lim) {
-        None => {
-            warnings.push(format!(
-                "N_LI: Rank's formula needs a sliding speed above 0.31 m/s (here {v_g:.3} m/s) \
-                 and a positive stress (reported null)"
-            ));
-            f64::NAN
-        }
-        Some(n) => within_life_data("N_LI", n, sigma_hm, &mut warnings),
-    };
-    let n_lii = if sigma_hm > 180.0 {
-        within_life_data("N_LII", n_lii, sigma_hm, &mut warnings)
-    } else {
-        warnings.push(format!(
-            "N_LII: Rank's growth formula needs sigma_Hm above 180 N/mm^2 (here {sigma_hm:.0}; \
-             reported null)"
-        ));
-        f64::NAN
-    };
-    let n_l_i_ii = within_life_data("N_L(I+II)", n_l_i_ii, sigma_hm, &mut warnings);
-    let n_li_stahl = if n_li_stahl.is_nan() {
-        warnings.push(format!(
-            "Stahl's N_LI holds for sigma_Hm up to 500 N/mm^2 (here {sigma_hm:.0}; reported null)"
-        ));
-        f64::NAN
-    } else {
-        within_life_data("Stahl's N_LI", n_li_stahl, sigma_hm, &mut warnings)
-    };
+    let n_li = rank_formula(v_g, sigma_hm, sigma_lim).unwrap_or(f64::NAN);
     Rating {
         efficiency,
         mesh_efficiency: eta_z,
@@ -260,7 +221,57 @@ pub fn rate(gear: &GearSet) -> Rating {
         wear_limit_backlash_m: 0.3 * m_x * 1e-3 * gamma.cos(),
         profile_shift: x2,
         lead_angle_deg: gamma.to_degrees(),
-        warnings,
+        warnings: Vec::new(),
+    }
+    .within_ranges()
+}
+
+impl Rating {
+    /// The same ratings with every quantity outside its formula's range set to NaN and a
+    /// warning saying why (MODEL §9's formulas hold for test-rig conditions only).
+    fn within_ranges(mut self) -> Self {
+        let w = &mut self.warnings;
+        let sigma_hm = self.sigma_hm_mpa;
+        if self.efficiency.is_nan() || self.efficiency < EFFICIENCY_FLOOR {
+            w.push(format!(
+                "efficiency {:.3e} below {EFFICIENCY_FLOOR}: the no-load losses (churning {:.0} W, \
+                 seals {:.0} W) take nearly all of the input power at {:.3} N m, outside the \
+                 loss method's range (reported null; the wheel torque and the stresses below \
+                 assume it)",
+                self.efficiency, self.loss_churning_w, self.loss_seals_w, self.worm_torque_nm
+            ));
+            self.efficiency = f64::NAN;
+        }
+        self.n_li_cycles = if self.n_li_cycles.is_nan() {
+            w.push(format!(
+                "N_LI: Rank's formula needs a sliding speed above 0.31 m/s (here {:.3} m/s) and \
+                 a positive stress (reported null)",
+                self.sliding_speed_m_s
+            ));
+            f64::NAN
+        } else {
+            within_life_data("N_LI", self.n_li_cycles, sigma_hm, w)
+        };
+        self.n_lii_cycles = if sigma_hm > 180.0 {
+            within_life_data("N_LII", self.n_lii_cycles, sigma_hm, w)
+        } else {
+            w.push(format!(
+                "N_LII: Rank's growth formula needs sigma_Hm above 180 N/mm^2 (here \
+                 {sigma_hm:.0}; reported null)"
+            ));
+            f64::NAN
+        };
+        self.n_l_i_ii_cycles = within_life_data("N_L(I+II)", self.n_l_i_ii_cycles, sigma_hm, w);
+        self.n_li_stahl_cycles = if self.n_li_stahl_cycles.is_nan() {
+            w.push(format!(
+                "Stahl's N_LI holds for sigma_Hm up to 500 N/mm^2 (here {sigma_hm:.0}; reported \
+                 null)"
+            ));
+            f64::NAN
+        } else {
+            within_life_data("Stahl's N_LI", self.n_li_stahl_cycles, sigma_hm, w)
+        };
+        self
     }
 }
 

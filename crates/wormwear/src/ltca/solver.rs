@@ -1512,21 +1512,45 @@ impl BlockPreconditioner {
 mod tests {
     use super::*;
 
+    /// Hertz data of the test sphere: contact radius a (m), peak pressure p0 (Pa), load (N).
+    struct Sphere {
+        a: f64,
+        p0: f64,
+        load: f64,
+    }
+
+    /// A 10 mm sphere on a plane under 100 N (the Hertz check of VALIDATION.md), in forces, on
+    /// n x n cells spanning +-`span` Hertz radii.
+    fn sphere_on_a_plane(
+        n: usize,
+        span: f64,
+    ) -> (Vec<crate::contact::ContactCell>, Problem, Sphere) {
+        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
+        let (radius, load) = (10e-3, 100.0);
+        let e_star = steel_on_bronze().effective_modulus;
+        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
+        let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+        let h = span * a / n as f64;
+        let cells = flat_cells(n, n, h, h);
+        let pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+        (cells, pb, Sphere { a, p0, load })
+    }
+
+    /// A rank-2 term 50 times more compliant than a cell's own contact coefficient, along a
+    /// uniform and a tilting mode (a "bending" of the whole plane).
+    fn compliant_rank_two(cells: &[crate::contact::ContactCell], pb: &Problem, a: f64) -> LowRank {
+        let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
+        let scale = 50.0 * pb.blocks[0].matrix[0];
+        LowRank::new(2, rows, vec![scale, 0.0, 0.0, 0.3 * scale], Vec::new())
+    }
+
     #[test]
     fn the_active_set_method_solves_hertz_and_agrees_with_pk() {
         // Sphere on a plane (the Hertz check of VALIDATION.md) plus a low-rank term (a
         // compliant "bending" mode): the primal active-set fallback gives the KKT point PK
         // gives (the problem is positive definite: one solution), and without the low-rank
         // term Hertz's peak pressure.
-        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
-        let (radius, load) = (10e-3, 100.0);
-        let e_star = steel_on_bronze().effective_modulus;
-        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
-        let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
-        let n = 24;
-        let h = 1.4 * a / n as f64;
-        let cells = flat_cells(n, n, h, h);
-        let mut pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+        let (cells, mut pb, Sphere { a, p0, load }) = sphere_on_a_plane(24, 1.4);
         let settings = SolverSettings {
             tolerance: 1e-10,
             ..SolverSettings::default()
@@ -1536,14 +1560,7 @@ mod tests {
         let pmax = exact.q.iter().copied().fold(0.0, f64::max) / cells[0].area();
         assert!((pmax / p0 - 1.0).abs() < 0.03, "{pmax:e} vs {p0:e}");
         // Add a rank-2 term much more compliant than the contact along two smooth modes.
-        let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
-        let scale = 50.0 * pb.blocks[0].matrix[0];
-        pb.low_rank = Some(LowRank::new(
-            2,
-            rows,
-            vec![scale, 0.0, 0.0, 0.3 * scale],
-            Vec::new(),
-        ));
+        pb.low_rank = Some(compliant_rank_two(&cells, &pb, a));
         // PK alone, without the fallback (the compliant modes slow it: ~470 iterations).
         let q0 = initial(&pb, None);
         let by_pk = pk_inner(&pb, &settings, q0, &vec![false; pb.len()], false).unwrap();
@@ -1570,23 +1587,8 @@ mod tests {
         // The sphere with the compliant rank-2 term and a pressure cap at 0.8 p0: an
         // elastic-perfectly-plastic solution (no cell above its cap, capped cells in plastic
         // flow with a closed or negative gap, the others complementary) carrying the load.
-        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
-        let (radius, load) = (10e-3, 100.0);
-        let e_star = steel_on_bronze().effective_modulus;
-        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
-        let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
-        let n = 24;
-        let h = 1.4 * a / n as f64;
-        let cells = flat_cells(n, n, h, h);
-        let mut pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
-        let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
-        let scale = 50.0 * pb.blocks[0].matrix[0];
-        pb.low_rank = Some(LowRank::new(
-            2,
-            rows,
-            vec![scale, 0.0, 0.0, 0.3 * scale],
-            Vec::new(),
-        ));
+        let (cells, mut pb, Sphere { a, p0, load }) = sphere_on_a_plane(24, 1.4);
+        pb.low_rank = Some(compliant_rank_two(&cells, &pb, a));
         let area = cells[0].area();
         let cap = 0.8 * p0 * area;
         pb.upper = Some(vec![cap; cells.len()]);
@@ -1647,13 +1649,8 @@ mod tests {
     /// a compliant rank-4 term whose rows live on the cell's half of the plane (two "teeth":
     /// columns 0-1 for x < 0, 2-3 for x >= 0), coupled through the core.
     fn sphere_with_two_halves(n: usize) -> (Vec<crate::contact::ContactCell>, Problem, f64) {
-        use crate::validation::analytic::{flat_cells, flat_problem, steel_on_bronze};
-        let (radius, load) = (10e-3, 100.0);
-        let e_star = steel_on_bronze().effective_modulus;
-        let a = (3.0 * load * radius / (4.0 * e_star)).cbrt();
-        let h = 4.0 * a / n as f64;
-        let cells = flat_cells(n, n, h, h);
-        let mut pb = flat_problem(&cells, |c| (c.x * c.x + c.y * c.y) / (2.0 * radius), load);
+        let (cells, mut pb, Sphere { load, .. }) = sphere_on_a_plane(n, 4.0);
+        let h = cells[0].half_nu;
         let k = 4;
         let mut rows = vec![0.0; cells.len() * k];
         let mut ranges = Vec::new();
