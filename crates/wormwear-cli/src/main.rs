@@ -602,6 +602,17 @@ fn wear(
         _ => Failure::Run(anyhow::Error::new(e).context("wear simulation")),
     })?;
     progress.finish_and_clear();
+    if let Some(why) = &end.stopped {
+        eprintln!("warning: wear limit: {why}");
+    }
+    if let Some(r) = end.records.iter().find(|r| r.worn_through_loaded) {
+        eprintln!(
+            "warning: wear: from {} cycles the loaded pattern reaches flank nodes whose tooth is \
+             worn through (contact computed on material that is gone; see wear.limits in \
+             summary.json)",
+            wormwear::output::cycles_label(r.cycles)
+        );
+    }
     if !quiet {
         let first = end.records.first().expect("record");
         let last = end.records.last().expect("record");

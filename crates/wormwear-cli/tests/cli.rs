@@ -616,6 +616,40 @@ fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_differenc
         std::fs::read(dir.path().join("wear_records.jsonl")).unwrap(),
         records
     );
+    // Where a life ends is not an input of its results: resumed with a backlash limit below
+    // the checkpoint's backlash, the life ends at its state (exit 0, a warning, the reason in
+    // summary.json) and the records are those of the run before.
+    std::fs::write(&path, &sound).unwrap();
+    let text = std::fs::read_to_string(&design).unwrap().replace(
+        "step_wear_um = 4.0",
+        "step_wear_um = 4.0\nstop_at = \"backlash-limit\"\nbacklash_limit_um = 0.001",
+    );
+    let limited = dir.path().join("limited.toml");
+    std::fs::write(&limited, text).unwrap();
+    let out = wear_into(
+        &limited,
+        dir.path(),
+        &["--cycles", "30000", "--step-cycles", "10000", "--resume"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: wear limit: backlash limit"), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let limits = &summary["wear"]["limits"];
+    assert!(limits["stopped"]
+        .as_str()
+        .unwrap()
+        .contains("(wear.backlash_limit_um)"));
+    let reached = limits["backlash_limit_cycles"].as_f64().unwrap();
+    assert!(reached > 0.0 && reached < 10_000.0, "{reached}");
+    // The thinnest tooth is the tip at the blank's outer radius (0.91 mm), barely worn.
+    let thinnest = limits["thinnest_tooth_m"].as_f64().unwrap();
+    assert!(thinnest > 5e-4 && thinnest < 2e-3, "{thinnest}");
+    assert_eq!(
+        std::fs::read(dir.path().join("wear_records.jsonl")).unwrap(),
+        records
+    );
 }
 
 #[test]

@@ -576,3 +576,125 @@ fn k_is_recovered_from_a_backlash_curve() {
     assert!((fit.k / k_true - 1.0).abs() < 1e-3, "{}", fit.k);
     assert!(runs <= 5, "{runs} simulations");
 }
+
+/// Issue 16, item 6: a life ends at the first state past the wear limit it stops at (the
+/// backlash limit when asked; the pointed tip always), with the records so far, which are
+/// those of the life that does not stop; the cycles at which a limit is reached are linear
+/// between the states around it.
+#[test]
+fn a_life_ends_at_the_first_state_past_its_wear_limit() {
+    let bench = Bench::new(&example("gear-1x40-design.toml"));
+    let full = plan(50_000.0, wear::StepControl::Cycles(10_000.0), 5e-6);
+    let reference = bench.simulate(&full, None, &mut |_| Ok(())).unwrap();
+    assert_eq!(reference.records.len(), 6);
+    assert!(reference.stopped.is_none());
+    let b: Vec<f64> = reference
+        .records
+        .iter()
+        .map(|r| r.backlash_increase_m)
+        .collect();
+    assert!(b.windows(2).all(|w| w[1] > w[0]), "{b:?}");
+    // A backlash limit a quarter of the way from the second step's backlash to the third's.
+    let limit = b[2] + 0.25 * (b[3] - b[2]);
+    let stopping = wear::WearPlan {
+        stop_at: wear::LifeStop::BacklashLimit,
+        backlash_limit: Some(limit),
+        ..full.clone()
+    };
+    let mut seen = Vec::new();
+    let end = bench
+        .simulate(&stopping, None, &mut |v| {
+            seen.push((v.state.step, v.last));
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(end.records[..], reference.records[..4]);
+    assert_eq!(
+        seen.last(),
+        Some(&(3, true)),
+        "the stopping state is the last"
+    );
+    let why = end.stopped.as_deref().unwrap();
+    assert!(
+        why.contains("backlash limit (wear.backlash_limit_um)") && why.contains("30 000"),
+        "{why}"
+    );
+    let c = wear::WearLimits::cycles_reached(&end.records, limit).unwrap();
+    assert!((c - 22_500.0).abs() < 1e-6, "{c}");
+    // The default stops at the pointed tip only: the same limit lets the life run on.
+    let on = wear::WearPlan {
+        backlash_limit: Some(limit),
+        ..full.clone()
+    };
+    let end = bench.simulate(&on, None, &mut |_| Ok(())).unwrap();
+    assert!(end.stopped.is_none() && end.records == reference.records);
+
+    // The standard's pointed tip (a), on the mean flank loss that the backlash gives,
+    // delta_Wn = dj_t cos(alpha_n) cos(gamma): m_x cos(gamma) (pi/2 - 2 tan(alpha_0)).
+    let geo = &bench.geo;
+    let wf = geo.wheel_flank(bench.tca.loaded_flank);
+    let limits = wear::WearLimits::new(&bench.g, geo, &bench.tca, &full);
+    let rating = wormwear::rating::rate(&bench.g);
+    let gamma = rating.lead_angle_deg.to_radians();
+    let per = bench.g.worm.normal_pressure_angle.cos() * gamma.cos();
+    let tip = 4.95e-3
+        * gamma.cos()
+        * (std::f64::consts::FRAC_PI_2 - 2.0 * bench.g.worm.normal_pressure_angle.tan());
+    assert!((limits.pointed_tip_flank_loss_m / tip - 1.0).abs() < 1e-3);
+    assert!((limits.pointed_tip_backlash_increase_m * per / tip - 1.0).abs() < 1e-3);
+    let unworn = wear::WearState::new(wf).removal;
+    let no_contact = vec![0.0; wf.cells_height * wf.cells_face];
+    let mut r = reference.records[1].clone();
+    r.backlash_increase_m = limits.pointed_tip_backlash_increase_m * (1.0 - 1e-9);
+    assert_eq!(limits.passed(&r), None);
+    r.backlash_increase_m = limits.pointed_tip_backlash_increase_m * (1.0 + 1e-9);
+    let why = limits.passed(&r).unwrap();
+    assert!(why.contains("pointed (MODEL §9 (a))"), "{why}");
+
+    // The local form: the tooth behind each node of the loaded flank, as the normal depth
+    // that reaches the opposite flank. In the mid-plane at the reference radius r2 its
+    // circumferential thickness is the pitch less the hob's thickness (15.551 - 7.775 mm).
+    let mid = wf.cells_face / 2;
+    assert!(wf.z[mid].abs() < 1e-12);
+    let r2 = bench.g.wheel_reference_radius();
+    let column: Vec<(f64, f64)> = (0..=wf.cells_height)
+        .map(|i| {
+            let k = mid * (wf.cells_height + 1) + i;
+            let n = &wf.nodes[k];
+            let lever = kinematics::GapEvaluator::lever(&n.position(), &n.normal_vec());
+            (n.r, limits.node_thickness[k] / lever * n.r)
+        })
+        .collect();
+    let k = column.iter().position(|c| c.0 >= r2).unwrap();
+    let (lo, hi) = (column[k - 1], column[k]);
+    let at_r2 = lo.1 + (hi.1 - lo.1) * (r2 - lo.0) / (hi.0 - lo.0);
+    eprintln!(
+        "tooth thickness at r2 in the mid-plane {:.5} mm",
+        at_r2 * 1e3
+    );
+    assert!(
+        (at_r2 / (15.551e-3 - 7.775e-3) - 1.0).abs() < 1e-3,
+        "{at_r2}"
+    );
+    // Worn through at one node (its tooth thickness and a micrometre): reported per state
+    // when the node is in the loaded pattern (contact on material that is gone), as a share of
+    // the flank in any case; not a stop (the standard's limits are on the mean flank loss).
+    let k = mid * (wf.cells_height + 1) + wf.cells_height / 2;
+    let mut through = unworn.clone();
+    through.values[k] = limits.node_thickness[k] + 1e-6;
+    let mut pattern = no_contact.clone();
+    assert_eq!(limits.worn_through_loaded(&through, &pattern, wf), None);
+    assert!(limits.worn_through_share(&through) > 0.0);
+    let (left, at) = limits.thinnest(&through);
+    assert!(at == k && (left + 1e-6).abs() < 1e-15, "{left} at {at}");
+    pattern[mid * wf.cells_height + wf.cells_height / 2] = 1e8;
+    assert_eq!(limits.worn_through_loaded(&through, &pattern, wf), Some(k));
+    through.values[k] -= 2e-6;
+    assert_eq!(limits.worn_through_loaded(&through, &pattern, wf), None);
+    assert_eq!(limits.worn_through_share(&through), 0.0);
+    // The records carry both: unworn, the thinnest tooth is the tip at the blank's outer
+    // radius, nowhere worn through.
+    let first = &reference.records[0];
+    assert_eq!(first.thinnest_tooth_m, limits.thinnest(&unworn).0);
+    assert!(first.thinnest_tooth_m > 0.0 && !first.worn_through_loaded);
+}

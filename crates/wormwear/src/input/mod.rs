@@ -277,6 +277,19 @@ pub enum PitDepth {
     LoadedBand,
 }
 
+/// Which wear limit ends a life before its cycles (MODEL §9 (a), (d)); the pointed tip ends
+/// it in any case (no tooth is left to wear past it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LifeStop {
+    /// The wheel tooth's tip is pointed: flank loss delta_Wn = m_x cos(gamma) (pi/2 -
+    /// 2 tan(alpha_0)) (default).
+    PointedTip,
+    /// The backlash limit: the plan's `backlash_limit` (default: the standard's limit (d),
+    /// flank loss 0.3 m_x cos(gamma)).
+    BacklashLimit,
+}
+
 /// Life simulation plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct WearPlan {
@@ -295,6 +308,11 @@ pub struct WearPlan {
     /// Cycles at which the life stops for a state whose maps are written (steps are cut
     /// there); None: the states 0, 1, 2, 4, 8, ...
     pub map_cycles: Option<Vec<f64>>,
+    /// Which wear limit ends the life early.
+    pub stop_at: LifeStop,
+    /// Backlash limit: increase of the tangential backlash at r2, m (None: the standard's
+    /// limit (d)).
+    pub backlash_limit: Option<f64>,
 }
 
 impl WearPlan {
@@ -310,6 +328,8 @@ impl WearPlan {
             film_load: FilmLoad::LoadedAnalysis,
             pit_depth: PitDepth::Hertz,
             map_cycles: None,
+            stop_at: LifeStop::PointedTip,
+            backlash_limit: None,
         }
     }
 }

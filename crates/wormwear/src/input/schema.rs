@@ -122,6 +122,14 @@ pub struct WearSpec {
     /// the states 0, 1, 2, 4, 8, ...).
     #[serde(default)]
     pub map_cycles: Option<Vec<f64>>,
+    /// Which wear limit ends the life early: "pointed-tip" (default) or "backlash-limit"
+    /// (MODEL §9 (a), (d)).
+    #[serde(default)]
+    pub stop_at: Option<String>,
+    /// Backlash limit: increase of the tangential backlash at r2, um (default: the
+    /// standard's limit (d), 0.3 m_x / cos(alpha_n)).
+    #[serde(default)]
+    pub backlash_limit_um: Option<f64>,
 }
 
 /// One phase of the schedule.

@@ -1449,6 +1449,20 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             ok.then(|| Some(list.clone()))
         }
     };
+    let stop_at = ck.choice(
+        "wear.stop_at",
+        w.stop_at.as_deref().unwrap_or("pointed-tip"),
+        &[
+            ("pointed-tip", LifeStop::PointedTip),
+            ("backlash-limit", LifeStop::BacklashLimit),
+        ],
+    );
+    let backlash_limit = match w.backlash_limit_um {
+        None => Some(None),
+        Some(v) => ck
+            .positive("wear.backlash_limit_um", v, 1e5, "um")
+            .map(|v| Some(v * 1e-6)),
+    };
     Some(WearPlan {
         life_cycles: life?,
         step: step?,
@@ -1458,6 +1472,8 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         film_load: film_load?,
         pit_depth: pit_depth?,
         map_cycles: map_cycles?,
+        stop_at: stop_at?,
+        backlash_limit: backlash_limit?,
     })
 }
 

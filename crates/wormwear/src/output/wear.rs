@@ -80,9 +80,70 @@ pub struct WearSummary<'a> {
     /// What `max_pressure_pa` is: the largest cell of the loaded pattern (raw, grows with
     /// refinement at a sharp edge); `pressure_patch_max_pa` is the mesh-converged companion.
     pub max_pressure_definition: &'static str,
+    /// The wear limits and where the life reached them.
+    pub limits: LimitsSummary,
     /// One record per state: the start and after each step (per-position curves in
     /// `wear_positions.csv`).
     pub steps: Vec<crate::wear::StepRecord>,
+}
+
+/// The wear limits of the life (MODEL §9 (a), (d)) and where it reached them.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LimitsSummary {
+    /// The limits, as flank loss and as tangential backlash increase.
+    #[serde(flatten)]
+    pub limits: crate::wear::WearLimits,
+    /// Flank loss in the normal section at the last state (from the backlash increase), m.
+    pub flank_loss_m: f64,
+    /// Thinnest wheel tooth left at the last state (the normal wear depth that would go
+    /// through it), m, and where (node radius and face position, m).
+    pub thinnest_tooth_m: f64,
+    pub thinnest_tooth_r_m: f64,
+    pub thinnest_tooth_z_m: f64,
+    /// Share of the loaded flank's nodes whose tooth is worn through at the last state, and
+    /// the first cycles at which a worn-through node was in the loaded pattern (contact on
+    /// material that is gone; null: never).
+    pub worn_through_share: f64,
+    pub worn_through_loaded_cycles: Option<f64>,
+    /// Cycles at which each limit was reached (linear between states); null: not reached.
+    pub pointed_tip_cycles: Option<f64>,
+    pub backlash_limit_cycles: Option<f64>,
+    /// Why the life ended before its cycles (null: it did not).
+    pub stopped: Option<String>,
+}
+
+impl LimitsSummary {
+    /// The limits of this plan over the records of `state`.
+    pub fn new(
+        gear: &GearSet,
+        geo: &Geometry,
+        tca: &Tca,
+        plan: &WearPlan,
+        state: &WearState,
+    ) -> Self {
+        let limits = crate::wear::WearLimits::new(gear, geo, tca, plan);
+        let (thinnest, k) = limits.thinnest(&state.removal);
+        let node = &geo.wheel_flank(tca.loaded_flank).nodes[k];
+        let reached = |limit| crate::wear::WearLimits::cycles_reached(&state.records, limit);
+        Self {
+            flank_loss_m: state.records.last().map_or(0.0, |r| {
+                r.backlash_increase_m * limits.flank_loss_per_backlash
+            }),
+            thinnest_tooth_m: thinnest,
+            thinnest_tooth_r_m: node.r,
+            thinnest_tooth_z_m: node.z,
+            worn_through_share: limits.worn_through_share(&state.removal),
+            worn_through_loaded_cycles: state
+                .records
+                .iter()
+                .find(|r| r.worn_through_loaded)
+                .map(|r| r.cycles),
+            pointed_tip_cycles: reached(limits.pointed_tip_backlash_increase_m),
+            backlash_limit_cycles: reached(limits.backlash_increase_limit_m),
+            stopped: state.stopped.clone(),
+            limits,
+        }
+    }
 }
 
 /// What a summary's `max_pressure_pa` means.
@@ -97,7 +158,8 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
 }
 
 /// The inputs that shape a life's results: the gear set without its title, its remarks and
-/// its life plan, and the plan without the life's length (a resume may extend a life).
+/// its life plan, and the plan without where the life ends (its length and the wear limit it
+/// stops at: a resume may extend a life).
 /// Stored in the checkpoint, compared on resume ([`input_changes`]).
 pub fn life_inputs(gear: &GearSet, plan: &WearPlan) -> serde_json::Value {
     let mut g = serde_json::to_value(gear).unwrap_or(serde_json::Value::Null);
@@ -108,7 +170,9 @@ pub fn life_inputs(gear: &GearSet, plan: &WearPlan) -> serde_json::Value {
     }
     let mut p = serde_json::to_value(plan).unwrap_or(serde_json::Value::Null);
     if let Some(map) = p.as_object_mut() {
-        map.remove("life_cycles");
+        for key in ["life_cycles", "stop_at", "backlash_limit"] {
+            map.remove(key);
+        }
     }
     serde_json::json!({ "gear": g, "plan": p })
 }
@@ -209,6 +273,8 @@ pub fn read_resume(
             pitted: c.pitted,
             band_factor: c.band_factor,
             warm: c.warm,
+            // Recomputed with the state's record on resume.
+            stopped: None,
         },
         c.inputs,
     )))
@@ -336,7 +402,7 @@ fn write_state(
     if !(tables || view.map || view.last) {
         return Ok(files);
     }
-    files.extend(write_tables(tca, plan, view, dir)?);
+    files.extend(write_tables(gear, geo, tca, plan, view, dir)?);
     // Maps and the node table: at the map states and the last (drawing every state would
     // cost more than the state itself on long lives).
     if !(view.map || view.last) {
@@ -375,6 +441,8 @@ fn write_state(
 /// The tables and curves over the states so far: `wear_steps.csv`, `wear_positions.csv`, the
 /// `wear` section of summary.json and the curves over cycles.
 fn write_tables(
+    gear: &GearSet,
+    geo: &Geometry,
     tca: &Tca,
     plan: &WearPlan,
     view: &StepView,
@@ -410,6 +478,8 @@ fn write_tables(
         "te_p2p_relative_rad",
         "n_li_model_cycles",
         "pitted_area_fraction",
+        "thinnest_tooth_um",
+        "worn_through_loaded",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -439,6 +509,8 @@ fn write_tables(
             r.te_p2p_relative_rad,
             r.n_li_model_cycles.unwrap_or(f64::NAN),
             r.pitted_area_fraction,
+            r.thinnest_tooth_m * UM,
+            f64::from(u8::from(r.worn_through_loaded)),
         ]);
     }
     let path = dir.join("wear_steps.csv");
@@ -456,6 +528,7 @@ fn write_tables(
         states: state.records.len(),
         loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
         max_pressure_definition: MAX_PRESSURE_DEFINITION,
+        limits: LimitsSummary::new(gear, geo, tca, plan, state),
         steps: state
             .records
             .iter()
@@ -527,7 +600,7 @@ fn write_tables(
                 curve(&|r| r.max_pressure_pa * MPA, "P_max (raw)", 1),
                 curve(
                     &|r| r.pressure_patch_max_pa * MPA,
-                    "P_99 (1 % of the area above)",
+                    "P_patch (largest mean over a patch)",
                     2,
                 ),
                 curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
