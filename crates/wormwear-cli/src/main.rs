@@ -428,6 +428,9 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
     for w in &tca.warnings {
         eprintln!("warning: {w}");
     }
+    for w in &result.warnings {
+        eprintln!("warning: loaded analysis: {w}");
+    }
     if !quiet {
         for f in &files {
             println!("  wrote {}", f.display());
@@ -604,6 +607,21 @@ fn wear(
     progress.finish_and_clear();
     if let Some(why) = &end.stopped {
         eprintln!("warning: wear limit: {why}");
+    }
+    if let Some(r) = end
+        .records
+        .iter()
+        .find(|r| r.power_balance.abs() > wormwear::ltca::POWER_BALANCE_LIMIT)
+    {
+        eprintln!(
+            "warning: wear: from {} cycles the loaded analyses depart from the frictionless \
+             power balance by {:+.1} % (more than {} %): the load sits at non-conjugate points \
+             (the wheel's face edge under a misalignment) and the model's torques, TE and wear \
+             there are unreliable (power_balance in wear_steps.csv)",
+            wormwear::output::cycles_label(r.cycles),
+            100.0 * r.power_balance,
+            100.0 * wormwear::ltca::POWER_BALANCE_LIMIT
+        );
     }
     if let Some(r) = end.records.iter().find(|r| r.worn_through_loaded) {
         eprintln!(

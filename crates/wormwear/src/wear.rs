@@ -806,6 +806,9 @@ pub struct StepRecord {
     /// ([`WearLimits::worn_through_loaded`]).
     #[serde(default)]
     pub worn_through_loaded: bool,
+    /// Frictionless power balance of this state's loaded analysis (`Ltca::power_balance`).
+    #[serde(default)]
+    pub power_balance: f64,
     /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -1199,6 +1202,7 @@ impl<'a> LifeLoop<'a> {
                 .limits
                 .worn_through_loaded(&state.removal, &l.pattern, wf)
                 .is_some(),
+            power_balance: l.power_balance,
             positions,
         }
     }

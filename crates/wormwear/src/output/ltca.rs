@@ -50,6 +50,10 @@ pub struct LtcaSummary {
     pub mesh_stiffness_without_shaft_torsion_nm_per_rad: f64,
     pub mesh_stiffness_linear_mean_n_per_m: f64,
     pub max_teeth_in_contact: usize,
+    /// Frictionless power balance: mean wheel torque / (u x worm torque) - 1.
+    pub power_balance: f64,
+    /// What makes these results doubtful (also on stderr and in report.html).
+    pub warnings: Vec<String>,
     /// Normal force per tooth (TCA tooth order) at each position, N.
     pub load_share: Vec<LoadShare>,
     pub solver_residuals: Vec<SolverResiduals>,
@@ -114,6 +118,8 @@ impl LtcaSummary {
                 .sum::<f64>()
                 / n,
             max_teeth_in_contact: ltca.max_teeth_in_contact(),
+            power_balance: ltca.power_balance,
+            warnings: ltca.warnings.clone(),
             load_share: ltca
                 .positions
                 .iter()

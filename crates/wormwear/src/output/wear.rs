@@ -480,6 +480,7 @@ fn write_tables(
         "pitted_area_fraction",
         "thinnest_tooth_um",
         "worn_through_loaded",
+        "power_balance",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -511,6 +512,7 @@ fn write_tables(
             r.pitted_area_fraction,
             r.thinnest_tooth_m * UM,
             f64::from(u8::from(r.worn_through_loaded)),
+            r.power_balance,
         ]);
     }
     let path = dir.join("wear_steps.csv");
