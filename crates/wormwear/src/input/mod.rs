@@ -598,9 +598,56 @@ fn cut_long_lines(message: &str) -> String {
 
 /// Parses and validates a gear file given as TOML text.
 pub fn load_from_str(text: &str) -> Result<GearSet, InputError> {
-    let file: GearFile =
-        toml::from_str(text).map_err(|e| InputError::Syntax(cut_long_lines(&e.to_string())))?;
+    let file: GearFile = toml::from_str(text).map_err(|e| {
+        let message = cut_long_lines(&e.to_string());
+        // An error without a place (the parser's recursion limit on a table header of
+        // thousands of keys): name the most deeply nested line.
+        InputError::Syntax(match (e.span(), deepest_line(text)) {
+            (None, Some((line, depth))) if depth > 8 => format!(
+                "{message}: line {line} nests {depth} levels deep (tables, arrays or inline \
+                 tables); a gear file needs at most 3"
+            ),
+            _ => message,
+        })
+    })?;
     validate::validate(&file)
+}
+
+/// The line (1-based) of the deepest nesting of a TOML text and its depth: keys of a table
+/// header, or brackets and braces of a value (quoted text and comments skipped).
+fn deepest_line(text: &str) -> Option<(usize, usize)> {
+    let mut best: Option<(usize, usize)> = None;
+    let mut depth = 0usize;
+    for (k, line) in text.lines().enumerate() {
+        let trimmed = line.trim_start();
+        let mut deepest = depth;
+        if depth == 0 && trimmed.starts_with('[') {
+            deepest = trimmed
+                .split(']')
+                .next()
+                .map_or(1, |h| h.matches('.').count() + 1);
+        } else {
+            let mut quote: Option<char> = None;
+            for c in line.chars() {
+                match (quote, c) {
+                    (Some(q), c) if c == q => quote = None,
+                    (Some(_), _) => {}
+                    (None, '"' | '\'') => quote = Some(c),
+                    (None, '#') => break,
+                    (None, '[' | '{') => {
+                        depth += 1;
+                        deepest = deepest.max(depth);
+                    }
+                    (None, ']' | '}') => depth = depth.saturating_sub(1),
+                    _ => {}
+                }
+            }
+        }
+        if best.is_none_or(|b| deepest > b.1) {
+            best = Some((k + 1, deepest));
+        }
+    }
+    best
 }
 
 /// Reads, parses and validates a gear file.

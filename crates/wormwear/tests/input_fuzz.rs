@@ -1,0 +1,273 @@
+//! Fuzzing the gear-file parser and validator (issue 16): documents generated from the
+//! examples' schema (every table and key of the five example files) and mutated one leaf or
+//! table at a time — hostile numbers, wrong types, missing and unknown keys, tables replaced
+//! by values and values by tables, deep nesting. Properties: nothing panics, and every
+//! rejection names a field (a field error with its dotted name, or a parse error that quotes
+//! the key). Runs for a bounded time (FUZZ_SECONDS, default 30) and prints how many documents
+//! it tried.
+
+use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+use proptest::test_runner::TestRunner;
+use std::path::Path;
+use toml::Value;
+use wormwear::input::{self, InputError};
+
+const EXAMPLES: [&str; 5] = [
+    "gear-1x40-design.toml",
+    "gear-1x40-case-a.toml",
+    "gear-1x40-case-b.toml",
+    "gear-1x40-case-c.toml",
+    "gear-k-2x25.toml",
+];
+
+fn examples() -> Vec<toml::Table> {
+    EXAMPLES
+        .iter()
+        .map(|name| {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../examples")
+                .join(name);
+            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+        })
+        .collect()
+}
+
+/// One step along a document: a key of a table or an index of an array.
+#[derive(Debug, Clone, PartialEq)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// Every path to a value of the document (tables, arrays and leaves), depth first.
+fn paths(value: &Value, prefix: &mut Vec<Step>, out: &mut Vec<Vec<Step>>) {
+    match value {
+        Value::Table(t) => {
+            for (k, v) in t {
+                prefix.push(Step::Key(k.clone()));
+                out.push(prefix.clone());
+                paths(v, prefix, out);
+                prefix.pop();
+            }
+        }
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                prefix.push(Step::Index(i));
+                out.push(prefix.clone());
+                paths(v, prefix, out);
+                prefix.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn at_mut<'a>(value: &'a mut Value, path: &[Step]) -> &'a mut Value {
+    path.iter().fold(value, |v, s| match (s, v) {
+        (Step::Key(k), Value::Table(t)) => t.get_mut(k).unwrap(),
+        (Step::Index(i), Value::Array(a)) => &mut a[*i],
+        _ => unreachable!("paths come from the document"),
+    })
+}
+
+/// What a mutation does to the value at the chosen path.
+#[derive(Debug, Clone)]
+enum Mutation {
+    Replace(Value),
+    Scale(f64),
+    Remove,
+    AddUnknownKey,
+    Nest(usize),
+}
+
+fn hostile_value() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        Just(Value::Float(f64::NAN)),
+        Just(Value::Float(f64::INFINITY)),
+        Just(Value::Float(f64::NEG_INFINITY)),
+        Just(Value::Float(-0.0)),
+        Just(Value::Float(1e308)),
+        Just(Value::Float(-1e308)),
+        Just(Value::Float(1e-300)),
+        Just(Value::Integer(0)),
+        Just(Value::Integer(-1)),
+        Just(Value::Integer(i64::MAX)),
+        Just(Value::Integer(i64::MIN)),
+        (-1e4f64..1e4).prop_map(Value::Float),
+        Just(Value::String(String::new())),
+        Just(Value::String("A".into())),
+        Just(Value::String("x".repeat(10_000))),
+        Just(Value::Boolean(true)),
+        Just(Value::Array(vec![])),
+        Just(Value::Array(vec![Value::Integer(1), Value::Integer(2)])),
+        Just(Value::Array(vec![Value::Float(1.0); 100_000])),
+        Just(Value::Table(toml::Table::new())),
+    ]
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        6 => hostile_value().prop_map(Mutation::Replace),
+        3 => prop_oneof![Just(-1.0), Just(0.0), Just(1e-6), Just(1e6), 0.2f64..5.0].prop_map(Mutation::Scale),
+        2 => Just(Mutation::Remove),
+        1 => Just(Mutation::AddUnknownKey),
+        1 => (2usize..5000).prop_map(Mutation::Nest),
+    ]
+}
+
+/// Applies `mutation` at `path`; returns the key that the rejection should name (the last key
+/// on the path, or the unknown key added).
+fn apply(doc: &mut Value, path: &[Step], mutation: &Mutation) -> String {
+    let key = path
+        .iter()
+        .rev()
+        .find_map(|s| match s {
+            Step::Key(k) => Some(k.clone()),
+            Step::Index(_) => None,
+        })
+        .unwrap_or_default();
+    let (parent, last) = path.split_at(path.len() - 1);
+    match mutation {
+        Mutation::Replace(v) => *at_mut(doc, path) = v.clone(),
+        Mutation::Scale(f) => {
+            let target = at_mut(doc, path);
+            match target {
+                Value::Float(x) => *x *= f,
+                Value::Integer(i) => *i = (*i as f64 * f).round() as i64,
+                _ => {}
+            }
+        }
+        Mutation::Remove => match (at_mut(doc, parent), &last[0]) {
+            (Value::Table(t), Step::Key(k)) => {
+                t.remove(k);
+            }
+            (Value::Array(a), Step::Index(i)) => {
+                a.remove(*i);
+            }
+            _ => {}
+        },
+        Mutation::AddUnknownKey => {
+            if let Value::Table(t) = at_mut(doc, parent) {
+                t.insert("zz_unknown_key".into(), Value::Integer(1));
+                return "zz_unknown_key".into();
+            }
+        }
+        Mutation::Nest(depth) => {
+            let target = at_mut(doc, path);
+            let mut v = target.clone();
+            for _ in 0..*depth {
+                v = Value::Array(vec![v]);
+            }
+            *target = v;
+        }
+    }
+    key
+}
+
+/// Whether a rejection names a field: field errors each with a dotted field name, or a parse
+/// error that quotes the key (the toml error echoes the offending line, or names a missing or
+/// unknown field).
+fn names_a_field(error: &InputError, key: &str) -> bool {
+    match error {
+        InputError::Invalid(fields) => {
+            !fields.is_empty() && fields.iter().all(|f| !f.field.is_empty())
+        }
+        InputError::Syntax(message) => message.contains(key),
+        InputError::Io { .. } => false,
+    }
+}
+
+#[test]
+fn mutated_gear_files_never_panic_and_every_rejection_names_a_field() {
+    let seconds: f64 = std::env::var("FUZZ_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(30.0);
+    let bases: Vec<Value> = examples().into_iter().map(Value::Table).collect();
+    let all_paths: Vec<Vec<Vec<Step>>> = bases
+        .iter()
+        .map(|b| {
+            let mut out = Vec::new();
+            paths(b, &mut Vec::new(), &mut out);
+            out
+        })
+        .collect();
+    let case = (
+        0..bases.len(),
+        any::<prop::sample::Index>(),
+        mutation(),
+        1usize..3,
+    );
+    // The same sequence of documents on every run (a failure prints its document).
+    let mut runner = TestRunner::deterministic();
+    let start = std::time::Instant::now();
+    let (mut tried, mut accepted, mut rejected) = (0usize, 0usize, 0usize);
+    let mut unnamed = Vec::new();
+    while start.elapsed().as_secs_f64() < seconds {
+        let (which, pick, first, count) = case.new_tree(&mut runner).unwrap().current();
+        let mut doc = bases[which].clone();
+        // One or two mutations: the first on a path of the example, a second (on the mutated
+        // document) from the same strategy.
+        let mut keys = Vec::new();
+        let mut mutation = first;
+        for k in 0..count {
+            let mut found = Vec::new();
+            paths(&doc, &mut Vec::new(), &mut found);
+            let candidates = if k == 0 { &all_paths[which] } else { &found };
+            if candidates.is_empty() {
+                break;
+            }
+            let path = candidates[pick.index(candidates.len())].clone();
+            keys.push(apply(&mut doc, &path, &mutation));
+            mutation = Mutation::Scale(0.5);
+        }
+        let text = match toml::to_string(&doc) {
+            Ok(t) => t,
+            Err(_) => continue,
+        };
+        tried += 1;
+        let outcome = std::panic::catch_unwind(|| input::load_from_str(&text));
+        match outcome {
+            Err(_) => panic!("the loader panicked on:\n{text}"),
+            Ok(Ok(_)) => accepted += 1,
+            Ok(Err(e)) => {
+                rejected += 1;
+                if !keys.iter().any(|k| names_a_field(&e, k)) && !names_a_field(&e, "\u{1}") {
+                    unnamed.push(format!("keys {keys:?}: {}", cut(&e.to_string())));
+                }
+            }
+        }
+    }
+    eprintln!(
+        "input fuzz: {tried} documents in {:.0} s: {accepted} accepted, {rejected} rejected, \
+         {} rejections without a field",
+        start.elapsed().as_secs_f64(),
+        unnamed.len()
+    );
+    assert!(tried >= 100, "only {tried} documents");
+    assert!(unnamed.is_empty(), "{}", unnamed.join("\n"));
+}
+
+fn cut(s: &str) -> String {
+    s.chars().take(300).collect()
+}
+
+/// Nesting deeper than the parser's recursion limit is named with its line.
+#[test]
+fn deep_nesting_names_its_line() {
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml"),
+    )
+    .unwrap();
+    let line = base.lines().count() + 2;
+    for tail in [
+        format!("\n[{}]\n", vec!["a"; 5000].join(".")),
+        format!("\nx = {}{}\n", "[".repeat(5000), "]".repeat(5000)),
+    ] {
+        let e = input::load_from_str(&format!("{base}{tail}")).unwrap_err();
+        let m = e.to_string();
+        assert!(m.contains(&format!("line {line}")), "{}", cut(&m));
+        assert!(m.len() < 2000, "{} characters", m.len());
+    }
+}
