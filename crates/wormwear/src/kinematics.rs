@@ -120,6 +120,31 @@ impl<'a> GapEvaluator<'a> {
         (e + relief * axial, de, rho, k)
     }
 
+    /// Unit normal of the worm flank (worm frame) at the worm point axially opposite the wheel
+    /// point (r, theta, z) (the point the axial gap is measured to), oriented like the
+    /// wheel flank normal `towards` (worm frame) there.
+    pub fn worm_normal(
+        &self,
+        r: f64,
+        theta: f64,
+        z: f64,
+        theta2: f64,
+        theta1: f64,
+        towards: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let p = wheel_point(r, theta, z, theta2);
+        let q = self.frame.wheel_to_worm(&p);
+        let (_, xy, xz, _, _) = self
+            .worm
+            .axial_gap_with_gradient(self.flank, &q, theta1, None);
+        let n = Vector3::new(1.0, -xy, -xz).normalize();
+        if n.dot(towards) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    }
+
     /// Normal relief at a wheel point (r, z) touching the worm at radius rho: the worm's tip
     /// relief C (s/L)^2 with s = rho - (r_a1 - L), plus the wheel's edge relief towards the blank
     /// top and the face ends. Returns the relief (m) and its derivative with respect to rho.

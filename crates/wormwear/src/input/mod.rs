@@ -410,6 +410,26 @@ pub struct Analysis {
     pub pressure_patch_along: f64,
     /// LTCA solver.
     pub solver: crate::ltca::solver::SolverKind,
+    /// Direction of the pressure on a contact cell (MODEL §5.2's n_i).
+    pub pressure_direction: PressureDirection,
+}
+
+/// Direction of the contact pressure on a cell of the loaded analysis: MODEL §5.2 writes n_i,
+/// "the pressure direction", without saying whose normal. Both coincide on the conjugate
+/// contact line; they differ where the wheel touches the worm with an edge (its face ends
+/// under a misalignment) or off the line on a worn flank.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PressureDirection {
+    /// The worm flank's normal at the point the gap is measured to (default): the worm is the
+    /// smooth, unworn body in every wheel-edge contact, and with it the loaded analysis keeps
+    /// the frictionless power balance (mean wheel torque = u x worm torque) within 1 % up to
+    /// the ends of the misalignment ranges.
+    WormFlank,
+    /// The wheel flank's normal of the unworn grid (the earlier reading): at a wheel edge it
+    /// is not the contact's, and the worm's small lever turns that into torque errors of
+    /// 13-180 % under misalignment.
+    WheelFlank,
 }
 
 /// Which bending model the loaded analysis uses.

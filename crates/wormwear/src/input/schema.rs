@@ -436,6 +436,10 @@ pub struct AnalysisSpec {
     /// ... and this long along the face width, mm (default 1).
     #[serde(default = "default_patch_along")]
     pub pressure_patch_along_mm: f64,
+    /// Direction of the contact pressure: "worm-flank" (default: the worm flank's normal) or
+    /// "wheel-flank" (MODEL §5.2's n_i; see PressureDirection).
+    #[serde(default)]
+    pub pressure_direction: Option<String>,
     /// LTCA solver: "conjugate-gradient" (default) or "fixed-point" (the published scheme).
     #[serde(default = "default_solver")]
     pub solver: String,
@@ -500,6 +504,7 @@ impl Default for AnalysisSpec {
             pressure_patch_across_mm: default_patch_across(),
             pressure_patch_along_mm: default_patch_along(),
             solver: default_solver(),
+            pressure_direction: None,
         }
     }
 }

@@ -328,6 +328,14 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         50.0,
         "Hertz half-widths",
     );
+    let pressure_direction = ck.choice(
+        "analysis.pressure_direction",
+        a.pressure_direction.as_deref().unwrap_or("worm-flank"),
+        &[
+            ("worm-flank", PressureDirection::WormFlank),
+            ("wheel-flank", PressureDirection::WheelFlank),
+        ],
+    );
     let solver = ck.choice(
         "analysis.solver",
         &a.solver,
@@ -564,6 +572,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         Some(solver),
         Some(patch_across),
         Some(patch_along),
+        Some(pressure_direction),
     ) = (
         slice_step,
         contact_columns,
@@ -571,6 +580,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         solver,
         patch_across,
         patch_along,
+        pressure_direction,
     )
     else {
         unreachable_input()?
@@ -623,6 +633,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             pressure_patch_across: patch_across * 1e-3,
             pressure_patch_along: patch_along * 1e-3,
             solver,
+            pressure_direction,
         },
         wear,
         rating: rating.unwrap_or_default(),

@@ -53,6 +53,8 @@ pub struct LtcaSettings {
     pub patch_across: f64,
     pub patch_along: f64,
     pub solver: SolverSettings,
+    /// Direction of the pressure on a cell (MODEL §5.2's n_i).
+    pub pressure_direction: crate::input::PressureDirection,
 }
 
 impl LtcaSettings {
@@ -69,6 +71,7 @@ impl LtcaSettings {
                 kind: a.solver,
                 ..SolverSettings::default()
             },
+            pressure_direction: a.pressure_direction,
         }
     }
 }
@@ -176,9 +179,9 @@ pub struct Ltca {
 pub const POWER_BALANCE_LIMIT: f64 = 0.02;
 
 /// Warnings on a loaded analysis whose mean wheel torque departs from u x the worm torque
-/// by more than [`POWER_BALANCE_LIMIT`]: the load sits at non-conjugate points (typically
-/// the wheel's face edge under a misalignment), where the model takes the force along the
-/// wheel flank's normal, which the small worm lever (|t| / |M| ~ tan of the lead angle) turns
+/// by more than [`POWER_BALANCE_LIMIT`]: the load sits at points where the pressure direction
+/// is not the contact's (with `pressure_direction = "wheel-flank"`, the wheel's face edge
+/// under a misalignment), which the small worm lever (|t| / |M| ~ tan of the lead angle) turns
 /// into large torque errors.
 fn power_balance_warnings(
     balance: f64,
@@ -192,11 +195,11 @@ fn power_balance_warnings(
     }
     vec![format!(
         "the mean wheel torque over the pitch, {wheel:.1} N m, departs from u x the worm torque, \
-         {:.1} N m, by {:+.1} % (frictionless power balance, limit {} %): the load sits at \
-         non-conjugate points (largest pressure at z = {:.2} mm), typically the wheel's face \
-         edge under a misalignment, where the model's force direction (the wheel flank's \
-         normal) is not the contact's; torques, TE and stiffness are unreliable. Localise the \
-         contact (hob oversize) or reduce the misalignment",
+         {:.1} N m, by {:+.1} % (frictionless power balance, limit {} %): the pressure \
+         direction is not the contact's where the load sits (largest pressure at z = {:.2} mm; \
+         with analysis.pressure_direction = \"wheel-flank\", the wheel's face edge under a \
+         misalignment); torques, TE and stiffness are unreliable. The default \
+         pressure_direction = \"worm-flank\" keeps the balance",
         ratio * worm,
         100.0 * balance,
         100.0 * POWER_BALANCE_LIMIT,
@@ -724,13 +727,21 @@ fn slice_cells(
         }
         let nb = wf.normal_at(r, z);
         let stat = wheel_point(r, theta + offset, z, pos.theta2);
-        let n_stat = from_wheel_body(&nb, offset + pos.theta2);
-        let lever = GapEvaluator::lever(&stat, &n_stat);
+        let mut n_stat = from_wheel_body(&nb, offset + pos.theta2);
         let centre = ev.placement.wheel_to_worm(&stat);
         let relief = ev
             .relief(r, z, (centre.y * centre.y + centre.z * centre.z).sqrt())
             .0;
-        let normal = ev.placement.vector_wheel_to_worm(&n_stat);
+        let mut normal = ev.placement.vector_wheel_to_worm(&n_stat);
+        // A depth worn off the wheel flank is normal to it: its angle is over the wheel's lever.
+        let wheel_lever = GapEvaluator::lever(&stat, &n_stat);
+        // The pressure acts along the worm flank's normal where the gap is measured to
+        // (default), or along the wheel grid's (the earlier reading; see PressureDirection).
+        if settings.pressure_direction == crate::input::PressureDirection::WormFlank {
+            normal = ev.worm_normal(r, theta + offset, z, pos.theta2, pos.theta1, &normal);
+            n_stat = ev.placement.vector_worm_to_wheel(&normal);
+        }
+        let lever = GapEvaluator::lever(&stat, &n_stat);
         // Radial direction of the flank: d P / d r in the body frame, to the worm frame.
         let (st, ct) = (theta + offset).sin_cos();
         let dpdr_body = Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0);
@@ -777,7 +788,7 @@ fn slice_cells(
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error
-                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(tip_floor)) / lever),
+                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(tip_floor)) / wheel_lever),
             relief,
         });
     }
