@@ -452,6 +452,13 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         plan.clone(),
     ));
     out.push((
+        "c-wheel-flank-pressure".to_string(),
+        variant(c, |g| {
+            g.analysis.pressure_direction = input::PressureDirection::WheelFlank
+        }),
+        plan.clone(),
+    ));
+    out.push((
         "c-band-pits".to_string(),
         c.clone(),
         WearPlan {

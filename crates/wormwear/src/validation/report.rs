@@ -32,7 +32,9 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
          from that run; the model is the default one, the published model of MODEL.md (§12 g-m): \
          sharp worm tip and wheel edges, an elastic contact without a pressure cap, the film at \
          the line load of the loaded analysis, pits 0.78 x the local Hertz half-width deep, FE \
-         bending of worm and wheel with their shafts and bearings. Section (d) shows each of our \
+         bending of worm and wheel with their shafts and bearings; the contact pressure acts \
+         along the worm flank's normal (MODEL §5.2 leaves n_i open; this reading keeps the \
+         frictionless power balance, README). Section (d) shows each of our \
          refinements against it. The published work gives no measured backlash values in \
          REFERENCE_GEARS.md, only the observed phases, so section (b) compares behaviours and \
          the phases, not curves.\n",
@@ -173,6 +175,7 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             ("pressure cap", "c-pressure-cap"),
             ("band-deep pits", "c-band-pits"),
             ("film-load floor", "c-film-floor"),
+            ("wheel-flank pressure direction", "c-wheel-flank-pressure"),
         ]
         .iter()
         .filter_map(|(name, id)| {
@@ -625,6 +628,12 @@ fn section_c_d(m: &mut String, results: &Results) {
         m,
         "film load floored: `film_load = \"hertz-peak-floor\"`",
         "c-film-floor",
+    );
+    row(
+        m,
+        "pressure along the wheel grid's normal (the other reading of MODEL §5.2's n_i): \
+         `pressure_direction = \"wheel-flank\"`",
+        "c-wheel-flank-pressure",
     );
     m.push('\n');
 }
