@@ -64,6 +64,18 @@ pub enum CalibrationError {
     NoSensitivity(f64),
     #[error("life simulation: {0}")]
     Simulation(#[from] WearError),
+    /// The fitted life ends (at a wear limit) before the last measured point, which the fit
+    /// then could not use.
+    #[error(
+        "the simulated life with the fitted K = {k:.4e} ends at {simulated:.4e} cycles (a wear \
+         limit: see wear.limits), before the measured point at {measured:.4e} cycles: the \
+         measured backlash is beyond the model's wear limits"
+    )]
+    LifeEnded {
+        k: f64,
+        simulated: f64,
+        measured: f64,
+    },
 }
 
 /// K from wear tests by least squares through the origin of V = (K / H) W_asp L (MODEL §10):
@@ -175,6 +187,15 @@ pub fn fit_to_backlash(
         }
         let factor = pairs.iter().map(|(s, b)| s * b).sum::<f64>() / sss;
         if (factor - 1.0).abs() < tolerance || runs >= max_runs {
+            let simulated = records.last().map_or(0.0, |r| r.cycles);
+            let measured_end = measured.iter().map(|m| m.0).fold(0.0, f64::max);
+            if pairs.len() < measured.len() {
+                return Err(CalibrationError::LifeEnded {
+                    k,
+                    simulated,
+                    measured: measured_end,
+                });
+            }
             return Ok((
                 KFit {
                     k,

@@ -575,6 +575,19 @@ fn k_is_recovered_from_a_backlash_curve() {
     );
     assert!((fit.k / k_true - 1.0).abs() < 1e-3, "{}", fit.k);
     assert!(runs <= 5, "{runs} simulations");
+    // A life that ends at a wear limit before the last measured point (here: its records
+    // cut after 20 000 cycles) cannot be fitted to that point: an error, not a K fitted to
+    // the points it reached.
+    let cut: Vec<_> = truth.iter().take(3).cloned().collect();
+    let e = wormwear::calibration::fit_to_backlash(&measured, k_true, 1e-4, 10, &mut |_| {
+        Ok(cut.clone())
+    })
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("before the measured point at 3.0000e4 cycles"),
+        "{e}"
+    );
 }
 
 /// Issue 16, item 6: a life ends at the first state past the wear limit it stops at (the
