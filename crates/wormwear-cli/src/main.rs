@@ -540,18 +540,7 @@ fn wear(
     wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
         .map_err(|e| Failure::Run(e.into()))?;
     let rating = write_rating(&gear, dir, quiet)?;
-    let progress = if quiet || verbose {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
-    };
+    let progress = life_progress(quiet || verbose);
     // Tables, summary and curves grow with the number of states: rewrite them at most every
     // two seconds (and at log-spaced states and the last); the checkpoint goes out every state.
     let mut tables_written = std::time::Instant::now();
@@ -605,6 +594,55 @@ fn wear(
         _ => Failure::Run(anyhow::Error::new(e).context("wear simulation")),
     })?;
     progress.finish_and_clear();
+    warn_about_the_life(&end);
+    if !quiet {
+        print_life(&end, &rating, dir);
+    }
+    Ok(())
+}
+
+/// A progress bar over the life's cycles (permille), or a hidden one.
+fn life_progress(hidden: bool) -> indicatif::ProgressBar {
+    if hidden {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// The one-paragraph result of a life and the standard's ratings, on stdout.
+fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating, dir: &Path) {
+    let first = end.records.first().expect("record");
+    let last = end.records.last().expect("record");
+    println!(
+        "wear: {} steps to {} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
+         P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; results in {}",
+        last.step,
+        wormwear::output::cycles_label(last.cycles),
+        last.max_wear_m * 1e6,
+        last.worn_volume_m3 * 1e9,
+        last.backlash_increase_m * 1e6,
+        first.max_pressure_pa / 1e6,
+        last.max_pressure_pa / 1e6,
+        first.contact_area_fraction,
+        last.contact_area_fraction,
+        dir.display()
+    );
+    println!(
+        "rating (ISO/TR 14521): efficiency {:.3}, worm torque {:.2} N m, sigma_Hm {:.0} MPa, N_LI {:.3e} cycles",
+        rating.efficiency, rating.worm_torque_nm, rating.sigma_hm_mpa, rating.n_li_cycles
+    );
+}
+
+/// Warnings on a finished life: the wear limit it stopped at, loaded analyses off the
+/// frictionless power balance, contact on worn-through material.
+fn warn_about_the_life(end: &wormwear::wear::WearState) {
     if let Some(why) = &end.stopped {
         eprintln!("warning: wear limit: {why}");
     }
@@ -631,29 +669,6 @@ fn wear(
             wormwear::output::cycles_label(r.cycles)
         );
     }
-    if !quiet {
-        let first = end.records.first().expect("record");
-        let last = end.records.last().expect("record");
-        println!(
-            "wear: {} steps to {} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
-             P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; results in {}",
-            last.step,
-            wormwear::output::cycles_label(last.cycles),
-            last.max_wear_m * 1e6,
-            last.worn_volume_m3 * 1e9,
-            last.backlash_increase_m * 1e6,
-            first.max_pressure_pa / 1e6,
-            last.max_pressure_pa / 1e6,
-            first.contact_area_fraction,
-            last.contact_area_fraction,
-            dir.display()
-        );
-        println!(
-            "rating (ISO/TR 14521): efficiency {:.3}, worm torque {:.2} N m, sigma_Hm {:.0} MPa, N_LI {:.3e} cycles",
-            rating.efficiency, rating.worm_torque_nm, rating.sigma_hm_mpa, rating.n_li_cycles
-        );
-    }
-    Ok(())
 }
 
 /// Writes the ratings and prints why any of them is null (outside its formula's range).

@@ -735,11 +735,8 @@ fn slice_cells(
         let mut normal = ev.placement.vector_wheel_to_worm(&n_stat);
         // A depth worn off the wheel flank is normal to it: its angle is over the wheel's lever.
         let wheel_lever = GapEvaluator::lever(&stat, &n_stat);
-        // The pressure acts along the worm flank's normal where the gap is measured to
-        // (default), or along the wheel grid's (the earlier reading; see PressureDirection).
         if settings.pressure_direction == crate::input::PressureDirection::WormFlank {
-            normal = ev.worm_normal(r, theta + offset, z, pos.theta2, pos.theta1, &normal);
-            n_stat = ev.placement.vector_worm_to_wheel(&normal);
+            (normal, n_stat) = worm_flank_direction(ev, r, theta + offset, z, &pos, &normal);
         }
         let lever = GapEvaluator::lever(&stat, &n_stat);
         // Radial direction of the flank: d P / d r in the body frame, to the worm frame.
@@ -793,6 +790,21 @@ fn slice_cells(
         });
     }
     cells
+}
+
+/// The pressure direction along the worm flank's normal where the gap of the wheel point
+/// (r, theta, z) is measured to (see `PressureDirection`): worm-frame and stationary
+/// wheel-frame components, oriented like the wheel normal `wheel_normal` (worm frame).
+fn worm_flank_direction(
+    ev: &GapEvaluator,
+    r: f64,
+    theta: f64,
+    z: f64,
+    pos: &crate::kinematics::Position,
+    wheel_normal: &Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let n = ev.worm_normal(r, theta, z, pos.theta2, pos.theta1, wheel_normal);
+    (n, ev.placement.vector_worm_to_wheel(&n))
 }
 
 #[allow(clippy::too_many_arguments)]
