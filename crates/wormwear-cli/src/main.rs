@@ -10,7 +10,6 @@ use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
 mod calibrate_cmd;
-mod geometry_cmd;
 
 #[derive(Parser)]
 #[command(
@@ -152,6 +151,27 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// A design study: variants of a base gear file (a grid or a list of cases, by dotted
+    /// name) run in parallel on the local cores; sweep.csv (one row per variant), sweep.html,
+    /// every variant's output in DIR/variants/NAME. Resumable: finished variants with the same
+    /// inputs are reused; a failing variant is recorded with its error and the others go on.
+    #[command(
+        after_help = "Example:\n  wormwear sweep examples/sweep-torque-roughness.toml -o out/sweep\n\n\
+                      Sweep file (TOML):\n  \
+                      base = \"gear-1x40-design.toml\"   # relative to the sweep file\n  \
+                      stages = [\"ltca\", \"wear\"]        # optional (default: as `run`)\n  \
+                      cycles = 180000                  # optional: --cycles, step_cycles, step_wear_um, no_pitting\n  \
+                      [grid]                           # or [[cases]] with name = \"...\" and values\n  \
+                      \"conditions.worm_torque_nm\" = [30.0, 60.0, 90.0]\n  \
+                      \"lubricant.composite_roughness_um\" = [0.5, 1.0]"
+    )]
+    Sweep {
+        /// Sweep file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -164,7 +184,7 @@ enum Command {
 }
 
 /// Overrides of the file's [wear] section.
-#[derive(clap::Args, Debug, Clone)]
+#[derive(clap::Args, Debug, Clone, Default)]
 struct LifeArgs {
     /// Wheel cycles to simulate (overrides wear.life_cycles).
     #[arg(long)]
@@ -181,6 +201,18 @@ struct LifeArgs {
     /// Continue from the checkpoint in the output directory.
     #[arg(long)]
     resume: bool,
+}
+
+impl LifeArgs {
+    /// The library's form of the overrides.
+    fn overrides(&self) -> wormwear::runner::LifeOverrides {
+        wormwear::runner::LifeOverrides {
+            cycles: self.cycles,
+            step_cycles: self.step_cycles,
+            step_wear_um: self.step_wear_um,
+            no_pitting: self.no_pitting,
+        }
+    }
 }
 
 /// Error classes mapped to exit codes.
@@ -200,6 +232,7 @@ fn main() -> ExitCode {
         | Command::Wear { output, .. }
         | Command::Run { output, .. }
         | Command::Calibrate { output, .. }
+        | Command::Sweep { output, .. }
         | Command::Validate { output, .. } => Some(output),
     };
     let lock = match output
@@ -247,6 +280,7 @@ fn main() -> ExitCode {
             examples,
             quick,
         } => validate(output, examples, *quick, cli.quiet),
+        Command::Sweep { file, output } => sweep(file, output, cli.quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -316,87 +350,166 @@ fn check(file: &Path, json: bool) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Runs `request` on the gear of `file` into `dir`: the library's runner with the CLI's
+/// progress (bending line, progress bar or one line per wear state), the life written state by
+/// state as it goes, then the other files; prints the warnings.
+fn analyse(
+    file: &Path,
+    gear: &GearSet,
+    dir: &Path,
+    request: wormwear::Request,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(wormwear::Results, Vec<PathBuf>), Failure> {
+    let source = wormwear::Source {
+        file: file.display().to_string(),
+        text: std::fs::read_to_string(file).unwrap_or_default(),
+    };
+    let life_cycles = request.life.as_ref().map_or(1.0, |p| p.life_cycles);
+    let progress = life_progress(quiet || verbose || request.life.is_none());
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir);
+    let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
+        match event {
+            wormwear::Event::Bending(info) if !quiet => print_bending(info),
+            wormwear::Event::WearState(life) => {
+                writer
+                    .write_view(life)
+                    .map_err(|e| wormwear::RunError::Stopped(e.to_string()))?;
+                let line = state_line(life.step.state);
+                if verbose {
+                    eprintln!("{line}");
+                }
+                let done = life.step.state.cycles / life_cycles;
+                progress.set_position((1000.0 * done).round() as u64);
+                progress.set_message(line);
+            }
+            _ => {}
+        }
+        Ok(())
+    };
+    let results = wormwear::run(gear, source, request, &mut on_event).map_err(|e| {
+        let context = match &e {
+            wormwear::RunError::Geometry(_) => format!("geometry of {}", file.display()),
+            wormwear::RunError::Wear(wormwear::wear::WearError::Checkpoint(_)) => {
+                "--resume".to_string()
+            }
+            _ => String::new(),
+        };
+        let error = match context.is_empty() {
+            true => anyhow::Error::new(e),
+            false => anyhow::Error::new(e).context(context),
+        };
+        match error
+            .downcast_ref::<wormwear::RunError>()
+            .map(|e| e.is_input())
+        {
+            Some(true) => Failure::Input(error),
+            _ => Failure::Run(error),
+        }
+    })?;
+    progress.finish_and_clear();
+    let files =
+        wormwear::output::write_results(&results, dir, true).map_err(|e| Failure::Run(e.into()))?;
+    for w in &results.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let (Some(rating), false) = (&results.rating, quiet) {
+        for w in &rating.warnings {
+            eprintln!("warning: rating: {w}");
+        }
+    }
+    Ok((results, files))
+}
+
+/// Where the FE bending model came from (cache or build), on stdout.
+fn print_bending(info: &wormwear::runner::BendingInfo) {
+    let place = info
+        .cache_file
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    match info.origin {
+        wormwear::bending::model::Origin::Cache => {
+            println!("bending (fe): read in {:.3} s from {place}", info.seconds)
+        }
+        wormwear::bending::model::Origin::Computed => println!(
+            "bending (fe): worm and wheel FE models computed in {:.1} s, cached in {place}",
+            info.seconds
+        ),
+    }
+}
+
+/// One line on a completed wear state.
+fn state_line(state: &wormwear::wear::WearState) -> String {
+    let r = state.records.last().expect("record");
+    format!(
+        "step {} at {} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
+        r.step,
+        wormwear::output::cycles_label(r.cycles),
+        r.phase,
+        r.max_wear_m * 1e6,
+        r.backlash_increase_m * 1e6,
+        r.max_pressure_pa / 1e6
+    )
+}
+
+/// Prints the files written (one line each).
+fn print_files(files: &[PathBuf]) {
+    for f in files {
+        println!("  wrote {}", f.display());
+    }
+}
+
 fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
-    let geo = build_geometry(&gear, file)?;
-    geometry_cmd::write_geometry(&gear, &geo, file, dir, quiet).map_err(Failure::Run)?;
+    let request = wormwear::Request::new([wormwear::Stage::Geometry]);
+    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
     if !quiet {
-        let s = GeometrySummary::new(&gear, &geo);
-        println!(
-            "geometry written to {}: lead angle {:.3} deg, active flank {:.1} mm^2",
-            dir.display(),
-            s.lead_angle_deg,
-            s.active_flank_area_mm2
-        );
+        print_files(&files);
+        print_geometry(&results, dir);
     }
     Ok(())
+}
+
+/// The geometry's one-line result.
+fn print_geometry(results: &wormwear::Results, dir: &Path) {
+    let s = GeometrySummary::new(&results.gear, &results.geometry);
+    println!(
+        "geometry written to {}: lead angle {:.3} deg, active flank {:.1} mm^2",
+        dir.display(),
+        s.lead_angle_deg,
+        s.active_flank_area_mm2
+    );
 }
 
 fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
-    let geo = build_geometry(&gear, file)?;
-    let result = wormwear::kinematics::analyse(&gear, &geo)
-        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
-    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
-        .map_err(|e| Failure::Run(e.into()))?;
-    let files = wormwear::output::tca::write_tca(&gear, &geo, &result, dir)
-        .map_err(|e| Failure::Run(e.into()))?;
-    for w in &result.warnings {
-        eprintln!("warning: {w}");
-    }
+    let request = wormwear::Request::new([wormwear::Stage::Tca]);
+    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
     if !quiet {
-        for f in &files {
-            println!("  wrote {}", f.display());
-        }
-        let s = wormwear::output::tca::TcaSummary::new(&result);
-        println!(
-            "tca: kinematic error mean {:.3e} rad, p2p {:.3e} rad; pattern {:.1} % of the flank; \
-             sliding max {:.2} m/s, pitch {:.3} m/s",
-            s.kinematic_error_mean_rad,
-            s.kinematic_error_p2p_rad,
-            100.0 * s.pattern_area_fraction,
-            s.max_sliding_speed_m_s,
-            s.sliding_speed_at_pitch_m_s
-        );
+        print_files(&files);
+        print_tca(&results);
     }
     Ok(())
 }
 
-/// The bending model the file asks for (`[bending] model`), from the cache or the FE build.
-fn bending_model(
-    gear: &wormwear::input::GearSet,
-    geo: &wormwear::geometry::Geometry,
-    quiet: bool,
-) -> Result<Option<wormwear::bending::worm_model::FeBending>, Failure> {
-    let (built, warnings) = wormwear::bending::model::build(gear, geo).map_err(|e| {
-        Failure::Run(anyhow::Error::new(e).context("bending influence coefficients"))
-    })?;
-    for w in &warnings {
-        eprintln!("warning: {w}");
-    }
-    Ok(built.map(|b| {
-        if !quiet {
-            let place = b
-                .cache_file
-                .as_ref()
-                .map(|p| p.display().to_string())
-                .unwrap_or_default();
-            match b.origin {
-                wormwear::bending::model::Origin::Cache => {
-                    println!("bending (fe): read in {:.3} s from {place}", b.seconds)
-                }
-                wormwear::bending::model::Origin::Computed => println!(
-                    "bending (fe): worm and wheel FE models computed in {:.1} s, cached in {place}",
-                    b.seconds
-                ),
-            }
-        }
-        b.model
-    }))
+/// The unloaded analysis's one-line result.
+fn print_tca(results: &wormwear::Results) {
+    let Some(tca) = &results.tca else { return };
+    let s = wormwear::output::tca::TcaSummary::new(tca);
+    println!(
+        "tca: kinematic error mean {:.3e} rad, p2p {:.3e} rad; pattern {:.1} % of the flank; \
+         sliding max {:.2} m/s, pitch {:.3} m/s",
+        s.kinematic_error_mean_rad,
+        s.kinematic_error_p2p_rad,
+        100.0 * s.pattern_area_fraction,
+        s.max_sliding_speed_m_s,
+        s.sliding_speed_at_pitch_m_s
+    );
 }
 
-fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(), Failure> {
-    let gear = load(file)?;
+/// `--map-position` among the file's positions (a usage error otherwise).
+fn check_map_position(file: &Path, gear: &GearSet, map_position: usize) -> Result<(), Failure> {
     let positions = gear.analysis.positions;
     if map_position >= positions {
         return Err(Failure::Input(anyhow::anyhow!(
@@ -405,101 +518,72 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
             positions.saturating_sub(1)
         )));
     }
-    let geo = build_geometry(&gear, file)?;
-    let tca = wormwear::kinematics::analyse(&gear, &geo)
-        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
-    let bending = bending_model(&gear, &geo, quiet)?;
-    let result = wormwear::ltca::analyse_with(
-        &gear,
-        &geo,
-        &tca,
-        &wormwear::ltca::LtcaSettings::from_gear(&gear),
-        bending
-            .as_ref()
-            .map(|b| b as &dyn wormwear::ltca::BendingModel),
-    )
-    .map_err(|e| Failure::Run(anyhow::Error::new(e).context("loaded tooth contact analysis")))?;
-    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
-        .map_err(|e| Failure::Run(e.into()))?;
-    wormwear::output::tca::write_tca(&gear, &geo, &tca, dir).map_err(|e| Failure::Run(e.into()))?;
-    let files = wormwear::output::ltca::write_ltca(&gear, &geo, &tca, &result, dir, map_position)
-        .map_err(|e| Failure::Run(e.into()))?;
-    write_rating(&gear, dir, quiet)?;
-    for w in &tca.warnings {
-        eprintln!("warning: {w}");
-    }
-    for w in &result.warnings {
-        eprintln!("warning: loaded analysis: {w}");
-    }
+    Ok(())
+}
+
+fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(), Failure> {
+    let gear = load(file)?;
+    check_map_position(file, &gear, map_position)?;
+    let mut request = wormwear::Request::new([wormwear::Stage::Ltca]);
+    request.map_position = map_position;
+    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
     if !quiet {
-        for f in &files {
-            println!("  wrote {}", f.display());
-        }
-        let (te, p2p) = result.te_stats();
-        println!(
-            "ltca ({}): P_max {:.0} MPa, P_mean {:.0} MPa, S0 {:.2}, TE mean {:.3e} rad p2p {:.3e} rad, \
-             stiffness {:.3e} N m/rad, up to {} teeth loaded",
-            result.bending_model,
-            result.max_pressure / 1e6,
-            result.mean_pressure / 1e6,
-            result.s0,
-            te,
-            p2p,
-            result.stiffness_mean(),
-            result.max_teeth_in_contact()
-        );
-        if result.shaft_torsion_compliance > 0.0 {
-            println!(
-                "  of which the wheel shaft's torsion: TE {:.3e} rad; stiffness without it {:.3e} N m/rad",
-                -result.shaft_torsion_compliance * result.wheel_torque,
-                result.stiffness_without_shaft_torsion_mean()
-            );
-        }
+        print_files(&files);
+        print_ltca(&results);
     }
     Ok(())
 }
 
+/// The loaded analysis's one-line result.
+fn print_ltca(results: &wormwear::Results) {
+    let Some(result) = &results.ltca else { return };
+    let (te, p2p) = result.te_stats();
+    println!(
+        "ltca ({}): P_max {:.0} MPa, P_mean {:.0} MPa, S0 {:.2}, TE mean {:.3e} rad p2p {:.3e} rad, \
+         stiffness {:.3e} N m/rad, up to {} teeth loaded",
+        result.bending_model,
+        result.max_pressure / 1e6,
+        result.mean_pressure / 1e6,
+        result.s0,
+        te,
+        p2p,
+        result.stiffness_mean(),
+        result.max_teeth_in_contact()
+    );
+    if result.shaft_torsion_compliance > 0.0 {
+        println!(
+            "  of which the wheel shaft's torsion: TE {:.3e} rad; stiffness without it {:.3e} N m/rad",
+            -result.shaft_torsion_compliance * result.wheel_torque,
+            result.stiffness_without_shaft_torsion_mean()
+        );
+    }
+}
+
 /// The file's life plan with the command-line overrides applied.
 fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPlan, Failure> {
-    use wormwear::input::{Phase, StepControl, WearPlan};
-    let bad = |m: String| Failure::Input(anyhow::anyhow!(m));
-    let mut plan = match (&gear.wear, args.cycles) {
-        (Some(p), _) => p.clone(),
-        (None, Some(_)) => WearPlan::with_life(0.0),
-        (None, None) => {
-            return Err(bad(
-                "the file has no [wear] section: add one (life_cycles, step_wear_um or step_cycles) or give --cycles".into(),
-            ))
-        }
+    args.overrides()
+        .plan(gear, wormwear::runner::OverrideNames::Cli)
+        .map_err(|e| Failure::Input(e.into()))
+}
+
+/// The life request of `wear` and `run`: the plan, and the checked checkpoint with --resume.
+fn life_request(
+    dir: &Path,
+    gear: &GearSet,
+    args: &LifeArgs,
+    stages: &[wormwear::Stage],
+) -> Result<wormwear::Request, Failure> {
+    let plan = life_plan(gear, args)?;
+    let resume = match args.resume {
+        true => Some(
+            wormwear::output::wear::resume_state(dir, gear, &plan)
+                .map_err(|e| Failure::Input(e.into()))?,
+        ),
+        false => None,
     };
-    if let Some(c) = args.cycles {
-        if !(c.is_finite() && c > 0.0 && c <= 1e12) {
-            return Err(bad(format!(
-                "--cycles = {c}: must be a number of cycles in (0, 1e12]"
-            )));
-        }
-        plan.life_cycles = c;
-    }
-    if let Some(c) = args.step_cycles {
-        if !(c.is_finite() && c > 0.0 && c <= 1e12) {
-            return Err(bad(format!(
-                "--step-cycles = {c}: must be a number of cycles in (0, 1e12]"
-            )));
-        }
-        plan.step = StepControl::Cycles(c);
-    }
-    if let Some(d) = args.step_wear_um {
-        if !(d.is_finite() && d > 0.0 && d <= 1000.0) {
-            return Err(bad(format!(
-                "--step-wear-um = {d}: must be a depth in (0, 1000] um"
-            )));
-        }
-        plan.step = StepControl::MaxRemoval(d * 1e-6);
-    }
-    if args.no_pitting {
-        plan.phases.retain(|p| matches!(p, Phase::Wear { .. }));
-    }
-    Ok(plan)
+    let mut request = wormwear::Request::new(stages.iter().copied()).with_life(plan);
+    request.resume = resume;
+    Ok(request)
 }
 
 fn wear(
@@ -510,95 +594,19 @@ fn wear(
     verbose: bool,
 ) -> Result<(), Failure> {
     let gear = load(file)?;
-    let plan = life_plan(&gear, args)?;
-    wormwear::wear::check_plan_can_end(&gear, &plan)
-        .map_err(|e| Failure::Input(anyhow::Error::new(e).context("life plan")))?;
-    let geo = build_geometry(&gear, file)?;
-    let tca = wormwear::kinematics::analyse(&gear, &geo)
-        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis")))?;
-    let bending = bending_model(&gear, &geo, quiet)?;
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let inputs = wormwear::output::wear::life_inputs(&gear, &plan);
-    let state = if args.resume {
-        match wormwear::output::wear::read_resume(dir) {
-            Ok(Some((s, stored))) => {
-                check_resume(dir, &s, stored.as_ref(), &inputs, plan.life_cycles)?;
-                s
-            }
-            Ok(None) => {
-                return Err(Failure::Input(anyhow::anyhow!(
-                    "--resume: no {} in {}",
-                    wormwear::output::wear::CHECKPOINT,
-                    dir.display()
-                )))
-            }
-            Err(e) => return Err(Failure::Input(anyhow::Error::new(e).context("--resume"))),
-        }
-    } else {
-        wormwear::wear::WearState::new(wf)
-    };
-    wormwear::output::geometry::write_geometry_summary(&gear, &geo, file, dir)
-        .map_err(|e| Failure::Run(e.into()))?;
-    let rating = write_rating(&gear, dir, quiet)?;
-    let progress = life_progress(quiet || verbose);
-    // Tables, summary and curves grow with the number of states: rewrite them at most every
-    // two seconds (and at log-spaced states and the last); the checkpoint goes out every state.
-    let mut tables_written = std::time::Instant::now();
-    let mut writer = wormwear::output::wear::LifeWriter::new(dir).with_inputs(inputs);
-    let mut on_state = |view: &wormwear::wear::StepView| -> Result<(), wormwear::wear::WearError> {
-        let tables = tables_written.elapsed().as_secs_f64() >= 2.0;
-        writer
-            .write_state(&gear, &geo, &tca, &plan, view, tables)
-            .map_err(|e| wormwear::wear::WearError::Output(e.to_string()))?;
-        if tables {
-            tables_written = std::time::Instant::now();
-        }
-        let r = view.state.records.last().expect("record");
-        let line = format!(
-            "step {} at {} cycles ({}): wear {:.2} um, backlash +{:.2} um, P_max {:.0} MPa",
-            r.step,
-            wormwear::output::cycles_label(r.cycles),
-            r.phase,
-            r.max_wear_m * 1e6,
-            r.backlash_increase_m * 1e6,
-            r.max_pressure_pa / 1e6
-        );
-        if verbose {
-            eprintln!("{line}");
-        }
-        progress.set_position((1000.0 * r.cycles / plan.life_cycles).round() as u64);
-        progress.set_message(line);
-        Ok(())
-    };
-    let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
-    let end = wormwear::wear::simulate(
-        &gear,
-        &geo,
-        &tca,
-        &settings,
-        bending
-            .as_ref()
-            .map(|b| b as &dyn wormwear::ltca::BendingModel),
-        &plan,
-        state,
-        &mut on_state,
-    )
-    .map_err(|e| match e {
-        // A checkpoint of another gear (wrong directory for --resume) is a usage problem.
-        wormwear::wear::WearError::Checkpoint(_) => {
-            Failure::Input(anyhow::Error::new(e).context("--resume"))
-        }
-        wormwear::wear::WearError::Plan(_) => {
-            Failure::Input(anyhow::Error::new(e).context("life plan"))
-        }
-        _ => Failure::Run(anyhow::Error::new(e).context("wear simulation")),
-    })?;
-    progress.finish_and_clear();
-    warn_about_the_life(&end);
-    if !quiet {
-        print_life(&end, &rating, dir);
-    }
+    let request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
+    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    finish_life(&results, dir, quiet);
     Ok(())
+}
+
+/// The end of a life: warnings, and the result paragraph unless quiet.
+fn finish_life(results: &wormwear::Results, dir: &Path, quiet: bool) {
+    let Some(life) = &results.life else { return };
+    warn_about_the_life(&life.end);
+    if let (Some(rating), false) = (&results.rating, quiet) {
+        print_life(&life.end, rating, dir);
+    }
 }
 
 /// A progress bar over the life's cycles (permille), or a hidden one.
@@ -671,69 +679,6 @@ fn warn_about_the_life(end: &wormwear::wear::WearState) {
     }
 }
 
-/// Writes the ratings and prints why any of them is null (outside its formula's range).
-fn write_rating(
-    gear: &GearSet,
-    dir: &Path,
-    quiet: bool,
-) -> Result<wormwear::rating::Rating, Failure> {
-    let rating = wormwear::output::write_rating(gear, dir).map_err(|e| Failure::Run(e.into()))?;
-    if !quiet {
-        for w in &rating.warnings {
-            eprintln!("warning: rating: {w}");
-        }
-    }
-    Ok(rating)
-}
-
-/// A checkpoint may be resumed only with the inputs it was computed with and towards a life
-/// at least as long as the cycles it reached.
-fn check_resume(
-    dir: &Path,
-    state: &wormwear::wear::WearState,
-    stored: Option<&serde_json::Value>,
-    inputs: &serde_json::Value,
-    life_cycles: f64,
-) -> Result<(), Failure> {
-    let checkpoint = dir.join(wormwear::output::wear::CHECKPOINT);
-    let Some(stored) = stored else {
-        return Err(Failure::Input(anyhow::anyhow!(
-            "--resume: {} holds no record of the inputs it was computed with (written by an \
-             earlier version): its states cannot be checked against this input file; run \
-             without --resume into a new directory",
-            checkpoint.display()
-        )));
-    };
-    let changes = wormwear::output::wear::input_changes(stored, inputs);
-    if !changes.is_empty() {
-        let shown: Vec<&str> = changes.iter().take(12).map(String::as_str).collect();
-        let more = changes.len().saturating_sub(shown.len());
-        return Err(Failure::Input(anyhow::anyhow!(
-            "--resume: the inputs differ from those {} was computed with ({} difference{}, \
-             checkpoint -> now):\n  {}{}\nresume with the original inputs, or run without \
-             --resume into a new directory",
-            checkpoint.display(),
-            changes.len(),
-            if changes.len() == 1 { "" } else { "s" },
-            shown.join("\n  "),
-            if more > 0 {
-                format!("\n  ... and {more} more")
-            } else {
-                String::new()
-            }
-        )));
-    }
-    if life_cycles < state.cycles {
-        return Err(Failure::Input(anyhow::anyhow!(
-            "--resume: the life asked for ({life_cycles:e} cycles) ends before the checkpoint's \
-             state ({:e} cycles, step {}); ask for at least that many cycles",
-            state.cycles,
-            state.step
-        )));
-    }
-    Ok(())
-}
-
 fn run(
     file: &Path,
     dir: &Path,
@@ -741,27 +686,23 @@ fn run(
     quiet: bool,
     verbose: bool,
 ) -> Result<(), Failure> {
+    use wormwear::Stage;
     let gear = load(file)?;
-    let with_life = gear.wear.is_some() || args.cycles.is_some();
-    if with_life {
-        // Check the overrides before any work.
-        life_plan(&gear, args)?;
-    }
-    geometry(file, dir, quiet)?;
-    ltca(file, dir, 0, quiet)?;
-    if with_life {
-        wear(file, dir, args, quiet, verbose)?;
-    }
-    let text = std::fs::read_to_string(file).unwrap_or_default();
-    let title = if gear.title.is_empty() {
-        file.display().to_string()
-    } else {
-        gear.title.clone()
+    let request = match gear.wear.is_some() || args.overrides().asks_for_life() {
+        true => life_request(dir, &gear, args, &Stage::ALL)?,
+        false => wormwear::Request::new([Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report]),
     };
-    let report = wormwear::output::report::write_report(dir, &title, &text)
-        .map_err(|e| Failure::Run(e.into()))?;
+    let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
     if !quiet {
-        println!("report: {}", report.display());
+        print_geometry(&results, dir);
+        print_tca(&results);
+        print_ltca(&results);
+    }
+    finish_life(&results, dir, quiet);
+    if !quiet {
+        if let Some(report) = files.iter().find(|f| f.ends_with("report.html")) {
+            println!("report: {}", report.display());
+        }
     }
     Ok(())
 }
@@ -807,49 +748,42 @@ fn calibrate(
             resume: false,
         };
         let plan = life_plan(&gear, &args)?;
-        let geo = build_geometry(&gear, file)?;
-        let tca = wormwear::kinematics::analyse(&gear, &geo).map_err(|e| {
-            Failure::Run(anyhow::Error::new(e).context("unloaded meshing analysis"))
-        })?;
-        let settings = wormwear::ltca::LtcaSettings::from_gear(&gear);
-        let bending = bending_model(&gear, &geo, quiet)?;
         let k_start = gear.wheel_material.wear_coefficient;
-        let mut runs = 0;
-        let mut simulate = |k: f64| {
-            let mut g = gear.clone();
-            g.wheel_material.wear_coefficient = k;
-            runs += 1;
-            let wf = geo.wheel_flank(tca.loaded_flank);
-            let end = wormwear::wear::simulate(
-                &g,
-                &geo,
-                &tca,
-                &settings,
-                bending
-                    .as_ref()
-                    .map(|b| b as &dyn wormwear::ltca::BendingModel),
-                &plan,
-                wormwear::wear::WearState::new(wf),
-                &mut |_| Ok(()),
-            )?;
+        let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
+            if let (wormwear::Event::Bending(info), false) = (event, quiet) {
+                print_bending(info);
+            }
+            Ok(())
+        };
+        let mut on_run = |run: usize, k: f64, records: &[wormwear::wear::StepRecord]| {
             if verbose {
-                let b = end.records.last().map_or(0.0, |r| r.backlash_increase_m);
+                let b = records.last().map_or(0.0, |r| r.backlash_increase_m);
                 eprintln!(
-                    "run {runs}: K = {k:.5e}, backlash +{:.2} um at {} cycles",
+                    "run {run}: K = {k:.5e}, backlash +{:.2} um at {} cycles",
                     b * 1e6,
                     wormwear::output::cycles_label(last)
                 );
             }
-            Ok(end.records)
         };
-        let (fit, records) =
-            wormwear::calibration::fit_to_backlash(&measured, k_start, 1e-3, 10, &mut simulate)
-                .map_err(|e| match e {
-                    wormwear::calibration::CalibrationError::Simulation(_) => {
-                        Failure::Run(anyhow::Error::new(e))
-                    }
-                    _ => Failure::Input(anyhow::Error::new(e).context(path.display().to_string())),
-                })?;
+        let (fit, records, runs) = wormwear::calibration::fit_life_to_backlash(
+            &gear,
+            &plan,
+            &measured,
+            &mut on_event,
+            &mut on_run,
+        )
+        .map_err(|e| match e {
+            wormwear::calibration::CalibrationError::Setup(wormwear::RunError::Geometry(_)) => {
+                Failure::Input(
+                    anyhow::Error::new(e).context(format!("geometry of {}", file.display())),
+                )
+            }
+            wormwear::calibration::CalibrationError::Simulation(_)
+            | wormwear::calibration::CalibrationError::Setup(_) => {
+                Failure::Run(anyhow::Error::new(e))
+            }
+            _ => Failure::Input(anyhow::Error::new(e).context(path.display().to_string())),
+        })?;
         // Measured and fitted curves side by side.
         let mut csv = wormwear::output::Csv::new(&["cycles", "measured_um", "simulated_um"]);
         let simulated: Vec<(f64, f64)> = records
@@ -937,4 +871,58 @@ fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(),
         println!("validation written to {}", path.display());
     }
     Ok(())
+}
+
+/// Runs a sweep file's variants into `dir`: a line per finished variant on stderr, the rows'
+/// table and page at the end. Fails only when no variant succeeds.
+fn sweep(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
+    use wormwear::sweep::SweepError;
+    let study = wormwear::sweep::Sweep::load(file).map_err(|e| match e {
+        SweepError::Output(_) => Failure::Run(e.into()),
+        _ => Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display()))),
+    })?;
+    if !quiet {
+        eprintln!(
+            "sweep: {} variants of {} on {} threads",
+            study.variants.len(),
+            study.base_file,
+            rayon_threads()
+        );
+    }
+    let on_progress = |p: wormwear::sweep::Progress| {
+        if quiet {
+            return;
+        }
+        let what = match (&p.row.error, p.reused) {
+            (Some(e), _) => format!("failed: {e}"),
+            (None, true) => "reused from an earlier run".to_string(),
+            (None, false) => format!("done in {:.1} s", p.row.seconds),
+        };
+        eprintln!("[{}/{}] {}: {what}", p.done, p.total, p.row.variant);
+    };
+    let rows = wormwear::sweep::run(&study, dir, &on_progress, &|| false)
+        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("sweep")))?;
+    let failed = rows.iter().filter(|r| !r.ok).count();
+    if failed > 0 {
+        eprintln!(
+            "warning: sweep: {failed} of {} variants failed (their errors are in sweep.csv)",
+            rows.len()
+        );
+    }
+    if failed == rows.len() {
+        return Err(Failure::Run(anyhow::anyhow!("sweep: every variant failed")));
+    }
+    if !quiet {
+        println!(
+            "sweep: {} variants ({failed} failed); results in {} (sweep.csv, sweep.html)",
+            rows.len(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// The threads the sweep's variants share.
+fn rayon_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }

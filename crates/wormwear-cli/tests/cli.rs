@@ -1016,3 +1016,161 @@ fn a_life_killed_after_every_state_and_resumed_ends_as_the_uninterrupted_one() {
         );
     }
 }
+
+/// The files of a directory (name -> bytes), its lock file left out.
+fn files_of(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file() && !p.ends_with(".wormwear.lock"))
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            (name, std::fs::read(&p).unwrap())
+        })
+        .collect()
+}
+
+/// The library's runner with its writer after the run gives the files the CLI writes while it
+/// runs (`run` with a life of two states, `ltca` with a map position), byte for byte, and its
+/// summary sections are summary.json's.
+#[test]
+fn the_library_runner_and_writers_give_the_cli_files_byte_for_byte() {
+    use wormwear::{Request, Source, Stage};
+    let design = example("gear-1x40-design.toml");
+    let file = design.display().to_string();
+    let text = std::fs::read_to_string(&design).unwrap();
+    let gear = wormwear::input::load(&design).unwrap();
+    let cases: [(&str, Vec<&str>, Request); 2] = [
+        (
+            "run",
+            vec!["--cycles", "20000", "--step-cycles", "10000"],
+            Request::new(Stage::ALL).with_life(
+                wormwear::runner::LifeOverrides {
+                    cycles: Some(20000.0),
+                    step_cycles: Some(10000.0),
+                    ..Default::default()
+                }
+                .plan(&gear, wormwear::runner::OverrideNames::Cli)
+                .unwrap(),
+            ),
+        ),
+        ("ltca", vec!["--map-position", "3"], {
+            let mut r = Request::new([Stage::Ltca]);
+            r.map_position = 3;
+            r
+        }),
+    ];
+    for (command, args, request) in cases {
+        let (cli, lib) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let mut args = args;
+        args.insert(0, "-q");
+        let out = bin()
+            .arg(command)
+            .arg(&design)
+            .arg("-o")
+            .arg(cli.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let source = Source {
+            file: file.clone(),
+            text: text.clone(),
+        };
+        let results = wormwear::run(&gear, source, request, &mut |_| Ok(())).unwrap();
+        wormwear::output::write_results(&results, lib.path(), false).unwrap();
+        let (a, b) = (files_of(cli.path()), files_of(lib.path()));
+        assert_eq!(
+            a.keys().collect::<Vec<_>>(),
+            b.keys().collect::<Vec<_>>(),
+            "{command}: the same files"
+        );
+        for (name, bytes) in &a {
+            assert!(bytes == &b[name], "{command}: {name} differs");
+        }
+        let sections = wormwear::output::summary_sections(&results).unwrap();
+        let written: serde_json::Value = serde_json::from_slice(&a["summary.json"]).unwrap();
+        assert_eq!(
+            serde_json::Value::Object(sections),
+            written,
+            "{command}: summary"
+        );
+        if command == "run" {
+            assert!(
+                a.len() > 60
+                    && a.contains_key("wear_map_step1.svg")
+                    && a.contains_key("report.html")
+            );
+        }
+    }
+}
+
+/// `wormwear sweep` of a 3 x 2 grid of torque x roughness on the design example: six rows in
+/// sweep.csv, sweep.html with the charts, every variant's output; run again, every variant is
+/// reused; a sweep file with an error exits 2 naming it.
+#[test]
+fn sweep_runs_a_grid_writes_its_table_and_page_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("sweep.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "base = {:?}\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque_nm\" = [30.0, 60.0, 90.0]\n\
+             \"lubricant.composite_roughness_um\" = [0.5, 1.0]\n",
+            example("gear-1x40-design.toml").display().to_string()
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    let sweep = || {
+        bin()
+            .arg("sweep")
+            .arg(&file)
+            .arg("-o")
+            .arg(&out_dir)
+            .output()
+            .unwrap()
+    };
+    let out = sweep();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(out_dir.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 7, "{csv}");
+    assert!(
+        lines[1..].iter().all(|l| l.split(',').nth(3) == Some("1")),
+        "{csv}"
+    );
+    let html = std::fs::read_to_string(out_dir.join("sweep.html")).unwrap();
+    assert!(html.contains("plots/max_pressure_vs_conditions_worm_torque_nm.svg"));
+    assert!(out_dir
+        .join("plots/max_pressure_vs_conditions_worm_torque_nm.svg")
+        .is_file());
+    assert!(out_dir.join("variants/v6/ltca_positions.csv").is_file());
+    let again = sweep();
+    assert!(again.status.success());
+    let err = String::from_utf8_lossy(&again.stderr);
+    assert_eq!(
+        err.matches("reused from an earlier run").count(),
+        6,
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out_dir.join("sweep.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        7
+    );
+    std::fs::write(&file, "base = \"missing.toml\"\n[grid]\na = [1]\n").unwrap();
+    let bad = sweep();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("missing.toml"));
+}

@@ -64,6 +64,9 @@ pub enum CalibrationError {
     NoSensitivity(f64),
     #[error("life simulation: {0}")]
     Simulation(#[from] WearError),
+    /// The geometry, unloaded analysis or bending model the lives need could not be built.
+    #[error("life simulation set-up")]
+    Setup(#[source] crate::RunError),
     /// The fitted life ends (at a wear limit) before the last measured point, which the fit
     /// then could not use.
     #[error(
@@ -207,6 +210,51 @@ pub fn fit_to_backlash(
         }
         k *= factor;
     }
+}
+
+/// [`fit_to_backlash`] through the gear's life simulation (MODEL §10): the geometry, unloaded
+/// analysis and bending model are built once (the bending model reported to `on_event`), then
+/// each run is the life of `plan` from the unworn flank with the wheel's wear coefficient set
+/// to the trial K; `on_run(run, K, records)` is told each. Returns the fit, the records of the
+/// last run and the number of runs.
+pub fn fit_life_to_backlash(
+    gear: &crate::input::GearSet,
+    plan: &crate::input::WearPlan,
+    measured: &[(f64, f64)],
+    on_event: &mut dyn FnMut(crate::Event) -> Result<(), crate::RunError>,
+    on_run: &mut dyn FnMut(usize, f64, &[StepRecord]),
+) -> Result<(KFit, Vec<StepRecord>, usize), CalibrationError> {
+    use crate::RunError;
+    let setup = CalibrationError::Setup;
+    let geo = crate::geometry::Geometry::build(gear).map_err(|e| setup(RunError::Geometry(e)))?;
+    let tca = crate::kinematics::analyse(gear, &geo).map_err(|e| setup(RunError::Tca(e)))?;
+    let mut warnings = Vec::new();
+    let (bending, _) =
+        crate::runner::bending_model(gear, &geo, &mut warnings, on_event).map_err(setup)?;
+    let settings = crate::ltca::LtcaSettings::from_gear(gear);
+    let mut runs = 0;
+    let mut simulate = |k: f64| {
+        let mut g = gear.clone();
+        g.wheel_material.wear_coefficient = k;
+        runs += 1;
+        let end = crate::wear::simulate(
+            &g,
+            &geo,
+            &tca,
+            &settings,
+            bending
+                .as_ref()
+                .map(|b| b as &dyn crate::ltca::BendingModel),
+            plan,
+            crate::wear::WearState::new(geo.wheel_flank(tca.loaded_flank)),
+            &mut |_| Ok(()),
+        )?;
+        on_run(runs, k, &end.records);
+        Ok(end.records)
+    };
+    let k_start = gear.wheel_material.wear_coefficient;
+    let (fit, records) = fit_to_backlash(measured, k_start, 1e-3, 10, &mut simulate)?;
+    Ok((fit, records, runs))
 }
 
 #[cfg(test)]

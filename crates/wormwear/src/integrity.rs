@@ -25,7 +25,11 @@ pub enum IntegrityError {
 }
 
 fn digest(value: &serde_json::Value) -> String {
-    let text = value.to_string();
+    digest_text(&value.to_string())
+}
+
+/// The SHA-256 of a text, hex (a fingerprint of inputs).
+pub fn digest_text(text: &str) -> String {
     let hash = Sha256::digest(text.as_bytes());
     hash.iter().map(|b| format!("{b:02x}")).collect()
 }

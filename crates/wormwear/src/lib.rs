@@ -13,8 +13,10 @@
 //!    wear over life, backlash, pitting phases (MODEL §7-8);
 //! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9).
 //!
-//! [`output`] writes results (summary.json, CSV, SVG, STL) atomically; [`validation`] runs the
-//! study behind VALIDATION.md.
+//! [`run`] chains them for one [`Request`] and returns one [`Results`] value; [`output`]
+//! writes results (summary.json, CSV, SVG, STL, report.html) atomically
+//! ([`output::write_results`]); [`sweep`] runs variants of a gear in parallel;
+//! [`validation`] runs the study behind VALIDATION.md.
 
 pub mod bending;
 pub mod calibration;
@@ -28,5 +30,68 @@ pub mod lubrication;
 pub mod output;
 pub mod plot;
 pub mod rating;
+pub mod runner;
+pub mod sweep;
 pub mod validation;
 pub mod wear;
+
+pub use runner::{Event, Request, Results, RunError, Source, Stage};
+
+/// Runs the stages `request` asks for on a validated gear (MODEL §0), reporting progress to
+/// `on_event` (an error from it stops the run); every stage runs the ones it needs first.
+pub fn run(
+    gear: &input::GearSet,
+    source: Source,
+    request: Request,
+    on_event: &mut dyn FnMut(Event) -> Result<(), RunError>,
+) -> Result<Results, RunError> {
+    request.check(gear)?;
+    let mut warnings = Vec::new();
+    let geometry = geometry::Geometry::build(gear).map_err(RunError::Geometry)?;
+    let tca = match request.needs_tca() {
+        true => Some(kinematics::analyse(gear, &geometry).map_err(RunError::Tca)?),
+        false => None,
+    };
+    warnings.extend(tca.iter().flat_map(|t| t.warnings.iter().cloned()));
+    let (bending, bending_info) = match request.needs_bending() {
+        true => runner::bending_model(gear, &geometry, &mut warnings, on_event)?,
+        false => (None, None),
+    };
+    let ltca = match (request.has(Stage::Ltca), &tca) {
+        (true, Some(tca)) => {
+            on_event(Event::Stage(Stage::Ltca))?;
+            let bending = bending.as_ref();
+            Some(runner::loaded_analysis(
+                gear,
+                &geometry,
+                tca,
+                bending,
+                &mut warnings,
+            )?)
+        }
+        _ => None,
+    };
+    let life = match (request.has(Stage::Wear), &tca, &request.life) {
+        (true, Some(tca), Some(plan)) => {
+            on_event(Event::Stage(Stage::Wear))?;
+            let (bending, resume) = (bending.as_ref(), request.resume.clone());
+            Some(runner::life(
+                gear, &source, &geometry, tca, bending, plan, resume, on_event,
+            )?)
+        }
+        _ => None,
+    };
+    Ok(Results {
+        rating: request.needs_bending().then(|| rating::rate(gear)),
+        gear: gear.clone(),
+        source,
+        stages: request.stages,
+        map_position: request.map_position,
+        geometry,
+        tca,
+        bending: bending_info,
+        ltca,
+        life,
+        warnings,
+    })
+}

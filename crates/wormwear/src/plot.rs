@@ -43,6 +43,12 @@ where
     for s in series {
         let color = COLORS[s.color % COLORS.len()];
         let style = color.stroke_width(if s.bold { 3 } else { 2 });
+        // A single point draws no line: mark it.
+        if s.points.len() == 1 {
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .map_err(plot_err)?;
+        }
         let anno = chart
             .draw_series(LineSeries::new(s.points.iter().copied(), style))
             .map_err(plot_err)?;

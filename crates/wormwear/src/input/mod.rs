@@ -618,19 +618,22 @@ fn cut_long_lines(message: &str) -> String {
 
 /// Parses and validates a gear file given as TOML text.
 pub fn load_from_str(text: &str) -> Result<GearSet, InputError> {
-    let file: GearFile = toml::from_str(text).map_err(|e| {
-        let message = cut_long_lines(&e.to_string());
-        // An error without a place (the parser's recursion limit on a table header of
-        // thousands of keys): name the most deeply nested line.
-        InputError::Syntax(match (e.span(), deepest_line(text)) {
-            (None, Some((line, depth))) if depth > 8 => format!(
-                "{message}: line {line} nests {depth} levels deep (tables, arrays or inline \
-                 tables); a gear file needs at most 3"
-            ),
-            _ => message,
-        })
-    })?;
+    let file: GearFile = toml::from_str(text).map_err(|e| syntax_error(&e, text))?;
     validate::validate(&file)
+}
+
+/// A parse error of `text` as an input error, its long lines cut.
+fn syntax_error(e: &toml::de::Error, text: &str) -> InputError {
+    let message = cut_long_lines(&e.to_string());
+    // An error without a place (the parser's recursion limit on a table header of
+    // thousands of keys): name the most deeply nested line.
+    InputError::Syntax(match (e.span(), deepest_line(text)) {
+        (None, Some((line, depth))) if depth > 8 => format!(
+            "{message}: line {line} nests {depth} levels deep (tables, arrays or inline \
+             tables); a gear file needs at most 3"
+        ),
+        _ => message,
+    })
 }
 
 /// The line (1-based) of the deepest nesting of a TOML text and its depth: keys of a table
@@ -668,6 +671,74 @@ fn deepest_line(text: &str) -> Option<(usize, usize)> {
         }
     }
     best
+}
+
+/// A gear file's document: the TOML table as written, before validation (what variants
+/// change by dotted name, [`set_dotted`]). Syntax errors as [`load_from_str`]'s.
+pub fn parse_document(text: &str) -> Result<toml::Table, InputError> {
+    toml::from_str::<toml::Table>(text).map_err(|e| syntax_error(&e, text))
+}
+
+/// Validates a gear document ([`parse_document`], or one built from another format) as the
+/// gear file it writes out to, so its errors are those of the same file.
+pub fn load_document(document: &toml::Table) -> Result<GearSet, InputError> {
+    load_from_str(&document_text(document)?)
+}
+
+/// A gear document as TOML text (comments are not kept).
+pub fn document_text(document: &toml::Table) -> Result<String, InputError> {
+    toml::to_string(document)
+        .map_err(|e| InputError::Syntax(format!("cannot write the gear document: {e}")))
+}
+
+/// Sets the value at a dotted name of a gear document (`conditions.worm_torque_nm`,
+/// `materials.wheel.wear_coefficient`), creating the tables on the way; `None` removes the key
+/// (the field takes its default). The value is checked when the document is loaded
+/// ([`load_document`]): an unknown name is an unknown field there.
+pub fn set_dotted(
+    document: &mut toml::Table,
+    name: &str,
+    value: Option<toml::Value>,
+) -> Result<(), InputError> {
+    let bad = |problem: &str| {
+        InputError::Invalid(vec![FieldError {
+            field: name.to_string(),
+            value: value.as_ref().map_or("(removed)".into(), |v| v.to_string()),
+            problem: problem.to_string(),
+        }])
+    };
+    let keys: Vec<&str> = name.split('.').map(str::trim).collect();
+    if keys.iter().any(|k| k.is_empty()) {
+        return Err(bad(
+            "a dotted name of the gear file, such as conditions.worm_torque_nm",
+        ));
+    }
+    let (leaf, tables) = keys.split_last().expect("split gives one key at least");
+    let mut table = document;
+    for (depth, key) in tables.iter().enumerate() {
+        let entry = table
+            .entry(key.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = match entry {
+            toml::Value::Table(t) => t,
+            _ => {
+                return Err(bad(&format!(
+                    "{} is a value, not a table: it has no field {}",
+                    keys[..=depth].join("."),
+                    keys[depth + 1]
+                )))
+            }
+        };
+    }
+    match value {
+        Some(v) => {
+            table.insert(leaf.to_string(), v);
+        }
+        None => {
+            table.remove(*leaf);
+        }
+    }
+    Ok(())
 }
 
 /// Reads, parses and validates a gear file.

@@ -5,19 +5,10 @@
 use super::{update_summary, write_atomic, Csv, OutputError};
 use crate::geometry::sections::rack_plane_section;
 use crate::geometry::stl::{wheel_mesh, worm_mesh};
-use crate::geometry::{Flank, Geometry, GeometryError, GeometrySummary};
+use crate::geometry::{Flank, Geometry, GeometrySummary};
 use crate::input::GearSet;
 use crate::plot::{line_chart, Series};
 use std::path::{Path, PathBuf};
-
-/// Error of the geometry outputs.
-#[derive(Debug, thiserror::Error)]
-pub enum GeometryOutputError {
-    #[error(transparent)]
-    Output(#[from] OutputError),
-    #[error(transparent)]
-    Geometry(#[from] GeometryError),
-}
 
 const MM: f64 = 1e3;
 
@@ -27,11 +18,11 @@ pub fn write_geometry(
     geo: &Geometry,
     input_file: &Path,
     dir: &Path,
-) -> Result<Vec<PathBuf>, GeometryOutputError> {
+) -> Result<Vec<PathBuf>, OutputError> {
     let mut files = Vec::new();
     // Sections in rack planes.
     for &offset in &gear.analysis.section_offsets {
-        let section = rack_plane_section(gear, geo, offset, 2)?;
+        let section = rack_plane_section(gear, geo, offset, 2).map_err(OutputError::Geometry)?;
         let stem = format!("section_z{:+.3}mm", offset * MM);
         let mut csv = Csv::new(&["member", "x_mm", "y_mm"]);
         for c in &section.curves {
@@ -213,19 +204,26 @@ pub fn write_geometry_summary(
     input_file: &Path,
     dir: &Path,
 ) -> Result<(), OutputError> {
-    update_summary(
-        dir,
-        "input",
-        serde_json::json!({
-            "file": input_file.display().to_string(),
-            "title": gear.title,
-            "program_version": env!("CARGO_PKG_VERSION"),
-        }),
-    )?;
-    let value =
+    let (input, geometry) = summary_values(gear, geo, input_file)?;
+    update_summary(dir, "input", input)?;
+    update_summary(dir, "geometry", geometry)
+}
+
+/// The `input` and `geometry` sections of summary.json.
+pub fn summary_values(
+    gear: &GearSet,
+    geo: &Geometry,
+    input_file: &Path,
+) -> Result<(serde_json::Value, serde_json::Value), OutputError> {
+    let input = serde_json::json!({
+        "file": input_file.display().to_string(),
+        "title": gear.title,
+        "program_version": env!("CARGO_PKG_VERSION"),
+    });
+    let geometry =
         serde_json::to_value(GeometrySummary::new(gear, geo)).map_err(|e| OutputError::Encode {
             what: "geometry summary".into(),
             message: e.to_string(),
         })?;
-    update_summary(dir, "geometry", value)
+    Ok((input, geometry))
 }

@@ -244,38 +244,7 @@ pub fn write_ltca(
     let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
     let np = ltca.positions.len();
-    // Per position table.
-    let mut header: Vec<String> = [
-        "position",
-        "wheel_torque_nm",
-        "worm_torque_nm",
-        "approach_rad",
-        "transmission_error_rad",
-        "kinematic_error_rad",
-        "stiffness_nm_per_rad",
-        "stiffness_n_per_m",
-        "max_pressure_pa",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    header.extend(tca.teeth.iter().map(|k| format!("tooth_{k}_load_n")));
-    let mut csv = Csv::new(&header.iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    for p in &ltca.positions {
-        let mut row = vec![
-            p.position as f64,
-            p.wheel_torque,
-            p.worm_torque,
-            p.approach,
-            p.transmission_error,
-            tca.positions[p.position].kinematic_error,
-            p.stiffness_angular,
-            p.stiffness_linear,
-            p.max_pressure,
-        ];
-        row.extend(&p.tooth_load);
-        csv.row(&row);
-    }
+    let csv = positions_table(tca, ltca);
     let path = dir.join("ltca_positions.csv");
     csv.write(&path)?;
     files.push(path);
@@ -360,19 +329,7 @@ pub fn write_ltca(
     )?;
     files.push(path);
     // Loaded pattern.
-    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "max_pressure_pa"]);
-    for j in 0..wf.cells_face {
-        for i in 0..wf.cells_height {
-            let c = &wf.cells[j * wf.cells_height + i];
-            csv.row(&[
-                i as f64,
-                j as f64,
-                c.r * MM,
-                c.z * MM,
-                ltca.pattern[j * wf.cells_height + i],
-            ]);
-        }
-    }
+    let csv = pattern_table(wf, ltca);
     let path = dir.join("ltca_pattern.csv");
     csv.write(&path)?;
     files.push(path);
@@ -424,6 +381,79 @@ pub fn write_ltca(
         files.push(path);
     }
     // Local pressures of every position.
+    let csv = pressures_table(ltca);
+    let path = dir.join("ltca_pressures.csv");
+    csv.write(&path)?;
+    files.push(path);
+    update_summary(dir, "ltca", summary_value(tca, wf, ltca)?)?;
+    files.push(dir.join("summary.json"));
+    let path = dir.join("wheel_flank_ltca.vtp");
+    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
+    super::vtk::add_pressure_pattern(&mut surface, &ltca.pattern);
+    surface.write_vtp(&path, &[], "loaded wheel flank: loaded analysis (mm)")?;
+    files.push(path);
+    Ok(files)
+}
+
+/// The table of positions (`ltca_positions.csv`): torques, approach, TE, KE, stiffness,
+/// maximum pressure and the normal force on each tooth (units in the names).
+pub fn positions_table(tca: &Tca, ltca: &Ltca) -> Csv {
+    let mut header: Vec<String> = [
+        "position",
+        "wheel_torque_nm",
+        "worm_torque_nm",
+        "approach_rad",
+        "transmission_error_rad",
+        "kinematic_error_rad",
+        "stiffness_nm_per_rad",
+        "stiffness_n_per_m",
+        "max_pressure_pa",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    header.extend(tca.teeth.iter().map(|k| format!("tooth_{k}_load_n")));
+    let mut csv = Csv::new(&header.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    for p in &ltca.positions {
+        let mut row = vec![
+            p.position as f64,
+            p.wheel_torque,
+            p.worm_torque,
+            p.approach,
+            p.transmission_error,
+            tca.positions[p.position].kinematic_error,
+            p.stiffness_angular,
+            p.stiffness_linear,
+            p.max_pressure,
+        ];
+        row.extend(&p.tooth_load);
+        csv.row(&row);
+    }
+    csv
+}
+
+/// The loaded pattern per flank cell (`ltca_pattern.csv`): the largest pressure over the
+/// cycle, Pa, at the cell's (r, z), mm.
+pub fn pattern_table(wf: &WheelFlank, ltca: &Ltca) -> Csv {
+    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "max_pressure_pa"]);
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let c = &wf.cells[j * wf.cells_height + i];
+            csv.row(&[
+                i as f64,
+                j as f64,
+                c.r * MM,
+                c.z * MM,
+                ltca.pattern[j * wf.cells_height + i],
+            ]);
+        }
+    }
+    csv
+}
+
+/// The local pressures of every position (`ltca_pressures.csv`): per contact cell its tooth,
+/// slice, column, (r, z) mm, pressure Pa, initial separation rad and relief um.
+pub fn pressures_table(ltca: &Ltca) -> Csv {
     let mut csv = Csv::new(&[
         "position",
         "tooth",
@@ -450,20 +480,17 @@ pub fn write_ltca(
             ]);
         }
     }
-    let path = dir.join("ltca_pressures.csv");
-    csv.write(&path)?;
-    files.push(path);
-    let value =
-        serde_json::to_value(LtcaSummary::new(tca, wf, ltca)).map_err(|e| OutputError::Encode {
-            what: "ltca summary".into(),
-            message: e.to_string(),
-        })?;
-    update_summary(dir, "ltca", value)?;
-    files.push(dir.join("summary.json"));
-    let path = dir.join("wheel_flank_ltca.vtp");
-    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
-    super::vtk::add_pressure_pattern(&mut surface, &ltca.pattern);
-    surface.write_vtp(&path, &[], "loaded wheel flank: loaded analysis (mm)")?;
-    files.push(path);
-    Ok(files)
+    csv
+}
+
+/// The `ltca` section of summary.json.
+pub fn summary_value(
+    tca: &Tca,
+    wf: &WheelFlank,
+    ltca: &Ltca,
+) -> Result<serde_json::Value, OutputError> {
+    serde_json::to_value(LtcaSummary::new(tca, wf, ltca)).map_err(|e| OutputError::Encode {
+        what: "ltca summary".into(),
+        message: e.to_string(),
+    })
 }

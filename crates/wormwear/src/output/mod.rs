@@ -7,6 +7,7 @@
 pub mod geometry;
 pub mod ltca;
 pub mod report;
+pub mod sweep;
 pub mod tca;
 pub mod vtk;
 pub mod wear;
@@ -28,6 +29,9 @@ pub enum OutputError {
     Encode { what: String, message: String },
     #[error("cannot read {path}: {message}")]
     Read { path: PathBuf, message: String },
+    /// A drawing of the geometry (a section) could not be computed.
+    #[error("geometry drawing")]
+    Geometry(#[source] crate::geometry::GeometryError),
 }
 
 /// Name of the lock file a run holds in its output directory.
@@ -209,6 +213,105 @@ pub fn update_summary(
     write_atomic(&path, text.as_bytes())
 }
 
+/// Writes the files of the stages a run was asked for into `dir`, as the CLI's command of
+/// the same stages does: the geometry's files (or only its summary section), the unloaded
+/// analysis's with the loaded one's, the loaded analysis's, the ratings, the life's (unless
+/// `life_written`: a [`wear::LifeWriter`] wrote them while the life ran) and report.html
+/// last. Returns the files written.
+pub fn write_results(
+    results: &crate::Results,
+    dir: &Path,
+    life_written: bool,
+) -> Result<Vec<PathBuf>, OutputError> {
+    use crate::Stage;
+    let (gear, geo) = (&results.gear, &results.geometry);
+    let file = Path::new(&results.source.file);
+    let mut files = Vec::new();
+    if results.stages.contains(&Stage::Geometry) {
+        files.extend(geometry::write_geometry(gear, geo, file, dir)?);
+    } else {
+        geometry::write_geometry_summary(gear, geo, file, dir)?;
+    }
+    let loaded = results.stages.contains(&Stage::Ltca);
+    if let Some(t) = results.tca.as_ref() {
+        if results.stages.contains(&Stage::Tca) || loaded {
+            files.extend(tca::write_tca(gear, geo, t, dir)?);
+        }
+        if let Some(l) = results.ltca.as_ref() {
+            files.extend(ltca::write_ltca(
+                gear,
+                geo,
+                t,
+                l,
+                dir,
+                results.map_position,
+            )?);
+        }
+        if let Some(r) = results.rating.as_ref() {
+            update_summary(dir, "rating", to_json("rating", r)?)?;
+        }
+        match results.life.as_ref() {
+            Some(life) if !life_written => files.extend(wear::write_life(gear, geo, t, life, dir)?),
+            _ => {}
+        }
+    }
+    if results.stages.contains(&Stage::Report) {
+        let title = results.source.title(gear);
+        files.push(report::write_report(dir, &title, &results.source.text)?);
+    }
+    Ok(files)
+}
+
+/// The sections of summary.json that [`write_results`] writes for `results` (into an empty
+/// directory), by name: `input`, `geometry`, `tca`, `ltca`, `rating`, `wear` as the stages
+/// ran.
+pub fn summary_sections(
+    results: &crate::Results,
+) -> Result<serde_json::Map<String, serde_json::Value>, OutputError> {
+    use crate::Stage;
+    let (gear, geo) = (&results.gear, &results.geometry);
+    let mut map = serde_json::Map::new();
+    let (input, geometry) = geometry::summary_values(gear, geo, Path::new(&results.source.file))?;
+    map.insert("input".into(), input);
+    map.insert("geometry".into(), geometry);
+    let Some(t) = results.tca.as_ref() else {
+        return Ok(map);
+    };
+    if results.stages.contains(&Stage::Tca) || results.stages.contains(&Stage::Ltca) {
+        map.insert("tca".into(), tca::summary_value(t)?);
+    }
+    if let Some(l) = results.ltca.as_ref() {
+        let wf = geo.wheel_flank(t.loaded_flank);
+        map.insert("ltca".into(), ltca::summary_value(t, wf, l)?);
+    }
+    if let Some(r) = results.rating.as_ref() {
+        map.insert("rating".into(), to_json("rating", r)?);
+    }
+    if let Some((life, last)) = results
+        .life
+        .as_ref()
+        .and_then(|l| l.maps.last().map(|m| (l, m)))
+    {
+        let view = crate::wear::StepView {
+            state: &life.end,
+            ..last.view()
+        };
+        map.insert(
+            "wear".into(),
+            wear::summary_value(gear, geo, t, &life.plan, &view)?,
+        );
+    }
+    Ok(map)
+}
+
+/// A value as JSON for the section `what` of summary.json.
+fn to_json(what: &str, value: &impl serde::Serialize) -> Result<serde_json::Value, OutputError> {
+    serde_json::to_value(value).map_err(|e| OutputError::Encode {
+        what: what.into(),
+        message: e.to_string(),
+    })
+}
+
 /// Writes the `rating` section of summary.json (MODEL §9) and returns the ratings.
 pub fn write_rating(
     gear: &crate::input::GearSet,
@@ -228,6 +331,9 @@ pub fn write_rating(
 pub struct Csv {
     text: String,
     columns: usize,
+    header: Vec<String>,
+    /// The numbers of the rows added with [`Csv::row`], at full precision.
+    rows: Vec<Vec<f64>>,
 }
 
 impl Csv {
@@ -236,13 +342,34 @@ impl Csv {
         Self {
             text: header.join(",") + "\n",
             columns: header.len(),
+            header: header.iter().map(|h| h.to_string()).collect(),
+            rows: Vec::new(),
         }
+    }
+
+    /// The column names.
+    pub fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    /// The numbers of each column at full precision (the file rounds them to 11 digits);
+    /// rows with a label ([`Csv::labelled_row`]) are not among them.
+    pub fn columns(&self) -> Vec<Vec<f64>> {
+        (0..self.columns)
+            .map(|k| self.rows.iter().map(|r| r[k]).collect())
+            .collect()
+    }
+
+    /// The table as CSV text, as written.
+    pub fn text(&self) -> &str {
+        &self.text
     }
 
     /// Appends a row of numbers (must match the header length); whole numbers (indices,
     /// counts) are written as integers, the rest with 11 significant digits.
     pub fn row(&mut self, values: &[f64]) {
         debug_assert_eq!(values.len(), self.columns);
+        self.rows.push(values.to_vec());
         for (k, v) in values.iter().enumerate() {
             if k > 0 {
                 self.text.push(',');

@@ -401,11 +401,7 @@ pub fn write_tca(
     let path = dir.join("tca_contact_lines.csv");
     csv.write(&path)?;
     files.push(path);
-    let value = serde_json::to_value(TcaSummary::new(tca)).map_err(|e| OutputError::Encode {
-        what: "tca summary".into(),
-        message: e.to_string(),
-    })?;
-    update_summary(dir, "tca", value)?;
+    update_summary(dir, "tca", summary_value(tca)?)?;
     files.push(dir.join("summary.json"));
     let path = dir.join("wheel_flank_tca.vtp");
     super::vtk::wheel_flank_tca(gear, geo, tca).write_vtp(
@@ -452,4 +448,12 @@ fn reachable_cell_means(
         }
     }
     out
+}
+
+/// The `tca` section of summary.json.
+pub fn summary_value(tca: &Tca) -> Result<serde_json::Value, OutputError> {
+    serde_json::to_value(TcaSummary::new(tca)).map_err(|e| OutputError::Encode {
+        what: "tca summary".into(),
+        message: e.to_string(),
+    })
 }

@@ -280,6 +280,95 @@ pub fn read_resume(
     )))
 }
 
+/// Why a checkpoint cannot be resumed (all input problems: exit code 2 from the CLI).
+#[derive(Debug, thiserror::Error)]
+pub enum ResumeError {
+    #[error("--resume: no {CHECKPOINT} in {0}")]
+    Missing(String),
+    #[error("--resume")]
+    Unreadable(#[source] OutputError),
+    #[error("{0}")]
+    Refused(String),
+}
+
+/// The checkpoint in `dir` to continue a life from, checked: it must hold the inputs it was
+/// computed with, they must equal this run's ([`life_inputs`]; every difference named), and
+/// the life asked for must reach at least the checkpoint's cycles.
+pub fn resume_state(dir: &Path, gear: &GearSet, plan: &WearPlan) -> Result<WearState, ResumeError> {
+    let (state, stored) = read_resume(dir)
+        .map_err(ResumeError::Unreadable)?
+        .ok_or_else(|| ResumeError::Missing(dir.display().to_string()))?;
+    let checkpoint = dir.join(CHECKPOINT);
+    let Some(stored) = stored else {
+        return Err(ResumeError::Refused(format!(
+            "--resume: {} holds no record of the inputs it was computed with (written by an \
+             earlier version): its states cannot be checked against this input file; run \
+             without --resume into a new directory",
+            checkpoint.display()
+        )));
+    };
+    let changes = input_changes(&stored, &life_inputs(gear, plan));
+    if !changes.is_empty() {
+        let shown: Vec<&str> = changes.iter().take(12).map(String::as_str).collect();
+        let more = changes.len().saturating_sub(shown.len());
+        return Err(ResumeError::Refused(format!(
+            "--resume: the inputs differ from those {} was computed with ({} difference{}, \
+             checkpoint -> now):\n  {}{}\nresume with the original inputs, or run without \
+             --resume into a new directory",
+            checkpoint.display(),
+            changes.len(),
+            if changes.len() == 1 { "" } else { "s" },
+            shown.join("\n  "),
+            if more > 0 {
+                format!("\n  ... and {more} more")
+            } else {
+                String::new()
+            }
+        )));
+    }
+    if plan.life_cycles < state.cycles {
+        return Err(ResumeError::Refused(format!(
+            "--resume: the life asked for ({:e} cycles) ends before the checkpoint's \
+             state ({:e} cycles, step {}); ask for at least that many cycles",
+            plan.life_cycles, state.cycles, state.step
+        )));
+    }
+    Ok(state)
+}
+
+/// Writes every file of a finished life ([`crate::runner::Life`]) at once, as [`LifeWriter`]
+/// leaves them when it writes the life state by state: the maps of each map state, then the
+/// records, checkpoint, tables and maps of the last. Returns the files written.
+pub fn write_life(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    life: &crate::runner::Life,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mut files = Vec::new();
+    for m in life.maps.iter().filter(|m| m.map && !m.last) {
+        let view = m.view();
+        let maps = StateMaps {
+            geo,
+            tca,
+            view: &view,
+            dir,
+        };
+        files.extend(maps.write(&format!("_step{}", m.state.step))?);
+    }
+    let Some(last) = life.maps.last().filter(|m| m.last) else {
+        return Ok(files);
+    };
+    let view = StepView {
+        state: &life.end,
+        ..last.view()
+    };
+    let mut writer = LifeWriter::new(dir).with_inputs(life_inputs(gear, &life.plan));
+    files.extend(writer.write_state(gear, geo, tca, &life.plan, &view, true)?);
+    Ok(files)
+}
+
 /// Writes the files of a life run state by state (see the module doc), appending to the
 /// records file: one writer per run (a new one after a resume rewrites the records file from
 /// the state's records first).
@@ -290,6 +379,8 @@ pub struct LifeWriter {
     records_written: Option<usize>,
     /// The run's [`life_inputs`], stored in every checkpoint.
     inputs: Option<serde_json::Value>,
+    /// When the tables were last written ([`LifeWriter::write_view`]), None: not yet.
+    tables_written: Option<std::time::Instant>,
 }
 
 impl LifeWriter {
@@ -299,7 +390,46 @@ impl LifeWriter {
             dir: dir.to_path_buf(),
             records_written: None,
             inputs: None,
+            tables_written: None,
         }
+    }
+
+    /// Writes one state of a running life ([`crate::Event::WearState`]): before the first,
+    /// the `input`, `geometry` and `rating` sections of summary.json (an interrupted life
+    /// keeps them); the tables, which grow with the number of states, at most every two
+    /// seconds (and at the map states and the last). Stores the life's inputs in the
+    /// checkpoints. Returns the files written.
+    pub fn write_view(
+        &mut self,
+        life: &crate::runner::LifeView,
+    ) -> Result<Vec<PathBuf>, OutputError> {
+        let mut files = Vec::new();
+        if self.tables_written.is_none() {
+            super::geometry::write_geometry_summary(
+                life.gear,
+                life.geometry,
+                Path::new(&life.source.file),
+                &self.dir,
+            )?;
+            super::write_rating(life.gear, &self.dir)?;
+            files.push(self.dir.join("summary.json"));
+            self.inputs = Some(life_inputs(life.gear, life.plan));
+        }
+        let tables = self
+            .tables_written
+            .is_none_or(|t| t.elapsed().as_secs_f64() >= 2.0);
+        files.extend(self.write_state(
+            life.gear,
+            life.geometry,
+            life.tca,
+            life.plan,
+            life.step,
+            tables,
+        )?);
+        if tables || self.tables_written.is_none() {
+            self.tables_written = Some(std::time::Instant::now());
+        }
+        Ok(files)
     }
 
     /// The same, storing the run's inputs ([`life_inputs`]) in every checkpoint so that a
@@ -451,103 +581,14 @@ fn write_tables(
     let state = view.state;
     let mut files = Vec::new();
     // Steps table and summary.
-    let mut csv = Csv::new(&[
-        "step",
-        "cycles",
-        "step_cycles",
-        "max_wear_m",
-        "mean_wear_m",
-        "worn_volume_m3",
-        "backlash_m",
-        "backlash_increase_m",
-        "max_pressure_pa",
-        "mean_pressure_pa",
-        "contact_area_fraction",
-        "s1",
-        "s2",
-        "te_mean_rad",
-        "te_p2p_rad",
-        "mesh_stiffness_mean_nm_per_rad",
-        "max_wear_per_cycle_m",
-        "lambda_min",
-        "substeps",
-        "loaded_analyses",
-        "pressure_patch_max_pa",
-        "rigid_lag_rad",
-        "te_mean_relative_rad",
-        "te_p2p_relative_rad",
-        "n_li_model_cycles",
-        "pitted_area_fraction",
-        "thinnest_tooth_um",
-        "worn_through_loaded",
-        "power_balance",
-    ]);
-    for r in &state.records {
-        csv.row(&[
-            r.step as f64,
-            r.cycles,
-            r.step_cycles,
-            r.max_wear_m,
-            r.mean_wear_m,
-            r.worn_volume_m3,
-            r.backlash_m,
-            r.backlash_increase_m,
-            r.max_pressure_pa,
-            r.mean_pressure_pa,
-            r.contact_area_fraction,
-            r.s1,
-            r.s2,
-            r.te_mean_rad,
-            r.te_p2p_rad,
-            r.mesh_stiffness_mean_nm_per_rad,
-            r.max_wear_per_cycle_m,
-            r.lambda_min,
-            r.substeps as f64,
-            r.loaded_analyses as f64,
-            r.pressure_patch_max_pa,
-            r.rigid_lag_rad,
-            r.te_mean_relative_rad,
-            r.te_p2p_relative_rad,
-            r.n_li_model_cycles.unwrap_or(f64::NAN),
-            r.pitted_area_fraction,
-            r.thinnest_tooth_m * UM,
-            f64::from(u8::from(r.worn_through_loaded)),
-            r.power_balance,
-        ]);
-    }
+    let csv = steps_table(state);
     let path = dir.join("wear_steps.csv");
     csv.write(&path)?;
     files.push(path);
     let path = dir.join("wear_positions.csv");
     position_table(tca, &state.records).write(&path)?;
     files.push(path);
-    let summary = WearSummary {
-        life_cycles: plan.life_cycles,
-        step_control: &plan.step,
-        bending_model: &view.ltca.bending_model,
-        film_load: plan.film_load,
-        pit_depth: plan.pit_depth,
-        states: state.records.len(),
-        loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
-        max_pressure_definition: MAX_PRESSURE_DEFINITION,
-        limits: LimitsSummary::new(gear, geo, tca, plan, state),
-        steps: state
-            .records
-            .iter()
-            .map(|r| crate::wear::StepRecord {
-                positions: Vec::new(),
-                ..r.clone()
-            })
-            .collect(),
-    };
-    update_summary(
-        dir,
-        "wear",
-        serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
-            what: "wear summary".into(),
-            message: e.to_string(),
-        })?,
-    )?;
+    update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
     // Curves over cycles.
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
@@ -619,7 +660,7 @@ fn write_tables(
 
 /// Per state and position: TE, TE relative to the wear's rigid lag, largest pressure and the
 /// normal force on each studied tooth (load sharing over life, MODEL §7.7).
-fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
+pub fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
     let tooth_columns: Vec<String> = tca
         .teeth
         .iter()
@@ -649,6 +690,146 @@ fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
                 (0..tooth_columns.len()).map(|t| p.tooth_load_n.get(t).copied().unwrap_or(0.0)),
             );
             csv.row(&row);
+        }
+    }
+    csv
+}
+
+/// The table of states (`wear_steps.csv`): one row per record (units in the names).
+pub fn steps_table(state: &WearState) -> Csv {
+    let mut csv = Csv::new(&[
+        "step",
+        "cycles",
+        "step_cycles",
+        "max_wear_m",
+        "mean_wear_m",
+        "worn_volume_m3",
+        "backlash_m",
+        "backlash_increase_m",
+        "max_pressure_pa",
+        "mean_pressure_pa",
+        "contact_area_fraction",
+        "s1",
+        "s2",
+        "te_mean_rad",
+        "te_p2p_rad",
+        "mesh_stiffness_mean_nm_per_rad",
+        "max_wear_per_cycle_m",
+        "lambda_min",
+        "substeps",
+        "loaded_analyses",
+        "pressure_patch_max_pa",
+        "rigid_lag_rad",
+        "te_mean_relative_rad",
+        "te_p2p_relative_rad",
+        "n_li_model_cycles",
+        "pitted_area_fraction",
+        "thinnest_tooth_um",
+        "worn_through_loaded",
+        "power_balance",
+    ]);
+    for r in &state.records {
+        csv.row(&[
+            r.step as f64,
+            r.cycles,
+            r.step_cycles,
+            r.max_wear_m,
+            r.mean_wear_m,
+            r.worn_volume_m3,
+            r.backlash_m,
+            r.backlash_increase_m,
+            r.max_pressure_pa,
+            r.mean_pressure_pa,
+            r.contact_area_fraction,
+            r.s1,
+            r.s2,
+            r.te_mean_rad,
+            r.te_p2p_rad,
+            r.mesh_stiffness_mean_nm_per_rad,
+            r.max_wear_per_cycle_m,
+            r.lambda_min,
+            r.substeps as f64,
+            r.loaded_analyses as f64,
+            r.pressure_patch_max_pa,
+            r.rigid_lag_rad,
+            r.te_mean_relative_rad,
+            r.te_p2p_relative_rad,
+            r.n_li_model_cycles.unwrap_or(f64::NAN),
+            r.pitted_area_fraction,
+            r.thinnest_tooth_m * UM,
+            f64::from(u8::from(r.worn_through_loaded)),
+            r.power_balance,
+        ]);
+    }
+    csv
+}
+
+/// The `wear` section of summary.json after the state of `view`.
+pub fn summary_value(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    plan: &WearPlan,
+    view: &StepView,
+) -> Result<serde_json::Value, OutputError> {
+    let state = view.state;
+    let summary = WearSummary {
+        life_cycles: plan.life_cycles,
+        step_control: &plan.step,
+        bending_model: &view.ltca.bending_model,
+        film_load: plan.film_load,
+        pit_depth: plan.pit_depth,
+        states: state.records.len(),
+        loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
+        max_pressure_definition: MAX_PRESSURE_DEFINITION,
+        limits: LimitsSummary::new(gear, geo, tca, plan, state),
+        steps: state
+            .records
+            .iter()
+            .map(|r| crate::wear::StepRecord {
+                positions: Vec::new(),
+                ..r.clone()
+            })
+            .collect(),
+    };
+    serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
+        what: "wear summary".into(),
+        message: e.to_string(),
+    })
+}
+
+/// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j
+/// across the face) its (r, z) mm, cumulative wear m, wear per cycle m, film ratio and film
+/// thickness m.
+pub fn node_table(
+    wf: &crate::geometry::WheelFlank,
+    state: &WearState,
+    cycle: &crate::wear::CycleWear,
+) -> Csv {
+    let mut csv = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "wear_m",
+        "wear_per_cycle_m",
+        "lambda",
+        "film_m",
+    ]);
+    for j in 0..=wf.cells_face {
+        for i in 0..=wf.cells_height {
+            let k = j * (wf.cells_height + 1) + i;
+            let n = wf.node(i, j);
+            csv.row(&[
+                i as f64,
+                j as f64,
+                n.r * 1e3,
+                n.z * 1e3,
+                state.removal.values[k],
+                cycle.depth.values[k],
+                cycle.lambda.values[k],
+                cycle.film.values[k],
+            ]);
         }
     }
     csv
@@ -763,32 +944,7 @@ impl StateMaps<'_> {
             None,
         )?;
         files.push(path);
-        let mut csv = Csv::new(&[
-            "i",
-            "j",
-            "r_mm",
-            "z_mm",
-            "wear_m",
-            "wear_per_cycle_m",
-            "lambda",
-            "film_m",
-        ]);
-        for j in 0..=wf.cells_face {
-            for i in 0..=wf.cells_height {
-                let k = j * (wf.cells_height + 1) + i;
-                let n = wf.node(i, j);
-                csv.row(&[
-                    i as f64,
-                    j as f64,
-                    n.r * 1e3,
-                    n.z * 1e3,
-                    state.removal.values[k],
-                    view.cycle.depth.values[k],
-                    view.cycle.lambda.values[k],
-                    view.cycle.film.values[k],
-                ]);
-            }
-        }
+        let csv = node_table(wf, state, view.cycle);
         let path = dir.join(format!("wear_map{suffix}.csv"));
         csv.write(&path)?;
         files.push(path);

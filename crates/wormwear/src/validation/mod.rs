@@ -216,7 +216,7 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
         .map(|b| b as &dyn crate::ltca::BendingModel);
     let settings = crate::ltca::LtcaSettings::from_gear(g);
     let l = crate::ltca::analyse_with(g, &geo, &tca, &settings, bending_ref)
-        .map_err(|e| fail(chain(&e)))?;
+        .map_err(|e| fail(crate::runner::error_chain(&e)))?;
     let unworn = unworn_pattern(&geo, &tca, &l);
     let mut records = Vec::new();
     if let Some(plan) = &job.plan {
@@ -231,7 +231,7 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
             WearState::new(wf),
             &mut |_| Ok(()),
         )
-        .map_err(|e| fail(chain(&e)))?;
+        .map_err(|e| fail(crate::runner::error_chain(&e)))?;
         records = end
             .records
             .into_iter()
@@ -251,18 +251,6 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
         phases: job.plan.as_ref().map(schedule).unwrap_or_default(),
         error: None,
     })
-}
-
-/// An error and its causes, one after the other.
-fn chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        text.push_str(": ");
-        text.push_str(&s.to_string());
-        source = s.source();
-    }
-    text
 }
 
 /// The unworn pattern's figures (MODEL §5.6) and the place of its maximum.

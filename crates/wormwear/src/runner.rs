@@ -1,0 +1,501 @@
+//! The pieces of the pipeline runner ([`crate::run`], MODEL §0): what a run is asked for
+//! ([`Request`], [`Stage`], [`LifeOverrides`]), what it reports while it goes ([`Event`]) and
+//! what it returns ([`Results`]). The CLI, the Python package and sweeps call [`crate::run`];
+//! [`crate::output::write_results`] turns its results into files.
+
+use crate::bending::model::{BuiltBending, Origin};
+use crate::bending::worm_model::FeBending;
+use crate::geometry::Geometry;
+use crate::input::{GearSet, Phase, StepControl, WearPlan};
+use crate::kinematics::Tca;
+use crate::ltca::{BendingModel, Ltca, LtcaSettings};
+use crate::rating::Rating;
+use crate::wear::{CycleWear, StepView, WearError, WearState};
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+/// A stage of the pipeline a request asks for. Each runs the stages it needs before it
+/// (the loaded analysis needs the unloaded one); what is written follows what was asked
+/// ([`crate::output::write_results`]).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Stage {
+    /// Worm, hob and wheel flanks (MODEL §2-3): sections, profiles, STL.
+    Geometry,
+    /// Unloaded meshing analysis (MODEL §4).
+    Tca,
+    /// Loaded tooth contact analysis (MODEL §5), with the ratings (MODEL §9).
+    Ltca,
+    /// Wear over life (MODEL §7-8), with the ratings.
+    Wear,
+    /// report.html over what the other stages wrote.
+    Report,
+}
+
+impl Stage {
+    /// Every stage, in pipeline order.
+    pub const ALL: [Stage; 5] = [
+        Stage::Geometry,
+        Stage::Tca,
+        Stage::Ltca,
+        Stage::Wear,
+        Stage::Report,
+    ];
+
+    /// The stage's name in requests and messages ("geometry", "tca", "ltca", "wear", "report").
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Geometry => "geometry",
+            Stage::Tca => "tca",
+            Stage::Ltca => "ltca",
+            Stage::Wear => "wear",
+            Stage::Report => "report",
+        }
+    }
+
+    /// The stage of a name (case-insensitive), None for an unknown one.
+    pub fn parse(name: &str) -> Option<Stage> {
+        Stage::ALL
+            .into_iter()
+            .find(|s| s.name().eq_ignore_ascii_case(name.trim()))
+    }
+}
+
+/// The input a run came from: its file name (or a label such as `<dict>`) and its text, for
+/// summary.json's `input` section and report.html.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Source {
+    pub file: String,
+    pub text: String,
+}
+
+impl Source {
+    /// The title of the results: the gear's title, else the file name.
+    pub fn title(&self, gear: &GearSet) -> String {
+        if gear.title.is_empty() {
+            self.file.clone()
+        } else {
+            gear.title.clone()
+        }
+    }
+}
+
+/// What a run is asked for.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// The stages whose results are wanted.
+    pub stages: BTreeSet<Stage>,
+    /// The life plan, needed with [`Stage::Wear`] (see [`LifeOverrides::plan`]).
+    pub life: Option<WearPlan>,
+    /// The state to continue the life from (a checkpoint checked by the caller:
+    /// [`crate::output::wear::resume_state`]); None: the unworn flank.
+    pub resume: Option<WearState>,
+    /// Position whose pressure maps are drawn, 0-based (below `analysis.positions`).
+    pub map_position: usize,
+}
+
+impl Request {
+    /// The stages given, no life, no resume, maps at position 0.
+    pub fn new(stages: impl IntoIterator<Item = Stage>) -> Self {
+        Self {
+            stages: stages.into_iter().collect(),
+            life: None,
+            resume: None,
+            map_position: 0,
+        }
+    }
+
+    /// The same with a life plan.
+    pub fn with_life(mut self, plan: WearPlan) -> Self {
+        self.life = Some(plan);
+        self
+    }
+
+    /// Whether the request asks for `stage`.
+    pub fn has(&self, stage: Stage) -> bool {
+        self.stages.contains(&stage)
+    }
+
+    /// Checks the request against the gear before any work: a life plan for the wear stage
+    /// and one that can end (MODEL §9 (a)), a map position among the analysed ones.
+    pub fn check(&self, gear: &GearSet) -> Result<(), RunError> {
+        if self.stages.is_empty() {
+            return Err(RunError::Request("no stage asked for".into()));
+        }
+        let positions = gear.analysis.positions;
+        if self.map_position >= positions {
+            return Err(RunError::Request(format!(
+                "map position = {}: the gear analyses {positions} positions, numbered 0 to {}",
+                self.map_position,
+                positions.saturating_sub(1)
+            )));
+        }
+        match (&self.life, self.has(Stage::Wear)) {
+            (None, true) => Err(RunError::Request(
+                "the wear stage needs a life plan: the gear has no [wear] section; add one \
+                 (life_cycles, step_wear_um or step_cycles) or give the cycles"
+                    .into(),
+            )),
+            (Some(plan), true) => {
+                crate::wear::check_plan_can_end(gear, plan).map_err(RunError::Wear)
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether the unloaded analysis is needed.
+    pub(crate) fn needs_tca(&self) -> bool {
+        self.has(Stage::Tca) || self.needs_bending()
+    }
+
+    /// Whether the bending model and the ratings are needed (a loaded stage).
+    pub(crate) fn needs_bending(&self) -> bool {
+        self.has(Stage::Ltca) || self.has(Stage::Wear)
+    }
+}
+
+/// Changes to the gear's `[wear]` plan (the CLI's `--cycles`, `--step-cycles`,
+/// `--step-wear-um`, `--no-pitting`; the Python `run`'s keywords).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LifeOverrides {
+    /// Wheel cycles to simulate.
+    pub cycles: Option<f64>,
+    /// Fixed steps of this many wheel cycles.
+    pub step_cycles: Option<f64>,
+    /// Adaptive steps removing at most this depth, um.
+    pub step_wear_um: Option<f64>,
+    /// Drop the pitting phases of the schedule (wear all along).
+    pub no_pitting: bool,
+}
+
+/// How overrides are named in messages: the CLI's flags or the Python keywords.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OverrideNames {
+    Cli,
+    Python,
+}
+
+impl OverrideNames {
+    fn of(self, field: &str) -> String {
+        match self {
+            OverrideNames::Cli => format!("--{}", field.replace('_', "-")),
+            OverrideNames::Python => field.to_string(),
+        }
+    }
+}
+
+impl LifeOverrides {
+    /// Whether any override asks for a life (cycles given).
+    pub fn asks_for_life(&self) -> bool {
+        self.cycles.is_some()
+    }
+
+    /// The gear's life plan with these overrides; an error names the override and its range.
+    pub fn plan(&self, gear: &GearSet, names: OverrideNames) -> Result<WearPlan, RunError> {
+        let bad = |field: &str, value: f64, range: &str| {
+            RunError::Request(format!("{} = {value}: must be {range}", names.of(field)))
+        };
+        let mut plan = match (&gear.wear, self.cycles) {
+            (Some(p), _) => p.clone(),
+            (None, Some(_)) => WearPlan::with_life(0.0),
+            (None, None) => {
+                return Err(RunError::Request(format!(
+                    "the file has no [wear] section: add one (life_cycles, step_wear_um or \
+                     step_cycles) or give {}",
+                    names.of("cycles")
+                )))
+            }
+        };
+        let cycles = |c: f64| c.is_finite() && c > 0.0 && c <= 1e12;
+        if let Some(c) = self.cycles {
+            if !cycles(c) {
+                return Err(bad("cycles", c, "a number of cycles in (0, 1e12]"));
+            }
+            plan.life_cycles = c;
+        }
+        if let Some(c) = self.step_cycles {
+            if !cycles(c) {
+                return Err(bad("step_cycles", c, "a number of cycles in (0, 1e12]"));
+            }
+            plan.step = StepControl::Cycles(c);
+        }
+        if let Some(d) = self.step_wear_um {
+            if !(d.is_finite() && d > 0.0 && d <= 1000.0) {
+                return Err(bad("step_wear_um", d, "a depth in (0, 1000] um"));
+            }
+            plan.step = StepControl::MaxRemoval(d * 1e-6);
+        }
+        if self.no_pitting {
+            plan.phases.retain(|p| matches!(p, Phase::Wear { .. }));
+        }
+        Ok(plan)
+    }
+}
+
+/// Where the bending model came from and what it cost (MODEL §5.5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BendingInfo {
+    pub origin: Origin,
+    /// Cache file read or written, if any.
+    pub cache_file: Option<PathBuf>,
+    /// Wall time of the build or the read, s.
+    pub seconds: f64,
+}
+
+/// What a run reports while it goes.
+pub enum Event<'a> {
+    /// A stage starts.
+    Stage(Stage),
+    /// The FE bending model is ready (built or read from the cache).
+    Bending(&'a BendingInfo),
+    /// A wear state is complete (its checkpoint and files may be written now).
+    WearState(&'a LifeView<'a>),
+}
+
+/// One completed wear state with everything a writer needs.
+pub struct LifeView<'a> {
+    pub gear: &'a GearSet,
+    pub source: &'a Source,
+    pub geometry: &'a Geometry,
+    pub tca: &'a Tca,
+    pub plan: &'a WearPlan,
+    pub step: &'a StepView<'a>,
+}
+
+/// A wear state kept for its maps: the state (with its last record only), the loaded
+/// analysis and the wear of one cycle on its geometry.
+#[derive(Debug, Clone)]
+pub struct MapState {
+    pub state: WearState,
+    pub ltca: Ltca,
+    pub cycle: CycleWear,
+    /// A map state of the plan (`map_cycles`).
+    pub map: bool,
+    /// The last state of the run.
+    pub last: bool,
+}
+
+impl MapState {
+    fn of(view: &StepView) -> Self {
+        let mut state = WearState {
+            records: Vec::new(),
+            warm: None,
+            ..view.state.clone()
+        };
+        state.records.extend(view.state.records.last().cloned());
+        Self {
+            state,
+            ltca: view.ltca.clone(),
+            cycle: view.cycle.clone(),
+            map: view.map,
+            last: view.last,
+        }
+    }
+
+    /// The view a writer draws this state's maps from.
+    pub fn view(&self) -> StepView<'_> {
+        StepView {
+            state: &self.state,
+            ltca: &self.ltca,
+            cycle: &self.cycle,
+            last: self.last,
+            map: self.map,
+        }
+    }
+}
+
+/// The life of a run: its plan, the final state (every record) and the states whose maps
+/// are drawn (the plan's map states and the last).
+#[derive(Debug, Clone)]
+pub struct Life {
+    pub plan: WearPlan,
+    pub end: WearState,
+    pub maps: Vec<MapState>,
+}
+
+/// Everything a run computed.
+#[derive(Debug, Clone)]
+pub struct Results {
+    pub gear: GearSet,
+    pub source: Source,
+    /// The stages asked for.
+    pub stages: BTreeSet<Stage>,
+    pub map_position: usize,
+    pub geometry: Geometry,
+    pub tca: Option<Tca>,
+    pub bending: Option<BendingInfo>,
+    pub ltca: Option<Ltca>,
+    pub life: Option<Life>,
+    /// The standard's ratings (MODEL §9), with the loaded stages.
+    pub rating: Option<Rating>,
+    /// Warnings of the stages, each with its stage's prefix where the CLI prints one.
+    pub warnings: Vec<String>,
+}
+
+/// Why a run failed. [`RunError::is_input`] tells an input problem (exit code 2) from a
+/// computation one.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The request does not fit the gear (a life without plan, a map position out of range,
+    /// an override out of range).
+    #[error("{0}")]
+    Request(String),
+    #[error("geometry")]
+    Geometry(#[source] crate::geometry::GeometryError),
+    #[error("unloaded meshing analysis")]
+    Tca(#[source] crate::kinematics::KinematicsError),
+    #[error("bending influence coefficients")]
+    Bending(#[source] crate::bending::model::BendingError),
+    #[error("loaded tooth contact analysis")]
+    Ltca(#[source] crate::ltca::LtcaError),
+    #[error("{}", wear_context(.0))]
+    Wear(#[source] WearError),
+    /// The caller's event handler stopped the run (an interrupt, a file that cannot be
+    /// written).
+    #[error("{0}")]
+    Stopped(String),
+}
+
+fn wear_context(e: &WearError) -> &'static str {
+    match e {
+        WearError::Checkpoint(_) => "resume",
+        WearError::Plan(_) => "life plan",
+        _ => "wear simulation",
+    }
+}
+
+impl RunError {
+    /// An input problem (the gear, the request, a checkpoint of another gear), not a failure
+    /// of the computation.
+    pub fn is_input(&self) -> bool {
+        matches!(
+            self,
+            RunError::Request(_)
+                | RunError::Geometry(_)
+                | RunError::Wear(WearError::Checkpoint(_) | WearError::Plan(_))
+        )
+    }
+}
+
+/// The bending model the gear asks for (`[bending] model`), from the cache or the FE build;
+/// reported as an event, its cache warnings added to `warnings`.
+pub(crate) fn bending_model(
+    gear: &GearSet,
+    geo: &Geometry,
+    warnings: &mut Vec<String>,
+    on_event: &mut dyn FnMut(Event) -> Result<(), RunError>,
+) -> Result<(Option<FeBending>, Option<BendingInfo>), RunError> {
+    let (built, cache_warnings) =
+        crate::bending::model::build(gear, geo).map_err(RunError::Bending)?;
+    warnings.extend(cache_warnings);
+    let Some(BuiltBending {
+        model,
+        origin,
+        cache_file,
+        seconds,
+    }) = built
+    else {
+        return Ok((None, None));
+    };
+    let info = BendingInfo {
+        origin,
+        cache_file,
+        seconds,
+    };
+    on_event(Event::Bending(&info))?;
+    Ok((Some(model), Some(info)))
+}
+
+/// The unworn loaded analysis (MODEL §5); its warnings added to `warnings`.
+pub(crate) fn loaded_analysis(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    bending: Option<&FeBending>,
+    warnings: &mut Vec<String>,
+) -> Result<Ltca, RunError> {
+    let result = crate::ltca::analyse_with(
+        gear,
+        geo,
+        tca,
+        &LtcaSettings::from_gear(gear),
+        bending.map(|b| b as &dyn BendingModel),
+    )
+    .map_err(RunError::Ltca)?;
+    warnings.extend(
+        result
+            .warnings
+            .iter()
+            .map(|w| format!("loaded analysis: {w}")),
+    );
+    Ok(result)
+}
+
+/// The life (MODEL §7-8) from the unworn flank or the request's resumed state: every
+/// completed state goes to `on_event`; the plan's map states and the last are kept.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn life(
+    gear: &GearSet,
+    source: &Source,
+    geo: &Geometry,
+    tca: &Tca,
+    bending: Option<&FeBending>,
+    plan: &WearPlan,
+    resume: Option<WearState>,
+    on_event: &mut dyn FnMut(Event) -> Result<(), RunError>,
+) -> Result<Life, RunError> {
+    let start = resume.unwrap_or_else(|| WearState::new(geo.wheel_flank(tca.loaded_flank)));
+    let mut maps = Vec::new();
+    let mut stopped: Option<RunError> = None;
+    let mut on_state = |view: &StepView| -> Result<(), WearError> {
+        if view.map || view.last {
+            maps.push(MapState::of(view));
+        }
+        let life_view = LifeView {
+            gear,
+            source,
+            geometry: geo,
+            tca,
+            plan,
+            step: view,
+        };
+        on_event(Event::WearState(&life_view)).map_err(|e| {
+            let message = format!("{e:#}");
+            stopped = Some(e);
+            WearError::Output(message)
+        })
+    };
+    let end = crate::wear::simulate(
+        gear,
+        geo,
+        tca,
+        &LtcaSettings::from_gear(gear),
+        bending.map(|b| b as &dyn BendingModel),
+        plan,
+        start,
+        &mut on_state,
+    );
+    match (end, stopped) {
+        (Ok(end), _) => Ok(Life {
+            plan: plan.clone(),
+            end,
+            maps,
+        }),
+        (Err(_), Some(stop)) => Err(stop),
+        (Err(e), None) => Err(RunError::Wear(e)),
+    }
+}
+
+/// An error and its sources on one line, `error: source: source...`.
+pub fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
