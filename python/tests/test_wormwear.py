@@ -1,0 +1,271 @@
+"""The Python package against the CLI (same numbers, same files), its input errors, its
+variants, sweeps locally / through the CLI / on a Dask cluster, resume and interrupts."""
+
+import json
+import math
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import wormwear
+
+from conftest import EXAMPLES, ROOT, cli_path
+
+RESULT_COLUMNS = [
+    "max_pressure_pa",
+    "contact_area_fraction",
+    "te_p2p_rad",
+    "power_balance",
+    "efficiency",
+    "life_cycles",
+    "backlash_increase_end_m",
+    "max_wear_end_m",
+    "backlash_limit_m",
+    "cycles_to_backlash_limit",
+]
+
+
+def files_of(directory):
+    d = pathlib.Path(directory)
+    return {p.name: p.read_bytes() for p in d.iterdir() if p.is_file() and p.name != ".wormwear.lock"}
+
+
+def assert_close(a, b, path="", rel=1e-12):
+    """Two JSON values equal, numbers to `rel` relative."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and a.keys() == b.keys(), path
+        for k in a:
+            assert_close(a[k], b[k], f"{path}.{k}", rel)
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), path
+        for k, (x, y) in enumerate(zip(a, b)):
+            assert_close(x, y, f"{path}[{k}]", rel)
+    elif isinstance(a, float) or isinstance(b, float):
+        if a is None or b is None:
+            assert a == b, path
+        else:
+            assert math.isclose(a, b, rel_tol=rel, abs_tol=1e-300), f"{path}: {a} != {b}"
+    else:
+        assert a == b, path
+
+
+def test_ltca_equals_the_cli_in_numbers_and_files(cli, design_file, tmp_path):
+    cli("-q", "ltca", design_file, "-o", tmp_path / "cli", "--map-position", "2")
+    gear = wormwear.load(str(design_file))
+    r = wormwear.run(gear, stages=["ltca"], map_position=2)
+    written = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert_close(r.summary, written)
+    # The issue's acceptance line: the value the CLI writes.
+    assert r.ltca.max_pressure_pa == written["ltca"]["max_pressure_pa"]
+    # Tables at full precision against the files (rounded to 11 significant digits).
+    for name, frame in [("ltca_positions", r.ltca.positions), ("ltca_pressures", r.ltca.pressures)]:
+        file = pd.read_csv(tmp_path / "cli" / f"{name}.csv")
+        assert list(frame.columns) == list(file.columns)
+        np.testing.assert_allclose(frame.to_numpy(float), file.to_numpy(float), rtol=6e-11, atol=0)
+    pattern = r.ltca.pattern
+    assert pattern.values.shape == (40, 60) and np.nanmax(pattern.values) == r.ltca.max_pressure_pa
+    # The radius grows up the tooth, z across the face.
+    assert np.all(np.diff(pattern.r_mm[:, 30]) > 0) and np.all(np.diff(pattern.z_mm[20, :]) != 0)
+    r.write(tmp_path / "py")
+    a, b = files_of(tmp_path / "cli"), files_of(tmp_path / "py")
+    assert a.keys() == b.keys()
+    for name in a:
+        assert a[name] == b[name], name
+
+
+def test_a_run_with_a_life_equals_the_cli(cli, design_file, tmp_path):
+    cli("-q", "run", design_file, "-o", tmp_path / "cli", "--cycles", "20000", "--step-cycles", "10000")
+    r = wormwear.run(wormwear.load(str(design_file)), cycles=20000, step_cycles=10000)
+    assert r.stages == ["geometry", "tca", "ltca", "wear", "report"]
+    written = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert_close(r.summary, written)
+    records = r.wear.records
+    assert list(records["step"]) == [0, 1, 2]
+    file = pd.read_csv(tmp_path / "cli" / "wear_steps.csv")
+    np.testing.assert_allclose(records.to_numpy(float), file.to_numpy(float), rtol=6e-11, atol=0)
+    # The wear map: depth zero where nothing wore, the maximum the records' last max_wear_m.
+    assert math.isclose(np.nanmax(r.wear.depth.values), records["max_wear_m"].iloc[-1], rel_tol=1e-12)
+    r.write(tmp_path / "py")
+    a, b = files_of(tmp_path / "cli"), files_of(tmp_path / "py")
+    assert a.keys() == b.keys()
+    for name in a:
+        assert a[name] == b[name], name
+
+
+def test_input_errors_raise_with_the_cli_message_and_every_problem(cli, design_file, tmp_path):
+    gear = wormwear.load(str(design_file))
+    document = gear.to_dict()
+    document["conditions"]["worm_torque_nm"] = -5.0
+    document["worm"]["pressure_angle_deg"] = 85.0
+    with pytest.raises(wormwear.InputError) as e:
+        wormwear.GearSet.from_dict(document)
+    fields = {p[0] for p in e.value.problems}
+    assert {"conditions.worm_torque_nm", "worm.pressure_angle_deg"} <= fields
+    # The same message as the CLI's for the same file.
+    bad = tmp_path / "bad.toml"
+    bad.write_text(design_file.read_text().replace("worm_torque_nm = 60.0", "worm_torque_nm = -5.0"))
+    out = cli("check", bad, check=False)
+    assert out.returncode == 2
+    with pytest.raises(wormwear.InputError) as e:
+        wormwear.load(str(bad))
+    assert str(e.value) in out.stderr
+    # Variants: an unknown field, a value out of range, a path through a value.
+    with pytest.raises(wormwear.InputError, match="worm_torq_nm"):
+        gear.with_(**{"conditions.worm_torq_nm": 5})
+    with pytest.raises(wormwear.InputError, match="conditions.worm_speed_rpm"):
+        gear.with_(**{"conditions.worm_speed_rpm": -1})
+    with pytest.raises(wormwear.InputError, match="is a value"):
+        gear.with_(**{"worm.profile.x": 1})
+    with pytest.raises(OSError):
+        wormwear.load(str(tmp_path / "missing.toml"))
+    # A life without plan, an override out of range.
+    with pytest.raises(wormwear.InputError, match="step_wear_um = 0"):
+        wormwear.run(gear, stages=["wear"], step_wear_um=0)
+
+
+def test_variants_and_pickling(design_file):
+    import pickle
+
+    gear = wormwear.load(str(design_file))
+    heavy = gear.with_(**{"conditions.worm_torque_nm": 90})
+    assert heavy.to_dict()["conditions"]["worm_torque_nm"] == 90
+    assert gear.to_dict()["conditions"]["worm_torque_nm"] == 60.0  # unchanged
+    assert heavy.validated()["conditions"]["torque"] == {"Worm": 90.0}
+    again = pickle.loads(pickle.dumps(heavy))
+    assert again.to_dict() == heavy.to_dict() and again.file == heavy.file
+    # A field removed takes its default.
+    assert "wear" not in gear.with_(wear=None).to_dict()
+
+
+def rows_of(frame):
+    """Rows comparable across engines: everything but the wall time."""
+    return frame.drop(columns=["seconds"]).sort_values("variant").reset_index(drop=True)
+
+
+GRID = {
+    "conditions.worm_torque_nm": [30.0, 90.0],
+    "lubricant.composite_roughness_um": [0.5, -1.0, 1.0],
+}
+
+
+def test_a_sweep_gives_the_same_rows_locally_through_the_cli_and_on_dask(cli, fast_gear_file, tmp_path):
+    base = wormwear.load(str(fast_gear_file))
+    local = wormwear.sweep(base, GRID, stages=["ltca", "wear"], cycles=20000, step_cycles=10000)
+    assert len(local) == 6
+    # The invalid roughness fails with its field named; the others go on.
+    failed = local[~local["ok"]]
+    assert list(failed["variant"]) == ["v2", "v5"]
+    assert failed["error"].str.contains("lubricant.composite_roughness_um").all()
+    assert local[local["ok"]]["backlash_increase_end_m"].gt(0).all()
+    # Wear grows with the load and with the roughness (a thinner film ratio).
+    by = local.set_index("variant")["backlash_increase_end_m"]
+    assert by["v4"] > by["v1"] and by["v3"] > by["v1"]
+    # The CLI's sweep.csv.
+    sweep_file = tmp_path / "sweep.toml"
+    sweep_file.write_text(
+        f'base = "{fast_gear_file}"\nstages = ["ltca", "wear"]\ncycles = 20000\nstep_cycles = 10000\n'
+        "[grid]\n" + "".join(f'"{k}" = {json.dumps(v)}\n' for k, v in GRID.items())
+    )
+    cli("-q", "sweep", sweep_file, "-o", tmp_path / "cli")
+    csv = pd.read_csv(tmp_path / "cli" / "sweep.csv")
+    assert len(csv) == 6
+    for column in RESULT_COLUMNS:
+        np.testing.assert_allclose(
+            local[column].to_numpy(float), csv[column].to_numpy(float), rtol=1e-15, equal_nan=True
+        )
+    assert list(csv["ok"]) == [int(x) for x in local["ok"]]
+    # A Dask LocalCluster of two worker processes.
+    from dask.distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with Client(cluster) as client:
+            distributed = wormwear.sweep(
+                base, GRID, stages=["ltca", "wear"], cycles=20000, step_cycles=10000, client=client
+            )
+    pd.testing.assert_frame_equal(rows_of(local), rows_of(distributed))
+
+
+def test_an_interrupted_sweep_resumes_where_it_stopped(cli, fast_gear_file, tmp_path):
+    sweep_file = tmp_path / "sweep.toml"
+    sweep_file.write_text(
+        f'base = "{fast_gear_file}"\nstages = ["ltca", "wear"]\ncycles = 40000\nstep_cycles = 10000\n'
+        '[grid]\n"conditions.worm_torque_nm" = [20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0]\n'
+    )
+    out = tmp_path / "out"
+    process = subprocess.Popen(
+        [str(cli_path()), "-q", "sweep", str(sweep_file), "-o", str(out)],
+        stderr=subprocess.PIPE,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not list(out.glob("variants/*/variant.json")):
+        time.sleep(0.05)
+    process.kill()
+    process.wait()
+    finished = {p.parent.name for p in out.glob("variants/*/variant.json")}
+    assert 1 <= len(finished) < 8, finished
+    # Resumed from Python into the same directory: the finished variants are reused (their
+    # recorded wall time comes back unchanged), the rest run, and the rows equal a fresh run.
+    before = pd.read_csv(out / "sweep.csv") if (out / "sweep.csv").exists() else None
+    base = wormwear.load(str(fast_gear_file))
+    grid = {"conditions.worm_torque_nm": [20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0]}
+    resumed = wormwear.sweep(base, grid, stages=["ltca", "wear"], cycles=40000, step_cycles=10000, output=out)
+    assert resumed["ok"].all() and len(resumed) == 8
+    if before is not None:
+        kept = before.set_index("variant")["seconds"]
+        now = resumed.set_index("variant")["seconds"]
+        for v in finished & set(kept.index):
+            assert math.isclose(now[v], kept[v], abs_tol=1e-3), v
+    fresh = wormwear.sweep(base, grid, stages=["ltca", "wear"], cycles=40000, step_cycles=10000)
+    pd.testing.assert_frame_equal(rows_of(resumed), rows_of(fresh))
+    assert (out / "sweep.html").is_file() and (out / "variants" / "v8" / "gear.toml").is_file()
+
+
+def test_the_gil_is_released_during_a_run(design_file):
+    gear = wormwear.load(str(design_file)).with_(**{"bending.model": "none"})
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.005)
+
+    t = threading.Thread(target=count)
+    t.start()
+    start = time.perf_counter()
+    wormwear.run(gear, stages=["ltca"])
+    elapsed = time.perf_counter() - start
+    done.set()
+    t.join()
+    during = [x for x in ticks if start < x < start + elapsed]
+    # A thread blocked on the GIL would not tick at all during the run.
+    assert len(during) > 0.3 * elapsed / 0.005, (len(during), elapsed)
+
+
+def test_ctrl_c_interrupts_a_life(design_file, tmp_path):
+    script = (
+        "import wormwear, sys\n"
+        f"g = wormwear.load({str(design_file)!r}).with_(**{{'bending.model': 'none'}})\n"
+        "print('start', flush=True)\n"
+        "try:\n"
+        "    wormwear.run(g, stages=['wear'], cycles=1e7, step_cycles=2000)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(7)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(3.0)
+    sent = time.time()
+    p.send_signal(signal.SIGINT)
+    code = p.wait(timeout=60)
+    assert code == 7, p.stdout.read()
+    assert time.time() - sent < 30

@@ -1,0 +1,366 @@
+"""wormwear — loaded contact and wear of steel-worm / bronze-wheel worm gears, from Python.
+
+The computation is the Rust library's (the ``wormwear`` command line calls the same runner);
+this package holds gears and results and hands them out in Python's habits: results'
+tables are pandas DataFrames, maps are numpy arrays on their (r, z) grids, sections are
+attribute namespaces. Units are SI inside, and every name says its unit
+(``max_pressure_pa``, ``backlash_increase_m``); gear documents use the file's names
+(``worm_torque_nm``, ``module_mm``).
+
+    >>> import wormwear
+    >>> gear = wormwear.load("examples/gear-1x40-design.toml")
+    >>> heavy = gear.with_(**{"conditions.worm_torque_nm": 90.0})
+    >>> r = wormwear.run(heavy, stages=["ltca"])
+    >>> r.ltca.max_pressure_pa, r.ltca.positions.head()
+    >>> r.write("out/heavy")                     # the files of `wormwear ltca`
+
+Design studies: :func:`sweep` runs variants on the local cores, or on a Dask cluster when
+given a ``dask.distributed.Client``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import types
+from typing import Any, Callable, Iterable, Mapping, Optional, Sequence
+
+import numpy as np
+import pandas as pd
+
+from . import _native
+from ._native import ComputationError, InputError
+
+__version__ = _native.__version__
+
+__all__ = [
+    "GearSet",
+    "Results",
+    "FlankMap",
+    "InputError",
+    "ComputationError",
+    "load",
+    "run",
+    "sweep",
+    "STAGES",
+]
+
+#: The pipeline's stages, in order. Each runs the ones it needs first.
+STAGES = ("geometry", "tca", "ltca", "wear", "report")
+
+
+class GearSet:
+    """A validated gear set (worm, hob, wheel, materials, lubricant, conditions, analysis).
+
+    Build one with :func:`load` or :meth:`from_dict`; derive variants with :meth:`with_`.
+    Immutable; picklable (a Dask task carries it as its source text).
+    """
+
+    __slots__ = ("_native",)
+
+    def __init__(self, native: "_native.NativeGear"):
+        self._native = native
+
+    @classmethod
+    def from_dict(cls, document: Mapping[str, Any], *, name: str = "<dict>") -> "GearSet":
+        """A gear from a document with the gear file's tables and names (units in the names:
+        ``{"worm": {"lead_mm": 15.551, ...}, "conditions": {"worm_torque_nm": 60.0}, ...}``).
+        Validated as the file would be: raises :class:`InputError` listing every problem."""
+        return cls(_native.NativeGear.from_json(json.dumps(document, allow_nan=True), name))
+
+    def with_(self, **changes: Any) -> "GearSet":
+        """The same gear with fields changed by dotted name, validated::
+
+            gear.with_(**{"conditions.worm_torque_nm": 50, "lubricant.temperature_c": 70})
+
+        A value of None removes the field (it takes its default)."""
+        return GearSet(self._native.with_changes(json.dumps(changes, allow_nan=True)))
+
+    def to_dict(self) -> dict:
+        """The gear document (the file's tables and names)."""
+        return json.loads(self._native.document_json())
+
+    def to_toml(self) -> str:
+        """The gear file's text: the file as read, or the document of a variant (a gear
+        file the CLI reads as the same gear)."""
+        return self._native.source()[1]
+
+    def validated(self) -> dict:
+        """The validated gear set in SI units, with the derived defaults filled in."""
+        return json.loads(self._native.validated_json())
+
+    @property
+    def title(self) -> str:
+        """The gear file's title."""
+        return self._native.title
+
+    @property
+    def file(self) -> str:
+        """The file the gear was read from (or a label: ``<dict>``, ``FILE with ...``)."""
+        return self._native.source()[0]
+
+    def __reduce__(self):
+        file, text = self._native.source()
+        return (_from_text, (text, file))
+
+    def __repr__(self) -> str:
+        return f"GearSet({self.title!r}, file={self.file!r})"
+
+
+def _from_text(text: str, file: str) -> GearSet:
+    return GearSet(_native.NativeGear.from_text_(text, file))
+
+
+def load(path: "str | os.PathLike[str]") -> GearSet:
+    """Reads and validates a gear file (TOML, the CLI's format). Raises :class:`InputError`
+    (every problem with its field, value and range) or OSError."""
+    return GearSet(_native.NativeGear.load(os.fspath(path)))
+
+
+class FlankMap:
+    """A field over the loaded wheel flank: ``values[i, j]`` at radius ``r_mm[i, j]`` and face
+    coordinate ``z_mm[i, j]`` (i up the tooth height, j across the face width)."""
+
+    def __init__(self, name: str, unit: str, values: np.ndarray, r_mm: np.ndarray, z_mm: np.ndarray):
+        self.name, self.unit = name, unit
+        self.values, self.r_mm, self.z_mm = values, r_mm, z_mm
+
+    @classmethod
+    def _from_table(cls, table: pd.DataFrame, column: str, unit: str) -> "FlankMap":
+        i = table["i"].to_numpy().astype(int)
+        j = table["j"].to_numpy().astype(int)
+        shape = (i.max() + 1, j.max() + 1)
+        grids = []
+        for c in (column, "r_mm", "z_mm"):
+            a = np.full(shape, np.nan)
+            a[i, j] = table[c].to_numpy()
+            grids.append(a)
+        return cls(column, unit, *grids)
+
+    def __repr__(self) -> str:
+        return f"FlankMap({self.name!r}, {self.values.shape[0]} x {self.values.shape[1]}, {self.unit})"
+
+
+def _namespace(section: Optional[dict], **extra: Any) -> Optional[types.SimpleNamespace]:
+    if section is None:
+        return None
+    ns = types.SimpleNamespace(**section)
+    for k, v in extra.items():
+        setattr(ns, k, v)
+    return ns
+
+
+class Results:
+    """What a run computed, by stage (None where the stage did not run).
+
+    - ``summary``: summary.json's sections (dict);
+    - ``geometry``: derived geometry (lead angle, radii, flank area...);
+    - ``tca``: unloaded analysis (kinematic error, pattern, sliding speeds);
+    - ``ltca``: the ``ltca`` section's values (``max_pressure_pa``, ``contact_area_fraction``,
+      ``te_p2p_rad``, ``power_balance``...) and the DataFrames ``positions`` (per position:
+      torques N m, TE rad, stiffness, tooth loads N), ``pressures`` (every loaded cell:
+      position, tooth, r_mm, z_mm, pressure_pa) and the map ``pattern`` (largest pressure
+      over the cycle, Pa);
+    - ``wear``: the ``wear`` section's values and the DataFrames ``records`` (one row per
+      state: cycles, max_wear_m, backlash_increase_m, max_pressure_pa, ...), ``positions``
+      (TE and loads per state and position) and the map ``depth`` (wear depth at the end, m);
+    - ``rating``: the standard's ratings (efficiency, sigma_Hm, lives...);
+    - ``warnings``: list of str.
+
+    ``write(directory)`` writes the files the CLI writes for the same stages.
+    """
+
+    def __init__(self, native: "_native.NativeResults"):
+        self._native = native
+        self.summary: dict = json.loads(native.summary_json())
+        self.stages: list = native.stages()
+        self.warnings: list = native.warnings()
+        self.geometry = _namespace(self.summary.get("geometry"))
+        self.tca = _namespace(self.summary.get("tca"))
+        self.rating = _namespace(self.summary.get("rating"))
+        ltca = self.summary.get("ltca")
+        self.ltca = None
+        if ltca is not None:
+            pattern = self.table("ltca_pattern")
+            self.ltca = _namespace(
+                ltca,
+                positions=self.table("ltca_positions"),
+                pressures=self.table("ltca_pressures"),
+                pattern=FlankMap._from_table(pattern, "max_pressure_pa", "Pa"),
+            )
+        wear = self.summary.get("wear")
+        self.wear = None
+        if wear is not None:
+            nodes = self.table("wear_map")
+            self.wear = _namespace(
+                wear,
+                records=self.table("wear_steps"),
+                positions=self.table("wear_positions"),
+                depth=FlankMap._from_table(nodes, "wear_m", "m"),
+                nodes=nodes,
+            )
+
+    def table(self, name: str) -> Optional[pd.DataFrame]:
+        """A table by its file's name without ``.csv`` (ltca_positions, ltca_pattern,
+        ltca_pressures, wear_steps, wear_positions, wear_map), at full precision (the files
+        round to 11 digits); None if its stage did not run."""
+        got = self._native.table(name)
+        if got is None:
+            return None
+        header, columns = got
+        frame = pd.DataFrame({h: np.asarray(c, dtype=float) for h, c in zip(header, columns)})
+        for h in header:  # indices and counts as integers, as in the files
+            col = frame[h]
+            if len(col) and np.all(np.isfinite(col)) and np.all(col == np.round(col)) and (
+                h in ("i", "j", "position", "tooth", "slice", "column", "step", "substeps", "loaded_analyses")
+            ):
+                frame[h] = col.astype(np.int64)
+        return frame
+
+    def write(self, directory: "str | os.PathLike[str]") -> list:
+        """Writes the files the CLI writes for the same stages (summary.json, CSV, SVG, VTK,
+        report.html) into ``directory`` (created); returns their paths."""
+        path = os.fspath(directory)
+        os.makedirs(path, exist_ok=True)
+        return self._native.write(path)
+
+    def __repr__(self) -> str:
+        return f"Results(stages={self.stages})"
+
+
+def run(
+    gear: GearSet,
+    stages: Optional[Sequence[str]] = None,
+    *,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    map_position: int = 0,
+    progress: Optional[Callable[[str, dict], None]] = None,
+) -> Results:
+    """Runs the pipeline on ``gear``: ``stages`` from :data:`STAGES` (default: all that
+    ``wormwear run`` runs; ``wear`` needs the gear's ``[wear]`` section or ``cycles``). Life
+    overrides as the CLI's flags: ``cycles`` (wheel cycles), ``step_cycles`` (fixed steps,
+    wheel cycles), ``step_wear_um`` (adaptive steps, um), ``no_pitting``. ``map_position``:
+    the position (0-based) whose pressure maps ``write`` draws. ``progress(event, details)``
+    is called at each stage and wear state.
+
+    The GIL is released while it computes; Ctrl-C raises KeyboardInterrupt at the next stage or
+    wear state. Raises :class:`InputError` for an input problem, :class:`ComputationError`
+    for a failed computation."""
+    callback = None
+    if progress is not None:
+        def callback(kind: str, details: str) -> None:
+            progress(kind, json.loads(details))
+    native = _native.run(
+        gear._native,
+        list(stages) if stages is not None else None,
+        cycles,
+        step_cycles,
+        step_wear_um,
+        no_pitting,
+        map_position,
+        callback,
+    )
+    return Results(native)
+
+
+def _settings_json(stages, cycles, step_cycles, step_wear_um, no_pitting) -> str:
+    return json.dumps(
+        {
+            "stages": list(stages) if stages is not None else None,
+            "cycles": cycles,
+            "step_cycles": step_cycles,
+            "step_wear_um": step_wear_um,
+            "no_pitting": no_pitting,
+        }
+    )
+
+
+def _variants(grid, cases) -> tuple:
+    if (grid is None) == (cases is None):
+        raise ValueError("sweep: give grid (dotted name -> list of values) or cases (a list of dicts), one of the two")
+    if grid is not None:
+        parameters, variants = _native.expand_grid(json.dumps(dict(grid)))
+        return parameters, json.loads(variants)
+    parameters, variants = [], []
+    width = len(str(len(cases)))
+    for k, case in enumerate(cases):
+        values = dict(case)
+        name = str(values.pop("name", f"c{k + 1:0{width}d}"))
+        for p in values:
+            if p not in parameters:
+                parameters.append(p)
+        variants.append([name, values])
+    return parameters, variants
+
+
+def _run_variant_task(variant: list, base: GearSet, settings: str, directory: Optional[str]) -> dict:
+    """One Dask task: one variant's row."""
+    return json.loads(_native.run_variant(base._native, json.dumps(variant), settings, directory))
+
+
+def _frame(parameters: list, rows: Iterable[dict]) -> pd.DataFrame:
+    records = []
+    for r in rows:
+        rec = {"variant": r["variant"]}
+        for p in parameters:
+            rec[p] = r["parameters"].get(p)
+        rec.update({k: v for k, v in r.items() if k not in ("variant", "parameters")})
+        records.append(rec)
+    frame = pd.DataFrame.from_records(records)
+    return frame
+
+
+def sweep(
+    base: GearSet,
+    grid: Optional[Mapping[str, Sequence[Any]]] = None,
+    *,
+    cases: Optional[Sequence[Mapping[str, Any]]] = None,
+    stages: Optional[Sequence[str]] = None,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    output: "str | os.PathLike[str] | None" = None,
+    client: Any = None,
+) -> pd.DataFrame:
+    """Runs variants of ``base`` and returns one row per variant: the variant's name, its
+    values, ``ok``, ``error`` and the key results (``max_pressure_pa``,
+    ``contact_area_fraction``, ``te_p2p_rad``, ``power_balance``, ``efficiency``,
+    ``life_cycles``, ``backlash_increase_end_m``, ``max_wear_end_m``, ``backlash_limit_m``,
+    ``cycles_to_backlash_limit``, ``seconds``), as ``wormwear sweep``'s sweep.csv.
+
+    Variants: ``grid`` (dotted name -> list of values: every combination, the first name
+    slowest, named v1, v2, ...) or ``cases`` (a list of dicts of dotted names, each with an
+    optional ``name``). A failing variant gives a row with its error; the others go on.
+
+    Without ``client`` the variants run in parallel on the local cores (with ``output``, into
+    that directory as ``wormwear sweep`` does: sweep.csv, sweep.html, variants/NAME/, and a
+    rerun reuses finished variants). With a ``dask.distributed.Client`` the base gear is
+    scattered to the workers and each variant is one task; the rows are gathered (with
+    ``output``, each worker writes its variant's folder there: a directory all workers see)."""
+    parameters, variants = _variants(grid, cases)
+    settings = _settings_json(stages, cycles, step_cycles, step_wear_um, no_pitting)
+    directory = os.fspath(output) if output is not None else None
+    if client is None:
+        if directory is not None:
+            os.makedirs(directory, exist_ok=True)
+        rows = json.loads(
+            _native.sweep(base._native, parameters, json.dumps(variants), settings, directory)
+        )
+        return _frame(parameters, rows)
+    base_future = client.scatter(base, broadcast=True)
+    futures = client.map(
+        _run_variant_task,
+        variants,
+        base=base_future,
+        settings=settings,
+        directory=directory,
+        pure=False,
+    )
+    rows = client.gather(futures)
+    if directory is not None:
+        _native.write_sweep_csv(os.path.join(directory, "sweep.csv"), parameters, json.dumps(rows))
+    return _frame(parameters, rows)

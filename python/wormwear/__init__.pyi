@@ -1,0 +1,76 @@
+"""Type stubs of the wormwear package (see the module's docstrings for units)."""
+
+import os
+import types
+from typing import Any, Callable, Mapping, Optional, Sequence
+
+import numpy as np
+import pandas as pd
+
+from ._native import ComputationError as ComputationError
+from ._native import InputError as InputError
+
+__version__: str
+STAGES: tuple[str, ...]
+
+class GearSet:
+    @classmethod
+    def from_dict(cls, document: Mapping[str, Any], *, name: str = ...) -> GearSet: ...
+    def with_(self, **changes: Any) -> GearSet: ...
+    def to_dict(self) -> dict: ...
+    def to_toml(self) -> str: ...
+    def validated(self) -> dict: ...
+    @property
+    def title(self) -> str: ...
+    @property
+    def file(self) -> str: ...
+
+def load(path: str | os.PathLike[str]) -> GearSet: ...
+
+class FlankMap:
+    """values[i, j] (unit ``unit``) at r_mm[i, j], z_mm[i, j] on the loaded wheel flank."""
+    name: str
+    unit: str
+    values: np.ndarray
+    r_mm: np.ndarray
+    z_mm: np.ndarray
+
+class Results:
+    summary: dict
+    stages: list[str]
+    warnings: list[str]
+    geometry: Optional[types.SimpleNamespace]
+    tca: Optional[types.SimpleNamespace]
+    #: ltca section values (max_pressure_pa, contact_area_fraction, te_p2p_rad, ...) and
+    #: positions / pressures (DataFrame), pattern (FlankMap, Pa).
+    ltca: Optional[types.SimpleNamespace]
+    #: wear section values and records / positions / nodes (DataFrame), depth (FlankMap, m).
+    wear: Optional[types.SimpleNamespace]
+    rating: Optional[types.SimpleNamespace]
+    def table(self, name: str) -> Optional[pd.DataFrame]: ...
+    def write(self, directory: str | os.PathLike[str]) -> list[str]: ...
+
+def run(
+    gear: GearSet,
+    stages: Optional[Sequence[str]] = None,
+    *,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    map_position: int = 0,
+    progress: Optional[Callable[[str, dict], None]] = None,
+) -> Results: ...
+def sweep(
+    base: GearSet,
+    grid: Optional[Mapping[str, Sequence[Any]]] = None,
+    *,
+    cases: Optional[Sequence[Mapping[str, Any]]] = None,
+    stages: Optional[Sequence[str]] = None,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    output: str | os.PathLike[str] | None = None,
+    client: Any = None,
+) -> pd.DataFrame: ...
