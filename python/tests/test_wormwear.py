@@ -38,6 +38,14 @@ def files_of(directory):
     return {p.name: p.read_bytes() for p in d.iterdir() if p.is_file() and p.name != ".wormwear.lock"}
 
 
+def assert_same_files(one, other):
+    """The same files in two directories, byte for byte."""
+    a, b = files_of(one), files_of(other)
+    assert a.keys() == b.keys()
+    for name in a:
+        assert a[name] == b[name], name
+
+
 def assert_close(a, b, path="", rel=1e-12):
     """Two JSON values equal, numbers to `rel` relative."""
     if isinstance(a, dict):
@@ -75,10 +83,7 @@ def test_ltca_equals_the_cli_in_numbers_and_files(cli, design_file, tmp_path):
     # The radius grows up the tooth, z across the face.
     assert np.all(np.diff(pattern.r_mm[:, 30]) > 0) and np.all(np.diff(pattern.z_mm[20, :]) != 0)
     r.write(tmp_path / "py")
-    a, b = files_of(tmp_path / "cli"), files_of(tmp_path / "py")
-    assert a.keys() == b.keys()
-    for name in a:
-        assert a[name] == b[name], name
+    assert_same_files(tmp_path / "cli", tmp_path / "py")
 
 
 def test_a_run_with_a_life_equals_the_cli(cli, design_file, tmp_path):
@@ -94,10 +99,7 @@ def test_a_run_with_a_life_equals_the_cli(cli, design_file, tmp_path):
     # The wear map: depth zero where nothing wore, the maximum the records' last max_wear_m.
     assert math.isclose(np.nanmax(r.wear.depth.values), records["max_wear_m"].iloc[-1], rel_tol=1e-12)
     r.write(tmp_path / "py")
-    a, b = files_of(tmp_path / "cli"), files_of(tmp_path / "py")
-    assert a.keys() == b.keys()
-    for name in a:
-        assert a[name] == b[name], name
+    assert_same_files(tmp_path / "cli", tmp_path / "py")
 
 
 def test_input_errors_raise_with_the_cli_message_and_every_problem(cli, design_file, tmp_path):

@@ -110,3 +110,96 @@ pub fn backlash_from_csv(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
     let rows = read_table(path, &["cycles", "backlash_increase_um"])?;
     Ok(rows.iter().map(|r| (r[0], r[1] * 1e-6)).collect())
 }
+
+/// K by least squares on wear tests (`--tests`); returns the `calibration` section.
+pub fn from_tests(
+    gear: &GearSet,
+    path: &Path,
+    quiet: bool,
+) -> Result<serde_json::Value, crate::Failure> {
+    use crate::Failure;
+    let data = tests_from_csv(gear, path).map_err(Failure::Input)?;
+    let fit = calibration::fit_from_tests(&data, gear.wheel_material.hardness)
+        .map_err(|e| Failure::Input(anyhow::Error::new(e).context(path.display().to_string())))?;
+    if !quiet {
+        println!(
+            "K = {:.4e} from {} wear tests (relative rms residual {:.3})",
+            fit.k, fit.points, fit.relative_rms
+        );
+    }
+    Ok(serde_json::json!({
+        "method": "wear tests",
+        "data": path.display().to_string(),
+        "k": fit.k,
+        "relative_rms": fit.relative_rms,
+        "points": fit.points,
+    }))
+}
+
+/// K from a measured backlash curve (`--backlash`) through the life simulation: the curves
+/// side by side in `dir`; returns the `calibration` section.
+pub fn from_backlash(
+    gear: &GearSet,
+    file: &Path,
+    dir: &Path,
+    path: &Path,
+    no_pitting: bool,
+    quiet: bool,
+    verbose: bool,
+) -> Result<serde_json::Value, crate::Failure> {
+    use crate::Failure;
+    use calibration::CalibrationError;
+    let measured = backlash_from_csv(path).map_err(Failure::Input)?;
+    let last = measured.iter().map(|m| m.0).fold(0.0, f64::max);
+    let args = crate::LifeArgs {
+        cycles: Some(last.max(1.0)),
+        no_pitting,
+        ..Default::default()
+    };
+    let plan = crate::life_plan(gear, &args)?;
+    let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
+        if let (wormwear::Event::Bending(info), false) = (event, quiet) {
+            crate::print_bending(info);
+        }
+        Ok(())
+    };
+    let mut on_run = |run: usize, k: f64, records: &[wormwear::wear::StepRecord]| {
+        if verbose {
+            let b = records.last().map_or(0.0, |r| r.backlash_increase_m);
+            eprintln!(
+                "run {run}: K = {k:.5e}, backlash +{:.2} um at {} cycles",
+                b * 1e6,
+                wormwear::output::cycles_label(last)
+            );
+        }
+    };
+    let (fit, records, runs) =
+        calibration::fit_life_to_backlash(gear, &plan, &measured, &mut on_event, &mut on_run)
+            .map_err(|e| match e {
+                CalibrationError::Setup(wormwear::RunError::Geometry(_)) => Failure::Input(
+                    anyhow::Error::new(e).context(format!("geometry of {}", file.display())),
+                ),
+                CalibrationError::Simulation(_) | CalibrationError::Setup(_) => {
+                    Failure::Run(anyhow::Error::new(e))
+                }
+                _ => Failure::Input(anyhow::Error::new(e).context(path.display().to_string())),
+            })?;
+    wormwear::output::write_calibration_curves(dir, &measured, &records, fit.k)
+        .map_err(|e| Failure::Run(e.into()))?;
+    let k_start = gear.wheel_material.wear_coefficient;
+    if !quiet {
+        println!(
+            "K = {:.4e} from the backlash curve ({} points, {runs} life runs from K = {k_start:.3e}; relative rms residual {:.3})",
+            fit.k, fit.points, fit.relative_rms
+        );
+    }
+    Ok(serde_json::json!({
+        "method": "backlash curve",
+        "data": path.display().to_string(),
+        "k": fit.k,
+        "k_start": k_start,
+        "relative_rms": fit.relative_rms,
+        "points": fit.points,
+        "life_runs": runs,
+    }))
+}

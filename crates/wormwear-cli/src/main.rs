@@ -707,6 +707,7 @@ fn run(
     Ok(())
 }
 
+/// K from wear tests or from a backlash curve; writes the `calibration` section.
 fn calibrate(
     file: &Path,
     dir: &Path,
@@ -717,129 +718,12 @@ fn calibrate(
     verbose: bool,
 ) -> Result<(), Failure> {
     let gear = load(file)?;
-    let hardness = gear.wheel_material.hardness;
-    let section = if let Some(path) = tests {
-        let data = calibrate_cmd::tests_from_csv(&gear, path).map_err(Failure::Input)?;
-        let fit = wormwear::calibration::fit_from_tests(&data, hardness).map_err(|e| {
-            Failure::Input(anyhow::Error::new(e).context(path.display().to_string()))
-        })?;
-        if !quiet {
-            println!(
-                "K = {:.4e} from {} wear tests (relative rms residual {:.3})",
-                fit.k, fit.points, fit.relative_rms
-            );
+    let section = match (tests, backlash) {
+        (Some(path), _) => calibrate_cmd::from_tests(&gear, path, quiet)?,
+        (None, Some(path)) => {
+            calibrate_cmd::from_backlash(&gear, file, dir, path, no_pitting, quiet, verbose)?
         }
-        serde_json::json!({
-            "method": "wear tests",
-            "data": path.display().to_string(),
-            "k": fit.k,
-            "relative_rms": fit.relative_rms,
-            "points": fit.points,
-        })
-    } else {
-        let path = backlash.expect("clap requires --tests or --backlash");
-        let measured = calibrate_cmd::backlash_from_csv(path).map_err(Failure::Input)?;
-        let last = measured.iter().map(|m| m.0).fold(0.0, f64::max);
-        let args = LifeArgs {
-            cycles: Some(last.max(1.0)),
-            step_cycles: None,
-            step_wear_um: None,
-            no_pitting,
-            resume: false,
-        };
-        let plan = life_plan(&gear, &args)?;
-        let k_start = gear.wheel_material.wear_coefficient;
-        let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
-            if let (wormwear::Event::Bending(info), false) = (event, quiet) {
-                print_bending(info);
-            }
-            Ok(())
-        };
-        let mut on_run = |run: usize, k: f64, records: &[wormwear::wear::StepRecord]| {
-            if verbose {
-                let b = records.last().map_or(0.0, |r| r.backlash_increase_m);
-                eprintln!(
-                    "run {run}: K = {k:.5e}, backlash +{:.2} um at {} cycles",
-                    b * 1e6,
-                    wormwear::output::cycles_label(last)
-                );
-            }
-        };
-        let (fit, records, runs) = wormwear::calibration::fit_life_to_backlash(
-            &gear,
-            &plan,
-            &measured,
-            &mut on_event,
-            &mut on_run,
-        )
-        .map_err(|e| match e {
-            wormwear::calibration::CalibrationError::Setup(wormwear::RunError::Geometry(_)) => {
-                Failure::Input(
-                    anyhow::Error::new(e).context(format!("geometry of {}", file.display())),
-                )
-            }
-            wormwear::calibration::CalibrationError::Simulation(_)
-            | wormwear::calibration::CalibrationError::Setup(_) => {
-                Failure::Run(anyhow::Error::new(e))
-            }
-            _ => Failure::Input(anyhow::Error::new(e).context(path.display().to_string())),
-        })?;
-        // Measured and fitted curves side by side.
-        let mut csv = wormwear::output::Csv::new(&["cycles", "measured_um", "simulated_um"]);
-        let simulated: Vec<(f64, f64)> = records
-            .iter()
-            .map(|r| (r.cycles, r.backlash_increase_m))
-            .collect();
-        for &(c, b) in &measured {
-            let sim = wormwear::calibration::backlash_at(&records, c).unwrap_or(f64::NAN);
-            csv.row(&[c, b * 1e6, sim * 1e6]);
-        }
-        csv.write(&dir.join("calibration_backlash.csv"))
-            .map_err(|e| Failure::Run(e.into()))?;
-        let chart = |points: Vec<(f64, f64)>, label: &str, color: usize| wormwear::plot::Series {
-            label: label.into(),
-            points,
-            color,
-            bold: color == 1,
-        };
-        wormwear::plot::line_chart(
-            &dir.join("calibration_backlash.svg"),
-            &format!(
-                "Backlash increase: measured and simulated with K = {:.3e}",
-                fit.k
-            ),
-            "wheel cycles (millions)",
-            "backlash increase (um)",
-            &[
-                chart(
-                    simulated.iter().map(|s| (s.0 * 1e-6, s.1 * 1e6)).collect(),
-                    "simulated",
-                    1,
-                ),
-                chart(
-                    measured.iter().map(|s| (s.0 * 1e-6, s.1 * 1e6)).collect(),
-                    "measured",
-                    0,
-                ),
-            ],
-            false,
-        )
-        .map_err(|e| Failure::Run(e.into()))?;
-        if !quiet {
-            println!(
-                "K = {:.4e} from the backlash curve ({} points, {runs} life runs from K = {k_start:.3e}; relative rms residual {:.3})",
-                fit.k, fit.points, fit.relative_rms
-            );
-        }
-        serde_json::json!({
-            "method": "backlash curve",
-            "data": path.display().to_string(),
-            "k": fit.k,
-            "k_start": k_start,
-            "relative_rms": fit.relative_rms,
-            "points": fit.points,
-            "life_runs": runs,
-        })
+        (None, None) => unreachable!("clap requires --tests or --backlash"),
     };
     wormwear::output::update_summary(dir, "calibration", section)
         .map_err(|e| Failure::Run(e.into()))?;

@@ -38,7 +38,8 @@ pub mod wear;
 pub use runner::{Event, Request, Results, RunError, Source, Stage};
 
 /// Runs the stages `request` asks for on a validated gear (MODEL §0), reporting progress to
-/// `on_event` (an error from it stops the run); every stage runs the ones it needs first.
+/// `on_event` (an error from it stops the run); every stage runs the ones it needs first and
+/// is skipped when nothing asked for needs it.
 pub fn run(
     gear: &input::GearSet,
     source: Source,
@@ -46,52 +47,11 @@ pub fn run(
     on_event: &mut dyn FnMut(Event) -> Result<(), RunError>,
 ) -> Result<Results, RunError> {
     request.check(gear)?;
-    let mut warnings = Vec::new();
+    let mut pipeline = runner::Pipeline::new(gear, source, request, on_event);
     let geometry = geometry::Geometry::build(gear).map_err(RunError::Geometry)?;
-    let tca = match request.needs_tca() {
-        true => Some(kinematics::analyse(gear, &geometry).map_err(RunError::Tca)?),
-        false => None,
-    };
-    warnings.extend(tca.iter().flat_map(|t| t.warnings.iter().cloned()));
-    let (bending, bending_info) = match request.needs_bending() {
-        true => runner::bending_model(gear, &geometry, &mut warnings, on_event)?,
-        false => (None, None),
-    };
-    let ltca = match (request.has(Stage::Ltca), &tca) {
-        (true, Some(tca)) => {
-            on_event(Event::Stage(Stage::Ltca))?;
-            let bending = bending.as_ref();
-            Some(runner::loaded_analysis(
-                gear,
-                &geometry,
-                tca,
-                bending,
-                &mut warnings,
-            )?)
-        }
-        _ => None,
-    };
-    let life = match (request.has(Stage::Wear), &tca, &request.life) {
-        (true, Some(tca), Some(plan)) => {
-            on_event(Event::Stage(Stage::Wear))?;
-            let (bending, resume) = (bending.as_ref(), request.resume.clone());
-            Some(runner::life(
-                gear, &source, &geometry, tca, bending, plan, resume, on_event,
-            )?)
-        }
-        _ => None,
-    };
-    Ok(Results {
-        rating: request.needs_bending().then(|| rating::rate(gear)),
-        gear: gear.clone(),
-        source,
-        stages: request.stages,
-        map_position: request.map_position,
-        geometry,
-        tca,
-        bending: bending_info,
-        ltca,
-        life,
-        warnings,
-    })
+    let tca = pipeline.unloaded_analysis(&geometry)?;
+    let bending = pipeline.bending_model(&geometry)?;
+    let ltca = pipeline.loaded_analysis(&geometry, tca.as_ref(), &bending)?;
+    let life = pipeline.life(&geometry, tca.as_ref(), &bending)?;
+    Ok(pipeline.results(geometry, tca, bending, ltca, life))
 }

@@ -379,6 +379,120 @@ impl RunError {
     }
 }
 
+/// A run in progress ([`crate::run`]): the gear, the request, the event handler and the
+/// warnings so far; each step runs its stage when the request needs it.
+pub(crate) struct Pipeline<'a> {
+    gear: &'a GearSet,
+    source: Source,
+    request: Request,
+    on_event: &'a mut dyn FnMut(Event) -> Result<(), RunError>,
+    warnings: Vec<String>,
+}
+
+/// The bending model of a run (None without bending or without a loaded stage).
+pub(crate) struct Bending {
+    model: Option<FeBending>,
+    info: Option<BendingInfo>,
+}
+
+impl<'a> Pipeline<'a> {
+    pub(crate) fn new(
+        gear: &'a GearSet,
+        source: Source,
+        request: Request,
+        on_event: &'a mut dyn FnMut(Event) -> Result<(), RunError>,
+    ) -> Self {
+        Self {
+            gear,
+            source,
+            request,
+            on_event,
+            warnings: Vec::new(),
+        }
+    }
+
+    /// The unloaded meshing analysis (MODEL §4), when a stage needs it.
+    pub(crate) fn unloaded_analysis(&mut self, geo: &Geometry) -> Result<Option<Tca>, RunError> {
+        if !self.request.needs_tca() {
+            return Ok(None);
+        }
+        let tca = crate::kinematics::analyse(self.gear, geo).map_err(RunError::Tca)?;
+        self.warnings.extend(tca.warnings.iter().cloned());
+        Ok(Some(tca))
+    }
+
+    /// The bending model (MODEL §5.5), when a loaded stage needs it.
+    pub(crate) fn bending_model(&mut self, geo: &Geometry) -> Result<Bending, RunError> {
+        let (model, info) = match self.request.needs_bending() {
+            true => bending_model(self.gear, geo, &mut self.warnings, self.on_event)?,
+            false => (None, None),
+        };
+        Ok(Bending { model, info })
+    }
+
+    /// The unworn loaded analysis (MODEL §5), when asked for.
+    pub(crate) fn loaded_analysis(
+        &mut self,
+        geo: &Geometry,
+        tca: Option<&Tca>,
+        bending: &Bending,
+    ) -> Result<Option<Ltca>, RunError> {
+        let Some(tca) = tca.filter(|_| self.request.has(Stage::Ltca)) else {
+            return Ok(None);
+        };
+        (self.on_event)(Event::Stage(Stage::Ltca))?;
+        let model = bending.model.as_ref();
+        loaded_analysis(self.gear, geo, tca, model, &mut self.warnings).map(Some)
+    }
+
+    /// The life (MODEL §7-8), when asked for.
+    pub(crate) fn life(
+        &mut self,
+        geo: &Geometry,
+        tca: Option<&Tca>,
+        bending: &Bending,
+    ) -> Result<Option<Life>, RunError> {
+        let (Some(tca), Some(plan), true) = (
+            tca,
+            self.request.life.as_ref(),
+            self.request.has(Stage::Wear),
+        ) else {
+            return Ok(None);
+        };
+        (self.on_event)(Event::Stage(Stage::Wear))?;
+        let (gear, source, resume) = (self.gear, &self.source, self.request.resume.clone());
+        let model = bending.model.as_ref();
+        life(gear, source, geo, tca, model, plan, resume, self.on_event).map(Some)
+    }
+
+    /// The results of the run, with the ratings (MODEL §9) beside a loaded stage.
+    pub(crate) fn results(
+        self,
+        geometry: Geometry,
+        tca: Option<Tca>,
+        bending: Bending,
+        ltca: Option<Ltca>,
+        life: Option<Life>,
+    ) -> Results {
+        Results {
+            rating: self
+                .request
+                .needs_bending()
+                .then(|| crate::rating::rate(self.gear)),
+            gear: self.gear.clone(),
+            source: self.source,
+            stages: self.request.stages,
+            map_position: self.request.map_position,
+            geometry,
+            tca,
+            bending: bending.info,
+            ltca,
+            life,
+            warnings: self.warnings,
+        }
+    }
+}
+
 /// The bending model the gear asks for (`[bending] model`), from the cache or the FE build;
 /// reported as an event, its cache warnings added to `warnings`.
 pub(crate) fn bending_model(

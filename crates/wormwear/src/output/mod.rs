@@ -304,6 +304,45 @@ pub fn summary_sections(
     Ok(map)
 }
 
+/// The measured and the simulated backlash curves of a calibration (MODEL §10), side by side:
+/// `calibration_backlash.csv` (cycles, measured and simulated at the measured cycles, um) and
+/// `calibration_backlash.svg`. `measured`: (wheel cycles, backlash increase m); `k`: the fit.
+pub fn write_calibration_curves(
+    dir: &Path,
+    measured: &[(f64, f64)],
+    records: &[crate::wear::StepRecord],
+    k: f64,
+) -> Result<(), OutputError> {
+    let mut csv = Csv::new(&["cycles", "measured_um", "simulated_um"]);
+    for &(c, b) in measured {
+        let sim = crate::calibration::backlash_at(records, c).unwrap_or(f64::NAN);
+        csv.row(&[c, b * 1e6, sim * 1e6]);
+    }
+    csv.write(&dir.join("calibration_backlash.csv"))?;
+    let series = |points: Vec<(f64, f64)>, label: &str, color: usize| crate::plot::Series {
+        label: label.into(),
+        points,
+        color,
+        bold: color == 1,
+    };
+    let simulated = records
+        .iter()
+        .map(|r| (r.cycles * 1e-6, r.backlash_increase_m * 1e6))
+        .collect();
+    let measured = measured.iter().map(|s| (s.0 * 1e-6, s.1 * 1e6)).collect();
+    crate::plot::line_chart(
+        &dir.join("calibration_backlash.svg"),
+        &format!("Backlash increase: measured and simulated with K = {k:.3e}"),
+        "wheel cycles (millions)",
+        "backlash increase (um)",
+        &[
+            series(simulated, "simulated", 1),
+            series(measured, "measured", 0),
+        ],
+        false,
+    )
+}
+
 /// A value as JSON for the section `what` of summary.json.
 fn to_json(what: &str, value: &impl serde::Serialize) -> Result<serde_json::Value, OutputError> {
     serde_json::to_value(value).map_err(|e| OutputError::Encode {
