@@ -28,6 +28,7 @@ pub mod kinematics;
 pub mod ltca;
 pub mod lubrication;
 pub mod output;
+pub mod pitting;
 pub mod plot;
 pub mod rating;
 pub mod runner;

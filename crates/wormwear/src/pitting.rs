@@ -1,0 +1,169 @@
+//! Fatigue damage of the wheel flank for a pitting forecast (issue 21; MODEL §8, "beyond the
+//! schedule-driven version"): the first piece, the damage law of one flank cell. The life loop
+//! does not use it yet.
+//!
+//! **Damage.** A cell loaded each cycle at the pressure p gathers 1 / N(p) of damage per cycle
+//! (Miner's rule). N(p) is the life on the bronze pressure–life curve
+//! p_lim(N) = p_ref (N / N_ref)^-b, inverted ([`Endurance::life`]).
+//!
+//! **Wear carries damage away.** The damage lives in the layer above the depth of the largest
+//! sub-surface shear stress, h = 0.78 a (MODEL §12 g), and is taken as uniform over it. Wear
+//! at w per cycle removes a slice w of that layer, and the layer gains w of fresh material at
+//! its bottom, so the damage falls by the fraction w / h:
+//!
+//!   dD/dN = r - D w / h,    r = 1 / N(p).
+//!
+//! With r, w and h constant over a step, the exact solution is
+//! D(N) = D* + (D0 - D*) exp(-N w / h), with the steady damage D* = r h / w. A cell whose
+//! steady damage stays below 1 wears faster than it accumulates damage, and it never pits; the
+//! published observation that wear and pitting compete. With w = 0 the damage grows
+//! linearly, D0 + r N, and a cell at constant pressure pits after exactly N(p) cycles.
+
+use crate::input::Endurance;
+
+impl Endurance {
+    /// Life at the pressure `p` on the pressure–life curve, cycles:
+    /// N = N_ref (p / p_ref)^(-1/b). Infinite for p <= 0 (an unloaded cell never pits).
+    pub fn life(&self, p: f64) -> f64 {
+        if p <= 0.0 {
+            return f64::INFINITY;
+        }
+        self.reference_cycles * (p / self.reference_pressure).powf(-1.0 / self.exponent)
+    }
+}
+
+/// The damage state of one cell over a step: the rate of damage per cycle, the wear per cycle
+/// (m) and the damaged layer's thickness (m), all constant over the step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellLoad {
+    /// Damage per cycle, 1 / N(p).
+    pub damage_rate: f64,
+    /// Wear depth per cycle, m (>= 0).
+    pub wear_rate: f64,
+    /// Damaged layer thickness 0.78 a, m (> 0).
+    pub layer: f64,
+}
+
+impl CellLoad {
+    /// The load of a cell at pressure `p` (Pa) on `curve`, wearing `wear_rate` m per cycle,
+    /// with a damaged layer `layer` m thick.
+    pub fn new(curve: &Endurance, p: f64, wear_rate: f64, layer: f64) -> Self {
+        Self {
+            damage_rate: 1.0 / curve.life(p),
+            wear_rate: wear_rate.max(0.0),
+            layer,
+        }
+    }
+
+    /// The steady damage r h / w that wear holds the cell at (infinite without wear).
+    pub fn steady_damage(&self) -> f64 {
+        if self.wear_rate > 0.0 {
+            self.damage_rate * self.layer / self.wear_rate
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Damage after `cycles` cycles from `d0`: the exact solution of dD/dN = r - D w / h.
+    pub fn damage_after(&self, d0: f64, cycles: f64) -> f64 {
+        if self.wear_rate <= 0.0 {
+            return d0 + self.damage_rate * cycles;
+        }
+        let steady = self.steady_damage();
+        // D* + (D0 - D*) e^{-x}, written with expm1 so that a short step keeps its digits.
+        let x = cycles * self.wear_rate / self.layer;
+        d0 - (d0 - steady) * (-(-x).exp_m1())
+    }
+
+    /// Cycles from the damage `d0` until the cell pits (damage 1): None if it never does
+    /// (steady damage at or below 1, or no damage rate); 0 if it has already.
+    pub fn cycles_to_pit(&self, d0: f64) -> Option<f64> {
+        if d0 >= 1.0 {
+            return Some(0.0);
+        }
+        if self.damage_rate <= 0.0 {
+            return None;
+        }
+        if self.wear_rate <= 0.0 {
+            return Some((1.0 - d0) / self.damage_rate);
+        }
+        let steady = self.steady_damage();
+        if steady <= 1.0 {
+            return None;
+        }
+        // e^{-N w/h} = (D* - 1) / (D* - D0)
+        Some(-(self.layer / self.wear_rate) * ((steady - 1.0) / (steady - d0)).ln())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CURVE: Endurance = Endurance::DEFAULT;
+
+    #[test]
+    fn the_life_inverts_the_pressure_life_curve() {
+        for n in [1e5, 7e5, 11e6, 3e8] {
+            let p = CURVE.pressure(n);
+            assert!((CURVE.life(p) / n - 1.0).abs() < 1e-12, "{n}");
+        }
+        // The published points: 425 MPa at 11e6 cycles; higher pressure, shorter life.
+        assert!((CURVE.life(425e6) / 11e6 - 1.0).abs() < 1e-12);
+        assert!(CURVE.life(700e6) < CURVE.life(425e6));
+        assert_eq!(CURVE.life(0.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_cell_at_constant_pressure_without_wear_pits_at_the_curves_life() {
+        for p in [450e6, 538e6, 700e6] {
+            let cell = CellLoad::new(&CURVE, p, 0.0, 50e-6);
+            let n = cell.cycles_to_pit(0.0).unwrap();
+            assert!((n / CURVE.life(p) - 1.0).abs() < 1e-12, "{p}");
+            assert!((cell.damage_after(0.0, n) - 1.0).abs() < 1e-12);
+            // Miner: half the life at this pressure leaves half the damage to go.
+            let half = cell.damage_after(0.0, 0.5 * n);
+            assert!((cell.cycles_to_pit(half).unwrap() / (0.5 * n) - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_cell_that_wears_faster_than_it_accumulates_damage_never_pits() {
+        // At 500 MPa the life is 4.37e6 cycles; a 40 um layer worn at 1e-11 m per cycle
+        // (4e6 cycles to wear through it) holds the damage at r h / w = 0.92.
+        let cell = CellLoad::new(&CURVE, 500e6, 1e-11, 40e-6);
+        let steady = cell.steady_damage();
+        assert!(steady < 1.0, "{steady}");
+        assert_eq!(cell.cycles_to_pit(0.0), None);
+        let mut d = 0.0;
+        for _ in 0..1000 {
+            d = cell.damage_after(d, 1e6);
+            assert!(d < steady + 1e-15, "{d}");
+        }
+        assert!(
+            (d - steady).abs() < 1e-12,
+            "tends to the steady damage: {d}"
+        );
+        // Slower wear (steady damage 1.83): the cell pits, later than without wear.
+        let slow = CellLoad::new(&CURVE, 500e6, 0.5e-11, 40e-6);
+        let n = slow.cycles_to_pit(0.0).unwrap();
+        assert!(n > CURVE.life(500e6));
+        assert!((slow.damage_after(0.0, n) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn steps_compose_so_the_damage_does_not_depend_on_the_step_size() {
+        let cell = CellLoad::new(&CURVE, 600e6, 2e-12, 30e-6);
+        let whole = cell.damage_after(0.1, 3e6);
+        let mut d = 0.1;
+        for _ in 0..300 {
+            d = cell.damage_after(d, 1e4);
+        }
+        assert!((d / whole - 1.0).abs() < 1e-12, "{d} {whole}");
+        // A damaged cell that starts above its steady damage heals towards it (wear removes
+        // the damaged layer faster than damage builds).
+        let fast = CellLoad::new(&CURVE, 450e6, 1e-10, 30e-6);
+        assert!(fast.damage_after(0.9, 1e5) < 0.9);
+        assert_eq!(fast.cycles_to_pit(1.0), Some(0.0));
+    }
+}
