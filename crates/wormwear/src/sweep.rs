@@ -618,6 +618,48 @@ fn finished_row(
     (finished.fingerprint == expected && finished.row.ok).then_some(finished.row)
 }
 
+/// One gear per distinct FE bending model the variants need (by cache key, in variant
+/// order): the variants whose loaded stages use `[bending] model = "fe"`. Variants that do
+/// not load are left to report their own errors.
+pub fn distinct_bending_models(sweep: &Sweep, wanted: &dyn Fn(&Variant) -> bool) -> Vec<GearSet> {
+    let loaded = sweep.settings.stages.contains(&Stage::Ltca)
+        || sweep.settings.stages.contains(&Stage::Wear);
+    let mut keys = BTreeSet::new();
+    let mut gears = Vec::new();
+    for variant in sweep.variants.iter().filter(|v| loaded && wanted(v)) {
+        let Ok(gear) =
+            variant_document(&sweep.base, variant).and_then(|d| input::load_document(&d))
+        else {
+            continue;
+        };
+        if gear.bending.kind == crate::input::BendingKind::Fe
+            && keys.insert(crate::bending::model::cache_key(&gear))
+        {
+            gears.push(gear);
+        }
+    }
+    gears
+}
+
+/// Builds (or reads) the FE bending models of the variants into the cache, one after the
+/// other, before the variants run side by side: variants that share a model would otherwise
+/// each build it on a cold cache (a waste of the build time and twice the memory). Failures
+/// are left for the variants to report.
+fn warm_bending_cache(
+    sweep: &Sweep,
+    wanted: &dyn Fn(&Variant) -> bool,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) {
+    for gear in distinct_bending_models(sweep, wanted) {
+        if interrupt() {
+            return;
+        }
+        if let Ok(geo) = crate::geometry::Geometry::build(&gear) {
+            let _ = crate::bending::model::build(&gear, &geo);
+        }
+    }
+}
+
 /// What [`run`] reports as variants finish: the row, whether it was reused from an earlier
 /// run, and how many of how many are done.
 pub struct Progress<'a> {
@@ -639,6 +681,9 @@ pub fn run(
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<Row>, SweepError> {
     use rayon::prelude::*;
+    let unfinished =
+        |v: &Variant| finished_row(&variant_dir(dir, v), &sweep.base, v, &sweep.settings).is_none();
+    warm_bending_cache(sweep, &unfinished, interrupt);
     let total = sweep.variants.len();
     let rows: std::sync::Mutex<Vec<Option<Row>>> = std::sync::Mutex::new(vec![None; total]);
     sweep.variants.par_iter().enumerate().try_for_each(
@@ -689,6 +734,7 @@ pub fn run_in_memory(
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Vec<Row> {
     use rayon::prelude::*;
+    warm_bending_cache(sweep, &|_| true, interrupt);
     let total = sweep.variants.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
     sweep

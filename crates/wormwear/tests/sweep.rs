@@ -6,7 +6,9 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use wormwear::input;
 use wormwear::runner::LifeOverrides;
-use wormwear::sweep::{grid_variants, run, Row, Sweep, Variant, VARIANT_FILE};
+use wormwear::sweep::{
+    distinct_bending_models, grid_variants, run, Row, Sweep, Variant, VARIANT_FILE,
+};
 
 /// The design example, fast: no bending, 6 positions, a coarser flank grid.
 fn fast_base() -> toml::Table {
@@ -249,4 +251,43 @@ fn sweep_files_give_their_errors_with_the_field() {
         sweep.parameters,
         ["conditions.worm_torque_nm", "conditions.worm_speed_rpm"]
     );
+}
+
+/// The FE bending models a sweep builds before its variants run side by side: one per cache
+/// key (the torque does not enter it, the hob does), none without FE bending or without a
+/// loaded stage, none for invalid variants.
+#[test]
+fn a_sweep_builds_each_bending_model_once_before_its_variants() {
+    let mut base = fast_base();
+    input::set_dotted(&mut base, "bending.model", Some("fe".into())).unwrap();
+    let grid: toml::Table = toml::from_str(
+        r#""conditions.worm_torque_nm" = [30.0, 60.0, -1.0]
+           "hob.tip_radius_mm" = [31.95, 31.5]"#,
+    )
+    .unwrap();
+    let (parameters, variants) = grid_variants(&grid).unwrap();
+    let sweep_of = |base: &toml::Table, stages: &[&str]| {
+        let stages: Vec<String> = stages.iter().map(|s| s.to_string()).collect();
+        let (p, v) = (parameters.clone(), variants.clone());
+        Sweep::new(
+            "fe".into(),
+            base.clone(),
+            p,
+            v,
+            Some(&stages),
+            LifeOverrides::default(),
+        )
+        .unwrap()
+    };
+    let all = |_: &Variant| true;
+    let models = distinct_bending_models(&sweep_of(&base, &["ltca"]), &all);
+    assert_eq!(models.len(), 2, "two hobs, any torque");
+    assert_ne!(models[0].hob, models[1].hob);
+    let only_first = |v: &Variant| v.name == "v1";
+    assert_eq!(
+        distinct_bending_models(&sweep_of(&base, &["ltca"]), &only_first).len(),
+        1
+    );
+    assert!(distinct_bending_models(&sweep_of(&base, &["tca"]), &all).is_empty());
+    assert!(distinct_bending_models(&sweep_of(&fast_base(), &["ltca"]), &all).is_empty());
 }
