@@ -371,8 +371,8 @@ pub struct Csv {
     text: String,
     columns: usize,
     header: Vec<String>,
-    /// The numbers of the rows added with [`Csv::row`], at full precision.
-    rows: Vec<Vec<f64>>,
+    /// The numbers of the rows added with [`Csv::row`], at full precision, row after row.
+    numbers: Vec<f64>,
 }
 
 impl Csv {
@@ -382,7 +382,7 @@ impl Csv {
             text: header.join(",") + "\n",
             columns: header.len(),
             header: header.iter().map(|h| h.to_string()).collect(),
-            rows: Vec::new(),
+            numbers: Vec::new(),
         }
     }
 
@@ -395,7 +395,14 @@ impl Csv {
     /// rows with a label ([`Csv::labelled_row`]) are not among them.
     pub fn columns(&self) -> Vec<Vec<f64>> {
         (0..self.columns)
-            .map(|k| self.rows.iter().map(|r| r[k]).collect())
+            .map(|k| {
+                self.numbers
+                    .iter()
+                    .skip(k)
+                    .step_by(self.columns.max(1))
+                    .copied()
+                    .collect()
+            })
             .collect()
     }
 
@@ -408,7 +415,7 @@ impl Csv {
     /// counts) are written as integers, the rest with 11 significant digits.
     pub fn row(&mut self, values: &[f64]) {
         debug_assert_eq!(values.len(), self.columns);
-        self.rows.push(values.to_vec());
+        self.numbers.extend_from_slice(values);
         for (k, v) in values.iter().enumerate() {
             if k > 0 {
                 self.text.push(',');
@@ -440,6 +447,21 @@ impl Csv {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_table_keeps_its_numbers_exactly_and_writes_them_rounded() {
+        let mut csv = Csv::new(&["i", "x_m"]);
+        let xs = [0.1 + 0.2, std::f64::consts::PI * 1e-7, -2.5e9];
+        for (i, x) in xs.iter().enumerate() {
+            csv.row(&[i as f64, *x]);
+        }
+        assert_eq!(csv.header(), ["i", "x_m"]);
+        assert_eq!(csv.columns(), vec![vec![0.0, 1.0, 2.0], xs.to_vec()]);
+        for (line, x) in csv.text().lines().skip(1).zip(xs) {
+            let written: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
+            assert!((written / x - 1.0).abs() < 1e-10, "{line}");
+        }
+    }
 
     #[test]
     fn cycle_labels_read_easily() {
