@@ -1,6 +1,6 @@
-//! Fatigue damage of the wheel flank for a pitting forecast (issue 21; MODEL §8, "beyond the
-//! schedule-driven version"): the first piece, the damage law of one flank cell. The life loop
-//! does not use it yet.
+//! Fatigue damage of the wheel flank for a pitting forecast (MODEL §8, "beyond the
+//! schedule-driven version", and §12 n): the damage law of one flank cell. The life loop
+//! applies it at every node of the loaded flank (`wear::forecast`).
 //!
 //! **Damage.** A cell loaded each cycle at the pressure p gathers 1 / N(p) of damage per cycle
 //! (Miner's rule). N(p) is the life on the bronze pressure–life curve
@@ -23,12 +23,15 @@ use crate::input::Endurance;
 
 impl Endurance {
     /// Life at the pressure `p` on the pressure–life curve, cycles:
-    /// N = N_ref (p / p_ref)^(-1/b). Infinite for p <= 0 (an unloaded cell never pits).
+    /// N = f N_ref (p / p_ref)^(-1/b), f the life factor. Infinite for p <= 0 (an unloaded
+    /// cell never pits).
     pub fn life(&self, p: f64) -> f64 {
         if p <= 0.0 {
             return f64::INFINITY;
         }
-        self.reference_cycles * (p / self.reference_pressure).powf(-1.0 / self.exponent)
+        self.life_factor
+            * self.reference_cycles
+            * (p / self.reference_pressure).powf(-1.0 / self.exponent)
     }
 }
 
@@ -112,6 +115,14 @@ mod tests {
         assert!((CURVE.life(425e6) / 11e6 - 1.0).abs() < 1e-12);
         assert!(CURVE.life(700e6) < CURVE.life(425e6));
         assert_eq!(CURVE.life(0.0), f64::INFINITY);
+        // The life factor moves the curve along the life axis: the same pressure lasts f
+        // times as long, and the pressure of a life f N is that of N on the fitted curve.
+        let low = Endurance {
+            life_factor: 0.4,
+            ..CURVE
+        };
+        assert!((low.life(500e6) / CURVE.life(500e6) - 0.4).abs() < 1e-12);
+        assert!((low.pressure(0.4 * 3e6) / CURVE.pressure(3e6) - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -229,6 +229,7 @@ impl LifeOverrides {
         }
         if self.no_pitting {
             plan.phases.retain(|p| matches!(p, Phase::Wear { .. }));
+            plan.pitting = crate::input::Pitting::Off;
         }
         Ok(plan)
     }

@@ -231,12 +231,20 @@ pub enum Phase {
     },
 }
 
-/// Power-law pressure-life curve p_lim(N) = p_ref (N / N_ref)^-exponent (Pa, cycles).
+/// Power-law pressure-life curve p_lim(N) = p_ref (N / (f N_ref))^-exponent (Pa, cycles),
+/// with f the curve's position within its scatter band as a factor on the life axis.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Endurance {
     pub reference_pressure: f64,
     pub reference_cycles: f64,
     pub exponent: f64,
+    /// Factor on the life axis (1: the fitted curve; < 1 towards the band's lower edge).
+    #[serde(default = "one")]
+    pub life_factor: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 impl Endurance {
@@ -245,11 +253,13 @@ impl Endurance {
         reference_pressure: 425e6,
         reference_cycles: 11e6,
         exponent: 0.176,
+        life_factor: 1.0,
     };
 
     /// Endurance pressure for a life of n cycles, Pa.
     pub fn pressure(&self, n: f64) -> f64 {
-        self.reference_pressure * (n / self.reference_cycles).powf(-self.exponent)
+        self.reference_pressure
+            * (n / (self.life_factor * self.reference_cycles)).powf(-self.exponent)
     }
 }
 
@@ -277,6 +287,25 @@ pub enum PitDepth {
     LoadedBand,
 }
 
+/// How pitting enters a life (MODEL §8, §12 n).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Pitting {
+    /// The published coupling: at the start of each pitting phase of the schedule the pits
+    /// are cut where the loaded pattern exceeds the phase's limit; no wear in the phase.
+    Schedule,
+    /// No pitting: the schedule's pitting phases are dropped.
+    Off,
+    /// Pits from the fatigue damage of every flank node ([`crate::pitting`]): a node pits
+    /// when its damage reaches 1, in any phase; the schedule's pitting phases only stop the
+    /// wear. With the phases a forecast found it repeats the forecast.
+    Damage,
+    /// Pits from the damage as with `Damage`, and the phases found from them: a pit forming
+    /// in a wear phase starts a pitting phase (no wear), which ends when its pits re-enter
+    /// contact.
+    Forecast,
+}
+
 /// Which wear limit ends a life before its cycles (MODEL §9 (a), (d)); the pointed tip ends
 /// it in any case (no tooth is left to wear past it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -300,6 +329,11 @@ pub struct WearPlan {
     pub max_substep_removal: f64,
     /// Phase schedule (empty: wear all along).
     pub phases: Vec<Phase>,
+    /// Schedule, off, damage, or forecast.
+    pub pitting: Pitting,
+    /// Forecast: share of the active flank whose damage must have reached 1 for a pitting
+    /// phase to start (default 0.02; 0: the first node).
+    pub pitting_onset_share: f64,
     pub endurance: Endurance,
     /// Line load of the film formula.
     pub film_load: FilmLoad,
@@ -324,6 +358,8 @@ impl WearPlan {
             step: StepControl::MaxRemoval(4e-6),
             max_substep_removal: 5e-6,
             phases: Vec::new(),
+            pitting: Pitting::Schedule,
+            pitting_onset_share: 0.02,
             endurance: Endurance::DEFAULT,
             film_load: FilmLoad::LoadedAnalysis,
             pit_depth: PitDepth::Hertz,

@@ -107,6 +107,16 @@ pub struct WearSpec {
     /// Phase schedule (MODEL §8): wear and pitting phases, each until a number of cycles.
     #[serde(default)]
     pub phases: Vec<PhaseSpec>,
+    /// How pitting enters the life (MODEL §8, §12 n): "schedule" (default; the published
+    /// coupling: pits cut above each pitting phase's limit), "off", "damage" (pits where a
+    /// node's fatigue damage reaches 1; the schedule's pitting phases stop the wear) or
+    /// "forecast" (pits from the damage, and the phases found from them).
+    #[serde(default)]
+    pub pitting: Option<String>,
+    /// Forecast: share of the active flank whose damage must have reached 1 for a pitting
+    /// phase to start, % (default 2; 0: the first node).
+    #[serde(default)]
+    pub pitting_onset_percent: Option<f64>,
     /// Bronze pressure-life curve p_lim(N) = p_ref (N / N_ref)^-exponent (default: MODEL §8).
     #[serde(default)]
     pub endurance: Option<EnduranceSpec>,
@@ -160,6 +170,10 @@ pub struct EnduranceSpec {
     pub reference_cycles: f64,
     #[serde(default = "default_exponent")]
     pub exponent: f64,
+    /// The curve's position within its scatter band: a factor on the life axis (default 1;
+    /// `wormwear calibrate --backlash` fits it with a forecast).
+    #[serde(default)]
+    pub life_factor: Option<f64>,
 }
 
 fn default_reference_pressure_mpa() -> f64 {

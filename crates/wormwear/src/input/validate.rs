@@ -1346,11 +1346,18 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
                 "cycles",
             );
             let x = ck.range("wear.endurance.exponent", e.exponent, 0.0, 5.0, "");
-            match (p, n, x) {
-                (Some(p), Some(n), Some(x)) => Some(Endurance {
+            let f = ck.positive(
+                "wear.endurance.life_factor",
+                e.life_factor.unwrap_or(1.0),
+                100.0,
+                "",
+            );
+            match (p, n, x, f) {
+                (Some(p), Some(n), Some(x), Some(f)) => Some(Endurance {
                     reference_pressure: p * 1e6,
                     reference_cycles: n,
                     exponent: x,
+                    life_factor: f,
                 }),
                 _ => None,
             }
@@ -1414,6 +1421,27 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     }
     if !ok {
         return None;
+    }
+    let pitting = pitting_mode(ck, w, &w.phases);
+    let onset = match w.pitting_onset_percent {
+        Some(v) if pitting.is_some() && pitting != Some(Pitting::Forecast) => {
+            ck.fail(
+                "wear.pitting_onset_percent",
+                v,
+                "only a forecast (wear.pitting = \"forecast\") takes a pitting onset share",
+            );
+            None
+        }
+        v => ck.range(
+            "wear.pitting_onset_percent",
+            v.unwrap_or(2.0),
+            0.0,
+            100.0,
+            "%",
+        ),
+    };
+    if pitting == Some(Pitting::Off) {
+        phases.retain(|p| matches!(p, Phase::Wear { .. }));
     }
     let guard = ck.range(
         "wear.max_substep_wear_um",
@@ -1479,6 +1507,8 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         step: step?,
         max_substep_removal: guard? * 1e-6,
         phases,
+        pitting: pitting?,
+        pitting_onset_share: onset? * 1e-2,
         endurance: endurance?,
         film_load: film_load?,
         pit_depth: pit_depth?,
@@ -1486,6 +1516,43 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         stop_at: stop_at?,
         backlash_limit: backlash_limit?,
     })
+}
+
+/// `wear.pitting` (MODEL §8, §12 n): a forecast finds its own pitting phases, so it takes
+/// none from the schedule; pits from the damage take no pressure limit.
+fn pitting_mode(ck: &mut Checker, w: &WearSpec, phases: &[PhaseSpec]) -> Option<Pitting> {
+    let mode = ck.choice(
+        "wear.pitting",
+        w.pitting.as_deref().unwrap_or("schedule"),
+        &[
+            ("schedule", Pitting::Schedule),
+            ("off", Pitting::Off),
+            ("damage", Pitting::Damage),
+            ("forecast", Pitting::Forecast),
+        ],
+    )?;
+    for (k, p) in phases.iter().enumerate() {
+        let field = |f: &str| format!("wear.phases[{k}].{f}");
+        if mode == Pitting::Forecast && p.kind == "pitting" {
+            ck.fail(
+                &field("kind"),
+                "pitting",
+                "a forecast (wear.pitting = \"forecast\") finds its own pitting phases: remove \
+                 them from the schedule or use wear.pitting = \"schedule\" or \"damage\"",
+            );
+            return None;
+        }
+        if mode == Pitting::Damage && (p.pressure_limit_mpa.is_some() || p.margin.is_some()) {
+            ck.fail(
+                &field("pressure_limit_mpa"),
+                p.pressure_limit_mpa.or(p.margin).unwrap_or_default(),
+                "pits from the damage (wear.pitting = \"damage\") take no pressure limit or \
+                 margin: they form where a node's damage reaches 1",
+            );
+            return None;
+        }
+    }
+    Some(mode)
 }
 
 fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {

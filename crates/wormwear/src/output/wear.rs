@@ -37,6 +37,8 @@ struct CheckpointOut<'a> {
     pitted: &'a [bool],
     band_factor: Option<f64>,
     warm: Option<&'a crate::ltca::WarmStart>,
+    damage: &'a [f64],
+    found_phases: &'a [crate::wear::Phase],
     record_count: usize,
     /// The inputs the states were computed with ([`life_inputs`]).
     inputs: Option<&'a serde_json::Value>,
@@ -56,6 +58,10 @@ struct CheckpointIn {
     band_factor: Option<f64>,
     #[serde(default)]
     warm: Option<crate::ltca::WarmStart>,
+    #[serde(default)]
+    damage: Vec<f64>,
+    #[serde(default)]
+    found_phases: Vec<crate::wear::Phase>,
     #[serde(default)]
     record_count: Option<usize>,
     #[serde(default)]
@@ -82,6 +88,13 @@ pub struct WearSummary<'a> {
     pub max_pressure_definition: &'static str,
     /// The wear limits and where the life reached them.
     pub limits: LimitsSummary,
+    /// How pitting entered the life (schedule, off, forecast with its margin).
+    pub pitting: crate::input::Pitting,
+    /// The phases of the life as they happened (consecutive states of one kind joined).
+    pub phases: Vec<crate::wear::forecast::PhaseSpan>,
+    /// The schedule a forecast found (its phases with their pressure limits; run it as a
+    /// `[wear] phases` schedule to repeat the life); empty without a forecast.
+    pub found_phases: &'a [crate::wear::Phase],
     /// One record per state: the start and after each step (per-position curves in
     /// `wear_positions.csv`).
     pub steps: Vec<crate::wear::StepRecord>,
@@ -275,6 +288,8 @@ pub fn read_resume(
             warm: c.warm,
             // Recomputed with the state's record on resume.
             stopped: None,
+            damage: c.damage,
+            found_phases: c.found_phases,
         },
         c.inputs,
     )))
@@ -498,6 +513,8 @@ impl LifeWriter {
             pitted: &state.pitted,
             band_factor: state.band_factor,
             warm: state.warm.as_ref(),
+            damage: &state.damage,
+            found_phases: &state.found_phases,
             record_count: state.records.len(),
             inputs: self.inputs.as_ref(),
         };
@@ -783,6 +800,9 @@ pub fn summary_value(
         loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
         max_pressure_definition: MAX_PRESSURE_DEFINITION,
         limits: LimitsSummary::new(gear, geo, tca, plan, state),
+        pitting: plan.pitting,
+        phases: crate::wear::forecast::phase_spans(&state.records),
+        found_phases: &state.found_phases,
         steps: state
             .records
             .iter()
@@ -815,6 +835,7 @@ pub fn node_table(
         "wear_per_cycle_m",
         "lambda",
         "film_m",
+        "damage",
     ]);
     for j in 0..=wf.cells_face {
         for i in 0..=wf.cells_height {
@@ -829,6 +850,7 @@ pub fn node_table(
                 cycle.depth.values[k],
                 cycle.lambda.values[k],
                 cycle.film.values[k],
+                state.damage.get(k).copied().unwrap_or(0.0),
             ]);
         }
     }
@@ -844,40 +866,53 @@ struct StateMaps<'a> {
 }
 
 impl StateMaps<'_> {
-    /// Writes the maps (cumulative wear, wear per cycle, film ratio and thickness, loaded
-    /// pattern) and the node table, their names ending with `suffix` before the extension.
+    /// Map of a node field of the loaded flank (cell means, times `scale`), coloured over
+    /// [0, top] or [0, its maximum], with the active flank and the worm tip's trace.
+    fn node_map(
+        &self,
+        path: &Path,
+        title: &str,
+        field: &FlankField,
+        scale: f64,
+        bar: &str,
+        top: Option<f64>,
+    ) -> Result<(), OutputError> {
+        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
+        let overlays = [
+            flank_outline(wf, "active flank", 5),
+            tip_trace_series(self.tca),
+        ];
+        let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
+        let hi = top.unwrap_or_else(|| {
+            values
+                .iter()
+                .copied()
+                .filter(|v| v.is_finite())
+                .fold(0.0, f64::max)
+        });
+        wheel_flank_map(
+            path,
+            title,
+            wf,
+            &values,
+            (0.0, if hi > 0.0 { hi } else { 1.0 }),
+            bar,
+            &overlays,
+            &[],
+        )
+    }
+
+    /// Writes the maps (cumulative wear, wear per cycle, film ratio and thickness, fatigue
+    /// damage, loaded pattern) and the node table, their names ending with `suffix` before
+    /// the extension.
     fn write(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
         let (tca, view, dir) = (self.tca, self.view, self.dir);
         let state = view.state;
         let wf = self.geo.wheel_flank(tca.loaded_flank);
         let mut files = Vec::new();
-        // Maps of the current state.
         let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
-        // Map of a node field (cell means, times `scale`), over [0, top] or [0, its maximum].
-        let map = |path: &Path,
-                   title: &str,
-                   field: &FlankField,
-                   scale: f64,
-                   bar: &str,
-                   top: Option<f64>| {
-            let values: Vec<f64> = field.cell_means().iter().map(|v| v * scale).collect();
-            let hi = top.unwrap_or_else(|| {
-                values
-                    .iter()
-                    .copied()
-                    .filter(|v| v.is_finite())
-                    .fold(0.0, f64::max)
-            });
-            wheel_flank_map(
-                path,
-                title,
-                wf,
-                &values,
-                (0.0, if hi > 0.0 { hi } else { 1.0 }),
-                bar,
-                &overlays,
-                &[],
-            )
+        let map = |path: &Path, title: &str, field: &FlankField, scale, bar: &str, top| {
+            self.node_map(path, title, field, scale, bar, top)
         };
         let r = state.records.last().expect("a state has a record");
         let path = dir.join(format!("wear_map{suffix}.svg"));
@@ -942,6 +977,23 @@ impl StateMaps<'_> {
             UM,
             "h_min (um)",
             None,
+        )?;
+        files.push(path);
+        let path = dir.join(format!("wear_damage_map{suffix}.svg"));
+        map(
+            &path,
+            &format!(
+                "Fatigue damage at {} cycles (max {:.3}; 1: pits; map: cell means)",
+                super::cycles_label(r.cycles),
+                r.max_damage
+            ),
+            &FlankField {
+                values: state.damage.clone(),
+                ..state.removal.clone()
+            },
+            1.0,
+            "damage (Miner, wear-relieved)",
+            Some(1.0),
         )?;
         files.push(path);
         let csv = node_table(wf, state, view.cycle);

@@ -21,6 +21,8 @@ use crate::lubrication::{self, LineContact};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
+pub mod forecast;
+
 /// Wear of one mesh cycle (one passage of the contact over every point of the reference
 /// tooth) on the loaded wheel flank's nodes.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -508,7 +510,7 @@ impl Backlash {
 
 pub use crate::input::StepControl;
 
-pub use crate::input::{LifeStop, Phase, WearPlan};
+pub use crate::input::{LifeStop, Phase, Pitting, WearPlan};
 
 /// The wear limits a life is checked against (MODEL §9 (a), (d)). The standard's limits are
 /// on the mean flank loss in the normal section, which the backlash increase gives:
@@ -705,6 +707,12 @@ pub struct WearState {
     /// Why the life ended before its cycles: the wear limit passed ([`WearLimits::passed`]).
     #[serde(default)]
     pub stopped: Option<String>,
+    /// Fatigue damage of every node of the loaded flank ([`forecast`]; empty: none yet).
+    #[serde(default)]
+    pub damage: Vec<f64>,
+    /// The schedule a pitting forecast has found so far (empty without a forecast).
+    #[serde(default)]
+    pub found_phases: Vec<Phase>,
 }
 
 impl WearState {
@@ -720,6 +728,8 @@ impl WearState {
             band_factor: None,
             warm: None,
             stopped: None,
+            damage: vec![0.0; wf.nodes.len()],
+            found_phases: Vec::new(),
         }
     }
 }
@@ -809,6 +819,10 @@ pub struct StepRecord {
     /// Frictionless power balance of this state's loaded analysis (`Ltca::power_balance`).
     #[serde(default)]
     pub power_balance: f64,
+    /// Largest fatigue damage of the loaded flank's nodes (1: a node's life on the
+    /// pressure-life curve is spent; [`forecast`]).
+    #[serde(default)]
+    pub max_damage: f64,
     /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -890,6 +904,9 @@ pub fn simulate(
     if state.pitted.len() != wf.nodes.len() {
         state.pitted = vec![false; wf.nodes.len()];
     }
+    if state.damage.len() != wf.nodes.len() {
+        state.damage = vec![0.0; wf.nodes.len()];
+    }
     check_plan_can_end(gear, life)?;
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
@@ -897,7 +914,9 @@ pub fn simulate(
     loop {
         let (l, band) = life_loop.analyse(&state)?;
         let cw = per_cycle(gear, geo, tca, &l, life.film_load);
-        let phase = life_loop.phase_at(state.cycles);
+        let loads = forecast::NodeLoads::new(wf, &l.pattern, &cw, &life.endurance, life.pit_depth);
+        life_loop.start_forecast_phase(&mut state, &loads);
+        let phase = life_loop.phase_at(&state, state.cycles);
         let record = life_loop.record(&state, &l, &cw, phase, step_cycles, substeps);
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
@@ -919,26 +938,7 @@ pub fn simulate(
         // state's analysis used).
         state.band_factor = band;
         state.warm = Some(l.warm_start());
-        let end = match phase {
-            Some((k, Phase::Pitting { .. }, end)) => {
-                step_cycles = life_loop.pitting_step(&mut state, &l, &cw, k, end);
-                substeps = 1;
-                state.step += 1;
-                continue;
-            }
-            Some((_, Phase::Wear { .. }, end)) => end,
-            None => life.life_cycles,
-        };
-        let left = left
-            .min(end - state.cycles)
-            .min(life_loop.next_map_cycles(state.cycles) - state.cycles);
-        let rate = cw.depth.max();
-        step_cycles = match life.step {
-            StepControl::Cycles(c) => c.min(left),
-            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
-            StepControl::MaxRemoval(_) => left,
-        };
-        substeps = life_loop.wear_step(&mut state, cw, step_cycles)?;
+        (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
         state.step += 1;
     }
     Ok(state)
@@ -1042,13 +1042,96 @@ impl<'a> LifeLoop<'a> {
         }
     }
 
+    /// The schedule of this life: the plan's, or the one its forecast has found so far.
+    fn schedule<'s>(&'s self, state: &'s WearState) -> &'s [Phase] {
+        match self.life.pitting {
+            Pitting::Forecast => &state.found_phases,
+            _ => &self.life.phases,
+        }
+    }
+
+    /// Whether the pits come from the damage (MODEL §12 n).
+    fn pits_from_damage(&self) -> bool {
+        matches!(self.life.pitting, Pitting::Damage | Pitting::Forecast)
+    }
+
+    /// A forecast starts a pitting phase at a state of a wear phase (after its first state)
+    /// where loaded nodes whose damage has reached 1 make up the onset share of the flank
+    /// (default 2 %; 0: the first such node; MODEL §12 n). The phase lasts the life on
+    /// the pressure–life curve of its least loaded pit.
+    fn start_forecast_phase(&self, state: &mut WearState, loads: &forecast::NodeLoads) {
+        if self.life.pitting != Pitting::Forecast {
+            return;
+        }
+        let cycles = state.cycles;
+        if let Some((_, Phase::Pitting { .. }, _)) = self.phase_at(state, cycles) {
+            return;
+        }
+        let wear_start = state.found_phases.last().map_or(0.0, phase_end);
+        let Some(pressure) = loads.median_due_pressure(&state.damage) else {
+            return;
+        };
+        let onset = self.life.pitting_onset_share;
+        if cycles > wear_start && loads.due_share(&state.damage) >= onset {
+            state.found_phases.push(Phase::Wear { until: cycles });
+            state.found_phases.push(Phase::Pitting {
+                until: cycles + self.life.endurance.life(pressure),
+                pressure_limit: None,
+                margin: 0.0,
+            });
+        }
+    }
+
+    /// The step from a state (`left`: cycles to the life's end): in a pitting phase, its pits
+    /// or its passing without wear ([`Self::pitting_step`]); in a wear phase, a wear step,
+    /// which with pits from the damage ends where the nodes due make up the onset share. The damage advances
+    /// over a wear step and holds in a pitting phase (MODEL §12 n). Returns the step's cycles
+    /// and sub-steps.
+    fn step(
+        &self,
+        state: &mut WearState,
+        l: &Ltca,
+        cw: CycleWear,
+        loads: &forecast::NodeLoads,
+        phase: Option<(usize, Phase, f64)>,
+        left: f64,
+    ) -> Result<(f64, usize), WearError> {
+        let end = match phase {
+            Some((k, Phase::Pitting { .. }, end)) => {
+                let advanced = self.pitting_step(state, l, &cw, loads, k, end);
+                return Ok((advanced, 1));
+            }
+            Some((_, Phase::Wear { .. }, end)) => end,
+            None => self.life.life_cycles,
+        };
+        let mut left = left
+            .min(end - state.cycles)
+            .min(self.next_map_cycles(state.cycles) - state.cycles);
+        if self.pits_from_damage() {
+            // Steps end where the nodes due to pit make up the onset share: a forecast starts
+            // its phases there, and a schedule with pits from the damage resolves the same
+            // states (the phases a forecast found repeat it).
+            let onset = self.life.pitting_onset_share;
+            if let Some(n) = loads.cycles_to_onset(&state.damage, onset) {
+                left = left.min(n);
+            }
+        }
+        let rate = cw.depth.max();
+        let step_cycles = match self.life.step {
+            StepControl::Cycles(c) => c.min(left),
+            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
+            StepControl::MaxRemoval(_) => left,
+        };
+        let substeps = self.wear_step(state, cw, step_cycles)?;
+        loads.advance(&mut state.damage, step_cycles, true);
+        Ok((step_cycles, substeps))
+    }
+
     /// Phase at some cycles: (index, phase, end); None after the schedule (wear).
-    fn phase_at(&self, cycles: f64) -> Option<(usize, Phase, f64)> {
+    fn phase_at(&self, state: &WearState, cycles: f64) -> Option<(usize, Phase, f64)> {
         let mut start = 0.0;
-        for (k, p) in self.life.phases.iter().enumerate() {
-            let end = match *p {
-                Phase::Wear { until } | Phase::Pitting { until, .. } => until,
-            };
+        for (k, p) in self.schedule(state).iter().enumerate() {
+            let end = phase_end(p);
             if cycles < end * (1.0 - 1e-12) && cycles >= start * (1.0 - 1e-12) {
                 return Some((k, *p, end));
             }
@@ -1203,18 +1286,22 @@ impl<'a> LifeLoop<'a> {
                 .worn_through_loaded(&state.removal, &l.pattern, wf)
                 .is_some(),
             power_balance: l.power_balance,
+            max_damage: state.damage.iter().copied().fold(0.0, f64::max),
             positions,
         }
     }
 
     /// A state in pitting phase k (ending at `end`): at its start the pits are cut (same
-    /// cycles; the next record shows the new pressures), then the phase passes without wear
-    /// up to its end (or the life's, if first). Returns the cycles advanced.
+    /// cycles; the next record shows the new pressures): above the phase's limit (published
+    /// coupling) or where the damage has reached 1 (MODEL §12 n; the cut nodes start again
+    /// undamaged). Then the phase passes without wear up to its end (or the life's, if
+    /// first). Returns the cycles advanced.
     fn pitting_step(
         &self,
         state: &mut WearState,
         l: &Ltca,
         cw: &CycleWear,
+        loads: &forecast::NodeLoads,
         k: usize,
         end: f64,
     ) -> f64 {
@@ -1222,23 +1309,30 @@ impl<'a> LifeLoop<'a> {
             pressure_limit,
             margin,
             ..
-        } = self.life.phases[k]
+        } = self.schedule(state)[k]
         else {
             return 0.0;
         };
+        if !state.pitted_phases.contains(&k) && self.pits_from_damage() {
+            loads.cut_due(&mut state.damage, &mut state.removal, &mut state.pitted);
+            state.pitted_phases.push(k);
+            return 0.0;
+        }
         if !state.pitted_phases.contains(&k) {
             let duration = end - state.cycles;
             let limit = pressure_limit
                 .unwrap_or_else(|| self.life.endurance.pressure(duration) * (1.0 + margin));
             let depth = pit_depths(cw, self.life.pit_depth);
-            cut_pits(
+            for k in cut_pits(
                 self.wf,
                 &l.pattern,
                 limit,
                 &depth,
                 &mut state.removal,
                 &mut state.pitted,
-            );
+            ) {
+                state.damage[k] = 0.0;
+            }
             state.pitted_phases.push(k);
             return 0.0;
         }
@@ -1283,6 +1377,13 @@ impl<'a> LifeLoop<'a> {
             state.warm = Some(l.warm_start());
             rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
         }
+    }
+}
+
+/// The cycles a phase lasts until.
+fn phase_end(p: &Phase) -> f64 {
+    match *p {
+        Phase::Wear { until } | Phase::Pitting { until, .. } => until,
     }
 }
 
@@ -1332,7 +1433,7 @@ fn pitted_fraction(wf: &WheelFlank, pitted: &[bool]) -> f64 {
 /// Cuts the pits of a pitting phase (MODEL §8): every node whose loaded-pattern pressure (the
 /// largest of its cells) exceeds `limit` (Pa) and that the contact passes (depth > 0) loses
 /// `depth` more (m; [`pit_depths`]: 0.78 a, the depth of the largest shear stress under a
-/// line contact).
+/// line contact). Returns the nodes cut.
 pub fn cut_pits(
     wf: &WheelFlank,
     pattern: &[f64],
@@ -1340,13 +1441,16 @@ pub fn cut_pits(
     depth: &FlankField,
     removal: &mut FlankField,
     pitted: &mut [bool],
-) {
+) -> Vec<usize> {
+    let mut cut = Vec::new();
     for (k, pit) in pitted.iter_mut().enumerate() {
         if node_pattern_pressure(wf, pattern, k) > limit && depth.values[k] > 0.0 {
             removal.values[k] += depth.values[k];
             *pit = true;
+            cut.push(k);
         }
     }
+    cut
 }
 
 /// Loaded-pattern pressure at node k of the flank grid: the largest of the (up to four)

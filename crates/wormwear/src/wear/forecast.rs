@@ -1,0 +1,228 @@
+//! Fatigue damage of every node of the loaded wheel flank over life, the pits it makes, and
+//! the pitting phases a forecast finds from them (MODEL §8 "beyond the schedule", §12 n).
+//!
+//! Each node carries the damage law of [`crate::pitting`]: its loaded-pattern pressure (the
+//! largest of its cells, as the published pits are cut) on the pressure–life curve, its wear
+//! per cycle, and a damaged layer as deep as its pit would be (0.78 a, [`super::pit_depths`]).
+//! Over a wear step the loads of the state that starts it hold, as the wear rates do (MODEL
+//! §7.3); in a pitting phase, which the published coupling models as the incubation of the
+//! pits cut at its start and nothing else, the damage holds. The damage is tracked in every
+//! life (maps and records compare); it acts with pits from the damage
+//! (`[wear] pitting = "damage"` or `"forecast"`): at the start of a pitting phase the pits are
+//! cut where a loaded node's damage has reached 1 (0.78 a removed; the node starts again
+//! undamaged, its damaged layer gone with the flakes), not above a pressure limit.
+//!
+//! A forecast also finds the phases. A wear step ends where the next loaded node's damage
+//! reaches 1; at a state of a wear phase (after its first) with such a node a pitting phase
+//! starts. It lasts the life on the curve at the lowest pattern pressure among its pits, the
+//! incubation of the least loaded pit: the published coupling's relation between a phase's
+//! duration and its limit, p_lim(D) = limit (the curve's scatter, the published +10 %, is the
+//! life factor's to carry). Then wear resumes on the pitted flank.
+
+use super::{node_pattern_pressure, pit_depths, CycleWear};
+use crate::geometry::WheelFlank;
+use crate::input::{Endurance, PitDepth};
+use crate::pitting::CellLoad;
+
+/// Damage at or above which a node has reached its life (round-off of the exact step end).
+pub const REACHED: f64 = 1.0 - 1e-9;
+
+/// The damage loads of the loaded flank's nodes in one state.
+#[derive(Debug, Clone)]
+pub struct NodeLoads {
+    /// Loaded-pattern pressure of every node (the largest of its cells), Pa.
+    pub pressure: Vec<f64>,
+    /// The damage law's load of every node the contact loads (pressure and pit depth > 0);
+    /// None where it does not, whose damage stays as it is.
+    pub cells: Vec<Option<CellLoad>>,
+    /// Share of the active flank each node stands for (a quarter of each cell around it).
+    pub share: Vec<f64>,
+}
+
+impl NodeLoads {
+    /// Loads of every node from a state's loaded pattern (Pa per cell) and wear of one cycle.
+    pub fn new(
+        wf: &WheelFlank,
+        pattern: &[f64],
+        cw: &CycleWear,
+        curve: &Endurance,
+        rule: PitDepth,
+    ) -> Self {
+        let layer = pit_depths(cw, rule);
+        let pressure: Vec<f64> = (0..wf.nodes.len())
+            .map(|k| node_pattern_pressure(wf, pattern, k))
+            .collect();
+        let ni = wf.cells_height;
+        let mut share = vec![0.0; wf.nodes.len()];
+        let total = wf.active_area();
+        for j in 0..wf.cells_face {
+            for i in 0..ni {
+                for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    share[(j + dj) * (ni + 1) + i + di] += 0.25 * wf.cell_area[j * ni + i] / total;
+                }
+            }
+        }
+        let cells = pressure
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                let h = layer.values[k];
+                (p > 0.0 && h > 0.0).then(|| CellLoad::new(curve, p, cw.depth.values[k], h))
+            })
+            .collect();
+        Self {
+            pressure,
+            cells,
+            share,
+        }
+    }
+
+    /// Cycles until the first loaded node reaches a damage of 1 (None: no node would).
+    pub fn cycles_to_first_pit(&self, damage: &[f64]) -> Option<f64> {
+        self.cells
+            .iter()
+            .zip(damage)
+            .filter(|(_, &d)| d < REACHED)
+            .filter_map(|(c, &d)| c.as_ref()?.cycles_to_pit(d))
+            .min_by(f64::total_cmp)
+    }
+
+    /// The same loads without wear (a pitting phase: no wear carries the damage away).
+    pub fn without_wear(&self) -> Self {
+        Self {
+            pressure: self.pressure.clone(),
+            share: self.share.clone(),
+            cells: self
+                .cells
+                .iter()
+                .map(|c| {
+                    c.map(|c| CellLoad {
+                        wear_rate: 0.0,
+                        ..c
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// Advances every loaded node's damage over `cycles`, with its wear (a wear step) or
+    /// without.
+    pub fn advance(&self, damage: &mut [f64], cycles: f64, wear: bool) {
+        for (d, c) in damage.iter_mut().zip(&self.cells) {
+            if let Some(c) = c {
+                let load = CellLoad {
+                    wear_rate: if wear { c.wear_rate } else { 0.0 },
+                    ..*c
+                };
+                *d = load.damage_after(*d, cycles);
+            }
+        }
+    }
+
+    /// The nodes due to pit: loaded, with their damage at 1.
+    pub fn due(&self, damage: &[f64]) -> Vec<usize> {
+        (0..damage.len())
+            .filter(|&k| self.cells[k].is_some() && damage[k] >= REACHED)
+            .collect()
+    }
+
+    /// Share of the active flank of the nodes due to pit.
+    pub fn due_share(&self, damage: &[f64]) -> f64 {
+        self.due(damage).iter().map(|&k| self.share[k]).sum()
+    }
+
+    /// Cycles until the nodes due to pit make up `onset` of the active flank (and at least
+    /// one node), the nodes reaching 1 in turn under these loads (None: they never would).
+    pub fn cycles_to_onset(&self, damage: &[f64], onset: f64) -> Option<f64> {
+        let mut due = self.due_share(damage);
+        let mut next: Vec<(f64, usize)> = self
+            .cells
+            .iter()
+            .zip(damage)
+            .enumerate()
+            .filter(|(_, (_, &d))| d < REACHED)
+            .filter_map(|(k, (c, &d))| Some((c.as_ref()?.cycles_to_pit(d)?, k)))
+            .collect();
+        next.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (n, k) in next {
+            due += self.share[k];
+            if due >= onset {
+                return Some(n);
+            }
+        }
+        None
+    }
+
+    /// The median pattern pressure of the nodes due to pit, weighted by their flank shares
+    /// (Pa; None: none is due). A median, not the lowest: a damaged node that the moving
+    /// pattern now barely touches does not stand for the pressure that damaged it.
+    pub fn median_due_pressure(&self, damage: &[f64]) -> Option<f64> {
+        let mut due: Vec<(f64, f64)> = self
+            .due(damage)
+            .into_iter()
+            .map(|k| (self.pressure[k], self.share[k]))
+            .collect();
+        due.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let half = 0.5 * due.iter().map(|d| d.1).sum::<f64>();
+        let mut sum = 0.0;
+        due.into_iter().find_map(|(p, w)| {
+            sum += w;
+            (sum >= half).then_some(p)
+        })
+    }
+
+    /// Cuts the pits of the nodes due (MODEL §12 n): each loses its damaged layer (0.78 a)
+    /// and starts again undamaged. Returns the nodes cut.
+    pub fn cut_due(
+        &self,
+        damage: &mut [f64],
+        removal: &mut crate::geometry::FlankField,
+        pitted: &mut [bool],
+    ) -> Vec<usize> {
+        let due = self.due(damage);
+        for &k in &due {
+            if let Some(c) = &self.cells[k] {
+                removal.values[k] += c.layer;
+                pitted[k] = true;
+                damage[k] = 0.0;
+            }
+        }
+        due
+    }
+}
+
+/// A phase of a life as it happened: kind ("wear" or "pitting"), start and end cycles, and
+/// the pitted share of the active flank at its end.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PhaseSpan {
+    pub kind: String,
+    pub start_cycles: f64,
+    pub end_cycles: f64,
+    pub pitted_share_end: f64,
+}
+
+/// The phases of a life from its records (consecutive states of the same phase joined; a
+/// phase ends where the next begins): what the report and summary show.
+pub fn phase_spans(records: &[super::StepRecord]) -> Vec<PhaseSpan> {
+    let mut spans: Vec<PhaseSpan> = Vec::new();
+    for r in records {
+        match spans.last_mut() {
+            Some(s) if s.kind == r.phase => {
+                s.end_cycles = r.cycles;
+                s.pitted_share_end = r.pitted_area_fraction;
+            }
+            last => {
+                if let Some(s) = last {
+                    s.end_cycles = r.cycles;
+                }
+                spans.push(PhaseSpan {
+                    kind: r.phase.clone(),
+                    start_cycles: r.cycles,
+                    end_cycles: r.cycles,
+                    pitted_share_end: r.pitted_area_fraction,
+                });
+            }
+        }
+    }
+    spans
+}

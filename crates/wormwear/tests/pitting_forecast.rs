@@ -1,0 +1,155 @@
+//! Pitting forecast (MODEL §12 n): pits from the fatigue damage of every flank node, and the
+//! phases a forecast finds from them. The cell law's own checks (a constant-pressure cell pits
+//! at the curve's life; a cell worn faster than it is damaged never pits) are the unit tests of
+//! `wormwear::pitting`.
+
+use std::path::Path;
+use wormwear::geometry::Geometry;
+use wormwear::input::{self, GearSet, Phase, Pitting};
+use wormwear::kinematics;
+use wormwear::ltca;
+use wormwear::wear;
+
+fn design() -> GearSet {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
+    input::load(&path).unwrap()
+}
+
+struct Bench {
+    g: GearSet,
+    geo: Geometry,
+    tca: kinematics::Tca,
+}
+
+impl Bench {
+    fn new(g: &GearSet) -> Self {
+        let geo = Geometry::build(g).unwrap();
+        let tca = kinematics::analyse(g, &geo).unwrap();
+        Self {
+            g: g.clone(),
+            geo,
+            tca,
+        }
+    }
+
+    fn simulate(
+        &self,
+        plan: &wear::WearPlan,
+        start: Option<wear::WearState>,
+        on_state: &mut dyn FnMut(&wear::StepView) -> Result<(), wear::WearError>,
+    ) -> Result<wear::WearState, wear::WearError> {
+        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
+        wear::simulate(
+            &self.g,
+            &self.geo,
+            &self.tca,
+            &ltca::LtcaSettings::from_gear(&self.g),
+            None,
+            plan,
+            start.unwrap_or_else(|| wear::WearState::new(wf)),
+            on_state,
+        )
+    }
+}
+
+/// A forecast of the design case over 200 000 cycles in 40 000-cycle steps: its edge cells
+/// (over 1 GPa unworn) spend their lives within it.
+fn forecast_plan() -> wear::WearPlan {
+    wear::WearPlan {
+        step: wear::StepControl::Cycles(40_000.0),
+        pitting: Pitting::Forecast,
+        pitting_onset_share: 0.005,
+        ..wear::WearPlan::with_life(200_000.0)
+    }
+}
+
+#[test]
+fn a_forecast_run_again_with_the_phases_it_found_as_a_schedule_gives_the_same_records() {
+    let bench = Bench::new(&design());
+    let plan = forecast_plan();
+    let forecast = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
+    for r in &forecast.records {
+        eprintln!(
+            "{:>3} {:>10.1} {:<8} pitted {:.4} damage {:.3} backlash {:.2} um",
+            r.step,
+            r.cycles,
+            r.phase,
+            r.pitted_area_fraction,
+            r.max_damage,
+            r.backlash_increase_m * 1e6
+        );
+    }
+    let pitting: Vec<_> = forecast
+        .found_phases
+        .iter()
+        .filter(|p| matches!(p, Phase::Pitting { .. }))
+        .collect();
+    assert!(!pitting.is_empty(), "no pitting phase found");
+    let r = &forecast.records;
+    // Each phase found: the pits cut at its start, no wear through it (the backlash flat).
+    let spans = wear::forecast::phase_spans(r);
+    let first = spans.iter().find(|s| s.kind == "pitting").unwrap();
+    assert!(first.pitted_share_end >= 0.005, "{first:?}");
+    let inside: Vec<_> = r
+        .iter()
+        .filter(|x| x.cycles >= first.start_cycles && x.cycles <= first.end_cycles)
+        .collect();
+    let after_cut = inside[1];
+    assert!(after_cut.pitted_area_fraction > inside[0].pitted_area_fraction);
+    assert_eq!(inside.last().unwrap().backlash_m, after_cut.backlash_m);
+    assert_eq!(r.last().unwrap().cycles, 200_000.0);
+
+    // The same life with the phases found imposed as a schedule, pits from the damage.
+    let schedule = wear::WearPlan {
+        pitting: Pitting::Damage,
+        phases: forecast.found_phases.clone(),
+        ..plan.clone()
+    };
+    let again = bench.simulate(&schedule, None, &mut |_| Ok(())).unwrap();
+    assert_eq!(again.records.len(), forecast.records.len());
+    for (a, b) in again.records.iter().zip(&forecast.records) {
+        assert_eq!(a, b, "state {}", a.step);
+    }
+    assert_eq!(again.removal, forecast.removal);
+    assert_eq!(again.damage, forecast.damage);
+}
+
+#[test]
+fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
+    // The checkpoint holds the damage and the phases found: resume after the first pitting
+    // phase has started, with damage on the flank, and compare exactly.
+    let bench = Bench::new(&design());
+    let plan = forecast_plan();
+    let straight = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let write = |writer: &mut wormwear::output::wear::LifeWriter, view: &wear::StepView| {
+        writer
+            .write_state(&bench.g, &bench.geo, &bench.tca, &plan, view, false)
+            .map(|_| ())
+            .map_err(|e| wear::WearError::Output(e.to_string()))
+    };
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir.path());
+    let interrupted = bench.simulate(&plan, None, &mut |view| {
+        write(&mut writer, view)?;
+        let state = view.state;
+        if !state.found_phases.is_empty() && state.damage.iter().any(|&d| d > 0.0) {
+            return Err(wear::WearError::Output("killed".into()));
+        }
+        Ok(())
+    });
+    assert!(interrupted.is_err());
+    let saved = wormwear::output::wear::read_checkpoint(dir.path())
+        .unwrap()
+        .unwrap();
+    assert!(!saved.found_phases.is_empty());
+    assert!(saved.damage.iter().any(|&d| d > 0.0));
+    assert!(saved.records.len() < straight.records.len());
+    let mut writer = wormwear::output::wear::LifeWriter::new(dir.path());
+    let resumed = bench
+        .simulate(&plan, Some(saved), &mut |view| write(&mut writer, view))
+        .unwrap();
+    assert_eq!(resumed.records, straight.records);
+    assert_eq!(resumed.removal, straight.removal);
+    assert_eq!(resumed.damage, straight.damage);
+    assert_eq!(resumed.found_phases, straight.found_phases);
+}
