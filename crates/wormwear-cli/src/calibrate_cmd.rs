@@ -192,6 +192,12 @@ pub fn from_backlash(
             "K = {:.4e} from the backlash curve ({} points, {runs} life runs from K = {k_start:.3e}; relative rms residual {:.3})",
             fit.k, fit.points, fit.relative_rms
         );
+        if let Some(f) = fit.life_factor {
+            println!(
+                "life factor of the pressure-life curve = {f:.4} (the forecast's first pitting \
+                 where the measured backlash first stays flat); set [wear.endurance] life_factor"
+            );
+        }
     }
     Ok(serde_json::json!({
         "method": "backlash curve",
@@ -201,5 +207,6 @@ pub fn from_backlash(
         "relative_rms": fit.relative_rms,
         "points": fit.points,
         "life_runs": runs,
+        "life_factor": fit.life_factor,
     }))
 }

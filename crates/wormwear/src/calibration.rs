@@ -47,6 +47,10 @@ pub struct KFit {
     pub relative_rms: f64,
     /// Number of data points used.
     pub points: usize,
+    /// The pressure–life curve's life factor fitted with K (a pitting forecast's backlash
+    /// curve, [`fit_with_life_factor`]); None when K alone was fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub life_factor: Option<f64>,
 }
 
 /// Errors of the calibration.
@@ -113,6 +117,7 @@ pub fn fit_from_tests(tests: &[WearTest], hardness: f64) -> Result<KFit, Calibra
         k,
         relative_rms: relative_rms(tests.iter().zip(&x).map(|(t, x)| (k * x, t.worn_volume))),
         points: tests.len(),
+        life_factor: None,
     })
 }
 
@@ -204,6 +209,7 @@ pub fn fit_to_backlash(
                     k,
                     relative_rms: relative_rms(pairs.into_iter()),
                     points: measured.len(),
+                    life_factor: None,
                 },
                 records,
             ));
@@ -212,11 +218,148 @@ pub fn fit_to_backlash(
     }
 }
 
+/// Range of the life factor [`fit_with_life_factor`] searches: a decade either side of
+/// the fitted curve, wider than the bronze's scatter band (about 150 MPa wide around
+/// 425 MPa, MODEL §8: life factors of 0.4 to 3 with the exponent 0.176).
+pub const LIFE_FACTOR_RANGE: (f64, f64) = (0.1, 10.0);
+
+/// Where a backlash curve first stays flat (a pitting phase: no wear, MODEL §8): the cycles
+/// of the first point after which the backlash grows by less than 5 % of the curve's mean
+/// rate (increase over cycles) up to the next point. None if it never does.
+pub fn first_flat(points: &[(f64, f64)]) -> Option<f64> {
+    let (first, last) = (points.first()?, points.last()?);
+    let mean = (last.1 - first.1) / (last.0 - first.0).max(f64::MIN_POSITIVE);
+    points
+        .windows(2)
+        .find(|w| w[1].0 > w[0].0 && (w[1].1 - w[0].1) <= 0.05 * mean * (w[1].0 - w[0].0))
+        .map(|w| w[0].0)
+}
+
+/// The first pitting phase's start in a life's records (cycles; None: it has none).
+pub fn first_pitting(records: &[StepRecord]) -> Option<f64> {
+    records
+        .iter()
+        .find(|r| r.phase == "pitting")
+        .map(|r| r.cycles)
+}
+
+/// Why the life factor cannot be fitted.
+fn no_life_factor(what: String) -> CalibrationError {
+    CalibrationError::Simulation(WearError::Plan(format!(
+        "the life factor of the pressure-life curve cannot be fitted: {what}"
+    )))
+}
+
+/// K and the life factor of the pressure–life curve from a measured backlash curve, for a
+/// pitting forecast (MODEL §10, §8). The life factor moves the phases a forecast finds along
+/// the life axis; K sets the slopes between them. So the life factor is set to put the
+/// forecast's first pitting phase where the measured curve first stays flat ([`first_flat`]),
+/// and K by [`fit_to_backlash`] to the points up to there (the first wear phase, where the
+/// backlash follows K smoothly: later phases come and go with small changes of K, and a
+/// least-squares K over them need not converge), in turn until neither changes by 0.01 %
+/// (at most 8 rounds). The residual is over every point. The life factor is solved by the Illinois method in log f over
+/// [`LIFE_FACTOR_RANGE`] (the first pitting comes later as f grows; a life without pitting
+/// counts as latest). `simulate(K, f)` runs the life. Returns the fit (with its life factor)
+/// and the records of the last run.
+pub fn fit_with_life_factor(
+    measured: &[(f64, f64)],
+    k_start: f64,
+    simulate: &mut dyn FnMut(f64, f64) -> Result<Vec<StepRecord>, WearError>,
+) -> Result<(KFit, Vec<StepRecord>), CalibrationError> {
+    let target = first_flat(measured)
+        .filter(|&c| c > 0.0)
+        .ok_or_else(|| no_life_factor("the measured backlash never stays flat".into()))?;
+    let before: Vec<(f64, f64)> = measured
+        .iter()
+        .copied()
+        .filter(|m| m.0 <= target * (1.0 + 1e-12))
+        .collect();
+    let (mut k, mut f) = (k_start, 1.0);
+    let mut records = Vec::new();
+    for _ in 0..8 {
+        let (fit, _) = fit_to_backlash(&before, k, 1e-6, 20, &mut |k| simulate(k, f))?;
+        let k_change = (fit.k / k - 1.0).abs();
+        k = fit.k;
+        let f_new = solve_life_factor(target, &mut |f| simulate(k, f))?;
+        let f_change = (f_new / f - 1.0).abs();
+        f = f_new;
+        if f_change < 1e-4 && k_change < 1e-4 {
+            records = simulate(k, f)?;
+            break;
+        }
+    }
+    if records.is_empty() {
+        records = simulate(k, f)?;
+    }
+    let pairs: Vec<(f64, f64)> = measured
+        .iter()
+        .filter_map(|&(c, b)| backlash_at(&records, c).map(|s| (s, b)))
+        .collect();
+    if pairs.len() < measured.len() {
+        return Err(CalibrationError::LifeEnded {
+            k,
+            simulated: records.last().map_or(0.0, |r| r.cycles),
+            measured: measured.iter().map(|m| m.0).fold(0.0, f64::max),
+        });
+    }
+    let fit = KFit {
+        k,
+        relative_rms: relative_rms(pairs.into_iter()),
+        points: measured.len(),
+        life_factor: Some(f),
+    };
+    Ok((fit, records))
+}
+
+/// The life factor whose forecast starts its first pitting phase at `target` cycles.
+fn solve_life_factor(
+    target: f64,
+    simulate: &mut dyn FnMut(f64) -> Result<Vec<StepRecord>, WearError>,
+) -> Result<f64, CalibrationError> {
+    // Signed log-distance of the first pitting from the target (a life without one: latest).
+    let mut miss = |x: f64| -> Result<f64, CalibrationError> {
+        let records = simulate(x.exp())?;
+        Ok(first_pitting(&records).map_or(10.0, |c| (c.max(1.0) / target).ln()))
+    };
+    let (mut a, mut b) = (LIFE_FACTOR_RANGE.0.ln(), LIFE_FACTOR_RANGE.1.ln());
+    let (mut ya, mut yb) = (miss(a)?, miss(b)?);
+    if ya > 0.0 || yb < 0.0 {
+        return Err(no_life_factor(format!(
+            "the first flat part of the measured curve ({target:.4e} cycles) is outside the \
+             forecast's first pitting for life factors {} to {}",
+            LIFE_FACTOR_RANGE.0, LIFE_FACTOR_RANGE.1
+        )));
+    }
+    let mut side = 0;
+    for _ in 0..60 {
+        let x = (a * yb - b * ya) / (yb - ya);
+        let y = miss(x)?;
+        if y.abs() < 1e-9 || (b - a) < 1e-4 {
+            return Ok(x.exp());
+        }
+        if y < 0.0 {
+            (a, ya) = (x, y);
+            if side == -1 {
+                yb *= 0.5;
+            }
+            side = -1;
+        } else {
+            (b, yb) = (x, y);
+            if side == 1 {
+                ya *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok((0.5 * (a + b)).exp())
+}
+
 /// [`fit_to_backlash`] through the gear's life simulation (MODEL §10): the geometry, unloaded
 /// analysis and bending model are built once (the bending model reported to `on_event`), then
 /// each run is the life of `plan` from the unworn flank with the wheel's wear coefficient set
-/// to the trial K; `on_run(run, K, records)` is told each. Returns the fit, the records of the
-/// last run and the number of runs.
+/// to the trial K; `on_run(run, K, records)` is told each. A pitting forecast's plan fits the
+/// curve's life factor with K ([`fit_with_life_factor`]). Returns the fit, the records of the
+/// last (best) run and the number of runs.
 pub fn fit_life_to_backlash(
     gear: &crate::input::GearSet,
     plan: &crate::input::WearPlan,
@@ -233,9 +376,11 @@ pub fn fit_life_to_backlash(
         crate::runner::bending_model(gear, &geo, &mut warnings, on_event).map_err(setup)?;
     let settings = crate::ltca::LtcaSettings::from_gear(gear);
     let mut runs = 0;
-    let mut simulate = |k: f64| {
+    let mut simulate = |k: f64, life_factor: f64| {
         let mut g = gear.clone();
         g.wheel_material.wear_coefficient = k;
+        let mut plan = plan.clone();
+        plan.endurance.life_factor = life_factor;
         runs += 1;
         let end = crate::wear::simulate(
             &g,
@@ -245,7 +390,7 @@ pub fn fit_life_to_backlash(
             bending
                 .as_ref()
                 .map(|b| b as &dyn crate::ltca::BendingModel),
-            plan,
+            &plan,
             crate::wear::WearState::new(geo.wheel_flank(tca.loaded_flank)),
             &mut |_| Ok(()),
         )?;
@@ -253,7 +398,12 @@ pub fn fit_life_to_backlash(
         Ok(end.records)
     };
     let k_start = gear.wheel_material.wear_coefficient;
-    let (fit, records) = fit_to_backlash(measured, k_start, 1e-3, 10, &mut simulate)?;
+    let (fit, records) = if plan.pitting == crate::input::Pitting::Forecast {
+        fit_with_life_factor(measured, k_start, &mut simulate)?
+    } else {
+        let f = plan.endurance.life_factor;
+        fit_to_backlash(measured, k_start, 1e-3, 10, &mut |k| simulate(k, f))?
+    };
     Ok((fit, records, runs))
 }
 

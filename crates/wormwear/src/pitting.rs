@@ -1,5 +1,5 @@
 //! Fatigue damage of the wheel flank for a pitting forecast (MODEL §8, "beyond the
-//! schedule-driven version", and §12 n): the damage law of one flank cell. The life loop
+//! schedule-driven version", and `wear::forecast`): the damage law of one flank cell. The life loop
 //! applies it at every node of the loaded flank (`wear::forecast`).
 //!
 //! **Damage.** A cell loaded each cycle at the pressure p gathers 1 / N(p) of damage per cycle

@@ -293,6 +293,54 @@ fn wear_and_rating_sections_are_checked() {
         &error_of(&text),
         &["wear.phases[0].pressure_limit_mpa", "only pitting"],
     );
+    // A forecast finds its own pitting phases; pits from the damage take no pressure limit;
+    // only a forecast takes an onset share; a life factor must be positive.
+    let with = |lines: &str| set(&design(), "wear", "life_cycles", lines);
+    assert_mentions(
+        &error_of(&with(
+            "life_cycles = 1e6\npitting = \"forecast\"\nphases = [ { kind = \"wear\", \
+             until_cycles = 5e5 }, { kind = \"pitting\", until_cycles = 6e5 } ]",
+        )),
+        &["wear.phases[1].kind", "finds its own pitting phases"],
+    );
+    assert_mentions(
+        &error_of(&with(
+            "life_cycles = 1e6\npitting = \"damage\"\nphases = [ { kind = \"pitting\", \
+             until_cycles = 6e5, pressure_limit_mpa = 500 } ]",
+        )),
+        &[
+            "wear.phases[0].pressure_limit_mpa",
+            "take no pressure limit",
+        ],
+    );
+    assert_mentions(
+        &error_of(&with("life_cycles = 1e6\npitting_onset_percent = 5")),
+        &["wear.pitting_onset_percent = 5", "only a forecast"],
+    );
+    assert_mentions(
+        &error_of(&with("life_cycles = 1e6\npitting = \"foresight\"")),
+        &["wear.pitting", "forecast"],
+    );
+    assert_mentions(
+        &error_of(&with(
+            "life_cycles = 1e6\npitting = \"forecast\"\npitting_onset_percent = 120",
+        )),
+        &["wear.pitting_onset_percent = 120"],
+    );
+    assert_mentions(
+        &error_of(&with("life_cycles = 1e6\nendurance = { life_factor = -1 }")),
+        &["wear.endurance.life_factor = -1"],
+    );
+    // A valid forecast.
+    let g = input::load_from_str(&with(
+        "life_cycles = 1e6\npitting = \"forecast\"\npitting_onset_percent = 0.5\n\
+         endurance = { life_factor = 0.4 }",
+    ))
+    .unwrap();
+    let plan = g.wear.unwrap();
+    assert_eq!(plan.pitting, input::Pitting::Forecast);
+    assert!((plan.pitting_onset_share - 0.005).abs() < 1e-15);
+    assert_eq!(plan.endurance.life_factor, 0.4);
     // Rating factors and the pressure cap out of range.
     let text = set(
         &design(),

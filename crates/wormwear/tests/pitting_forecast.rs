@@ -1,4 +1,4 @@
-//! Pitting forecast (MODEL §12 n): pits from the fatigue damage of every flank node, and the
+//! Pitting forecast (`wear::forecast`): pits from the fatigue damage of every flank node, and the
 //! phases a forecast finds from them. The cell law's own checks (a constant-pressure cell pits
 //! at the curve's life; a cell worn faster than it is damaged never pits) are the unit tests of
 //! `wormwear::pitting`.
@@ -152,4 +152,62 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
     assert_eq!(resumed.removal, straight.removal);
     assert_eq!(resumed.damage, straight.damage);
     assert_eq!(resumed.found_phases, straight.found_phases);
+}
+
+/// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life
+/// factor (the "measurement") is fitted from another K and the fitted curve (life factor 1);
+/// both come back. The gear is coarsened (10 positions, 24 x 30 cells) to keep the ~45 lives
+/// of the search quick.
+#[test]
+fn k_and_the_life_factor_are_recovered_from_a_forecast_backlash_curve() {
+    let mut g = design();
+    g.analysis.positions = 10;
+    g.analysis.flank_cells_height = 24;
+    g.analysis.flank_cells_face = 30;
+    let bench = Bench::new(&g);
+    let plan = forecast_plan();
+    let (k_true, f_true) = (1.6e-8, 0.55);
+    let mut runs = 0;
+    let mut simulate = |k: f64, f: f64| {
+        runs += 1;
+        let mut b = Bench {
+            g: bench.g.clone(),
+            geo: bench.geo.clone(),
+            tca: bench.tca.clone(),
+        };
+        b.g.wheel_material.wear_coefficient = k;
+        let mut p = plan.clone();
+        p.endurance.life_factor = f;
+        let r = b.simulate(&p, None, &mut |_| Ok(())).map(|s| s.records);
+        if let Ok(r) = &r {
+            eprintln!(
+                "life {runs}: K {k:.5e} f {f:.5} first pitting {:?} backlash {:.3} um",
+                wormwear::calibration::first_pitting(r),
+                r.last().unwrap().backlash_increase_m * 1e6
+            );
+        }
+        r
+    };
+    let truth = simulate(k_true, f_true).unwrap();
+    let spans = wear::forecast::phase_spans(&truth);
+    assert!(
+        spans.iter().any(|s| s.kind == "pitting"),
+        "the measured curve has a pitting phase"
+    );
+    let measured: Vec<(f64, f64)> = truth
+        .iter()
+        .skip(1)
+        .map(|r| (r.cycles, r.backlash_increase_m))
+        .collect();
+    let (fit, _) =
+        wormwear::calibration::fit_with_life_factor(&measured, 2.4e-8, &mut simulate).unwrap();
+    let f = fit.life_factor.unwrap();
+    println!(
+        "K {:.5e} (true {k_true:e}), life factor {f:.5} (true {f_true}), residual {:.2e}, {runs} lives",
+        fit.k, fit.relative_rms
+    );
+    assert!((fit.k / k_true - 1.0).abs() < 1e-3, "{}", fit.k);
+    assert!((f / f_true - 1.0).abs() < 1e-3, "{f}");
+    assert!(fit.relative_rms < 1e-4, "{}", fit.relative_rms);
+    assert!(runs < 80, "{runs} lives");
 }

@@ -287,7 +287,7 @@ pub enum PitDepth {
     LoadedBand,
 }
 
-/// How pitting enters a life (MODEL §8, §12 n).
+/// How pitting enters a life (MODEL §8 beyond the schedule).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Pitting {

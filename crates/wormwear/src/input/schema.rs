@@ -107,7 +107,7 @@ pub struct WearSpec {
     /// Phase schedule (MODEL §8): wear and pitting phases, each until a number of cycles.
     #[serde(default)]
     pub phases: Vec<PhaseSpec>,
-    /// How pitting enters the life (MODEL §8, §12 n): "schedule" (default; the published
+    /// How pitting enters the life (MODEL §8 beyond the schedule): "schedule" (default; the published
     /// coupling: pits cut above each pitting phase's limit), "off", "damage" (pits where a
     /// node's fatigue damage reaches 1; the schedule's pitting phases stop the wear) or
     /// "forecast" (pits from the damage, and the phases found from them).

@@ -1518,7 +1518,7 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     })
 }
 
-/// `wear.pitting` (MODEL §8, §12 n): a forecast finds its own pitting phases, so it takes
+/// `wear.pitting` (MODEL §8 beyond the schedule): a forecast finds its own pitting phases, so it takes
 /// none from the schedule; pits from the damage take no pressure limit.
 fn pitting_mode(ck: &mut Checker, w: &WearSpec, phases: &[PhaseSpec]) -> Option<Pitting> {
     let mode = ck.choice(

@@ -49,10 +49,12 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "wear_per_cycle_map",
             "wear_film_ratio_map",
             "wear_film_thickness_map",
+            "wear_damage_map",
             "wear_pattern",
             "wear_map_step*",
             "wear_film_ratio_map_step*",
             "wear_pattern_step*",
+            "wear_damage_map_step*",
         ],
     ),
     ("Ratings (ISO/TR 14521)", "rating", &[]),
@@ -117,6 +119,58 @@ fn figures(dir: &Path, pattern: &str) -> Vec<PathBuf> {
 }
 
 /// Writes `dir/report.html` from the files in `dir` and the input text; returns its path.
+/// The phases of a life (summary.json `wear.phases`) as a bar over the cycles (wear blue,
+/// pitting orange) and a table: kind, start, end, pitted share at the end. `mode` is how
+/// pitting entered the life (`wear.pitting`).
+fn phase_timeline(phases: &[serde_json::Value], mode: Option<&serde_json::Value>) -> String {
+    let span = |p: &serde_json::Value, k: &str| p[k].as_f64().unwrap_or(0.0);
+    let total = phases.last().map_or(0.0, |p| span(p, "end_cycles"));
+    if total <= 0.0 {
+        return String::new();
+    }
+    let how = match mode.and_then(|m| m.as_str()) {
+        Some("forecast") => {
+            "found by the forecast from the fatigue damage (README: Pitting forecast)"
+        }
+        Some("damage") => "from the schedule, pits from the fatigue damage",
+        Some("off") => "no pitting",
+        _ => "from the schedule (published coupling)",
+    };
+    let mut h = format!(
+        "<h3>Phases</h3><p>Wear and pitting phases, {how}. Pitting: no wear, the backlash \
+         flat.</p><div style=\"display:flex;height:1.4em;border:1px solid #999;margin:.5em 0\">"
+    );
+    for p in phases {
+        let pitting = p["kind"].as_str() == Some("pitting");
+        let width = 100.0 * (span(p, "end_cycles") - span(p, "start_cycles")) / total;
+        let _ = write!(
+            h,
+            "<div title=\"{} {:.4e}-{:.4e}\" style=\"width:{width:.3}%;background:{}\"></div>",
+            if pitting { "pitting" } else { "wear" },
+            span(p, "start_cycles"),
+            span(p, "end_cycles"),
+            if pitting { "#ff7f0e" } else { "#1f77b4" }
+        );
+    }
+    h.push_str(
+        "</div><table><tr><th>phase</th><th>from (cycles)</th><th>to (cycles)</th>\
+         <th>pitted share at the end</th></tr>",
+    );
+    for p in phases {
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td class=\"n\">{:.4e}</td><td class=\"n\">{:.4e}</td>\
+             <td class=\"n\">{:.4}</td></tr>",
+            escape(p["kind"].as_str().unwrap_or("")),
+            span(p, "start_cycles"),
+            span(p, "end_cycles"),
+            span(p, "pitted_share_end")
+        );
+    }
+    h.push_str("</table>");
+    h
+}
+
 pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf, OutputError> {
     let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
         .ok()
@@ -275,6 +329,9 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
                 }
             }
             h.push_str("</table>");
+        }
+        if let Some(serde_json::Value::Array(phases)) = section.get("phases") {
+            h.push_str(&phase_timeline(phases, section.get("pitting")));
         }
         if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
             let columns = [

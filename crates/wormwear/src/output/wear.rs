@@ -622,7 +622,7 @@ fn write_tables(
             "wear_backlash.svg",
             "Backlash increase (tangential at r2, mean over positions)",
             "backlash increase (um)",
-            vec![curve(&|r| r.backlash_increase_m * UM, "", 0)],
+            backlash_series(&state.records),
         ),
         (
             "wear_depth.svg",
@@ -744,6 +744,7 @@ pub fn steps_table(state: &WearState) -> Csv {
         "thinnest_tooth_um",
         "worn_through_loaded",
         "power_balance",
+        "max_damage",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -776,6 +777,7 @@ pub fn steps_table(state: &WearState) -> Csv {
             r.thinnest_tooth_m * UM,
             f64::from(u8::from(r.worn_through_loaded)),
             r.power_balance,
+            r.max_damage,
         ]);
     }
     csv
@@ -816,6 +818,46 @@ pub fn summary_value(
         what: "wear summary".into(),
         message: e.to_string(),
     })
+}
+
+/// The backlash increase over cycles (1e6, um): the whole curve, and its pitting phases drawn
+/// over it in orange (no wear: flat).
+fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series> {
+    let points = |rs: &[crate::wear::StepRecord]| -> Vec<(f64, f64)> {
+        rs.iter()
+            .map(|r| (r.cycles * 1e-6, r.backlash_increase_m * UM))
+            .collect()
+    };
+    let spans = crate::wear::forecast::phase_spans(records);
+    let pitting: Vec<_> = spans.iter().filter(|s| s.kind == "pitting").collect();
+    let mut series = vec![Series {
+        label: if pitting.is_empty() {
+            String::new()
+        } else {
+            "wear".into()
+        },
+        points: points(records),
+        color: 0,
+        bold: true,
+    }];
+    for (k, s) in pitting.iter().enumerate() {
+        let inside: Vec<_> = records
+            .iter()
+            .filter(|r| r.cycles >= s.start_cycles && r.cycles <= s.end_cycles)
+            .cloned()
+            .collect();
+        series.push(Series {
+            label: if k == 0 {
+                "pitting phase".into()
+            } else {
+                String::new()
+            },
+            points: points(&inside),
+            color: 4,
+            bold: true,
+        });
+    }
+    series
 }
 
 /// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j

@@ -241,6 +241,16 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
             })
             .collect();
     }
+    let phases = match &job.plan {
+        Some(p) if p.pitting == crate::input::Pitting::Forecast => {
+            crate::wear::forecast::phase_spans(&records)
+                .into_iter()
+                .map(|s| (s.kind, s.start_cycles, s.end_cycles))
+                .collect()
+        }
+        Some(p) => schedule(p),
+        None => Vec::new(),
+    };
     Ok(JobResult {
         id: job.id.clone(),
         key: key(job),
@@ -248,7 +258,7 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
         bending_model: l.bending_model.clone(),
         unworn,
         records,
-        phases: job.plan.as_ref().map(schedule).unwrap_or_default(),
+        phases,
         error: None,
     })
 }
@@ -382,6 +392,14 @@ pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     let mut wear_only = life(&b);
     wear_only.phases.clear();
     push("case-b-wear-only", b.clone(), Some(wear_only));
+    // (b) The pitting forecast of each endurance case: its schedule's phases dropped, found
+    // from the damage (the forecast law of `wear::forecast`; the example's curve, life factor 1, no fit per case).
+    for (id, g) in [("a", &a), ("b", &b), ("c", &c)] {
+        let mut plan = life(g);
+        plan.phases.clear();
+        plan.pitting = crate::input::Pitting::Forecast;
+        push(&format!("case-{id}-forecast"), g.clone(), Some(plan));
+    }
     // (b) Speed study: case C's torque at 100 / 600 / 1200 rpm (900 rpm is case C).
     for rpm in [100.0, 600.0, 1200.0] {
         let g = variant(&c, |g| {

@@ -300,6 +300,7 @@ fn section_b(m: &mut String, results: &Results) {
     unworn_table(m, results);
     step_tables(m, results);
     schedule_table(m, results);
+    forecast_table(m, results);
     wear_only_table(m, results);
     speed_table(m, results);
 }
@@ -461,6 +462,91 @@ fn schedule_table(m: &mut String, results: &Results) {
                 e.pitted_area_fraction
             );
         }
+    }
+    m.push('\n');
+}
+
+/// The phases as "kind start-end" in millions of cycles, pitting phases only.
+fn pitting_phases(phases: &[(String, f64, f64)]) -> String {
+    let list: Vec<String> = phases
+        .iter()
+        .filter(|p| p.0 == "pitting")
+        .map(|p| format!("{:.2}-{:.2}", p.1 * 1e-6, p.2 * 1e-6))
+        .collect();
+    if list.is_empty() {
+        "none".into()
+    } else {
+        list.join(", ")
+    }
+}
+
+/// The forecast's phases against the observed schedules, and the two backlash curves.
+fn forecast_table(m: &mut String, results: &Results) {
+    let cases = [("A", "case-a"), ("B", "case-b"), ("C", "case-c")];
+    if !cases
+        .iter()
+        .any(|c| results.contains_key(&format!("{}-forecast", c.1)))
+    {
+        return;
+    }
+    let _ = writeln!(
+        m,
+        "### Pitting forecast against the observed schedules\n\n\
+         The same cases with their schedules dropped: `[wear] pitting = \"forecast\"` finds the \
+         phases from the fatigue damage of every flank node (README, \"Pitting forecast\"; the default curve, life \
+         factor 1, onset share 2 %, nothing fitted per case). Pitting phases in millions of \
+         cycles; the pitted share at the end of life.
+"
+    );
+    let _ = writeln!(
+        m,
+        "| case | observed pitting phases | forecast pitting phases | forecast first pitting | pitted share: schedule / forecast | states: schedule / forecast |"
+    );
+    let _ = writeln!(m, "|---|---|---|---|---|---|");
+    for (name, id) in cases {
+        let (Some(s), Some(f)) = (results.get(id), results.get(&format!("{id}-forecast"))) else {
+            continue;
+        };
+        let first = f
+            .phases
+            .iter()
+            .find(|p| p.0 == "pitting")
+            .map_or("-".to_string(), |p| format!("{:.3}", p.1 * 1e-6));
+        let share = |r: &JobResult| last(r).map_or(f64::NAN, |x| x.pitted_area_fraction);
+        let _ = writeln!(
+            m,
+            "| {name} | {} | {} | {first} | {:.3} / {:.3} | {} / {} |",
+            pitting_phases(&s.phases),
+            pitting_phases(&f.phases),
+            share(s),
+            share(f),
+            s.records.len(),
+            f.records.len()
+        );
+    }
+    let _ = writeln!(
+        m,
+        "\nBacklash increase (um), schedule / forecast, every million cycles:\n"
+    );
+    let _ = writeln!(m, "| cycles (1e6) | A | B | C |");
+    let _ = writeln!(m, "|---|---|---|---|");
+    for n in 0..=20 {
+        let c = n as f64 * 1e6;
+        let cell = |id: &str| {
+            let get = |k: &str| {
+                results
+                    .get(k)
+                    .filter(|r| last(r).is_some_and(|x| x.cycles >= c * (1.0 - 1e-9)))
+                    .and_then(|r| at(&r.records, c))
+                    .map_or("-".to_string(), |x| num(x.backlash_increase_m * UM, 0))
+            };
+            format!("{} / {}", get(id), get(&format!("{id}-forecast")))
+        };
+        let row = [cell("case-a"), cell("case-b"), cell("case-c")];
+        if row.iter().all(|c| c == "- / -") {
+            continue;
+        }
+        let _ = writeln!(m, "| {n} | {} | {} | {} |", row[0], row[1], row[2]);
     }
     m.push('\n');
 }

@@ -1,5 +1,5 @@
 //! Fatigue damage of every node of the loaded wheel flank over life, the pits it makes, and
-//! the pitting phases a forecast finds from them (MODEL §8 "beyond the schedule", §12 n).
+//! the pitting phases a forecast finds from them (MODEL §8, "beyond the schedule-driven version"; the law is ours, stated here).
 //!
 //! Each node carries the damage law of [`crate::pitting`]: its loaded-pattern pressure (the
 //! largest of its cells, as the published pits are cut) on the pressure–life curve, its wear
@@ -171,7 +171,7 @@ impl NodeLoads {
         })
     }
 
-    /// Cuts the pits of the nodes due (MODEL §12 n): each loses its damaged layer (0.78 a)
+    /// Cuts the pits of the nodes due (`wear::forecast`): each loses its damaged layer (0.78 a)
     /// and starts again undamaged. Returns the nodes cut.
     pub fn cut_due(
         &self,

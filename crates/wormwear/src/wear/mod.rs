@@ -1050,14 +1050,14 @@ impl<'a> LifeLoop<'a> {
         }
     }
 
-    /// Whether the pits come from the damage (MODEL §12 n).
+    /// Whether the pits come from the damage (`wear::forecast`).
     fn pits_from_damage(&self) -> bool {
         matches!(self.life.pitting, Pitting::Damage | Pitting::Forecast)
     }
 
     /// A forecast starts a pitting phase at a state of a wear phase (after its first state)
     /// where loaded nodes whose damage has reached 1 make up the onset share of the flank
-    /// (default 2 %; 0: the first such node; MODEL §12 n). The phase lasts the life on
+    /// (default 2 %; 0: the first such node; `wear::forecast`). The phase lasts the life on
     /// the pressure–life curve of its least loaded pit.
     fn start_forecast_phase(&self, state: &mut WearState, loads: &forecast::NodeLoads) {
         if self.life.pitting != Pitting::Forecast {
@@ -1085,7 +1085,7 @@ impl<'a> LifeLoop<'a> {
     /// The step from a state (`left`: cycles to the life's end): in a pitting phase, its pits
     /// or its passing without wear ([`Self::pitting_step`]); in a wear phase, a wear step,
     /// which with pits from the damage ends where the nodes due make up the onset share. The damage advances
-    /// over a wear step and holds in a pitting phase (MODEL §12 n). Returns the step's cycles
+    /// over a wear step and holds in a pitting phase (`wear::forecast`). Returns the step's cycles
     /// and sub-steps.
     fn step(
         &self,
@@ -1293,8 +1293,8 @@ impl<'a> LifeLoop<'a> {
 
     /// A state in pitting phase k (ending at `end`): at its start the pits are cut (same
     /// cycles; the next record shows the new pressures): above the phase's limit (published
-    /// coupling) or where the damage has reached 1 (MODEL §12 n; the cut nodes start again
-    /// undamaged). Then the phase passes without wear up to its end (or the life's, if
+    /// coupling) or where the damage has reached 1 ([`forecast`]; the cut nodes start
+    /// again undamaged). Then the phase passes without wear up to its end (or the life's, if
     /// first). Returns the cycles advanced.
     fn pitting_step(
         &self,
