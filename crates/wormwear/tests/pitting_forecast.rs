@@ -152,6 +152,27 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
     assert_eq!(resumed.removal, straight.removal);
     assert_eq!(resumed.damage, straight.damage);
     assert_eq!(resumed.found_phases, straight.found_phases);
+    // The files: the phases as they happened and the schedule found in summary.json, the
+    // damage maps and the damage column of the node table.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let wear = &summary["wear"];
+    assert_eq!(wear["pitting"], "forecast");
+    let phases = wear["phases"].as_array().unwrap();
+    assert_eq!(phases[0]["kind"], "wear");
+    assert!(phases.iter().any(|p| p["kind"] == "pitting"));
+    assert_eq!(
+        phases.last().unwrap()["end_cycles"].as_f64(),
+        Some(200_000.0)
+    );
+    assert_eq!(
+        wear["found_phases"].as_array().unwrap().len(),
+        straight.found_phases.len()
+    );
+    assert!(dir.path().join("wear_damage_map.svg").exists());
+    let nodes = std::fs::read_to_string(dir.path().join("wear_map.csv")).unwrap();
+    assert!(nodes.lines().next().unwrap().ends_with(",damage"));
 }
 
 /// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life
