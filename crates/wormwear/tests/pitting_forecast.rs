@@ -15,6 +15,16 @@ fn design() -> GearSet {
     input::load(&path).unwrap()
 }
 
+/// The design case on a coarser grid (10 positions, 24 x 30 cells): these tests check the
+/// life loop's logic, not the model's convergence, and run many lives.
+fn coarse() -> GearSet {
+    let mut g = design();
+    g.analysis.positions = 10;
+    g.analysis.flank_cells_height = 24;
+    g.analysis.flank_cells_face = 30;
+    g
+}
+
 struct Bench {
     g: GearSet,
     geo: Geometry,
@@ -65,7 +75,7 @@ fn forecast_plan() -> wear::WearPlan {
 
 #[test]
 fn a_forecast_run_again_with_the_phases_it_found_as_a_schedule_gives_the_same_records() {
-    let bench = Bench::new(&design());
+    let bench = Bench::new(&coarse());
     let plan = forecast_plan();
     let forecast = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
     for r in &forecast.records {
@@ -107,18 +117,55 @@ fn a_forecast_run_again_with_the_phases_it_found_as_a_schedule_gives_the_same_re
     };
     let again = bench.simulate(&schedule, None, &mut |_| Ok(())).unwrap();
     assert_eq!(again.records.len(), forecast.records.len());
+    // The same to round-off: a step to a phase's end is end - cycles in the schedule and the
+    // cycles to the onset in the forecast, which differ in the last bit.
     for (a, b) in again.records.iter().zip(&forecast.records) {
-        assert_eq!(a, b, "state {}", a.step);
+        let (a, b) = (serde_json::json!(a), serde_json::json!(b));
+        assert_close(&a, &b, &format!("state {}", a["step"]));
     }
-    assert_eq!(again.removal, forecast.removal);
-    assert_eq!(again.damage, forecast.damage);
+    assert_close(
+        &serde_json::json!(again.removal.values),
+        &serde_json::json!(forecast.removal.values),
+        "removal",
+    );
+    // Damage is dimensionless (1: a pit): to 1e-9 absolute.
+    for (k, (a, b)) in again.damage.iter().zip(&forecast.damage).enumerate() {
+        assert!((a - b).abs() < 1e-9, "damage[{k}]: {a} != {b}");
+    }
+}
+
+/// Equal JSON values, numbers to 1e-9 relative (1e-300 absolute).
+fn assert_close(a: &serde_json::Value, b: &serde_json::Value, at: &str) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 1e-9 * x.abs().max(y.abs()) + 1e-300,
+                "{at}: {x} != {y}"
+            );
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{at}");
+            for (k, (x, y)) in x.iter().zip(y).enumerate() {
+                assert_close(x, y, &format!("{at}[{k}]"));
+            }
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            assert_eq!(x.len(), y.len(), "{at}");
+            for (k, v) in x {
+                assert_close(v, &y[k], &format!("{at}.{k}"));
+            }
+        }
+        _ => assert_eq!(a, b, "{at}"),
+    }
 }
 
 #[test]
 fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
     // The checkpoint holds the damage and the phases found: resume after the first pitting
     // phase has started, with damage on the flank, and compare exactly.
-    let bench = Bench::new(&design());
+    let bench = Bench::new(&coarse());
     let plan = forecast_plan();
     let straight = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -177,15 +224,10 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
 
 /// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life
 /// factor (the "measurement") is fitted from another K and the fitted curve (life factor 1);
-/// both come back. The gear is coarsened (10 positions, 24 x 30 cells) to keep the ~45 lives
-/// of the search quick.
+/// both come back (about 45 lives).
 #[test]
 fn k_and_the_life_factor_are_recovered_from_a_forecast_backlash_curve() {
-    let mut g = design();
-    g.analysis.positions = 10;
-    g.analysis.flank_cells_height = 24;
-    g.analysis.flank_cells_face = 30;
-    let bench = Bench::new(&g);
+    let bench = Bench::new(&coarse());
     let plan = forecast_plan();
     let (k_true, f_true) = (1.6e-8, 0.55);
     let mut runs = 0;

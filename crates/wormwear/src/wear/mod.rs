@@ -1122,7 +1122,15 @@ impl<'a> LifeLoop<'a> {
             StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
             StepControl::MaxRemoval(_) => left,
         };
+        let target = state.cycles + step_cycles;
         let substeps = self.wear_step(state, cw, step_cycles)?;
+        // The sub-steps' sum lands on the step's end, and a step to a phase's end on that
+        // end, exactly: a schedule's phases then start at the cycles they were found at.
+        state.cycles = if (end - target).abs() <= 1e-9 * end {
+            end
+        } else {
+            target
+        };
         loads.advance(&mut state.damage, step_cycles, true);
         Ok((step_cycles, substeps))
     }
