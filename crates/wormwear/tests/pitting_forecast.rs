@@ -3,16 +3,13 @@
 //! at the curve's life; a cell worn faster than it is damaged never pits) are the unit tests of
 //! `wormwear::pitting`.
 
-use std::path::Path;
-use wormwear::geometry::Geometry;
-use wormwear::input::{self, GearSet, Phase, Pitting};
-use wormwear::kinematics;
-use wormwear::ltca;
+mod common;
+use common::Bench;
+use wormwear::input::{GearSet, Phase, Pitting};
 use wormwear::wear;
 
 fn design() -> GearSet {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
-    input::load(&path).unwrap()
+    common::example("gear-1x40-design.toml")
 }
 
 /// The design case on a coarser grid (10 positions, 24 x 30 cells): these tests check the
@@ -23,43 +20,6 @@ fn coarse() -> GearSet {
     g.analysis.flank_cells_height = 24;
     g.analysis.flank_cells_face = 30;
     g
-}
-
-struct Bench {
-    g: GearSet,
-    geo: Geometry,
-    tca: kinematics::Tca,
-}
-
-impl Bench {
-    fn new(g: &GearSet) -> Self {
-        let geo = Geometry::build(g).unwrap();
-        let tca = kinematics::analyse(g, &geo).unwrap();
-        Self {
-            g: g.clone(),
-            geo,
-            tca,
-        }
-    }
-
-    fn simulate(
-        &self,
-        plan: &wear::WearPlan,
-        start: Option<wear::WearState>,
-        on_state: &mut dyn FnMut(&wear::StepView) -> Result<(), wear::WearError>,
-    ) -> Result<wear::WearState, wear::WearError> {
-        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
-        wear::simulate(
-            &self.g,
-            &self.geo,
-            &self.tca,
-            &ltca::LtcaSettings::from_gear(&self.g),
-            None,
-            plan,
-            start.unwrap_or_else(|| wear::WearState::new(wf)),
-            on_state,
-        )
-    }
 }
 
 /// A forecast of the design case over 200 000 cycles in 40 000-cycle steps: its edge cells

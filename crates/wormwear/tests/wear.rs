@@ -1,19 +1,13 @@
 //! Wear over life (MODEL §7): per-cycle Archard wear on the flank, its convergence with the
 //! number of positions, consistency of the Archard law with the geometry frozen, backlash.
 
-use std::path::Path;
+mod common;
+use common::{example, Bench};
 use wormwear::geometry::Geometry;
-use wormwear::input::{self, FilmLoad, GearSet};
+use wormwear::input::{FilmLoad, GearSet};
 use wormwear::kinematics;
 use wormwear::ltca;
 use wormwear::wear;
-
-fn example(name: &str) -> GearSet {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples")
-        .join(name);
-    input::load(&path).unwrap()
-}
 
 fn cycle(g: &GearSet) -> (Geometry, kinematics::Tca, wear::CycleWear) {
     let geo = Geometry::build(g).unwrap();
@@ -149,45 +143,6 @@ fn archard_wear_is_linear_in_k_and_in_one_over_h() {
         worst <= 1e-12 * base.depth.max(),
         "K x2, H x4 must halve the wear: {worst:e}"
     );
-}
-
-/// A gear ready for life runs: geometry and unloaded analysis built once.
-struct Bench {
-    g: GearSet,
-    geo: Geometry,
-    tca: kinematics::Tca,
-}
-
-impl Bench {
-    fn new(g: &GearSet) -> Self {
-        let geo = Geometry::build(g).unwrap();
-        let tca = kinematics::analyse(g, &geo).unwrap();
-        Self {
-            g: g.clone(),
-            geo,
-            tca,
-        }
-    }
-
-    /// Runs `plan` from `start` (None: unworn), calling `on_state` after every state.
-    fn simulate(
-        &self,
-        plan: &wear::WearPlan,
-        start: Option<wear::WearState>,
-        on_state: &mut dyn FnMut(&wear::StepView) -> Result<(), wear::WearError>,
-    ) -> Result<wear::WearState, wear::WearError> {
-        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
-        wear::simulate(
-            &self.g,
-            &self.geo,
-            &self.tca,
-            &ltca::LtcaSettings::from_gear(&self.g),
-            None,
-            plan,
-            start.unwrap_or_else(|| wear::WearState::new(wf)),
-            on_state,
-        )
-    }
 }
 
 /// A life plan without phases.

@@ -22,3 +22,47 @@ pub const EXAMPLES: [&str; 5] = [
     "gear-1x40-case-c.toml",
     "gear-k-2x25.toml",
 ];
+
+/// A gear ready for life runs: geometry and unloaded analysis built once.
+#[allow(dead_code)]
+pub struct Bench {
+    pub g: GearSet,
+    pub geo: wormwear::geometry::Geometry,
+    pub tca: wormwear::kinematics::Tca,
+}
+
+#[allow(dead_code)]
+impl Bench {
+    pub fn new(g: &GearSet) -> Self {
+        let geo = wormwear::geometry::Geometry::build(g).unwrap();
+        let tca = wormwear::kinematics::analyse(g, &geo).unwrap();
+        Self {
+            g: g.clone(),
+            geo,
+            tca,
+        }
+    }
+
+    /// Runs `plan` without bending from `start` (None: unworn), calling `on_state` after
+    /// every state.
+    pub fn simulate(
+        &self,
+        plan: &wormwear::wear::WearPlan,
+        start: Option<wormwear::wear::WearState>,
+        on_state: &mut dyn FnMut(
+            &wormwear::wear::StepView,
+        ) -> Result<(), wormwear::wear::WearError>,
+    ) -> Result<wormwear::wear::WearState, wormwear::wear::WearError> {
+        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
+        wormwear::wear::simulate(
+            &self.g,
+            &self.geo,
+            &self.tca,
+            &wormwear::ltca::LtcaSettings::from_gear(&self.g),
+            None,
+            plan,
+            start.unwrap_or_else(|| wormwear::wear::WearState::new(wf)),
+            on_state,
+        )
+    }
+}
