@@ -10,6 +10,7 @@ use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
 mod calibrate_cmd;
+mod rexs_cmd;
 
 #[derive(Parser)]
 #[command(
@@ -172,6 +173,46 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Take a worm stage from a REXS file (.rexs XML, .rexsj JSON, .rexsz zip; REXS 1.x) and
+    /// write it as a commented gear file, then validate it as `check` does.
+    #[command(
+        after_help = "Examples:\n  wormwear import examples/rexs/worm-stage-zi-2x41.rexs -o zi.toml\n  \
+                      wormwear import gearbox.rexsj -o stage.toml --stage 3   # several stages\n\n\
+                      Every REXS attribute the import did not use is listed at the end of the file."
+    )]
+    Import {
+        /// REXS file.
+        file: PathBuf,
+        /// Gear file to write (TOML).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Component id of the worm stage (needed when the file has several).
+        #[arg(long)]
+        stage: Option<u64>,
+    },
+    /// Analyse a gear file and write its stage with the results as REXS (DIR/<name>.rexs), beside
+    /// the usual outputs. Results go to the standard's attribute ids where REXS has them, the
+    /// others to custom_wormwear_* attributes; `wormwear import` reads the file back.
+    #[command(
+        name = "export-rexs",
+        after_help = "Examples:\n  wormwear export-rexs examples/gear-1x40-design.toml -o out/rexs --no-life\n  \
+                      wormwear export-rexs examples/gear-1x40-design.toml -o out/rexs --json"
+    )]
+    ExportRexs {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Write JSON (.rexsj) instead of XML (.rexs).
+        #[arg(long)]
+        json: bool,
+        /// Skip the life even when the file has a [wear] section.
+        #[arg(long)]
+        no_life: bool,
+        #[command(flatten)]
+        life: LifeArgs,
+    },
     /// Unloaded meshing analysis (TCA): kinematic error, no-load pattern, sliding velocities.
     #[command(after_help = "Example:\n  wormwear tca examples/gear-1x40-design.toml -o out/1x40")]
     Tca {
@@ -225,7 +266,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // One run per output directory: the lock lives until the process ends.
     let output = match &cli.command {
-        Command::Check { .. } => None,
+        Command::Check { .. } | Command::Import { .. } => None,
         Command::Geometry { output, .. }
         | Command::Tca { output, .. }
         | Command::Ltca { output, .. }
@@ -233,6 +274,7 @@ fn main() -> ExitCode {
         | Command::Run { output, .. }
         | Command::Calibrate { output, .. }
         | Command::Sweep { output, .. }
+        | Command::ExportRexs { output, .. }
         | Command::Validate { output, .. } => Some(output),
     };
     let lock = match output
@@ -281,6 +323,18 @@ fn main() -> ExitCode {
             quick,
         } => validate(output, examples, *quick, cli.quiet),
         Command::Sweep { file, output } => sweep(file, output, cli.quiet),
+        Command::Import {
+            file,
+            output,
+            stage,
+        } => rexs_cmd::import(file, output, *stage, cli.quiet),
+        Command::ExportRexs {
+            file,
+            output,
+            json,
+            no_life,
+            life,
+        } => rexs_cmd::export(file, output, *json, *no_life, life, cli.quiet, cli.verbose),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

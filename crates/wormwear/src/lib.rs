@@ -31,6 +31,7 @@ pub mod output;
 pub mod pitting;
 pub mod plot;
 pub mod rating;
+pub mod rexs;
 pub mod runner;
 pub mod sweep;
 pub mod validation;
