@@ -1174,3 +1174,107 @@ fn sweep_runs_a_grid_writes_its_table_and_page_and_resumes() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("missing.toml"));
 }
+
+#[test]
+fn import_writes_a_gear_file_that_check_accepts_and_bad_rexs_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let gear = dir.path().join("new/zi.toml");
+    let out = bin()
+        .arg("import")
+        .arg(example("rexs/worm-stage-zi-2x41.rexs"))
+        .arg("-o")
+        .arg(&gear)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("(valid)"));
+    let check = bin().arg("check").arg(&gear).output().unwrap();
+    assert!(check.status.success());
+    // Malformed, wrong content, missing attribute: exit 2, a message, no panic.
+    let text = std::fs::read_to_string(example("rexs/worm-stage-zi-2x41.rexs")).unwrap();
+    for (name, content, expected) in [
+        (
+            "cut.rexs",
+            text[..text.len() / 3].to_string(),
+            "not a REXS file",
+        ),
+        ("empty.rexsj", "{}".to_string(), "\"model\""),
+        (
+            "no-a.rexs",
+            text.replace(
+                "<attribute id=\"center_distance\" unit=\"mm\">100.0</attribute>",
+                "",
+            ),
+            "center_distance",
+        ),
+    ] {
+        let bad = dir.path().join(name);
+        std::fs::write(&bad, content).unwrap();
+        let out = bin()
+            .arg("import")
+            .arg(&bad)
+            .arg("-o")
+            .arg(dir.path().join("x.toml"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(
+            err.contains(expected) && !err.contains("panicked"),
+            "{name}: {err}"
+        );
+    }
+}
+
+#[test]
+fn export_rexs_writes_the_stage_with_results_and_imports_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let gear = dir.path().join("zi.toml");
+    let out = bin()
+        .args(["-q", "import"])
+        .arg(example("rexs/worm-stage-zi-2x41.rexs"))
+        .arg("-o")
+        .arg(&gear)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    // Coarse and without bending, so that the analysis takes a second.
+    let text = std::fs::read_to_string(&gear)
+        .unwrap()
+        .replace("model = \"fe\"", "model = \"none\"")
+        + "\n[analysis]\nflank_cells_height = 16\nflank_cells_face = 24\npositions = 6\n";
+    std::fs::write(&gear, text).unwrap();
+    let out = bin()
+        .args(["-q", "export-rexs"])
+        .arg(&gear)
+        .arg("-o")
+        .arg(dir.path().join("out"))
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rexsj = dir.path().join("out/zi.rexsj");
+    let written = std::fs::read_to_string(&rexsj).unwrap();
+    assert!(written.contains("mean_hertzian_stress_ltca_worm_stage"));
+    assert!(dir.path().join("out/summary.json").is_file());
+    let out = bin()
+        .args(["import"])
+        .arg(&rexsj)
+        .arg("-o")
+        .arg(dir.path().join("again.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

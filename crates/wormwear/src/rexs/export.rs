@@ -21,13 +21,23 @@ struct Builder {
     next_id: u64,
 }
 
-/// Attribute constructors (value and REXS unit).
+/// Attribute constructors (value and REXS unit). Numbers are written to 12 significant
+/// digits: the conversions from SI leave round-off in the last bits (0.018 m x 2 x 1000 =
+/// 36.00000000000001 mm) that the file should not carry.
 fn float(id: &str, unit: &str, x: f64) -> Attribute {
     Attribute {
         id: id.into(),
         unit: unit.into(),
-        value: Value::Float(x),
+        value: Value::Float(significant(x, 12)),
     }
+}
+
+/// `x` rounded to `digits` significant digits (non-finite values unchanged).
+fn significant(x: f64, digits: usize) -> f64 {
+    if !x.is_finite() || x == 0.0 {
+        return x;
+    }
+    format!("{:.*e}", digits - 1, x).parse().unwrap_or(x)
 }
 fn custom(name: &str, unit: &str, x: f64) -> Attribute {
     float(&format!("{CUSTOM_PREFIX}{name}"), unit, x)
@@ -250,7 +260,6 @@ fn gears(b: &mut Builder, gear: &GearSet) -> (u64, u64) {
     let worm = b.component("worm_gear", "worm", worm_attrs);
     let wh = &gear.wheel;
     let a = gear.nominal_centre_distance;
-    let body = gear.wheel_body();
     let mut wheel_attrs = vec![
         enumeration("flank_form", flank_form(gear.hob.profile)),
         integer("number_of_teeth", wh.teeth as i64),
@@ -278,10 +287,17 @@ fn gears(b: &mut Builder, gear: &GearSet) -> (u64, u64) {
             2.0 * (gear.cutting.centre_distance - gear.hob.tip_radius) * MM,
         ),
         float("u_coordinate_on_shaft", "mm", 0.0),
-        custom("rim_thickness", "mm", body.rim_thickness * MM),
-        custom("web_thickness", "mm", body.web_thickness * MM),
-        custom("hub_radius", "mm", body.hub_radius * MM),
     ];
+    // Body dimensions the gear file gives (a default stays a default).
+    for (name, value) in [
+        ("rim_thickness", wh.rim_thickness),
+        ("web_thickness", wh.web_thickness),
+        ("hub_radius", wh.hub_radius),
+    ] {
+        if let Some(v) = value {
+            wheel_attrs.push(custom(name, "mm", v * MM));
+        }
+    }
     wheel_attrs.extend(placed([0.0, a * MM, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]));
     let wheel = b.component("worm_wheel", "wheel", wheel_attrs);
     (worm, wheel)

@@ -109,11 +109,7 @@ pub fn import(model: &Model, stage: Option<u64>, source: &str) -> Result<Importe
         model.application_id,
         model.application_version
     );
-    out.field_text(
-        "title",
-        &format!("{} (from REXS)", stage_title(&parts)),
-        None,
-    );
+    out.field_text("title", &stage_title(&parts), None);
     let worm = worm_thread(&reader, &parts, &mut out)?;
     hob_thread(&reader, &parts, &worm, &mut out)?;
     let wheel = wheel_blank(&reader, &parts, &worm, &mut out)?;
@@ -164,6 +160,7 @@ struct Parts<'m> {
     wheel_settings: Option<&'m Component>,
     lubricant: Option<&'m Component>,
     casing: Option<&'m Component>,
+    unit: Option<&'m Component>,
     worm_material: Option<&'m Component>,
     wheel_material: Option<&'m Component>,
     worm_bearings: Vec<&'m Component>,
@@ -254,6 +251,7 @@ impl<'m> Parts<'m> {
             wheel_settings: step(&wheel_flanks, "manufacturing_settings", ""),
             lubricant,
             casing,
+            unit: model.components.iter().find(|c| c.kind == "gear_unit"),
             worm_material: referenced(worm, "material"),
             wheel_material: referenced(wheel, "material"),
             worm_bearings: bearings(worm_shaft),
@@ -280,6 +278,7 @@ impl<'m> Parts<'m> {
             self.wheel_settings,
             self.lubricant,
             self.casing,
+            self.unit,
             self.worm_material,
             self.wheel_material,
             self.worm_gear_data,
@@ -915,6 +914,9 @@ fn hob_thread(
     Ok(())
 }
 
+/// A value (mm) with the attribute or rule it comes from.
+type Sourced = (f64, String);
+
 /// The hob's tip and root radii with their sources, mm.
 fn hob_radii(
     reader: &Reader,
@@ -922,7 +924,7 @@ fn hob_radii(
     worm: &Worm,
     cutting_distance: f64,
     wheel_root: Option<f64>,
-) -> Result<((f64, String), (f64, String)), RexsError> {
+) -> Result<(Sourced, Sourced), RexsError> {
     let clearance = 0.2 * worm.axial_module;
     let tip_given = match hob {
         Some(h) => reader
@@ -1327,12 +1329,15 @@ fn materials(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<(), R
             .ok_or_else(|| {
                 RexsError::attribute(m, "poisson_ratio", "missing: Poisson's ratio is needed")
             })?;
-        let name = reader
+        let (name, source) = match reader
             .text(m, "material_designation")
             .filter(|s| !s.is_empty())
-            .unwrap_or(m.name.clone());
+        {
+            Some(n) => (n, "material.material_designation"),
+            None => (m.name.clone(), "the material component's name"),
+        };
         out.section(&format!("materials.{member}"));
-        out.field_text("name", &name, Some("material.material_designation"));
+        out.field_text("name", &name, Some(source));
         out.field("youngs_modulus_gpa", e / 1000.0, "material.elastic_modulus");
         out.field("poisson_ratio", nu, "material.poisson_ratio");
         if let Some(rho) = reader.positive(m, "density", Quantity::Density)? {
@@ -1445,11 +1450,11 @@ fn lubricant(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<(), R
         }
         return Ok(());
     };
-    let name = reader
-        .text(l, "name")
-        .filter(|s| !s.is_empty())
-        .unwrap_or(l.name.clone());
-    out.field_text("name", &name, Some("lubricant.name"));
+    let (name, source) = match reader.text(l, "name").filter(|s| !s.is_empty()) {
+        Some(n) => (n, "lubricant.name"),
+        None => (l.name.clone(), "the lubricant component's name"),
+    };
+    out.field_text("name", &name, Some(source));
     let (t, t_source) =
         temperature.unwrap_or((60.0, "default: REXS gives no lubricant temperature".into()));
     out.field("temperature_c", t, &t_source);
@@ -1742,7 +1747,7 @@ fn bending(
 ) -> Result<(), RexsError> {
     out.section("bending");
     match custom(reader, parts.stage, "fe_bending", Quantity::Ratio)? {
-        Some(x) if x == 0.0 => {
+        Some(0.0) => {
             out.field_text("model", "none", Some("custom_wormwear_fe_bending = 0"))
         }
         _ => out.field_text(
@@ -1827,6 +1832,12 @@ fn write_bearings(
     near_first: bool,
     what: &str,
 ) {
+    if points.is_empty() {
+        out.note(&format!(
+            "{key}: default (no bearings on this shaft in the file)"
+        ));
+        return;
+    }
     if points.len() != 2 {
         out.warn(format!("{key}: the file has {} bearings on this shaft, wormwear's model takes two: default positions used", points.len()));
         return;

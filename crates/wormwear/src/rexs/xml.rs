@@ -23,21 +23,35 @@ pub(super) fn parse(text: &str, name: &str) -> Result<Model, RexsError> {
         component: None,
         attribute: None,
     };
+    let mut open: Vec<String> = Vec::new();
     loop {
         let at = reader.buffer_position();
         let event = reader
             .read_event()
             .map_err(|e| p.error(at, e.to_string()))?;
         match event {
-            Event::Start(e) => p.open(&e, at, false)?,
+            Event::Start(e) => {
+                open.push(String::from_utf8_lossy(e.name().as_ref()).into_owned());
+                p.open(&e, at, false)?
+            }
             Event::Empty(e) => p.open(&e, at, true)?,
-            Event::End(e) => p.close(e.name().as_ref(), at)?,
+            Event::End(e) => {
+                open.pop();
+                p.close(e.name().as_ref(), at)?
+            }
             Event::Text(t) => {
                 let s = t.unescape().map_err(|e| p.error(at, e.to_string()))?;
                 p.text(&s);
             }
             Event::CData(t) => p.text(&String::from_utf8_lossy(&t)),
-            Event::Eof => break,
+            Event::Eof => {
+                if let Some(tag) = open.last() {
+                    return Err(
+                        p.error(at, format!("the document ends inside <{tag}> (truncated?)"))
+                    );
+                }
+                break;
+            }
             _ => {}
         }
     }
