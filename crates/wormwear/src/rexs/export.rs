@@ -337,6 +337,30 @@ fn shafts(
         b.relation("assembly", None, &[(unit_id, "assembly"), (shaft, "part")]);
         b.relation("assembly", None, &[(shaft, "assembly"), (gear_id, "part")]);
     }
+    let (worm_bearings, wheel_bearings) = supports(b, gear, casing, worm_shaft, wheel_shaft);
+    loads(
+        b,
+        gear,
+        worm_shaft,
+        wheel_shaft,
+        worm_bearings,
+        wheel_bearings,
+        worm,
+        wheel,
+    );
+    (worm_shaft, wheel_shaft)
+}
+
+/// One shaft section between the bearings of each shaft, and the bearings (side relations
+/// to the casing); returns the bearing positions along each shaft, mm.
+fn supports(
+    b: &mut Builder,
+    gear: &GearSet,
+    casing: u64,
+    worm_shaft: u64,
+    wheel_shaft: u64,
+) -> ([f64; 2], [f64; 2]) {
+    let a = gear.nominal_centre_distance * MM;
     let body = gear.wheel_body();
     let worm_bearings = gear.bending.worm_bearings.map(|x| x * MM);
     let wheel_bearings = body.bearings.map(|x| x * MM);
@@ -365,36 +389,14 @@ fn shafts(
         b.relation("assembly", None, &[(shaft, "assembly"), (section, "part")]);
     }
     for (k, x) in worm_bearings.iter().enumerate() {
-        bearing(
-            b,
-            casing,
-            worm_shaft,
-            &format!("worm bearing {}", k + 1),
-            [*x, 0.0, 0.0],
-            *x,
-        );
+        let name = format!("worm bearing {}", k + 1);
+        bearing(b, casing, worm_shaft, &name, [*x, 0.0, 0.0], *x);
     }
     for (k, z) in wheel_bearings.iter().enumerate() {
-        bearing(
-            b,
-            casing,
-            wheel_shaft,
-            &format!("wheel bearing {}", k + 1),
-            [0.0, a, *z],
-            *z,
-        );
+        let name = format!("wheel bearing {}", k + 1);
+        bearing(b, casing, wheel_shaft, &name, [0.0, a, *z], *z);
     }
-    loads(
-        b,
-        gear,
-        worm_shaft,
-        wheel_shaft,
-        worm_bearings,
-        wheel_bearings,
-        worm,
-        wheel,
-    );
-    (worm_shaft, wheel_shaft)
+    (worm_bearings, wheel_bearings)
 }
 
 fn bearing(b: &mut Builder, casing: u64, shaft: u64, name: &str, at: [f64; 3], u: f64) {
@@ -607,6 +609,46 @@ fn references(b: &mut Builder, gear: &GearSet, stage: u64, casing: u64, worm: u6
     }
 }
 
+/// The standard's rating (MODEL §9) under the DIN 3996 ids; the two wear limits, the total
+/// efficiency and the pitting life as custom attributes.
+fn rating_attributes(r: &crate::rating::Rating) -> Vec<Attribute> {
+    let din = |name: &str| format!("{name}_din_3996_2019");
+    vec![
+        float(
+            &din("gear_efficiency_in_reducer"),
+            "none",
+            r.mesh_efficiency,
+        ),
+        float(&din("mean_hertzian_stress"), "N / mm^2", r.sigma_hm_mpa),
+        float(&din("parameter_mean_hertzian_stress"), "none", r.p_m_star),
+        float(
+            &din("mean_tooth_coefficient_of_friction"),
+            "none",
+            r.friction_coefficient,
+        ),
+        float(
+            &din("sliding_velocity_at_reference_diameter"),
+            "m / s",
+            r.sliding_speed_m_s,
+        ),
+        float(&din("meshing_power_loss"), "W", r.loss_mesh_w),
+        float(&din("safety_factor_pitting"), "none", r.pitting_safety),
+        float(
+            &din("limiting_value_flank_loss"),
+            "mm",
+            r.wear_limit_pointed_tip_m.min(r.wear_limit_backlash_m) * MM,
+        ),
+        custom("total_efficiency", "none", r.efficiency),
+        custom(
+            "wear_limit_pointed_tip",
+            "mm",
+            r.wear_limit_pointed_tip_m * MM,
+        ),
+        custom("wear_limit_backlash", "mm", r.wear_limit_backlash_m * MM),
+        custom("pitting_life_cycles", "none", r.n_l_i_ii_cycles),
+    ]
+}
+
 /// Our results as worm_stage attributes: the standard's ids where REXS has one, custom ones
 /// otherwise.
 fn result_attributes(
@@ -619,55 +661,11 @@ fn result_attributes(
             .and_then(|s| s.get(key))
             .and_then(serde_json::Value::as_f64)
     };
-    let mut v = Vec::new();
-    if let Some(r) = &results.rating {
-        v.extend([
-            float(
-                "gear_efficiency_in_reducer_din_3996_2019",
-                "none",
-                r.mesh_efficiency,
-            ),
-            float(
-                "mean_hertzian_stress_din_3996_2019",
-                "N / mm^2",
-                r.sigma_hm_mpa,
-            ),
-            float(
-                "parameter_mean_hertzian_stress_din_3996_2019",
-                "none",
-                r.p_m_star,
-            ),
-            float(
-                "mean_tooth_coefficient_of_friction_din_3996_2019",
-                "none",
-                r.friction_coefficient,
-            ),
-            float(
-                "sliding_velocity_at_reference_diameter_din_3996_2019",
-                "m / s",
-                r.sliding_speed_m_s,
-            ),
-            float("meshing_power_loss_din_3996_2019", "W", r.loss_mesh_w),
-            float(
-                "safety_factor_pitting_din_3996_2019",
-                "none",
-                r.pitting_safety,
-            ),
-            float(
-                "limiting_value_flank_loss_din_3996_2019",
-                "mm",
-                r.wear_limit_pointed_tip_m.min(r.wear_limit_backlash_m) * MM,
-            ),
-            custom("total_efficiency", "none", r.efficiency),
-            custom(
-                "wear_limit_pointed_tip",
-                "mm",
-                r.wear_limit_pointed_tip_m * MM,
-            ),
-            custom("wear_limit_backlash", "mm", r.wear_limit_backlash_m * MM),
-            custom("pitting_life_cycles", "none", r.n_l_i_ii_cycles),
-        ]);
-    }
+    let mut v = results
+        .rating
+        .as_ref()
+        .map(rating_attributes)
+        .unwrap_or_default();
     if let Some(p) = get("ltca", "mean_pressure_pa") {
         v.push(float(
             "mean_hertzian_stress_ltca_worm_stage",

@@ -181,88 +181,39 @@ impl<'m> Parts<'m> {
                 .component(id)
                 .ok_or_else(|| RexsError::Model(format!("component {id} is missing")))
         };
-        let stage = get(info.id)?;
-        let worm = get(info.worm)?;
-        let wheel = get(info.wheel)?;
-        let shaft_of = |g: &Component| {
-            model
-                .related("assembly", g.id, "part", "assembly")
-                .into_iter()
-                .find(|c| c.kind == "shaft")
-        };
-        let worm_shaft = shaft_of(worm);
-        let wheel_shaft = shaft_of(wheel);
-        let on_shaft = |s: Option<&Component>, kind: &str| -> Vec<&'m Component> {
-            s.map(|s| {
-                model
-                    .related("assembly", s.id, "assembly", "part")
-                    .into_iter()
-                    .filter(|c| c.kind == kind)
-                    .collect()
-            })
-            .unwrap_or_default()
-        };
-        let bearings = |s: Option<&Component>| -> Vec<&'m Component> {
-            s.map(|s| model.related("side", s.id, "inner_part", "assembly"))
-                .unwrap_or_default()
-        };
-        let flanks_of = |g: &Component| {
-            model
-                .related("flank", g.id, "gear", "left")
-                .into_iter()
-                .chain(model.related("flank", g.id, "gear", "right"))
-                .collect::<Vec<_>>()
-        };
-        let worm_flanks = flanks_of(worm);
-        let wheel_flanks = flanks_of(wheel);
-        let step = |flanks: &[&Component], role: &str, kind: &str| {
-            flanks
-                .iter()
-                .flat_map(|f| model.related("manufacturing_step", f.id, "workpiece", role))
-                .find(|c| kind.is_empty() || c.kind == kind)
-        };
-        let referenced = |c: &Component, kind: &str| {
-            model
-                .related("reference", c.id, "origin", "referenced")
-                .into_iter()
-                .find(|x| x.kind == kind)
-        };
-        let gear_data = |g: &Component| {
-            model
-                .related("stage_gear_data", g.id, "gear", "stage_gear_data")
-                .into_iter()
-                .next()
-        };
-        let casing = model.components.iter().find(|c| c.kind == "gear_casing");
-        let lubricant = referenced(stage, "lubricant")
-            .or_else(|| casing.and_then(|c| referenced(c, "lubricant")))
-            .or_else(|| model.components.iter().find(|c| c.kind == "lubricant"));
-        let mut flanks = worm_flanks.clone();
-        flanks.extend(wheel_flanks.iter().copied());
+        let (stage, worm, wheel) = (get(info.id)?, get(info.worm)?, get(info.wheel)?);
+        let l = Links(model);
+        let (worm_shaft, wheel_shaft) = (l.shaft_of(worm), l.shaft_of(wheel));
+        let (worm_flanks, wheel_flanks) = (l.flanks_of(worm), l.flanks_of(wheel));
+        let casing = l.first("gear_casing");
+        let lubricant = l
+            .referenced(stage, "lubricant")
+            .or_else(|| casing.and_then(|c| l.referenced(c, "lubricant")))
+            .or_else(|| l.first("lubricant"));
         Ok(Parts {
             stage,
             worm,
             wheel,
             worm_shaft,
             wheel_shaft,
-            hob: step(&wheel_flanks, "tool", "worm_wheel_hob_tool"),
-            disc: step(&worm_flanks, "tool", "worm_grinding_disc_tool"),
-            worm_settings: step(&worm_flanks, "manufacturing_settings", ""),
-            wheel_settings: step(&wheel_flanks, "manufacturing_settings", ""),
+            hob: l.step(&wheel_flanks, "tool", "worm_wheel_hob_tool"),
+            disc: l.step(&worm_flanks, "tool", "worm_grinding_disc_tool"),
+            worm_settings: l.step(&worm_flanks, "manufacturing_settings", ""),
+            wheel_settings: l.step(&wheel_flanks, "manufacturing_settings", ""),
             lubricant,
             casing,
-            unit: model.components.iter().find(|c| c.kind == "gear_unit"),
-            worm_material: referenced(worm, "material"),
-            wheel_material: referenced(wheel, "material"),
-            worm_bearings: bearings(worm_shaft),
-            wheel_bearings: bearings(wheel_shaft),
-            worm_loads: on_shaft(worm_shaft, "external_load"),
-            wheel_loads: on_shaft(wheel_shaft, "external_load"),
-            worm_sections: on_shaft(worm_shaft, "shaft_section"),
-            wheel_sections: on_shaft(wheel_shaft, "shaft_section"),
-            worm_gear_data: gear_data(worm),
-            wheel_gear_data: gear_data(wheel),
-            flanks,
+            unit: l.first("gear_unit"),
+            worm_material: l.referenced(worm, "material"),
+            wheel_material: l.referenced(wheel, "material"),
+            worm_bearings: l.bearings(worm_shaft),
+            wheel_bearings: l.bearings(wheel_shaft),
+            worm_loads: l.on_shaft(worm_shaft, "external_load"),
+            wheel_loads: l.on_shaft(wheel_shaft, "external_load"),
+            worm_sections: l.on_shaft(worm_shaft, "shaft_section"),
+            wheel_sections: l.on_shaft(wheel_shaft, "shaft_section"),
+            worm_gear_data: l.gear_data(worm),
+            wheel_gear_data: l.gear_data(wheel),
+            flanks: worm_flanks.into_iter().chain(wheel_flanks).collect(),
         })
     }
 
@@ -299,6 +250,68 @@ impl<'m> Parts<'m> {
         let mut seen = BTreeSet::new();
         v.retain(|c| seen.insert(c.id));
         v
+    }
+}
+
+/// The relations of the model that lead from a stage to its parts.
+struct Links<'m>(&'m Model);
+
+impl<'m> Links<'m> {
+    /// The first component of a type.
+    fn first(&self, kind: &str) -> Option<&'m Component> {
+        self.0.components.iter().find(|c| c.kind == kind)
+    }
+
+    /// The shaft a gear is assembled on.
+    fn shaft_of(&self, g: &Component) -> Option<&'m Component> {
+        let owners = self.0.related("assembly", g.id, "part", "assembly");
+        owners.into_iter().find(|c| c.kind == "shaft")
+    }
+
+    /// The parts of a type assembled on a shaft (loads, sections).
+    fn on_shaft(&self, s: Option<&Component>, kind: &str) -> Vec<&'m Component> {
+        let Some(s) = s else { return Vec::new() };
+        let parts = self.0.related("assembly", s.id, "assembly", "part");
+        parts.into_iter().filter(|c| c.kind == kind).collect()
+    }
+
+    /// The bearings a shaft sits in (`side` relations, the shaft as inner part).
+    fn bearings(&self, s: Option<&Component>) -> Vec<&'m Component> {
+        s.map(|s| self.0.related("side", s.id, "inner_part", "assembly"))
+            .unwrap_or_default()
+    }
+
+    /// A gear's left and right flanks.
+    fn flanks_of(&self, g: &Component) -> Vec<&'m Component> {
+        let mut v = self.0.related("flank", g.id, "gear", "left");
+        v.extend(self.0.related("flank", g.id, "gear", "right"));
+        v
+    }
+
+    /// The component in `role` of the first manufacturing step of these flanks (of `kind`,
+    /// or any when empty).
+    fn step(&self, flanks: &[&Component], role: &str, kind: &str) -> Option<&'m Component> {
+        flanks
+            .iter()
+            .flat_map(|f| {
+                self.0
+                    .related("manufacturing_step", f.id, "workpiece", role)
+            })
+            .find(|c| kind.is_empty() || c.kind == kind)
+    }
+
+    /// The component of a type a component references (material, lubricant).
+    fn referenced(&self, c: &Component, kind: &str) -> Option<&'m Component> {
+        let targets = self.0.related("reference", c.id, "origin", "referenced");
+        targets.into_iter().find(|x| x.kind == kind)
+    }
+
+    /// A gear's stage gear data.
+    fn gear_data(&self, g: &Component) -> Option<&'m Component> {
+        let data = self
+            .0
+            .related("stage_gear_data", g.id, "gear", "stage_gear_data");
+        data.into_iter().next()
     }
 }
 
@@ -530,132 +543,125 @@ fn profile_of(reader: &Reader, c: &Component) -> Result<char, RexsError> {
 
 /// [worm]: form, starts, module, diameters, pressure angle and its plane, hand.
 fn worm_thread(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<Worm, RexsError> {
+    let (worm, sources) = read_worm(reader, parts)?;
+    out.section("worm");
+    let form = worm.profile.to_string();
+    out.field_text("profile", &form, Some("worm_gear.flank_form"));
+    out.line(
+        "starts",
+        worm.starts.to_string(),
+        Some("worm_gear.number_of_teeth"),
+    );
+    let hand = if worm.right_hand { "right" } else { "left" };
+    out.field_text("hand", hand, Some(&sources.hand));
+    out.field("axial_module_mm", worm.axial_module, &sources.module);
+    let diameter = |what: &str| format!("worm_gear.{what}_diameter_worm_gear / 2");
+    out.field(
+        "reference_radius_mm",
+        worm.reference_radius,
+        &diameter("reference"),
+    );
+    out.field("tip_radius_mm", worm.tip_radius, &diameter("tip"));
+    out.field("root_radius_mm", worm.root_radius, &diameter("root"));
+    let alpha_note = "worm_gear.pressure_angle_worm_gear (alpha_0)";
+    out.field("pressure_angle_deg", worm.pressure_angle, alpha_note);
+    let plane = if worm.normal_plane { "normal" } else { "axial" };
+    let plane_note = "as the flank form implies (DIN 3975: ZA axial, ZN/ZI/ZK/ZC normal)";
+    out.field_text("pressure_angle_plane", plane, Some(plane_note));
+    out.field(
+        "axial_thickness_mm",
+        worm.axial_thickness,
+        &sources.thickness,
+    );
+    out.note(&format!(
+        "lead angle atan(z1 m_x / d_m1) = {:.4} deg; tip relief: wormwear's default",
+        worm.lead_angle_deg
+    ));
+    if let Some(g) = sources.lead_angle {
+        if (g.abs() - worm.lead_angle_deg).abs() > 0.01 {
+            out.warn(format!(
+                "worm_gear.lead_angle_worm_gear = {g} deg does not match atan(z1 m_x / d_m1) = \
+                 {:.4} deg; the module and the diameter are used",
+                worm.lead_angle_deg
+            ));
+        }
+    }
+    if let Some(g) = worm.grinding {
+        write_grinding(out, "worm", g);
+    }
+    Ok(worm)
+}
+
+/// Where the worm's values came from, for the comments.
+struct WormSources {
+    hand: String,
+    module: String,
+    thickness: String,
+    /// The file's lead angle, degrees (signed).
+    lead_angle: Option<f64>,
+}
+
+/// The worm's attributes, read and checked.
+fn read_worm(reader: &Reader, parts: &Parts) -> Result<(Worm, WormSources), RexsError> {
     let c = parts.worm;
     let profile = profile_of(reader, c)?;
-    let starts = reader
-        .integer(c, "number_of_teeth")?
-        .filter(|z| *z > 0)
-        .ok_or_else(|| {
-            RexsError::attribute(
-                c,
-                "number_of_teeth",
-                "missing: the number of starts z1 is needed",
-            )
-        })?;
-    let d1 = reader.required(
-        c,
+    let starts = reader.integer(c, "number_of_teeth")?.filter(|z| *z > 0);
+    let starts = starts.ok_or_else(|| {
+        RexsError::attribute(
+            c,
+            "number_of_teeth",
+            "missing: the number of starts z1 is needed",
+        )
+    })?;
+    let length = |id: &str, what: &str| reader.required(c, id, Quantity::Length, what);
+    let d1 = length(
         "reference_diameter_worm_gear",
-        Quantity::Length,
         "the reference diameter d_m1",
     )?;
-    let da = reader.required(
-        c,
-        "tip_diameter_worm_gear",
-        Quantity::Length,
-        "the tip diameter d_a1",
-    )?;
-    let df = reader.required(
-        c,
-        "root_diameter_worm_gear",
-        Quantity::Length,
-        "the root diameter d_f1",
-    )?;
-    let alpha = reader.required(
-        c,
-        "pressure_angle_worm_gear",
-        Quantity::Angle,
-        "the pressure angle alpha_0",
-    )?;
+    let da = length("tip_diameter_worm_gear", "the tip diameter d_a1")?;
+    let df = length("root_diameter_worm_gear", "the root diameter d_f1")?;
+    let alpha_what = "the pressure angle alpha_0";
+    let alpha = reader.required(c, "pressure_angle_worm_gear", Quantity::Angle, alpha_what)?;
     let gamma_file = reader.number(c, "lead_angle_worm_gear", Quantity::Angle)?;
-    let (m_x, source) = axial_module(reader, c, starts, gamma_file)?;
-    let lead_angle = (starts as f64 * m_x / d1).atan().to_degrees();
-    let right_hand = gamma_file.is_none_or(|g| g >= 0.0);
+    let (m_x, module) = axial_module(reader, c, starts, gamma_file)?;
+    let (thickness, thickness_source) =
+        match custom(reader, c, "axial_thickness", Quantity::Length)? {
+            Some(t) => (t, format!("{CUSTOM_PREFIX}axial_thickness")),
+            None => (
+                0.5 * std::f64::consts::PI * m_x,
+                "default: half the axial pitch, p_x / 2 (DIN 3975; REXS has no thread thickness)"
+                    .into(),
+            ),
+        };
     let grinding = match profile {
         'K' | 'C' => Some(grinding_disc(reader, parts, profile)?),
         _ => None,
     };
-    out.section("worm");
-    out.field_text(
-        "profile",
-        &profile.to_string(),
-        Some("worm_gear.flank_form"),
-    );
-    out.line(
-        "starts",
-        starts.to_string(),
-        Some("worm_gear.number_of_teeth"),
-    );
-    let hand_note = match gamma_file {
+    let hand = match gamma_file {
         Some(g) => format!("sign of worm_gear.lead_angle_worm_gear = {g} deg (positive: right)"),
         None => "default: REXS gives no lead angle, so no hand".into(),
     };
-    out.field_text(
-        "hand",
-        if right_hand { "right" } else { "left" },
-        Some(&hand_note),
-    );
-    out.field("axial_module_mm", m_x, &source);
-    out.field(
-        "reference_radius_mm",
-        0.5 * d1,
-        "worm_gear.reference_diameter_worm_gear / 2",
-    );
-    out.field(
-        "tip_radius_mm",
-        0.5 * da,
-        "worm_gear.tip_diameter_worm_gear / 2",
-    );
-    out.field(
-        "root_radius_mm",
-        0.5 * df,
-        "worm_gear.root_diameter_worm_gear / 2",
-    );
-    let normal_plane = profile != 'A';
-    out.field(
-        "pressure_angle_deg",
-        alpha,
-        "worm_gear.pressure_angle_worm_gear (alpha_0)",
-    );
-    out.field_text(
-        "pressure_angle_plane",
-        if normal_plane { "normal" } else { "axial" },
-        Some("as the flank form implies (DIN 3975: ZA axial, ZN/ZI/ZK/ZC normal)"),
-    );
-    let thickness = custom(reader, c, "axial_thickness", Quantity::Length)?
-        .unwrap_or(0.5 * std::f64::consts::PI * m_x);
-    out.field(
-        "axial_thickness_mm",
-        thickness,
-        "default: half the axial pitch, p_x / 2 (DIN 3975; REXS has no thread thickness)",
-    );
-    out.note(&format!(
-        "lead angle atan(z1 m_x / d_m1) = {lead_angle:.4} deg; tip relief: wormwear's default"
-    ));
-    if let Some(g) = gamma_file {
-        if (g.abs() - lead_angle).abs() > 0.01 {
-            out.warn(format!(
-                "worm_gear.lead_angle_worm_gear = {g} deg does not match atan(z1 m_x / d_m1) = \
-                 {lead_angle:.4} deg; the module and the diameter are used"
-            ));
-        }
-    }
-    if let Some(g) = grinding {
-        write_grinding(out, "worm", g);
-    }
-    Ok(Worm {
+    let worm = Worm {
         profile,
         starts,
-        right_hand,
+        right_hand: gamma_file.is_none_or(|g| g >= 0.0),
         axial_module: m_x,
         reference_radius: 0.5 * d1,
         tip_radius: 0.5 * da,
         root_radius: 0.5 * df,
         pressure_angle: alpha,
-        normal_plane,
+        normal_plane: profile != 'A',
         axial_thickness: thickness,
-        lead_angle_deg: lead_angle,
+        lead_angle_deg: (starts as f64 * m_x / d1).atan().to_degrees(),
         grinding,
-    })
+    };
+    let sources = WormSources {
+        hand,
+        module,
+        thickness: thickness_source,
+        lead_angle: gamma_file,
+    };
+    Ok((worm, sources))
 }
 
 /// The axial module and the attribute it came from.
@@ -768,79 +774,91 @@ fn custom(
     reader.number(c, &format!("{CUSTOM_PREFIX}{name}"), q)
 }
 
+/// What the hob tool gives, each None where the file has no value.
+struct HobTool {
+    profile: Option<char>,
+    starts: Option<i64>,
+    lead: Option<f64>,
+    pressure_angle: Option<f64>,
+    reference_diameter: Option<f64>,
+    axial_thickness: Option<f64>,
+}
+
+fn read_hob(reader: &Reader, hob: Option<&Component>) -> Result<HobTool, RexsError> {
+    let Some(h) = hob else {
+        return Ok(HobTool {
+            profile: None,
+            starts: None,
+            lead: None,
+            pressure_angle: None,
+            reference_diameter: None,
+            axial_thickness: None,
+        });
+    };
+    let profile = match h.attribute("flank_form") {
+        Some(_) => Some(profile_of(reader, h)?),
+        None => None,
+    };
+    Ok(HobTool {
+        profile,
+        starts: reader.integer(h, "number_of_teeth")?.filter(|z| *z > 0),
+        lead: reader.positive(h, "lead", Quantity::Length)?,
+        pressure_angle: reader.positive(h, "pressure_angle_worm_gear", Quantity::Angle)?,
+        reference_diameter: custom(reader, h, "reference_diameter", Quantity::Length)?,
+        axial_thickness: custom(reader, h, "axial_thickness", Quantity::Length)?,
+    })
+}
+
+/// The wheel's manufacturing settings: centre-distance and pressure-angle corrections.
+fn corrections(reader: &Reader, parts: &Parts) -> Result<(f64, f64), RexsError> {
+    let Some(s) = parts.wheel_settings else {
+        return Ok((0.0, 0.0));
+    };
+    let da = reader.number(s, "center_distance_correction", Quantity::Length)?;
+    let dalpha = reader.number(s, "pressure_angle_correction", Quantity::Angle)?;
+    Ok((da.unwrap_or(0.0), dalpha.unwrap_or(0.0)))
+}
+
 /// [hob]: the worm_wheel_hob_tool where the file has one, otherwise the worm with its tip
-/// raised to cut the wheel's root.
+/// raised to cut the wheel's root; then [cutting].
 fn hob_thread(
     reader: &Reader,
     parts: &Parts,
     worm: &Worm,
     out: &mut GearText,
 ) -> Result<(), RexsError> {
-    let hob = parts.hob;
-    let a = reader.required(
-        parts.stage,
-        "center_distance",
-        Quantity::Length,
-        "the centre distance a",
-    )?;
-    let correction = match parts.wheel_settings {
-        Some(s) => reader
-            .number(s, "center_distance_correction", Quantity::Length)?
-            .unwrap_or(0.0),
-        None => 0.0,
-    };
+    let what = "the centre distance a";
+    let a = reader.required(parts.stage, "center_distance", Quantity::Length, what)?;
+    let (correction, alpha_correction) = corrections(reader, parts)?;
     let wheel_root = reader.positive(parts.wheel, "root_diameter_worm_gear", Quantity::Length)?;
+    let tool = read_hob(reader, parts.hob)?;
+    let from = |given: bool, attr: &str| match given {
+        true => format!("worm_wheel_hob_tool.{attr}"),
+        false => "the worm's (REXS gives no hob value)".to_string(),
+    };
+    let profile = tool.profile.unwrap_or(worm.profile);
+    if profile != worm.profile {
+        out.warn(format!(
+            "the hob's flank form Z{profile} differs from the worm's Z{}",
+            worm.profile
+        ));
+    }
     out.section("hob");
-    let (profile, starts, lead, alpha) = match hob {
-        Some(h) => {
-            let p = match h.attribute("flank_form") {
-                Some(_) => profile_of(reader, h)?,
-                None => worm.profile,
-            };
-            if p != worm.profile {
-                out.warn(format!(
-                    "the hob's flank form Z{p} differs from the worm's Z{}",
-                    worm.profile
-                ));
-            }
-            let z = reader.integer(h, "number_of_teeth")?.filter(|z| *z > 0);
-            let lead = reader.positive(h, "lead", Quantity::Length)?;
-            let alpha = reader.positive(h, "pressure_angle_worm_gear", Quantity::Angle)?;
-            (p, z, lead, alpha)
-        }
-        None => (worm.profile, None, None, None),
-    };
-    let from_hob = |given: bool, attr: &str| {
-        if given {
-            format!("worm_wheel_hob_tool.{attr}")
-        } else {
-            "the worm's (REXS gives no hob value)".to_string()
-        }
-    };
-    out.field_text(
-        "profile",
-        &profile.to_string(),
-        Some(&from_hob(hob.is_some(), "flank_form")),
-    );
+    let profile_note = from(tool.profile.is_some(), "flank_form");
+    out.field_text("profile", &profile.to_string(), Some(&profile_note));
+    let starts = tool.starts.unwrap_or(worm.starts).to_string();
     out.line(
         "starts",
-        starts.unwrap_or(worm.starts).to_string(),
-        Some(&from_hob(starts.is_some(), "number_of_teeth")),
+        starts,
+        Some(&from(tool.starts.is_some(), "number_of_teeth")),
     );
-    out.field_text(
-        "hand",
-        if worm.right_hand { "right" } else { "left" },
-        Some("the worm's"),
-    );
-    match lead {
+    let hand = if worm.right_hand { "right" } else { "left" };
+    out.field_text("hand", hand, Some("the worm's"));
+    match tool.lead {
         Some(l) => out.field("lead_mm", l, "worm_wheel_hob_tool.lead"),
         None => out.field("axial_module_mm", worm.axial_module, "the worm's"),
     }
-    let hob_custom = |name: &str| match hob {
-        Some(h) => custom(reader, h, name, Quantity::Length),
-        None => Ok(None),
-    };
-    match hob_custom("reference_diameter")? {
+    match tool.reference_diameter {
         Some(d) => out.field(
             "reference_radius_mm",
             0.5 * d,
@@ -852,42 +870,35 @@ fn hob_thread(
             "the worm's (a hob of the worm's size)",
         ),
     }
-    let pressure_correction = match parts.wheel_settings {
-        Some(s) => reader
-            .number(s, "pressure_angle_correction", Quantity::Angle)?
-            .unwrap_or(0.0),
-        None => 0.0,
-    };
-    let base_alpha = alpha.unwrap_or(worm.pressure_angle);
-    let alpha_note = format!(
-        "{}{}",
-        from_hob(alpha.is_some(), "pressure_angle_worm_gear"),
-        if pressure_correction != 0.0 {
-            " + worm_gear_manufacturing_settings.pressure_angle_correction"
-        } else {
-            ""
-        }
-    );
-    out.field(
-        "pressure_angle_deg",
-        base_alpha + pressure_correction,
-        &alpha_note,
-    );
-    out.field_text(
-        "pressure_angle_plane",
-        if worm.normal_plane { "normal" } else { "axial" },
-        Some("as the worm's"),
-    );
-    let (tip, root) = hob_radii(reader, hob, worm, a + correction, wheel_root)?;
+    let mut alpha_note = from(tool.pressure_angle.is_some(), "pressure_angle_worm_gear");
+    if alpha_correction != 0.0 {
+        alpha_note.push_str(" + worm_gear_manufacturing_settings.pressure_angle_correction");
+    }
+    let alpha = tool.pressure_angle.unwrap_or(worm.pressure_angle) + alpha_correction;
+    out.field("pressure_angle_deg", alpha, &alpha_note);
+    let plane = if worm.normal_plane { "normal" } else { "axial" };
+    out.field_text("pressure_angle_plane", plane, Some("as the worm's"));
+    let (tip, root) = hob_radii(reader, parts.hob, worm, a + correction, wheel_root)?;
     out.field("tip_radius_mm", tip.0, &tip.1);
     out.field("root_radius_mm", root.0, &root.1);
-    match hob_custom("axial_thickness")? {
+    match tool.axial_thickness {
         Some(t) => out.field("axial_thickness_mm", t, "custom_wormwear_axial_thickness"),
         None => out.field("axial_thickness_mm", worm.axial_thickness, "the worm's"),
     }
     if let Some(g) = worm.grinding {
         write_grinding(out, "hob", g);
     }
+    cutting(reader, parts, a, correction, out)
+}
+
+/// [cutting]: the hobbing centre distance; the settings wormwear does not model, warned.
+fn cutting(
+    reader: &Reader,
+    parts: &Parts,
+    a: f64,
+    correction: f64,
+    out: &mut GearText,
+) -> Result<(), RexsError> {
     out.section("cutting");
     let note = if correction != 0.0 {
         "worm_stage.center_distance + worm_gear_manufacturing_settings.center_distance_correction"
@@ -897,19 +908,20 @@ fn hob_thread(
     out.field("centre_distance_mm", a + correction, note);
     out.field("offset_mm", 0.0, "default: hob centred on the wheel");
     out.field("inclination_deg", 0.0, "default");
-    if let Some(s) = parts.wheel_settings {
-        if let Some(l) = reader.number(s, "lyra_angle", Quantity::Angle)? {
-            if l != 0.0 {
-                out.warn(format!(
-                    "lyra angle {l} deg of the wheel's hobbing is not modelled"
-                ));
-            }
-        }
-        if let Some(p) = reader.text(s, "hobbing_procedure") {
-            out.note(&format!(
-                "hobbing procedure {p}: the wheel is the hob's envelope either way"
+    let Some(s) = parts.wheel_settings else {
+        return Ok(());
+    };
+    if let Some(l) = reader.number(s, "lyra_angle", Quantity::Angle)? {
+        if l != 0.0 {
+            out.warn(format!(
+                "lyra angle {l} deg of the wheel's hobbing is not modelled"
             ));
         }
+    }
+    if let Some(p) = reader.text(s, "hobbing_procedure") {
+        out.note(&format!(
+            "hobbing procedure {p}: the wheel is the hob's envelope either way"
+        ));
     }
     Ok(())
 }
@@ -1005,40 +1017,8 @@ fn wheel_blank(
     let m = worm.axial_module;
     let d2 = z2 as f64 * m;
     let x2 = (a - worm.reference_radius - 0.5 * d2) / m;
-    let mut width = None;
-    for id in [
-        "face_width_worm_wheel",
-        "effective_face_width_worm_wheel",
-        "rim_width_worm_wheel",
-    ] {
-        if let Some(b) = reader.positive(c, id, Quantity::Length)? {
-            width = Some((b, format!("worm_wheel.{id}")));
-            break;
-        }
-    }
-    let (b2, width_source) = width.ok_or_else(|| {
-        RexsError::attribute(c, "face_width_worm_wheel", "missing: the wheel face width is needed (or effective_face_width_worm_wheel, rim_width_worm_wheel)")
-    })?;
-    let tip = match custom(reader, c, "throat_radius", Quantity::Length)? {
-        Some(r) => (r, "custom_wormwear_throat_radius".to_string()),
-        None => match reader.positive(c, "tip_diameter_worm_gear", Quantity::Length)? {
-            Some(d) => (0.5 * d, "worm_wheel.tip_diameter_worm_gear / 2".to_string()),
-            None => (
-                0.5 * d2 + (1.0 + x2) * m,
-                "default: d_a2 = d_2 + 2 (1 + x2) m_x (DIN 3975, h_a* = 1)".to_string(),
-            ),
-        },
-    };
-    let outer = match reader.positive(c, "outer_diameter_worm_wheel", Quantity::Length)? {
-        Some(d) => (
-            0.5 * d,
-            "worm_wheel.outer_diameter_worm_wheel / 2".to_string(),
-        ),
-        None => (
-            tip.0 + 0.5 * m,
-            "default: d_e2 = d_a2 + m_x (DIN 3975 guidance)".to_string(),
-        ),
-    };
+    let (b2, width_source) = face_width(reader, c)?;
+    let (tip, outer) = wheel_radii(reader, c, d2, x2, m)?;
     out.section("wheel");
     out.line("teeth", z2.to_string(), Some("worm_wheel.number_of_teeth"));
     out.field("face_width_mm", b2, &width_source);
@@ -1066,6 +1046,51 @@ fn wheel_blank(
         reference_radius: 0.5 * d2,
         face_width: b2,
     })
+}
+
+/// The wheel's face width: the face width, else the effective face width, else the rim width.
+fn face_width(reader: &Reader, c: &Component) -> Result<Sourced, RexsError> {
+    let ids = [
+        "face_width_worm_wheel",
+        "effective_face_width_worm_wheel",
+        "rim_width_worm_wheel",
+    ];
+    for id in ids {
+        if let Some(b) = reader.positive(c, id, Quantity::Length)? {
+            return Ok((b, format!("worm_wheel.{id}")));
+        }
+    }
+    let need = "missing: the wheel face width is needed (or effective_face_width_worm_wheel, \
+                rim_width_worm_wheel)";
+    Err(RexsError::attribute(c, "face_width_worm_wheel", need))
+}
+
+/// The wheel's tip (throat) and outer radii, mm: the file's, else DIN 3975's rules.
+fn wheel_radii(
+    reader: &Reader,
+    c: &Component,
+    d2: f64,
+    x2: f64,
+    m: f64,
+) -> Result<(Sourced, Sourced), RexsError> {
+    let tip = match reader.positive(c, "tip_diameter_worm_gear", Quantity::Length)? {
+        Some(d) => (0.5 * d, "worm_wheel.tip_diameter_worm_gear / 2".to_string()),
+        None => (
+            0.5 * d2 + (1.0 + x2) * m,
+            "default: d_a2 = d_2 + 2 (1 + x2) m_x (DIN 3975, h_a* = 1)".to_string(),
+        ),
+    };
+    let outer = match reader.positive(c, "outer_diameter_worm_wheel", Quantity::Length)? {
+        Some(d) => (
+            0.5 * d,
+            "worm_wheel.outer_diameter_worm_wheel / 2".to_string(),
+        ),
+        None => (
+            tip.0 + 0.5 * m,
+            "default: d_e2 = d_a2 + m_x (DIN 3975 guidance)".to_string(),
+        ),
+    };
+    Ok((tip, outer))
 }
 
 /// Warnings where the wheel's attributes disagree with the worm's data.
@@ -1747,9 +1772,7 @@ fn bending(
 ) -> Result<(), RexsError> {
     out.section("bending");
     match custom(reader, parts.stage, "fe_bending", Quantity::Ratio)? {
-        Some(0.0) => {
-            out.field_text("model", "none", Some("custom_wormwear_fe_bending = 0"))
-        }
+        Some(0.0) => out.field_text("model", "none", Some("custom_wormwear_fe_bending = 0")),
         _ => out.field_text(
             "model",
             "fe",

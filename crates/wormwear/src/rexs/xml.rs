@@ -120,96 +120,97 @@ impl Parser<'_> {
     fn open(&mut self, e: &BytesStart, at: u64, empty: bool) -> Result<(), RexsError> {
         let tag = String::from_utf8_lossy(e.name().as_ref()).into_owned();
         match tag.as_str() {
-            "model" => {
-                let a = self.attrs(e, at)?;
-                self.seen_model = true;
-                let get = |k: &str| a.get(k).cloned().unwrap_or_default();
-                self.model.version = get("version");
-                self.model.application_id = get("applicationId");
-                self.model.application_version = get("applicationVersion");
-                self.model.date = get("date");
-            }
-            "relation" => {
-                let a = self.attrs(e, at)?;
-                let order = a.get("order").and_then(|o| o.trim().parse().ok());
-                let relation = Relation {
-                    id: self.id(&a, "relation", at)?,
-                    kind: a.get("type").cloned().unwrap_or_default(),
-                    order,
-                    refs: Vec::new(),
-                };
-                if empty {
-                    self.model.relations.push(relation);
-                } else {
-                    self.relation = Some(relation);
-                }
-            }
-            "ref" => {
-                let a = self.attrs(e, at)?;
-                let r = Ref {
-                    id: self.id(&a, "ref", at)?,
-                    role: a.get("role").cloned().unwrap_or_default(),
-                    hint: a.get("hint").cloned().unwrap_or_default(),
-                };
-                match self.relation.as_mut() {
-                    Some(rel) => rel.refs.push(r),
-                    None => return Err(self.error(at, "<ref> outside a <relation>".into())),
-                }
-            }
-            "component" => {
-                let a = self.attrs(e, at)?;
-                let component = Component {
-                    id: self.id(&a, "component", at)?,
-                    kind: a.get("type").cloned().unwrap_or_default(),
-                    name: a.get("name").cloned().unwrap_or_default(),
-                    attributes: Vec::new(),
-                };
-                if empty {
-                    self.model.components.push(component);
-                } else {
-                    self.component = Some(component);
-                }
-            }
-            "attribute" if self.component.is_some() => {
-                let a = self.attrs(e, at)?;
-                let id = a
-                    .get("id")
-                    .cloned()
-                    .ok_or_else(|| self.error(at, "<attribute> without an id".into()))?;
-                self.attribute = Some(OpenAttribute {
-                    id,
-                    unit: a.get("unit").cloned().unwrap_or_default(),
-                    text: String::new(),
-                    array: None,
-                    coded: false,
-                    matrix: None,
-                    row: None,
-                    in_cell: false,
-                });
-                if empty {
-                    self.close("attribute".as_bytes(), at)?;
-                }
-            }
+            "model" => self.open_model(e, at),
+            "relation" => self.open_relation(e, at, empty),
+            "ref" => self.open_ref(e, at),
+            "component" => self.open_component(e, at, empty),
+            "attribute" if self.component.is_some() => self.open_attribute(e, at, empty),
             "array" | "matrix" | "r" | "c" => {
                 let coded = tag == "array" && self.attrs(e, at)?.contains_key("coding");
                 if let Some(att) = self.attribute.as_mut() {
-                    match tag.as_str() {
-                        "array" => {
-                            att.array = Some(Vec::new());
-                            att.coded = coded;
-                        }
-                        "matrix" => att.matrix = Some(Vec::new()),
-                        "r" => att.row = Some(Vec::new()),
-                        _ => {
-                            att.in_cell = !empty;
-                            if empty {
-                                push_cell(att, String::new());
-                            }
-                        }
-                    }
+                    open_value(att, &tag, coded, empty);
                 }
+                Ok(())
             }
-            _ => {}
+            _ => Ok(()),
+        }
+    }
+
+    fn open_model(&mut self, e: &BytesStart, at: u64) -> Result<(), RexsError> {
+        let a = self.attrs(e, at)?;
+        self.seen_model = true;
+        let get = |k: &str| a.get(k).cloned().unwrap_or_default();
+        self.model.version = get("version");
+        self.model.application_id = get("applicationId");
+        self.model.application_version = get("applicationVersion");
+        self.model.date = get("date");
+        Ok(())
+    }
+
+    fn open_relation(&mut self, e: &BytesStart, at: u64, empty: bool) -> Result<(), RexsError> {
+        let a = self.attrs(e, at)?;
+        let relation = Relation {
+            id: self.id(&a, "relation", at)?,
+            kind: a.get("type").cloned().unwrap_or_default(),
+            order: a.get("order").and_then(|o| o.trim().parse().ok()),
+            refs: Vec::new(),
+        };
+        match empty {
+            true => self.model.relations.push(relation),
+            false => self.relation = Some(relation),
+        }
+        Ok(())
+    }
+
+    fn open_ref(&mut self, e: &BytesStart, at: u64) -> Result<(), RexsError> {
+        let a = self.attrs(e, at)?;
+        let r = Ref {
+            id: self.id(&a, "ref", at)?,
+            role: a.get("role").cloned().unwrap_or_default(),
+            hint: a.get("hint").cloned().unwrap_or_default(),
+        };
+        match self.relation.as_mut() {
+            Some(rel) => {
+                rel.refs.push(r);
+                Ok(())
+            }
+            None => Err(self.error(at, "<ref> outside a <relation>".into())),
+        }
+    }
+
+    fn open_component(&mut self, e: &BytesStart, at: u64, empty: bool) -> Result<(), RexsError> {
+        let a = self.attrs(e, at)?;
+        let component = Component {
+            id: self.id(&a, "component", at)?,
+            kind: a.get("type").cloned().unwrap_or_default(),
+            name: a.get("name").cloned().unwrap_or_default(),
+            attributes: Vec::new(),
+        };
+        match empty {
+            true => self.model.components.push(component),
+            false => self.component = Some(component),
+        }
+        Ok(())
+    }
+
+    fn open_attribute(&mut self, e: &BytesStart, at: u64, empty: bool) -> Result<(), RexsError> {
+        let a = self.attrs(e, at)?;
+        let id = a
+            .get("id")
+            .cloned()
+            .ok_or_else(|| self.error(at, "<attribute> without an id".into()))?;
+        self.attribute = Some(OpenAttribute {
+            id,
+            unit: a.get("unit").cloned().unwrap_or_default(),
+            text: String::new(),
+            array: None,
+            coded: false,
+            matrix: None,
+            row: None,
+            in_cell: false,
+        });
+        if empty {
+            self.close("attribute".as_bytes(), at)?;
         }
         Ok(())
     }
@@ -268,6 +269,24 @@ impl Parser<'_> {
             _ => {}
         }
         Ok(())
+    }
+}
+
+/// An `<array>`, `<matrix>`, `<r>` or `<c>` inside an attribute.
+fn open_value(att: &mut OpenAttribute, tag: &str, coded: bool, empty: bool) {
+    match tag {
+        "array" => {
+            att.array = Some(Vec::new());
+            att.coded = coded;
+        }
+        "matrix" => att.matrix = Some(Vec::new()),
+        "r" => att.row = Some(Vec::new()),
+        _ => {
+            att.in_cell = !empty;
+            if empty {
+                push_cell(att, String::new());
+            }
+        }
     }
 }
 
