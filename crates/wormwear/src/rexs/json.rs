@@ -109,31 +109,30 @@ fn value(a: &Json) -> Result<Value, String> {
         .iter()
         .find(|(k, _)| k.as_str() != "id" && k.as_str() != "unit")
         .ok_or("no value")?;
-    let bad = || format!("\"{key}\": {v} does not fit the value type");
+    // A value that does not fit its type (writers put null for "not set") is kept raw: it is
+    // listed when unused and refused by name when the import needs it.
+    let raw = || Value::Raw(format!("{key}: {v}"));
     let floats =
         |v: &Json| -> Option<Vec<f64>> { v.as_array()?.iter().map(Json::as_f64).collect() };
-    Ok(match key.as_str() {
-        "floating_point" => Value::Float(v.as_f64().ok_or_else(bad)?),
-        "integer" => Value::Integer(v.as_i64().ok_or_else(bad)?),
-        "boolean" => Value::Boolean(v.as_bool().ok_or_else(bad)?),
-        "enum" => Value::Enum(v.as_str().ok_or_else(bad)?.to_string()),
-        "string" | "file_reference" | "date_time" => {
-            Value::Text(v.as_str().ok_or_else(bad)?.to_string())
-        }
-        "reference_component" => Value::Reference(v.as_u64().ok_or_else(bad)?),
-        "floating_point_array" => Value::FloatArray(floats(v).ok_or_else(bad)?),
-        "integer_array" => Value::IntegerArray(
-            v.as_array()
-                .and_then(|x| x.iter().map(Json::as_i64).collect())
-                .ok_or_else(bad)?,
-        ),
-        "floating_point_matrix" => Value::FloatMatrix(
-            v.as_array()
-                .and_then(|rows| rows.iter().map(floats).collect())
-                .ok_or_else(bad)?,
-        ),
-        _ => Value::Raw(format!("{key}: {v}")),
-    })
+    let typed = match key.as_str() {
+        "floating_point" => v.as_f64().map(Value::Float),
+        "integer" => v.as_i64().map(Value::Integer),
+        "boolean" => v.as_bool().map(Value::Boolean),
+        "enum" => v.as_str().map(|s| Value::Enum(s.to_string())),
+        "string" | "file_reference" | "date_time" => v.as_str().map(|s| Value::Text(s.to_string())),
+        "reference_component" => v.as_u64().map(Value::Reference),
+        "floating_point_array" => floats(v).map(Value::FloatArray),
+        "integer_array" => v
+            .as_array()
+            .and_then(|x| x.iter().map(Json::as_i64).collect())
+            .map(Value::IntegerArray),
+        "floating_point_matrix" => v
+            .as_array()
+            .and_then(|rows| rows.iter().map(floats).collect())
+            .map(Value::FloatMatrix),
+        _ => None,
+    };
+    Ok(typed.unwrap_or_else(raw))
 }
 
 /// Writes a model as a `.rexsj` document.
