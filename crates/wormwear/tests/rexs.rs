@@ -484,6 +484,29 @@ fn export_writes_the_results_under_the_standard_ids() {
 }
 
 #[test]
+fn json_values_of_the_wrong_type_are_kept_and_refused_only_where_needed() {
+    let text = std::fs::read_to_string(data("za-1x40-left.rexsj")).unwrap();
+    // null on an attribute the import does not need: listed, the gear imports.
+    let unused = text.replace(
+        "{\"id\": \"u_coordinate_on_shaft\", \"unit\": \"mm\", \"floating_point\": -60.0}",
+        "{\"id\": \"transmits_torque\", \"unit\": \"none\", \"boolean\": null}",
+    );
+    assert_ne!(unused, text);
+    let model = rexs::parse_bytes(unused.as_bytes(), "x.rexsj").unwrap();
+    let imp = import::import(&model, None, "x").unwrap();
+    assert!(
+        imp.text.contains("transmits_torque = boolean: null"),
+        "{}",
+        imp.text
+    );
+    // null where the import needs the value: an error naming the attribute.
+    let needed = text.replace("\"enum\": \"za\"}", "\"enum\": null}");
+    let model = rexs::parse_bytes(needed.as_bytes(), "x.rexsj").unwrap();
+    let e = import::import(&model, None, "x").unwrap_err().to_string();
+    assert!(e.contains("flank_form") && e.contains("null"), "{e}");
+}
+
+#[test]
 fn units_the_importer_does_not_know_are_refused_where_used_only() {
     // An unknown unit on an attribute the import does not use is listed, not an error.
     let text = std::fs::read_to_string(zi_example()).unwrap().replace(
