@@ -172,6 +172,35 @@ fn zk_stage_takes_its_disc_and_standard_defaults_and_warns_of_a_steel_wheel() {
 }
 
 #[test]
+fn a_stated_operating_viscosity_and_pressure_viscosity_law_are_used() {
+    let text = std::fs::read_to_string(data("zk-1x30-placeholder.rexs"))
+        .unwrap()
+        .replace(
+            "<attribute id=\"temperature_lubricant\" unit=\"C\">80</attribute>",
+            "<attribute id=\"temperature_lubricant\" unit=\"C\">80</attribute>\n      \
+             <attribute id=\"operating_viscosity\" unit=\"mm^2 / s\">41.5</attribute>",
+        )
+        .replace(
+            "<attribute id=\"lubricant_type_iso_6336_2006\" unit=\"none\">mineral_oil</attribute>",
+            "<attribute id=\"parameter_k_for_calculation_of_pressure_viscosity_coefficient_agma_925_a03\" \
+             unit=\"none\">0.012</attribute>\n      \
+             <attribute id=\"parameter_s_for_calculation_of_pressure_viscosity_coefficient_agma_925_a03\" \
+             unit=\"none\">0.1</attribute>\n      \
+             <attribute id=\"thermal_conductivity\" unit=\"W / (m K)\">0.13</attribute>",
+        );
+    let model = rexs::parse_bytes(text.as_bytes(), "zk.rexs").unwrap();
+    let imp = import::import(&model, None, "zk").unwrap();
+    let g = input::load_from_str(&imp.text).unwrap();
+    // 41.5 mm^2/s at 80 degC x the default density 900 kg/m^3 less 7e-4/K over 65 K.
+    let eta = 41.5e-6 * 900.0 * (1.0 - 7e-4 * 65.0);
+    assert!(close(g.lubricant.viscosity, eta, 1e-14));
+    // alpha = k eta^s mm^2/N with eta in mPa s.
+    let alpha = 0.012 * (eta * 1e3).powf(0.1) * 1e-6;
+    assert!(close(g.lubricant.pressure_viscosity, alpha, 1e-12));
+    assert!(close(g.lubricant.thermal_conductivity, 0.13, 1e-15));
+}
+
+#[test]
 fn unused_attributes_are_listed_not_dropped() {
     let (imp, _) = imported(&zi_example());
     for listed in [

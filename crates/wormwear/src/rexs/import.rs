@@ -1459,14 +1459,7 @@ pub const OIL_EXPANSION_PER_K: f64 = 7e-4;
 /// [lubricant]: dynamic viscosity at the operating temperature from the 40/100 degC kinematic
 /// viscosities, thermo-viscosity from the same curve, pressure-viscosity by lubricant type.
 fn lubricant(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<(), RexsError> {
-    let mut temperature = None;
-    for c in [Some(parts.stage), parts.casing].into_iter().flatten() {
-        if temperature.is_none() {
-            temperature = reader
-                .number(c, "temperature_lubricant", Quantity::Temperature)?
-                .map(|t| (t, format!("{}.temperature_lubricant", c.kind)));
-        }
-    }
+    let temperature = oil_temperature(reader, parts)?;
     out.section("lubricant");
     let Some(l) = parts.lubricant else {
         out.note("no lubricant component: wormwear's default lubricant");
@@ -1486,54 +1479,126 @@ fn lubricant(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<(), R
     if let Some(eta) = custom(reader, l, "viscosity", Quantity::Ratio)? {
         return lubricant_as_written(reader, l, eta, out);
     }
-    let nu40 = reader.required(
-        l,
-        "viscosity_at_40_degree_celsius",
-        Quantity::KinematicViscosity,
-        "the viscosity at 40 degC",
-    )?;
-    let nu100 = reader.required(
-        l,
-        "viscosity_at_100_degree_celsius",
-        Quantity::KinematicViscosity,
-        "the viscosity at 100 degC",
-    )?;
+    let eta = viscosity(reader, parts, l, t, out)?;
+    pressure_viscosity(reader, l, eta, out)?;
+    match reader.positive(l, "thermal_conductivity", Quantity::Conductivity)? {
+        Some(k) => out.field(
+            "thermal_conductivity_w_m_k",
+            k,
+            "lubricant.thermal_conductivity",
+        ),
+        None => out.note("thermal_conductivity_w_m_k: wormwear's default (not in the file)"),
+    }
+    out.note("composite_roughness_um: wormwear's default (REXS has no flank roughness here)");
+    Ok(())
+}
+
+/// The oil temperature, degC, and its source: the stage's, else the casing's.
+fn oil_temperature(reader: &Reader, parts: &Parts) -> Result<Option<Sourced>, RexsError> {
+    for c in [Some(parts.stage), parts.casing].into_iter().flatten() {
+        if let Some(t) = reader.number(c, "temperature_lubricant", Quantity::Temperature)? {
+            return Ok(Some((t, format!("{}.temperature_lubricant", c.kind))));
+        }
+    }
+    Ok(None)
+}
+
+/// Writes the dynamic viscosity at `t` degC and the thermo-viscosity coefficient; returns
+/// the viscosity, Pa s. The stage's operating viscosity where the file gives it, else the
+/// Ubbelohde-Walther line through the 40 and 100 degC viscosities; the density at 15 degC
+/// brought to `t` with [`OIL_EXPANSION_PER_K`].
+fn viscosity(
+    reader: &Reader,
+    parts: &Parts,
+    l: &Component,
+    t: f64,
+    out: &mut GearText,
+) -> Result<f64, RexsError> {
+    let q = Quantity::KinematicViscosity;
+    let nu40 = reader.positive(l, "viscosity_at_40_degree_celsius", q)?;
+    let nu100 = reader.positive(l, "viscosity_at_100_degree_celsius", q)?;
+    let operating = reader.positive(parts.stage, "operating_viscosity", q)?;
     let (rho15, rho_note) =
         match reader.positive(l, "density_at_15_degree_celsius", Quantity::Density)? {
             Some(r) => (r, "lubricant.density_at_15_degree_celsius"),
             None => (900.0, "default 900 kg/m^3 (no density in the file)"),
         };
-    let eta_at = |tc: f64| {
-        walther_viscosity(nu40, nu100, tc)
-            * 1e-6
-            * rho15
-            * (1.0 - OIL_EXPANSION_PER_K * (tc - 15.0))
+    let density = |tc: f64| rho15 * (1.0 - OIL_EXPANSION_PER_K * (tc - 15.0));
+    let walther = nu40
+        .zip(nu100)
+        .map(|(a, b)| move |tc: f64| walther_viscosity(a, b, tc));
+    let density_note = format!("x density ({rho_note}, expansion {OIL_EXPANSION_PER_K}/K)");
+    let eta = match (operating, &walther) {
+        (Some(nu), _) => {
+            let note = format!("worm_stage.operating_viscosity = {nu} mm^2/s {density_note}");
+            out.field("viscosity_pa_s", nu * 1e-6 * density(t), &note);
+            nu * 1e-6 * density(t)
+        }
+        (None, Some(w)) => {
+            let note = format!(
+                "nu({t} degC) by Ubbelohde-Walther (ASTM D341) through nu40, nu100 {density_note}"
+            );
+            out.field("viscosity_pa_s", w(t) * 1e-6 * density(t), &note);
+            w(t) * 1e-6 * density(t)
+        }
+        (None, None) => {
+            let need = "missing: the lubricant's viscosities at 40 and 100 degC (or \
+                        worm_stage.operating_viscosity) are needed";
+            return Err(RexsError::attribute(
+                l,
+                "viscosity_at_40_degree_celsius",
+                need,
+            ));
+        }
     };
-    let eta = eta_at(t);
-    out.field("viscosity_pa_s", eta, &format!(
-        "nu({t} degC) by Ubbelohde-Walther (ASTM D341) through nu40 = {nu40}, nu100 = {nu100} mm^2/s, x density ({rho_note}, expansion {OIL_EXPANSION_PER_K}/K)"
-    ));
-    let (t1, t2) = (t - 10.0 + 273.15, t + 10.0 + 273.15);
-    let beta = (eta_at(t1 - 273.15) / eta_at(t2 - 273.15)).ln() / (1.0 / t1 - 1.0 / t2);
-    out.field(
-        "thermo_viscosity_k",
-        beta,
-        "d ln(eta) / d(1/T) of the same curve over +/- 10 K",
-    );
+    match walther {
+        Some(w) => {
+            let eta_at = |tc: f64| w(tc) * 1e-6 * density(tc);
+            let (t1, t2) = (t - 10.0 + 273.15, t + 10.0 + 273.15);
+            let beta = (eta_at(t - 10.0) / eta_at(t + 10.0)).ln() / (1.0 / t1 - 1.0 / t2);
+            let note = "d ln(eta) / d(1/T) of the Walther line over +/- 10 K";
+            out.field("thermo_viscosity_k", beta, note);
+        }
+        None => out.note("thermo_viscosity_k: wormwear's default (no 40 / 100 degC viscosities)"),
+    }
+    Ok(eta)
+}
+
+/// Writes the pressure-viscosity coefficient: the file's AGMA 925-A03 value, else k eta^s with
+/// the file's k and s, else with AGMA 925-A03's k and s for the lubricant type, else the
+/// default (warned). `eta` in Pa s.
+fn pressure_viscosity(
+    reader: &Reader,
+    l: &Component,
+    eta: f64,
+    out: &mut GearText,
+) -> Result<(), RexsError> {
+    let key = "pressure_viscosity_per_gpa";
+    let given = "pressure_viscosity_coefficient_agma_925_a03";
+    if let Some(a) = reader.positive(l, given, Quantity::PressureViscosity)? {
+        out.field(key, a, &format!("lubricant.{given}"));
+        return Ok(());
+    }
+    let k_id = "parameter_k_for_calculation_of_pressure_viscosity_coefficient_agma_925_a03";
+    let s_id = "parameter_s_for_calculation_of_pressure_viscosity_coefficient_agma_925_a03";
+    let k = reader.positive(l, k_id, Quantity::Ratio)?;
+    let s = reader.number(l, s_id, Quantity::Ratio)?;
+    if let (Some(k), Some(s)) = (k, s) {
+        let note = "AGMA 925-A03: k eta^s with the file's k and s (eta in mPa s, alpha in mm^2/N)";
+        out.field(key, 1e3 * k * (eta * 1e3).powf(s), note);
+        return Ok(());
+    }
     let kind = reader
         .text(l, "lubricant_type_iso_6336_2006")
         .unwrap_or_default();
     match agma_pressure_viscosity(&kind, eta * 1e3) {
-        Some(a) => out.field("pressure_viscosity_per_gpa", a, &format!(
+        Some(a) => out.field(key, a, &format!(
             "AGMA 925-A03: k eta^s for {kind} at the operating viscosity"
         )),
         None => out.warn(format!(
             "lubricant type \"{kind}\" has no pressure-viscosity rule (AGMA 925-A03 tabulates mineral oil, PAO and PAG): wormwear's default is used"
         )),
     }
-    out.note(
-        "thermal_conductivity_w_m_k, composite_roughness_um: wormwear's defaults (not in REXS)",
-    );
     Ok(())
 }
 

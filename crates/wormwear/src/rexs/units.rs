@@ -25,6 +25,10 @@ pub enum Quantity {
     Stress,
     /// Hardness (Vickers or Brinell number), to GPa.
     Hardness,
+    /// Pressure-viscosity coefficient, to 1/GPa.
+    PressureViscosity,
+    /// Thermal conductivity, to W/(m K).
+    Conductivity,
     /// Dimensionless.
     Ratio,
 }
@@ -42,6 +46,8 @@ impl Quantity {
             Quantity::Density => "kg/m^3",
             Quantity::Stress => "MPa",
             Quantity::Hardness => "GPa",
+            Quantity::PressureViscosity => "1/GPa",
+            Quantity::Conductivity => "W/(m K)",
             Quantity::Ratio => "-",
         }
     }
@@ -58,6 +64,8 @@ impl Quantity {
             Quantity::Density => &["kg / dm^3", "kg / m^3", "g / cm^3"],
             Quantity::Stress => &["N / mm^2", "MPa", "GPa", "Pa", "N / m^2"],
             Quantity::Hardness => &["HV", "HB"],
+            Quantity::PressureViscosity => &["mm^2 / N", "m^2 / N", "1 / GPa"],
+            Quantity::Conductivity => &["W / (m K)"],
             Quantity::Ratio => &["none", ""],
         }
     }
@@ -92,6 +100,10 @@ pub fn convert(value: f64, unit: &str, quantity: Quantity) -> Option<f64> {
         (Quantity::Stress, "GPa") => 1e3,
         (Quantity::Stress, "Pa" | "N / m^2") => 1e-6,
         (Quantity::Hardness, "HV" | "HB") => 9.80665e-3,
+        (Quantity::PressureViscosity, "mm^2 / N") => 1e3,
+        (Quantity::PressureViscosity, "m^2 / N") => 1e9,
+        (Quantity::PressureViscosity, "1 / GPa") => 1.0,
+        (Quantity::Conductivity, "W / (m K)") => 1.0,
         (Quantity::Ratio, "none" | "") => 1.0,
         _ => return None,
     };
