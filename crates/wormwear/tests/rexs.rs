@@ -228,6 +228,14 @@ fn xml_json_and_zip_encodings_give_the_same_gear_file() {
         let gear_text = import::import(&back, None, "same").unwrap().text;
         assert_eq!(gear_text, from_xml, "{encoding:?}");
     }
+    // Markup characters in names and texts survive both encodings.
+    let mut odd = xml.clone();
+    odd.components[0].name = "a < b & \"c\" > 'd' – ü".into();
+    for encoding in [Encoding::Xml, Encoding::Json] {
+        let text = rexs::to_string(&odd, encoding);
+        let back = rexs::parse_bytes(text.as_bytes(), "odd").unwrap();
+        assert_eq!(back.components[0].name, odd.components[0].name, "{encoding:?}");
+    }
     // A hand-written JSON file reads as well (types from the JSON keys).
     let json = rexs::read(&data("za-1x40-left.rexsj")).unwrap();
     let again = rexs::parse_bytes(rexs::to_string(&json, Encoding::Json).as_bytes(), "j").unwrap();
