@@ -490,9 +490,14 @@ impl GearText {
     }
 }
 
-/// A TOML float: shortest round-trip form, always with a decimal point or exponent.
+/// A TOML float: shortest round-trip form, always with a decimal point or exponent; a
+/// non-finite value as TOML's `nan` / `inf`, which validation then refuses by field name.
 fn float(x: f64) -> String {
-    format!("{x:?}")
+    match x {
+        x if x.is_nan() => "nan".into(),
+        x if x.is_infinite() => if x > 0.0 { "inf" } else { "-inf" }.into(),
+        x => format!("{x:?}"),
+    }
 }
 
 /// The worm thread as imported (lengths in mm, angles in degrees).
