@@ -5,6 +5,7 @@ import json
 import math
 import os
 import pathlib
+import shutil
 import signal
 import subprocess
 import sys
@@ -252,9 +253,29 @@ def test_the_gil_is_released_during_a_run(design_file):
     assert len(during) > 0.3 * elapsed / 0.005, (len(during), elapsed)
 
 
+def _stacks_of(p):
+    """Python tracebacks of every thread of a hung child (faulthandler on SIGUSR1) and, where
+    gdb may attach, its native stacks: what a timeout needs to be diagnosed."""
+    native = ""
+    if shutil.which("gdb"):
+        try:
+            native = subprocess.run(
+                ["gdb", "-p", str(p.pid), "-batch", "-ex", "thread apply all bt 30"],
+                capture_output=True, text=True, timeout=60,
+            ).stdout
+        except Exception as e:  # noqa: BLE001 - diagnostics only
+            native = f"gdb failed: {e}"
+    p.send_signal(signal.SIGUSR1)
+    time.sleep(1.0)
+    p.kill()
+    out, err = p.communicate()
+    return f"stdout:\n{out}\nstderr (Python stacks):\n{err}\nnative stacks:\n{native}"
+
+
 def test_ctrl_c_interrupts_a_life(design_file, tmp_path):
     script = (
-        "import wormwear, sys\n"
+        "import faulthandler, signal, wormwear, sys\n"
+        "faulthandler.register(signal.SIGUSR1, all_threads=True)\n"
         f"g = wormwear.load({str(design_file)!r}).with_(**{{'bending.model': 'none'}})\n"
         "print('start', flush=True)\n"
         "try:\n"
@@ -263,11 +284,17 @@ def test_ctrl_c_interrupts_a_life(design_file, tmp_path):
         "    print('interrupted', flush=True)\n"
         "    sys.exit(7)\n"
     )
-    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     assert p.stdout.readline().strip() == "start"
     time.sleep(3.0)
     sent = time.time()
     p.send_signal(signal.SIGINT)
-    code = p.wait(timeout=60)
-    assert code == 7, p.stdout.read()
+    try:
+        code = p.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        # Once in five CI runs the child did not exit (session 12); the stacks say where it was.
+        pytest.fail("no exit within 60 s of SIGINT\n" + _stacks_of(p))
+    assert code == 7, p.stdout.read() + p.stderr.read()
     assert time.time() - sent < 30
