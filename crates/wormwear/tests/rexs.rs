@@ -470,11 +470,15 @@ fn export_writes_the_results_under_the_standard_ids() {
         file: "za.toml".into(),
         text: text.clone(),
     };
+    let mut plan = wormwear::input::WearPlan::with_life(20_000.0);
+    plan.step = wormwear::input::StepControl::Cycles(10_000.0);
     let request = wormwear::Request::new([
         wormwear::Stage::Geometry,
         wormwear::Stage::Tca,
         wormwear::Stage::Ltca,
-    ]);
+        wormwear::Stage::Wear,
+    ])
+    .with_life(plan);
     let results = wormwear::run(&gear, source, request, &mut |_| Ok(())).unwrap();
     let model = rexs::export::stage_model(&gear, Some(&results), "2026-11-24T00:00:00Z").unwrap();
     let stage = model
