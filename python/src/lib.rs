@@ -351,6 +351,25 @@ impl NativeResults {
         w
     }
 
+    /// Writes the stage and these results as REXS to `path` (JSON when `json`, else XML),
+    /// atomically; as `wormwear export-rexs` writes it.
+    fn write_rexs(&self, path: &str, json: bool) -> PyResult<()> {
+        let r = &self.results;
+        let model = wormwear::rexs::export::stage_model(
+            &r.gear,
+            Some(r),
+            &wormwear::rexs::export::utc_now(),
+        )
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        let encoding = match json {
+            true => wormwear::rexs::Encoding::Json,
+            false => wormwear::rexs::Encoding::Xml,
+        };
+        let text = wormwear::rexs::to_string(&model, encoding);
+        wormwear::output::write_atomic(Path::new(path), text.as_bytes())
+            .map_err(|e| PyOSError::new_err(e.to_string()))
+    }
+
     /// Writes the files the CLI writes for the same stages into `directory` (created), under
     /// the same lock; returns the paths written.
     fn write(&self, py: Python<'_>, directory: &str) -> PyResult<Vec<String>> {
@@ -514,6 +533,29 @@ fn write_sweep_csv(path: &str, parameters: Vec<String>, rows_json: &str) -> PyRe
         .map_err(|e| PyOSError::new_err(e.to_string()))
 }
 
+/// The worm stages of a REXS file as (id, name, worm id, wheel id).
+#[pyfunction]
+fn rexs_stages(path: &str) -> PyResult<Vec<(u64, String, u64, u64)>> {
+    let model =
+        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError_::new_err(e.to_string()))?;
+    Ok(wormwear::rexs::import::worm_stages(&model)
+        .into_iter()
+        .map(|s| (s.id, s.name, s.worm, s.wheel))
+        .collect())
+}
+
+/// A REXS file's worm stage as a gear file: (TOML text, warnings), as `wormwear import`
+/// writes it. REXS problems raise InputError.
+#[pyfunction]
+#[pyo3(signature = (path, stage=None))]
+fn import_rexs(path: &str, stage: Option<u64>) -> PyResult<(String, Vec<String>)> {
+    let model =
+        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError_::new_err(e.to_string()))?;
+    let imported = wormwear::rexs::import::import(&model, stage, path)
+        .map_err(|e| InputError_::new_err(format!("in {path}: {e}")))?;
+    Ok((imported.text, imported.warnings))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", m.py().get_type::<InputError_>())?;
@@ -526,5 +568,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(run_variant, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;
+    m.add_function(wrap_pyfunction!(import_rexs, m)?)?;
     Ok(())
 }

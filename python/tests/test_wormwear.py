@@ -298,3 +298,38 @@ def test_ctrl_c_interrupts_a_life(design_file, tmp_path):
         pytest.fail("no exit within 60 s of SIGINT\n" + _stacks_of(p))
     assert code == 7, p.stdout.read() + p.stderr.read()
     assert time.time() - sent < 30
+
+
+def test_rexs_stage_loads_and_results_go_back_to_rexs(tmp_path):
+    path = ROOT / "examples" / "rexs" / "worm-stage-zi-2x41.rexs"
+    assert wormwear.rexs_stages(path) == [
+        {"id": 3, "name": "worm stage ZI 2/41", "worm": 10, "wheel": 20}
+    ]
+    gear = wormwear.load_rexs(path)
+    v = gear.validated()
+    assert v["worm"]["starts"] == 2 and v["wheel"]["teeth"] == 41
+    # tan(gamma) = z1 m_x / d_m1 = 8 / 36 (the worm's lead angle, from the validated gear).
+    assert math.isclose(v["worm"]["axial_pitch"], 4e-3 * math.pi, rel_tol=1e-15)
+    assert "worm_gear.flank_form" in gear.to_toml()
+    # Coarse and without bending: a second's loaded analysis, written back as REXS JSON.
+    quick = gear.with_(**{
+        "bending.model": "none",
+        "analysis.flank_cells_height": 16,
+        "analysis.flank_cells_face": 24,
+        "analysis.positions": 6,
+    })
+    r = wormwear.run(quick, stages=["ltca"])
+    out = tmp_path / "zi.rexsj"
+    r.to_rexs(out)
+    text = out.read_text()
+    assert "mean_hertzian_stress_ltca_worm_stage" in text
+    back, first = wormwear.load_rexs(out).validated(), quick.validated()
+    for key in ("axial_pitch", "reference_radius", "tip_radius", "axial_thickness"):
+        assert math.isclose(back["worm"][key], first["worm"][key], rel_tol=1e-11), key
+    # A placeholder steel wheel warns; a file that is not REXS raises InputError.
+    with pytest.warns(UserWarning, match="not a bronze"):
+        wormwear.load_rexs(ROOT / "crates/wormwear/tests/data/rexs/zk-1x30-placeholder.rexs")
+    bad = tmp_path / "bad.rexs"
+    bad.write_text("<model version='1.4'><components>")
+    with pytest.raises(wormwear.InputError, match="ends inside"):
+        wormwear.load_rexs(bad)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import os
 import types
+import warnings
 from typing import Any, Callable, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
@@ -40,6 +41,8 @@ __all__ = [
     "InputError",
     "ComputationError",
     "load",
+    "load_rexs",
+    "rexs_stages",
     "run",
     "sweep",
     "STAGES",
@@ -115,6 +118,27 @@ def load(path: "str | os.PathLike[str]") -> GearSet:
     """Reads and validates a gear file (TOML, the CLI's format). Raises :class:`InputError`
     (every problem with its field, value and range) or OSError."""
     return GearSet(_native.NativeGear.load(os.fspath(path)))
+
+
+def rexs_stages(path: "str | os.PathLike[str]") -> list:
+    """The worm stages of a REXS file (``.rexs`` XML, ``.rexsj`` JSON, ``.rexsz`` zip) as
+    dicts with their component ``id``, ``name`` and the ``worm`` and ``wheel`` ids."""
+    return [
+        {"id": i, "name": n, "worm": w, "wheel": h}
+        for i, n, w, h in _native.rexs_stages(os.fspath(path))
+    ]
+
+
+def load_rexs(path: "str | os.PathLike[str]", stage: Optional[int] = None) -> GearSet:
+    """A worm stage of a REXS file as a validated gear, mapped as ``wormwear import`` maps it
+    (README, "REXS"); ``stage`` is the worm stage's component id, needed when the file has
+    several. The importer's warnings (a wheel material that is not a bronze, values that
+    disagree) are issued as :class:`UserWarning`; ``gear.to_toml()`` is the commented gear
+    file. Raises :class:`InputError` for a file that cannot be read or mapped."""
+    text, notes = _native.import_rexs(os.fspath(path), stage)
+    for note in notes:
+        warnings.warn(f"REXS import: {note}", UserWarning, stacklevel=2)
+    return _from_text(text, os.fspath(path))
 
 
 class FlankMap:
@@ -216,6 +240,13 @@ class Results:
             ):
                 frame[h] = col.astype(np.int64)
         return frame
+
+    def to_rexs(self, path: "str | os.PathLike[str]") -> None:
+        """Writes the stage and these results as REXS, as ``wormwear export-rexs`` does:
+        JSON for a ``.rexsj`` path, XML otherwise. :func:`load_rexs` reads it back to the
+        same gear."""
+        path = os.fspath(path)
+        self._native.write_rexs(path, path.lower().endswith((".rexsj", ".json")))
 
     def write(self, directory: "str | os.PathLike[str]") -> list:
         """Writes the files the CLI writes for the same stages (summary.json, CSV, SVG, VTK,
