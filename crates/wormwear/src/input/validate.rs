@@ -94,136 +94,248 @@ impl Checker {
 pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let mut ck = Checker::default();
     let mut warnings = Vec::new();
-
+    // Each section in file order, so the errors come in the file's order.
     let worm = thread(&mut ck, "worm", &f.worm);
     let hob = thread(&mut ck, "hob", &f.hob);
-
-    let cutting = Placement {
-        centre_distance: ck
-            .positive(
-                "cutting.centre_distance_mm",
-                f.cutting.centre_distance_mm,
-                10_000.0,
-                "mm",
-            )
-            .unwrap_or(f64::NAN)
-            * MM,
-        offset: ck
-            .range(
-                "cutting.offset_mm",
-                f.cutting.offset_mm,
-                -1000.0,
-                1000.0,
-                "mm",
-            )
-            .unwrap_or(f64::NAN)
-            * MM,
-        inclination: ck
-            .range(
-                "cutting.inclination_deg",
-                f.cutting.inclination_deg,
-                -20.0,
-                20.0,
-                "deg",
-            )
-            .unwrap_or(f64::NAN)
-            * DEG,
+    let cutting = cutting_placement(&mut ck, &f.cutting);
+    let op = operating_parts(&mut ck, &f.operating);
+    let wheel = wheel_parts(&mut ck, &f.wheel);
+    let worm_material = material(
+        &mut ck,
+        "materials.worm",
+        f.materials.worm.as_ref(),
+        default_worm_material(),
+    );
+    let wheel_material = material(
+        &mut ck,
+        "materials.wheel",
+        f.materials.wheel.as_ref(),
+        default_wheel_material(),
+    );
+    let lubricant = lubricant(&mut ck, &f.lubricant);
+    let conditions = conditions(&mut ck, &f.conditions);
+    let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
+    let rating = rating_factors(&mut ck, &f.rating);
+    let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
+    let analysis = analysis_settings(&mut ck, &f.analysis, wheel.teeth, wheel.face_width);
+    // Cross-field checks, only when the fields involved are individually valid.
+    if let (Some(wm), Some(hb)) = (&worm, &hob) {
+        hob_matches_worm(&mut ck, wm, hb);
+        if let Some(blank) = BlankRadii::of(&op, &wheel) {
+            let mesh = Mesh {
+                worm: wm,
+                hob: hb,
+                cutting: &cutting,
+                blank,
+                worm_offset: op.worm_offset,
+                throat_radius_mm: f.wheel.throat_radius_mm,
+            };
+            mesh.check(&mut ck, &mut warnings);
+        }
+    }
+    if !ck.errors.is_empty() {
+        return Err(InputError::Invalid(ck.errors));
+    }
+    // All Options are Some here: every None above came with an error.
+    let (Some(worm), Some(hob), Some(operating), Some(rotation), Some(nominal_a)) = (
+        worm,
+        hob,
+        op.placement(),
+        op.rotation,
+        op.nominal_centre_distance,
+    ) else {
+        unreachable_input()?
     };
+    let (Some(worm_material), Some(wheel_material), Some(lubricant), Some(conditions)) =
+        (worm_material, wheel_material, lubricant, conditions)
+    else {
+        unreachable_input()?
+    };
+    let (Some(wheel), Some(analysis), Some(bending)) = (wheel.blank(), analysis, bending) else {
+        unreachable_input()?
+    };
+    let gear = GearSet {
+        title: f.title.clone().unwrap_or_default(),
+        worm,
+        hob,
+        cutting,
+        wheel,
+        nominal_centre_distance: nominal_a,
+        operating,
+        rotation,
+        worm_material,
+        wheel_material,
+        lubricant,
+        conditions,
+        analysis,
+        wear,
+        rating: rating.unwrap_or_default(),
+        bending,
+        warnings,
+    };
+    if gear.bending.kind == BendingKind::Fe {
+        check_wheel_body(&gear)?;
+    }
+    Ok(gear)
+}
 
-    let nominal_a = ck
-        .positive(
-            "operating.centre_distance_mm",
-            f.operating.centre_distance_mm,
-            10_000.0,
-            "mm",
-        )
-        .map(|v| v * MM);
-    let da = ck
-        .range(
-            "operating.centre_distance_error_mm",
-            f.operating.centre_distance_error_mm,
-            -1.0,
-            1.0,
-            "mm",
-        )
-        .map(|v| v * MM);
-    let worm_offset = ck
-        .range(
-            "operating.worm_offset_mm",
-            f.operating.worm_offset_mm,
-            -5.0,
-            5.0,
-            "mm",
-        )
-        .map(|v| v * MM);
-    let inclination = ck
-        .range(
-            "operating.inclination_deg",
-            f.operating.inclination_deg,
-            -2.0,
-            2.0,
-            "deg",
-        )
-        .map(|v| v * DEG);
+/// [cutting]: the hob's placement, SI; an invalid field is NaN (its error recorded).
+fn cutting_placement(ck: &mut Checker, c: &SettingSpec) -> Placement {
+    let a = ck.positive(
+        "cutting.centre_distance_mm",
+        c.centre_distance_mm,
+        10_000.0,
+        "mm",
+    );
+    let offset = ck.range("cutting.offset_mm", c.offset_mm, -1000.0, 1000.0, "mm");
+    let tilt = ck.range(
+        "cutting.inclination_deg",
+        c.inclination_deg,
+        -20.0,
+        20.0,
+        "deg",
+    );
+    Placement {
+        centre_distance: a.unwrap_or(f64::NAN) * MM,
+        offset: offset.unwrap_or(f64::NAN) * MM,
+        inclination: tilt.unwrap_or(f64::NAN) * DEG,
+    }
+}
+
+/// [operating], checked field by field (SI; None where the field is invalid).
+struct OperatingParts {
+    nominal_centre_distance: Option<f64>,
+    centre_distance_error: Option<f64>,
+    worm_offset: Option<f64>,
+    inclination: Option<f64>,
+    rotation: Option<Rotation>,
+}
+
+impl OperatingParts {
+    /// The operating placement: nominal centre distance plus its error.
+    fn placement(&self) -> Option<Placement> {
+        Some(Placement {
+            centre_distance: self.nominal_centre_distance? + self.centre_distance_error?,
+            offset: self.worm_offset?,
+            inclination: self.inclination?,
+        })
+    }
+}
+
+fn operating_parts(ck: &mut Checker, o: &OperatingSpec) -> OperatingParts {
+    let a = ck.positive(
+        "operating.centre_distance_mm",
+        o.centre_distance_mm,
+        10_000.0,
+        "mm",
+    );
+    let da = ck.range(
+        "operating.centre_distance_error_mm",
+        o.centre_distance_error_mm,
+        -1.0,
+        1.0,
+        "mm",
+    );
+    let offset = ck.range(
+        "operating.worm_offset_mm",
+        o.worm_offset_mm,
+        -5.0,
+        5.0,
+        "mm",
+    );
+    let tilt = ck.range(
+        "operating.inclination_deg",
+        o.inclination_deg,
+        -2.0,
+        2.0,
+        "deg",
+    );
     let rotation = ck.choice(
         "operating.worm_rotation",
-        &f.operating.worm_rotation,
+        &o.worm_rotation,
         &[
             ("positive", Rotation::Positive),
             ("negative", Rotation::Negative),
         ],
     );
+    OperatingParts {
+        nominal_centre_distance: a.map(|v| v * MM),
+        centre_distance_error: da.map(|v| v * MM),
+        worm_offset: offset.map(|v| v * MM),
+        inclination: tilt.map(|v| v * DEG),
+        rotation,
+    }
+}
 
-    let w = &f.wheel;
+/// [wheel], checked field by field (SI; None where the field is invalid).
+struct WheelParts {
+    teeth: Option<u32>,
+    face_width: Option<f64>,
+    outer_radius: Option<f64>,
+    throat_radius: Option<f64>,
+    rim_thickness: Option<f64>,
+    web_thickness: Option<f64>,
+    hub_radius: Option<f64>,
+    shaft_radius: Option<f64>,
+    bearing_positions: Option<Vec<f64>>,
+    edge_relief: Option<EdgeRelief>,
+}
+
+impl WheelParts {
+    /// The blank, when its required fields are valid.
+    fn blank(self) -> Option<WheelBlank> {
+        Some(WheelBlank {
+            teeth: self.teeth?,
+            face_width: self.face_width?,
+            outer_radius: self.outer_radius?,
+            throat_radius: self.throat_radius?,
+            rim_thickness: self.rim_thickness,
+            web_thickness: self.web_thickness,
+            hub_radius: self.hub_radius,
+            shaft_radius: self.shaft_radius,
+            bearing_positions: self.bearing_positions,
+            edge_relief: self.edge_relief.unwrap_or(EdgeRelief::SHARP),
+        })
+    }
+}
+
+fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
     let teeth = ck
         .int_range("wheel.teeth", w.teeth, 10, 500)
         .map(|v| v as u32);
+    let length =
+        |ck: &mut Checker, name: &str, v: f64| ck.positive(name, v, 5000.0, "mm").map(|x| x * MM);
     let face_width = ck
         .positive("wheel.face_width_mm", w.face_width_mm, 2000.0, "mm")
         .map(|v| v * MM);
-    let outer_radius = ck
-        .positive("wheel.outer_radius_mm", w.outer_radius_mm, 5000.0, "mm")
-        .map(|v| v * MM);
-    let throat_radius = ck
-        .positive("wheel.throat_radius_mm", w.throat_radius_mm, 5000.0, "mm")
-        .map(|v| v * MM);
-    let opt_len = |ck: &mut Checker, name: &str, v: Option<f64>| -> Option<f64> {
-        v.and_then(|x| ck.positive(name, x, 5000.0, "mm"))
-            .map(|x| x * MM)
-    };
-    let rim_thickness = opt_len(&mut ck, "wheel.rim_thickness_mm", w.rim_thickness_mm);
-    let web_thickness = opt_len(&mut ck, "wheel.web_thickness_mm", w.web_thickness_mm);
-    let hub_radius = opt_len(&mut ck, "wheel.hub_radius_mm", w.hub_radius_mm);
-    let shaft_radius = opt_len(&mut ck, "wheel.shaft_radius_mm", w.shaft_radius_mm);
+    let outer_radius = length(ck, "wheel.outer_radius_mm", w.outer_radius_mm);
+    let throat_radius = length(ck, "wheel.throat_radius_mm", w.throat_radius_mm);
+    let optional =
+        |ck: &mut Checker, name: &str, v: Option<f64>| v.and_then(|x| length(ck, name, x));
+    let rim_thickness = optional(ck, "wheel.rim_thickness_mm", w.rim_thickness_mm);
+    let web_thickness = optional(ck, "wheel.web_thickness_mm", w.web_thickness_mm);
+    let hub_radius = optional(ck, "wheel.hub_radius_mm", w.hub_radius_mm);
+    let shaft_radius = optional(ck, "wheel.shaft_radius_mm", w.shaft_radius_mm);
     let bearing_positions = w.bearing_positions_mm.as_ref().map(|v| {
         v.iter()
             .enumerate()
             .map(|(i, &x)| {
-                ck.range(
-                    &format!("wheel.bearing_positions_mm[{i}]"),
-                    x,
-                    -5000.0,
-                    5000.0,
-                    "mm",
-                )
-                .unwrap_or(f64::NAN)
+                let name = format!("wheel.bearing_positions_mm[{i}]");
+                ck.range(&name, x, -5000.0, 5000.0, "mm")
+                    .unwrap_or(f64::NAN)
                     * MM
             })
             .collect::<Vec<_>>()
     });
-
     if let (Some(re), Some(ra)) = (outer_radius, throat_radius) {
         if re < ra {
-            ck.fail(
-                "wheel.outer_radius_mm",
-                w.outer_radius_mm,
-                format!("must be >= wheel.throat_radius_mm = {}", w.throat_radius_mm),
-            );
+            let problem = format!("must be >= wheel.throat_radius_mm = {}", w.throat_radius_mm);
+            ck.fail("wheel.outer_radius_mm", w.outer_radius_mm, problem);
         }
     }
     let edge_relief = face_width.and_then(|b| {
         edge_relief(
-            &mut ck,
+            ck,
             "wheel.edge_relief_um",
             w.edge_relief_um,
             "wheel.edge_relief_length_mm",
@@ -233,55 +345,66 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     });
     if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
         if sh >= hub {
+            let problem = format!(
+                "must be < wheel.hub_radius_mm = {}",
+                w.hub_radius_mm.unwrap_or_default()
+            );
             ck.fail(
                 "wheel.shaft_radius_mm",
                 w.shaft_radius_mm.unwrap_or_default(),
-                format!(
-                    "must be < wheel.hub_radius_mm = {}",
-                    w.hub_radius_mm.unwrap_or_default()
-                ),
+                problem,
             );
         }
     }
+    WheelParts {
+        teeth,
+        face_width,
+        outer_radius,
+        throat_radius,
+        rim_thickness,
+        web_thickness,
+        hub_radius,
+        shaft_radius,
+        bearing_positions,
+        edge_relief,
+    }
+}
 
-    let worm_material = material(
-        &mut ck,
-        "materials.worm",
-        f.materials.worm.as_ref(),
-        Material {
-            name: "case-hardened steel (default)".into(),
-            youngs_modulus: 203e9,
-            poisson_ratio: 0.29,
-            hardness: 7.0e9,
-            wear_coefficient: 0.0,
-            density: 7850.0,
-            pitting_limit: f64::INFINITY,
-        },
-    );
-    let wheel_material = material(
-        &mut ck,
-        "materials.wheel",
-        f.materials.wheel.as_ref(),
-        Material {
-            name: "chill-cast phosphor bronze CuSn12 (default)".into(),
-            youngs_modulus: 110e9,
-            poisson_ratio: 0.29,
-            hardness: 1.0e9,
-            wear_coefficient: 2.5e-8,
-            density: 8800.0,
-            pitting_limit: 425e6,
-        },
-    );
-    let lubricant = lubricant(&mut ck, &f.lubricant);
-    let conditions = conditions(&mut ck, &f.conditions);
-    let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
-    let rating = rating_factors(&mut ck, &f.rating);
-    let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
+/// The worm's material when the file gives none (MODEL §11).
+fn default_worm_material() -> Material {
+    Material {
+        name: "case-hardened steel (default)".into(),
+        youngs_modulus: 203e9,
+        poisson_ratio: 0.29,
+        hardness: 7.0e9,
+        wear_coefficient: 0.0,
+        density: 7850.0,
+        pitting_limit: f64::INFINITY,
+    }
+}
 
-    let a = &f.analysis;
-    let flank_cells_height =
-        ck.int_range("analysis.flank_cells_height", a.flank_cells_height, 4, 400);
-    let flank_cells_face = ck.int_range("analysis.flank_cells_face", a.flank_cells_face, 4, 400);
+/// The wheel's material when the file gives none (MODEL §11).
+fn default_wheel_material() -> Material {
+    Material {
+        name: "chill-cast phosphor bronze CuSn12 (default)".into(),
+        youngs_modulus: 110e9,
+        poisson_ratio: 0.29,
+        hardness: 1.0e9,
+        wear_coefficient: 2.5e-8,
+        density: 8800.0,
+        pitting_limit: 425e6,
+    }
+}
+
+/// [analysis] with its defaults; None when a field is invalid (its error recorded).
+fn analysis_settings(
+    ck: &mut Checker,
+    a: &AnalysisSpec,
+    teeth: Option<u32>,
+    face_width: Option<f64>,
+) -> Option<Analysis> {
+    let height = ck.int_range("analysis.flank_cells_height", a.flank_cells_height, 4, 400);
+    let face = ck.int_range("analysis.flank_cells_face", a.flank_cells_face, 4, 400);
     let positions = ck.int_range("analysis.positions", a.positions, 4, 720);
     let teeth_each_side = ck.int_range("analysis.teeth_each_side", a.teeth_each_side, 1, 10);
     let marking = ck
@@ -294,41 +417,66 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         .map(|v| v * 1e-6);
     let stl_threads = ck.int_range("analysis.stl_worm_threads", a.stl_worm_threads, 1, 50);
     let stl_teeth = ck.int_range("analysis.stl_wheel_teeth", a.stl_wheel_teeth, 0, 500);
-    let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
-    let contact_columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
-    if let Some(v) = a.contact_pressure_cap_mpa {
-        if v != 0.0 {
-            ck.range(
-                "analysis.contact_pressure_cap_mpa",
-                v,
-                10.0,
-                100_000.0,
-                "MPa (0 = no cap)",
-            );
+    let contact = contact_settings(ck, a);
+    if let (Some(n), Some(z2)) = (stl_teeth, teeth) {
+        if n > z2 as i64 {
+            let problem = format!("allowed [0, wheel.teeth = {z2}] (0 = all)");
+            ck.fail("analysis.stl_wheel_teeth", n, problem);
         }
     }
-    let patch_across = ck.range(
+    let section_offsets = section_offsets(ck, a, face_width);
+    let mut analysis = contact?;
+    analysis.flank_cells_height = height? as usize;
+    analysis.flank_cells_face = face? as usize;
+    analysis.positions = positions? as usize;
+    analysis.teeth_each_side = teeth_each_side? as usize;
+    analysis.marking_thickness = marking?;
+    analysis.section_offsets = section_offsets;
+    analysis.stl_worm_threads = stl_threads? as usize;
+    analysis.stl_wheel_teeth = stl_teeth? as usize;
+    Some(analysis)
+}
+
+/// The loaded analysis' settings of [analysis] (the grid and output fields left at zero for
+/// [`analysis_settings`] to fill).
+fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
+    let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
+    let columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
+    if let Some(v) = a.contact_pressure_cap_mpa.filter(|v| *v != 0.0) {
+        let unit = "MPa (0 = no cap)";
+        ck.range(
+            "analysis.contact_pressure_cap_mpa",
+            v,
+            10.0,
+            100_000.0,
+            unit,
+        );
+    }
+    let across = a.pressure_patch_across_mm;
+    let across = ck.range(
         "analysis.pressure_patch_across_mm",
-        a.pressure_patch_across_mm,
+        across,
         0.01,
         100.0,
         "mm",
     );
-    let patch_along = ck.range(
+    let along = a.pressure_patch_along_mm;
+    let along = ck.range(
         "analysis.pressure_patch_along_mm",
-        a.pressure_patch_along_mm,
+        along,
         0.01,
         1000.0,
         "mm",
     );
-    let band_factor = ck.range(
+    let unit = "Hertz half-widths";
+    let band = ck.range(
         "analysis.contact_band_factor",
         a.contact_band_factor,
         1.0,
         50.0,
-        "Hertz half-widths",
+        unit,
     );
-    let pressure_direction = ck.choice(
+    let direction = ck.choice(
         "analysis.pressure_direction",
         a.pressure_direction.as_deref().unwrap_or("worm-flank"),
         &[
@@ -336,26 +484,41 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             ("wheel-flank", PressureDirection::WheelFlank),
         ],
     );
+    use crate::ltca::solver::SolverKind;
     let solver = ck.choice(
         "analysis.solver",
         &a.solver,
         &[
-            (
-                "conjugate-gradient",
-                crate::ltca::solver::SolverKind::ConjugateGradient,
-            ),
-            ("fixed-point", crate::ltca::solver::SolverKind::FixedPoint),
+            ("conjugate-gradient", SolverKind::ConjugateGradient),
+            ("fixed-point", SolverKind::FixedPoint),
         ],
     );
-    if let (Some(n), Some(z2)) = (stl_teeth, teeth) {
-        if n > z2 as i64 {
-            ck.fail(
-                "analysis.stl_wheel_teeth",
-                n,
-                format!("allowed [0, wheel.teeth = {z2}] (0 = all)"),
-            );
-        }
-    }
+    Some(Analysis {
+        flank_cells_height: 0,
+        flank_cells_face: 0,
+        positions: 0,
+        teeth_each_side: 0,
+        marking_thickness: 0.0,
+        section_offsets: Vec::new(),
+        stl_worm_threads: 0,
+        stl_wheel_teeth: 0,
+        contact_slice_step: slice_step? as usize,
+        contact_columns: columns? as usize,
+        contact_band_factor: band?,
+        contact_pressure_cap: match a.contact_pressure_cap_mpa {
+            Some(v) if v != 0.0 => v * 1e6,
+            _ => f64::INFINITY,
+        },
+        pressure_patch_across: across? * 1e-3,
+        pressure_patch_along: along? * 1e-3,
+        solver: solver?,
+        pressure_direction: direction?,
+    })
+}
+
+/// The offsets of the drawn sections, m: the file's (inside the face width, at most 50),
+/// else -b/4, 0, b/4.
+fn section_offsets(ck: &mut Checker, a: &AnalysisSpec, face_width: Option<f64>) -> Vec<f64> {
     // Each section is a profile computation and a plot: a few dozen is plenty.
     const MAX_SECTIONS: usize = 50;
     if let Some(v) = a
@@ -369,7 +532,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             format!("at most {MAX_SECTIONS} sections"),
         );
     }
-    let section_offsets = match (&a.section_offsets_mm, face_width) {
+    match (&a.section_offsets_mm, face_width) {
         (Some(v), Some(b)) if v.len() <= MAX_SECTIONS => v
             .iter()
             .enumerate()
@@ -386,267 +549,196 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
             .collect(),
         (None, Some(b)) => vec![-0.25 * b, 0.0, 0.25 * b],
         _ => vec![],
-    };
+    }
+}
 
-    // Cross-field checks, only when the fields involved are individually valid.
-    if let (Some(wm), Some(hb)) = (&worm, &hob) {
-        if ((hb.axial_pitch - wm.axial_pitch) / wm.axial_pitch).abs() > 1e-6 {
-            ck.fail(
-                "hob.axial_module_mm",
-                format!(
-                    "{:.6} (lead {:.6} mm)",
-                    hb.axial_module() / MM,
-                    hb.lead() / MM
-                ),
-                format!(
-                    "the hob must have the worm's axial pitch: axial module {:.6} mm \
-                     (relative difference allowed 1e-6)",
-                    wm.axial_module() / MM
-                ),
-            );
-        }
-        if hb.hand != wm.hand {
-            ck.fail(
-                "hob.hand",
-                format!("{:?}", hb.hand),
-                format!("must equal worm.hand ({:?})", wm.hand),
-            );
-        }
-        if let (Some(an), Some(z2), Some(b), Some(re), Some(ra)) =
-            (nominal_a, teeth, face_width, outer_radius, throat_radius)
-        {
-            let a0 = cutting.centre_distance;
-            let gorge = an - ra;
-            // Worm root must clear the wheel throat.
-            if gorge <= wm.root_radius {
-                ck.fail(
-                    "wheel.throat_radius_mm",
-                    w.throat_radius_mm,
-                    format!(
-                        "must be < operating.centre_distance_mm - worm.root_radius_mm = {:.4} mm \
-                         (the wheel tip would hit the worm root)",
-                        (an - wm.root_radius) / MM
-                    ),
-                );
-            }
-            // Hob root must not cut the blank's throat.
-            if a0.is_finite() && a0 - ra < hb.root_radius {
-                ck.fail(
-                    "hob.root_radius_mm",
-                    hb.root_radius / MM,
-                    format!(
-                        "must be <= cutting.centre_distance_mm - wheel.throat_radius_mm = {:.4} mm \
-                         (the hob root would cut the wheel tip)",
-                        (a0 - ra) / MM
-                    ),
-                );
-            }
-            // The hob tip must cut the wheel root deep enough for the worm tip.
-            if a0.is_finite() {
-                let clearance = (an - wm.tip_radius) - (a0 - hb.tip_radius);
-                if clearance < 0.0 {
-                    ck.fail(
-                        "hob.tip_radius_mm",
-                        hb.tip_radius / MM,
-                        format!(
-                            "must be >= worm.tip_radius_mm + (cutting - operating centre distance) \
-                             = {:.4} mm (the worm tip would hit the wheel root)",
-                            (wm.tip_radius + a0 - an) / MM
-                        ),
-                    );
-                }
-                if hb.tip_radius < wm.tip_radius + a0 - an + 1e-9 && clearance >= 0.0 {
-                    warnings.push(
-                        "no bottom clearance: the hob tip radius equals the worm tip radius"
-                            .to_string(),
-                    );
-                }
-            }
-            // Centre distance consistent with the radii (implied wheel profile shift).
-            let r2 = z2 as f64 * wm.axial_pitch / (2.0 * PI);
-            let x2 = (an - wm.reference_radius - r2) / wm.axial_module();
-            if x2.abs() > 1.5 {
-                ck.fail(
-                    "operating.centre_distance_mm",
-                    an / MM,
-                    format!(
-                        "inconsistent with worm.reference_radius_mm + wheel reference radius \
-                         (z2 m_x / 2 = {:.4} mm): the implied profile shift x2 = {:.3} is outside \
-                         [-1.5, 1.5]",
-                        r2 / MM,
-                        x2
-                    ),
-                );
-            } else if x2.abs() > 1.0 {
-                warnings.push(format!("large wheel profile shift x2 = {x2:.3}"));
-            }
-            if ra < r2 {
-                warnings.push(format!(
-                    "wheel throat radius {:.3} mm is below the reference radius {:.3} mm",
-                    ra / MM,
-                    r2 / MM
-                ));
-            }
-            // Face width the worm can reach: at |z| = b/2 the blank top must be inside the
-            // worm tip cylinder.
-            let reach = reachable_half_width(an, re, gorge, wm.tip_radius);
-            if 0.5 * b >= reach {
-                ck.fail(
-                    "wheel.face_width_mm",
-                    b / MM,
-                    format!(
-                        "larger than the worm can reach: must be < {:.3} mm (twice the half-width \
-                         at which the blank top leaves the worm tip cylinder)",
-                        2.0 * reach / MM
-                    ),
-                );
-            }
-            if let Some(off) = worm_offset {
-                if off.abs() >= 0.5 * b {
-                    ck.fail(
-                        "operating.worm_offset_mm",
-                        off / MM,
-                        format!(
-                            "must be inside the face width: |offset| < {} mm",
-                            0.5 * b / MM
-                        ),
-                    );
-                }
-            }
-            if cutting.offset.is_finite() && cutting.offset.abs() >= 0.5 * b {
-                ck.fail(
-                    "cutting.offset_mm",
-                    cutting.offset / MM,
-                    format!(
-                        "must be inside the face width: |offset| < {} mm",
-                        0.5 * b / MM
-                    ),
-                );
-            }
-            let lead_diff = hb.lead_angle() - wm.lead_angle();
-            if (lead_diff - cutting.inclination).abs() > 1.0 * DEG {
-                warnings.push(format!(
-                    "hob lead angle differs from the worm's by {:.3} deg and the hob inclination is \
-                     {:.3} deg: the wheel will have a lead mismatch",
-                    lead_diff / DEG,
-                    cutting.inclination / DEG
-                ));
-            }
+/// The hob must have the worm's axial pitch and hand.
+fn hob_matches_worm(ck: &mut Checker, wm: &ThreadDef, hb: &ThreadDef) {
+    if ((hb.axial_pitch - wm.axial_pitch) / wm.axial_pitch).abs() > 1e-6 {
+        ck.fail(
+            "hob.axial_module_mm",
+            format!(
+                "{:.6} (lead {:.6} mm)",
+                hb.axial_module() / MM,
+                hb.lead() / MM
+            ),
+            format!(
+                "the hob must have the worm's axial pitch: axial module {:.6} mm \
+                 (relative difference allowed 1e-6)",
+                wm.axial_module() / MM
+            ),
+        );
+    }
+    if hb.hand != wm.hand {
+        ck.fail(
+            "hob.hand",
+            format!("{:?}", hb.hand),
+            format!("must equal worm.hand ({:?})", wm.hand),
+        );
+    }
+}
+
+/// The blank's valid radii and the centre distance, SI.
+struct BlankRadii {
+    nominal_centre_distance: f64,
+    teeth: u32,
+    face_width: f64,
+    outer_radius: f64,
+    throat_radius: f64,
+}
+
+impl BlankRadii {
+    fn of(op: &OperatingParts, w: &WheelParts) -> Option<Self> {
+        Some(Self {
+            nominal_centre_distance: op.nominal_centre_distance?,
+            teeth: w.teeth?,
+            face_width: w.face_width?,
+            outer_radius: w.outer_radius?,
+            throat_radius: w.throat_radius?,
+        })
+    }
+}
+
+/// Worm, hob and blank together: what must fit for the wheel to be cut and to mesh.
+struct Mesh<'a> {
+    worm: &'a ThreadDef,
+    hob: &'a ThreadDef,
+    cutting: &'a Placement,
+    blank: BlankRadii,
+    worm_offset: Option<f64>,
+    throat_radius_mm: f64,
+}
+
+impl Mesh<'_> {
+    fn check(&self, ck: &mut Checker, warnings: &mut Vec<String>) {
+        self.radial_clearances(ck, warnings);
+        self.profile_shift(ck, warnings);
+        self.face_width(ck);
+        let lead_diff = self.hob.lead_angle() - self.worm.lead_angle();
+        if (lead_diff - self.cutting.inclination).abs() > 1.0 * DEG {
+            warnings.push(format!(
+                "hob lead angle differs from the worm's by {:.3} deg and the hob inclination is \
+                 {:.3} deg: the wheel will have a lead mismatch",
+                lead_diff / DEG,
+                self.cutting.inclination / DEG
+            ));
         }
     }
 
-    if !ck.errors.is_empty() {
-        return Err(InputError::Invalid(ck.errors));
+    /// The worm root clears the wheel throat; the hob root does not cut the blank's throat;
+    /// the hob tip cuts the wheel root deep enough for the worm tip.
+    fn radial_clearances(&self, ck: &mut Checker, warnings: &mut Vec<String>) {
+        let (wm, hb) = (self.worm, self.hob);
+        let (an, ra) = (self.blank.nominal_centre_distance, self.blank.throat_radius);
+        let a0 = self.cutting.centre_distance;
+        if an - ra <= wm.root_radius {
+            ck.fail(
+                "wheel.throat_radius_mm",
+                self.throat_radius_mm,
+                format!(
+                    "must be < operating.centre_distance_mm - worm.root_radius_mm = {:.4} mm \
+                     (the wheel tip would hit the worm root)",
+                    (an - wm.root_radius) / MM
+                ),
+            );
+        }
+        if !a0.is_finite() {
+            return;
+        }
+        if a0 - ra < hb.root_radius {
+            ck.fail(
+                "hob.root_radius_mm",
+                hb.root_radius / MM,
+                format!(
+                    "must be <= cutting.centre_distance_mm - wheel.throat_radius_mm = {:.4} mm \
+                     (the hob root would cut the wheel tip)",
+                    (a0 - ra) / MM
+                ),
+            );
+        }
+        let clearance = (an - wm.tip_radius) - (a0 - hb.tip_radius);
+        if clearance < 0.0 {
+            ck.fail(
+                "hob.tip_radius_mm",
+                hb.tip_radius / MM,
+                format!(
+                    "must be >= worm.tip_radius_mm + (cutting - operating centre distance) \
+                     = {:.4} mm (the worm tip would hit the wheel root)",
+                    (wm.tip_radius + a0 - an) / MM
+                ),
+            );
+        }
+        if hb.tip_radius < wm.tip_radius + a0 - an + 1e-9 && clearance >= 0.0 {
+            warnings
+                .push("no bottom clearance: the hob tip radius equals the worm tip radius".into());
+        }
     }
-    // All Options are Some here: every None above came with an error.
-    let (Some(worm), Some(hob), Some(nominal_a), Some(da), Some(worm_offset), Some(inclination)) =
-        (worm, hob, nominal_a, da, worm_offset, inclination)
-    else {
-        unreachable_input()?
-    };
-    let (Some(teeth), Some(face_width), Some(outer_radius), Some(throat_radius), Some(rotation)) =
-        (teeth, face_width, outer_radius, throat_radius, rotation)
-    else {
-        unreachable_input()?
-    };
-    let (Some(h), Some(fw), Some(p), Some(t), Some(m), Some(st), Some(sw)) = (
-        flank_cells_height,
-        flank_cells_face,
-        positions,
-        teeth_each_side,
-        marking,
-        stl_threads,
-        stl_teeth,
-    ) else {
-        unreachable_input()?
-    };
-    let (Some(worm_material), Some(wheel_material), Some(lubricant), Some(conditions)) =
-        (worm_material, wheel_material, lubricant, conditions)
-    else {
-        unreachable_input()?
-    };
-    let (
-        Some(slice_step),
-        Some(contact_columns),
-        Some(band_factor),
-        Some(solver),
-        Some(patch_across),
-        Some(patch_along),
-        Some(pressure_direction),
-    ) = (
-        slice_step,
-        contact_columns,
-        band_factor,
-        solver,
-        patch_across,
-        patch_along,
-        pressure_direction,
-    )
-    else {
-        unreachable_input()?
-    };
-    let gear = GearSet {
-        title: f.title.clone().unwrap_or_default(),
-        worm,
-        hob,
-        cutting,
-        wheel: WheelBlank {
-            teeth,
-            face_width,
-            outer_radius,
-            throat_radius,
-            rim_thickness,
-            web_thickness,
-            hub_radius,
-            shaft_radius,
-            bearing_positions,
-            edge_relief: edge_relief.unwrap_or(EdgeRelief::SHARP),
-        },
-        nominal_centre_distance: nominal_a,
-        operating: Placement {
-            centre_distance: nominal_a + da,
-            offset: worm_offset,
-            inclination,
-        },
-        rotation,
-        worm_material,
-        wheel_material,
-        lubricant,
-        conditions,
-        analysis: Analysis {
-            flank_cells_height: h as usize,
-            flank_cells_face: fw as usize,
-            positions: p as usize,
-            teeth_each_side: t as usize,
-            marking_thickness: m,
-            section_offsets,
-            stl_worm_threads: st as usize,
-            stl_wheel_teeth: sw as usize,
-            contact_slice_step: slice_step as usize,
-            contact_columns: contact_columns as usize,
-            contact_band_factor: band_factor,
-            contact_pressure_cap: match a.contact_pressure_cap_mpa {
-                Some(0.0) => f64::INFINITY,
-                Some(v) => v * 1e6,
-                None => f64::INFINITY,
-            },
-            pressure_patch_across: patch_across * 1e-3,
-            pressure_patch_along: patch_along * 1e-3,
-            solver,
-            pressure_direction,
-        },
-        wear,
-        rating: rating.unwrap_or_default(),
-        bending: match bending {
-            Some(b) => b,
-            None => unreachable_input()?,
-        },
-        warnings,
-    };
-    if gear.bending.kind == BendingKind::Fe {
-        check_wheel_body(&gear)?;
+
+    /// The centre distance must be consistent with the radii (implied wheel profile shift).
+    fn profile_shift(&self, ck: &mut Checker, warnings: &mut Vec<String>) {
+        let wm = self.worm;
+        let (an, ra) = (self.blank.nominal_centre_distance, self.blank.throat_radius);
+        let r2 = self.blank.teeth as f64 * wm.axial_pitch / (2.0 * PI);
+        let x2 = (an - wm.reference_radius - r2) / wm.axial_module();
+        if x2.abs() > 1.5 {
+            ck.fail(
+                "operating.centre_distance_mm",
+                an / MM,
+                format!(
+                    "inconsistent with worm.reference_radius_mm + wheel reference radius \
+                     (z2 m_x / 2 = {:.4} mm): the implied profile shift x2 = {:.3} is outside \
+                     [-1.5, 1.5]",
+                    r2 / MM,
+                    x2
+                ),
+            );
+        } else if x2.abs() > 1.0 {
+            warnings.push(format!("large wheel profile shift x2 = {x2:.3}"));
+        }
+        if ra < r2 {
+            warnings.push(format!(
+                "wheel throat radius {:.3} mm is below the reference radius {:.3} mm",
+                ra / MM,
+                r2 / MM
+            ));
+        }
     }
-    Ok(gear)
+
+    /// The face width the worm can reach (at |z| = b/2 the blank top must be inside the worm
+    /// tip cylinder), and the offsets inside it.
+    fn face_width(&self, ck: &mut Checker) {
+        let bl = &self.blank;
+        let b = bl.face_width;
+        let gorge = bl.nominal_centre_distance - bl.throat_radius;
+        let reach = reachable_half_width(
+            bl.nominal_centre_distance,
+            bl.outer_radius,
+            gorge,
+            self.worm.tip_radius,
+        );
+        if 0.5 * b >= reach {
+            ck.fail(
+                "wheel.face_width_mm",
+                b / MM,
+                format!(
+                    "larger than the worm can reach: must be < {:.3} mm (twice the half-width \
+                     at which the blank top leaves the worm tip cylinder)",
+                    2.0 * reach / MM
+                ),
+            );
+        }
+        let inside = format!(
+            "must be inside the face width: |offset| < {} mm",
+            0.5 * b / MM
+        );
+        if let Some(off) = self.worm_offset.filter(|o| o.abs() >= 0.5 * b) {
+            ck.fail("operating.worm_offset_mm", off / MM, inside.clone());
+        }
+        let off = self.cutting.offset;
+        if off.is_finite() && off.abs() >= 0.5 * b {
+            ck.fail("cutting.offset_mm", off / MM, inside);
+        }
+    }
 }
 
 /// The wheel body the bending model builds (rim, web, hub, shaft and its bearings), checked
