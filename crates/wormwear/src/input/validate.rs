@@ -1477,7 +1477,87 @@ fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
 
 fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     let life = ck.positive("wear.life_cycles", w.life_cycles, 1e12, "cycles");
-    let step = match (w.step_wear_um, w.step_cycles) {
+    let step = step_control(ck, w);
+    let endurance = endurance(ck, w.endurance.as_ref());
+    let mut phases = phases(ck, &w.phases)?;
+    let pitting = pitting_mode(ck, w, &w.phases);
+    let onset = match w.pitting_onset_percent {
+        Some(v) if pitting.is_some() && pitting != Some(Pitting::Forecast) => {
+            ck.fail(
+                "wear.pitting_onset_percent",
+                v,
+                "only a forecast (wear.pitting = \"forecast\") takes a pitting onset share",
+            );
+            None
+        }
+        v => ck.range(
+            "wear.pitting_onset_percent",
+            v.unwrap_or(2.0),
+            0.0,
+            100.0,
+            "%",
+        ),
+    };
+    if pitting == Some(Pitting::Off) {
+        phases.retain(|p| matches!(p, Phase::Wear { .. }));
+    }
+    let guard = ck.range(
+        "wear.max_substep_wear_um",
+        w.max_substep_wear_um.unwrap_or(5.0),
+        0.0,
+        1000.0,
+        "um",
+    );
+    let film_load = ck.choice(
+        "wear.film_load",
+        w.film_load.as_deref().unwrap_or("loaded-analysis"),
+        &[
+            ("loaded-analysis", FilmLoad::LoadedAnalysis),
+            ("hertz-peak-floor", FilmLoad::HertzPeakFloor),
+        ],
+    );
+    let pit_depth = ck.choice(
+        "wear.pit_depth",
+        w.pit_depth.as_deref().unwrap_or("hertz"),
+        &[
+            ("hertz", PitDepth::Hertz),
+            ("loaded-band", PitDepth::LoadedBand),
+        ],
+    );
+    let map_cycles = map_cycles(ck, w.map_cycles.as_ref());
+    let stop_at = ck.choice(
+        "wear.stop_at",
+        w.stop_at.as_deref().unwrap_or("pointed-tip"),
+        &[
+            ("pointed-tip", LifeStop::PointedTip),
+            ("backlash-limit", LifeStop::BacklashLimit),
+        ],
+    );
+    let backlash_limit = match w.backlash_limit_um {
+        None => Some(None),
+        Some(v) => ck
+            .positive("wear.backlash_limit_um", v, 1e5, "um")
+            .map(|v| Some(v * 1e-6)),
+    };
+    Some(WearPlan {
+        life_cycles: life?,
+        step: step?,
+        max_substep_removal: guard? * 1e-6,
+        phases,
+        pitting: pitting?,
+        pitting_onset_share: onset? * 1e-2,
+        endurance: endurance?,
+        film_load: film_load?,
+        pit_depth: pit_depth?,
+        map_cycles: map_cycles?,
+        stop_at: stop_at?,
+        backlash_limit: backlash_limit?,
+    })
+}
+
+/// The step control: adaptive (largest removal, default 4 um) or fixed cycles.
+fn step_control(ck: &mut Checker, w: &WearSpec) -> Option<StepControl> {
+    match (w.step_wear_um, w.step_cycles) {
         (Some(_), Some(c)) => {
             ck.fail(
                 "wear.step_cycles",
@@ -1493,8 +1573,12 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             .positive("wear.step_wear_um", d, 1000.0, "um")
             .map(|d| StepControl::MaxRemoval(d * 1e-6)),
         (None, None) => Some(StepControl::MaxRemoval(4e-6)),
-    };
-    let endurance = match &w.endurance {
+    }
+}
+
+/// The bronze pressure-life curve (MODEL §8; default when the section is absent).
+fn endurance(ck: &mut Checker, e: Option<&EnduranceSpec>) -> Option<Endurance> {
+    match e {
         None => Some(Endurance::DEFAULT),
         Some(e) => {
             let p = ck.positive(
@@ -1526,11 +1610,15 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
                 _ => None,
             }
         }
-    };
+    }
+}
+
+/// The phase schedule, each phase checked; None when one is invalid (recorded).
+fn phases(ck: &mut Checker, specs: &[PhaseSpec]) -> Option<Vec<Phase>> {
     let mut phases = Vec::new();
     let mut previous = 0.0;
     let mut ok = true;
-    for (k, p) in w.phases.iter().enumerate() {
+    for (k, p) in specs.iter().enumerate() {
         let field = |f: &str| format!("wear.phases[{k}].{f}");
         let until = ck.positive(&field("until_cycles"), p.until_cycles, 1e12, "cycles");
         let Some(until) = until else {
@@ -1583,54 +1671,12 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             None => ok = false,
         }
     }
-    if !ok {
-        return None;
-    }
-    let pitting = pitting_mode(ck, w, &w.phases);
-    let onset = match w.pitting_onset_percent {
-        Some(v) if pitting.is_some() && pitting != Some(Pitting::Forecast) => {
-            ck.fail(
-                "wear.pitting_onset_percent",
-                v,
-                "only a forecast (wear.pitting = \"forecast\") takes a pitting onset share",
-            );
-            None
-        }
-        v => ck.range(
-            "wear.pitting_onset_percent",
-            v.unwrap_or(2.0),
-            0.0,
-            100.0,
-            "%",
-        ),
-    };
-    if pitting == Some(Pitting::Off) {
-        phases.retain(|p| matches!(p, Phase::Wear { .. }));
-    }
-    let guard = ck.range(
-        "wear.max_substep_wear_um",
-        w.max_substep_wear_um.unwrap_or(5.0),
-        0.0,
-        1000.0,
-        "um",
-    );
-    let film_load = ck.choice(
-        "wear.film_load",
-        w.film_load.as_deref().unwrap_or("loaded-analysis"),
-        &[
-            ("loaded-analysis", FilmLoad::LoadedAnalysis),
-            ("hertz-peak-floor", FilmLoad::HertzPeakFloor),
-        ],
-    );
-    let pit_depth = ck.choice(
-        "wear.pit_depth",
-        w.pit_depth.as_deref().unwrap_or("hertz"),
-        &[
-            ("hertz", PitDepth::Hertz),
-            ("loaded-band", PitDepth::LoadedBand),
-        ],
-    );
-    let map_cycles = match &w.map_cycles {
+    ok.then_some(phases)
+}
+
+/// The cycles of the map states, increasing (None: the default 0, 1, 2, 4, ...).
+fn map_cycles(ck: &mut Checker, list: Option<&Vec<f64>>) -> Option<Option<Vec<f64>>> {
+    match list {
         None => Some(None),
         Some(list) => {
             let mut ok = true;
@@ -1651,35 +1697,7 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             }
             ok.then(|| Some(list.clone()))
         }
-    };
-    let stop_at = ck.choice(
-        "wear.stop_at",
-        w.stop_at.as_deref().unwrap_or("pointed-tip"),
-        &[
-            ("pointed-tip", LifeStop::PointedTip),
-            ("backlash-limit", LifeStop::BacklashLimit),
-        ],
-    );
-    let backlash_limit = match w.backlash_limit_um {
-        None => Some(None),
-        Some(v) => ck
-            .positive("wear.backlash_limit_um", v, 1e5, "um")
-            .map(|v| Some(v * 1e-6)),
-    };
-    Some(WearPlan {
-        life_cycles: life?,
-        step: step?,
-        max_substep_removal: guard? * 1e-6,
-        phases,
-        pitting: pitting?,
-        pitting_onset_share: onset? * 1e-2,
-        endurance: endurance?,
-        film_load: film_load?,
-        pit_depth: pit_depth?,
-        map_cycles: map_cycles?,
-        stop_at: stop_at?,
-        backlash_limit: backlash_limit?,
-    })
+    }
 }
 
 /// `wear.pitting` (MODEL §8 beyond the schedule): a forecast finds its own pitting phases, so it takes
