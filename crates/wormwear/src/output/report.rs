@@ -177,6 +177,28 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         .and_then(|t| serde_json::from_str(&t).ok())
         .unwrap_or(serde_json::Value::Null);
     let mut h = String::new();
+    page_head(&mut h, title);
+    contents(&mut h, &summary);
+    warnings_section(&mut h, &summary);
+    key_results(&mut h, &summary);
+    for (name, key, prefixes) in SECTIONS {
+        if let Some(section) = summary.get(key) {
+            stage_section(&mut h, dir, (name, key, prefixes), section);
+        }
+    }
+    files_section(&mut h, dir);
+    let _ = write!(
+        h,
+        "<section id=\"input\"><h2>Input</h2><pre>{}</pre></section>\n</body></html>\n",
+        escape(input_text)
+    );
+    let path = dir.join("report.html");
+    write_atomic(&path, h.as_bytes())?;
+    Ok(path)
+}
+
+/// The page's head, style and title.
+fn page_head(h: &mut String, title: &str) {
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
@@ -190,6 +212,10 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
          <h1>wormwear — {t}</h1>\n",
         t = escape(title)
     );
+}
+
+/// The contents bar: the key results, the stages the summary holds, files and input.
+fn contents(h: &mut String, summary: &serde_json::Value) {
     // Contents.
     h.push_str("<nav><a href=\"#key\">Key results</a>");
     for (name, key, _) in SECTIONS {
@@ -198,6 +224,10 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         }
     }
     h.push_str("<a href=\"#files\">Files</a><a href=\"#input\">Input</a></nav>\n");
+}
+
+/// The warnings of every stage.
+fn warnings_section(h: &mut String, summary: &serde_json::Value) {
     // Warnings of every stage.
     let mut warnings = Vec::new();
     if let serde_json::Value::Object(m) = &summary {
@@ -222,6 +252,10 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         h.push_str("</ul>");
     }
     h.push_str("</section>\n");
+}
+
+/// Key results first: what an engineer looks for before the details.
+fn key_results(h: &mut String, summary: &serde_json::Value) {
     // Key results first: what an engineer looks for before the details.
     let last_step = summary["wear"]["steps"]
         .as_array()
@@ -310,84 +344,98 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         }
     }
     h.push_str("</table></section>\n");
-    for (name, key, prefixes) in SECTIONS {
-        let Some(section) = summary.get(key) else {
-            continue;
-        };
-        let _ = write!(h, "<section id=\"{key}\"><h2>{}</h2>", escape(name));
-        // Scalars of the section as a table; the wear steps as their own table.
-        if let serde_json::Value::Object(m) = section {
-            h.push_str("<table>");
-            for (k, v) in m {
-                if let Some(text) = scalar(v) {
-                    let _ = write!(
-                        h,
-                        "<tr><th>{}</th><td class=\"n\">{}</td></tr>",
-                        escape(k),
-                        escape(&text)
-                    );
-                }
-            }
-            h.push_str("</table>");
-        }
-        if let Some(serde_json::Value::Array(phases)) = section.get("phases") {
-            h.push_str(&phase_timeline(phases, section.get("pitting")));
-        }
-        if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
-            let columns = [
-                ("cycles", 1.0, "cycles"),
-                ("phase", 1.0, "phase"),
-                ("max_wear_m", 1e6, "max wear (um)"),
-                ("mean_wear_m", 1e6, "mean wear (um)"),
-                ("backlash_increase_m", 1e6, "backlash increase (um)"),
-                ("max_pressure_pa", 1e-6, "P_max (MPa)"),
-                ("mean_pressure_pa", 1e-6, "P_mean (MPa)"),
-                ("contact_area_fraction", 1.0, "S0"),
-                ("te_mean_rad", 1e6, "TE mean (urad)"),
-            ];
-            h.push_str("<details><summary>Wear states (table)</summary><table><tr>");
-            for (_, _, label) in columns {
-                let _ = write!(h, "<th>{label}</th>");
-            }
-            h.push_str("</tr>");
-            for s in steps {
-                h.push_str("<tr>");
-                for (k, scale, _) in columns {
-                    let cell = match &s[k] {
-                        serde_json::Value::Number(n) => {
-                            format!("{:.4}", n.as_f64().unwrap_or(f64::NAN) * scale)
-                        }
-                        other => scalar(other).unwrap_or_default(),
-                    };
-                    let _ = write!(h, "<td class=\"n\">{}</td>", escape(&cell));
-                }
-                h.push_str("</tr>");
-            }
-            h.push_str("</table></details>");
-        }
-        for prefix in prefixes {
-            for path in figures(dir, prefix) {
-                let name = path
-                    .file_name()
-                    .and_then(|n| n.to_str())
-                    .unwrap_or_default()
-                    .to_string();
-                let Ok(svg) = std::fs::read_to_string(&path) else {
-                    continue;
-                };
-                let body = match svg.find("<svg") {
-                    Some(k) => &svg[k..],
-                    None => continue,
-                };
-                let _ = writeln!(
+}
+
+/// One stage's section: its scalars, its phase timeline and wear-state table when it has
+/// them, and its figures (inline SVG).
+fn stage_section(
+    h: &mut String,
+    dir: &Path,
+    (name, key, prefixes): (&str, &str, &[&str]),
+    section: &serde_json::Value,
+) {
+    let _ = write!(h, "<section id=\"{key}\"><h2>{}</h2>", escape(name));
+    // Scalars of the section as a table; the wear steps as their own table.
+    if let serde_json::Value::Object(m) = section {
+        h.push_str("<table>");
+        for (k, v) in m {
+            if let Some(text) = scalar(v) {
+                let _ = write!(
                     h,
-                    "<figure>{body}<figcaption>{}</figcaption></figure>",
-                    escape(&name)
+                    "<tr><th>{}</th><td class=\"n\">{}</td></tr>",
+                    escape(k),
+                    escape(&text)
                 );
             }
         }
-        h.push_str("</section>\n");
+        h.push_str("</table>");
     }
+    if let Some(serde_json::Value::Array(phases)) = section.get("phases") {
+        h.push_str(&phase_timeline(phases, section.get("pitting")));
+    }
+    if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
+        wear_states_table(h, steps);
+    }
+    for prefix in prefixes {
+        for path in figures(dir, prefix) {
+            let name = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or_default()
+                .to_string();
+            let Ok(svg) = std::fs::read_to_string(&path) else {
+                continue;
+            };
+            let body = match svg.find("<svg") {
+                Some(k) => &svg[k..],
+                None => continue,
+            };
+            let _ = writeln!(
+                h,
+                "<figure>{body}<figcaption>{}</figcaption></figure>",
+                escape(&name)
+            );
+        }
+    }
+    h.push_str("</section>\n");
+}
+
+/// The wear states as a folded table.
+fn wear_states_table(h: &mut String, steps: &[serde_json::Value]) {
+    let columns = [
+        ("cycles", 1.0, "cycles"),
+        ("phase", 1.0, "phase"),
+        ("max_wear_m", 1e6, "max wear (um)"),
+        ("mean_wear_m", 1e6, "mean wear (um)"),
+        ("backlash_increase_m", 1e6, "backlash increase (um)"),
+        ("max_pressure_pa", 1e-6, "P_max (MPa)"),
+        ("mean_pressure_pa", 1e-6, "P_mean (MPa)"),
+        ("contact_area_fraction", 1.0, "S0"),
+        ("te_mean_rad", 1e6, "TE mean (urad)"),
+    ];
+    h.push_str("<details><summary>Wear states (table)</summary><table><tr>");
+    for (_, _, label) in columns {
+        let _ = write!(h, "<th>{label}</th>");
+    }
+    h.push_str("</tr>");
+    for s in steps {
+        h.push_str("<tr>");
+        for (k, scale, _) in columns {
+            let cell = match &s[k] {
+                serde_json::Value::Number(n) => {
+                    format!("{:.4}", n.as_f64().unwrap_or(f64::NAN) * scale)
+                }
+                other => scalar(other).unwrap_or_default(),
+            };
+            let _ = write!(h, "<td class=\"n\">{}</td>", escape(&cell));
+        }
+        h.push_str("</tr>");
+    }
+    h.push_str("</table></details>");
+}
+
+/// The data files beside the report (relative links: they open from the same directory).
+fn files_section(h: &mut String, dir: &Path) {
     // The data files beside the report (relative links: they open from the same directory).
     let mut files: Vec<String> = std::fs::read_dir(dir)
         .map(|rd| {
@@ -411,12 +459,4 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
         let _ = write!(h, "<li><a href=\"{f}\">{f}</a></li>", f = escape(f));
     }
     h.push_str("</ul></section>\n");
-    let _ = write!(
-        h,
-        "<section id=\"input\"><h2>Input</h2><pre>{}</pre></section>\n</body></html>\n",
-        escape(input_text)
-    );
-    let path = dir.join("report.html");
-    write_atomic(&path, h.as_bytes())?;
-    Ok(path)
 }
