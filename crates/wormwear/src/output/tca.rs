@@ -197,7 +197,30 @@ pub fn write_tca(
 ) -> Result<Vec<PathBuf>, OutputError> {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
-    // Kinematic error.
+    kinematic_error_files(tca, dir, &mut files)?;
+    let trace = tip_trace_series(tca);
+    pattern_files(tca, wf, &trace, dir, &mut files)?;
+    flank_map_csv(tca, wf, dir, &mut files)?;
+    sliding_maps(tca, wf, &trace, dir, &mut files)?;
+    contact_lines_csv(tca, dir, &mut files)?;
+    update_summary(dir, "tca", summary_value(tca)?)?;
+    files.push(dir.join("summary.json"));
+    let path = dir.join("wheel_flank_tca.vtp");
+    super::vtk::wheel_flank_tca(gear, geo, tca).write_vtp(
+        &path,
+        &[],
+        "loaded wheel flank: unloaded analysis (mm)",
+    )?;
+    files.push(path);
+    Ok(files)
+}
+
+/// The kinematic error per position: CSV and chart.
+fn kinematic_error_files(
+    tca: &Tca,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let mut csv = Csv::new(&[
         "position",
         "theta1_rad",
@@ -247,7 +270,17 @@ pub fn write_tca(
         0.02,
     )?;
     files.push(path);
-    // Pattern.
+    Ok(())
+}
+
+/// The no-load contact pattern: CSV per cell and the flank map with the worm-tip trace.
+fn pattern_files(
+    tca: &Tca,
+    wf: &WheelFlank,
+    trace: &Series,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "min_separation_um", "marked"]);
     for j in 0..wf.cells_face {
         for i in 0..wf.cells_height {
@@ -266,7 +299,6 @@ pub fn write_tca(
     let path = dir.join("tca_pattern.csv");
     csv.write(&path)?;
     files.push(path);
-    let trace = tip_trace_series(tca);
     let j_um = tca.marking_thickness * UM;
     let sep_um: Vec<f64> = tca.min_separation.iter().map(|s| s * UM).collect();
     let path = dir.join("tca_pattern.svg");
@@ -281,11 +313,20 @@ pub fn write_tca(
         &sep_um,
         (0.0, 3.0 * j_um),
         "separation (um)",
-        std::slice::from_ref(&trace),
+        std::slice::from_ref(trace),
         &pattern_outline(wf, &tca.marked),
     )?;
     files.push(path);
-    // Contact map per node.
+    Ok(())
+}
+
+/// The contact map per node (reach, contact angle, ease-off, sliding): CSV.
+fn flank_map_csv(
+    tca: &Tca,
+    wf: &WheelFlank,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let mut csv = Csv::new(&[
         "i",
         "j",
@@ -325,8 +366,18 @@ pub fn write_tca(
     let path = dir.join("tca_flank_map.csv");
     csv.write(&path)?;
     files.push(path);
-    // Sliding speed maps: magnitude, and its components along and across the contact line
-    // (MODEL §4.5; the across component drives the film's entrainment, the along one does not).
+    Ok(())
+}
+
+/// Sliding speed maps: magnitude, and its components along and across the contact line
+/// (MODEL §4.5; the across component drives the film's entrainment, the along one does not).
+fn sliding_maps(
+    tca: &Tca,
+    wf: &WheelFlank,
+    trace: &Series,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     type Component = fn(&crate::kinematics::NodeContact) -> f64;
     let maps: [(&str, String, &str, Component); 3] = [
         (
@@ -368,12 +419,16 @@ pub fn write_tca(
             &values,
             (lo, hi),
             bar,
-            std::slice::from_ref(&trace),
+            std::slice::from_ref(trace),
             &[],
         )?;
         files.push(path);
     }
-    // Contact lines.
+    Ok(())
+}
+
+/// The contact lines of every position and tooth: CSV.
+fn contact_lines_csv(tca: &Tca, dir: &Path, files: &mut Vec<PathBuf>) -> Result<(), OutputError> {
     let mut csv = Csv::new(&[
         "position",
         "tooth",
@@ -401,16 +456,7 @@ pub fn write_tca(
     let path = dir.join("tca_contact_lines.csv");
     csv.write(&path)?;
     files.push(path);
-    update_summary(dir, "tca", summary_value(tca)?)?;
-    files.push(dir.join("summary.json"));
-    let path = dir.join("wheel_flank_tca.vtp");
-    super::vtk::wheel_flank_tca(gear, geo, tca).write_vtp(
-        &path,
-        &[],
-        "loaded wheel flank: unloaded analysis (mm)",
-    )?;
-    files.push(path);
-    Ok(files)
+    Ok(())
 }
 
 /// Per flank cell, the mean of `value` over its corner nodes that the worm flank reaches (NaN
