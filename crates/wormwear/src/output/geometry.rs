@@ -5,7 +5,7 @@
 use super::{update_summary, write_atomic, Csv, OutputError};
 use crate::geometry::sections::rack_plane_section;
 use crate::geometry::stl::{wheel_mesh, worm_mesh};
-use crate::geometry::{Flank, Geometry, GeometrySummary};
+use crate::geometry::{Flank, Geometry, GeometrySummary, WheelFlank};
 use crate::input::GearSet;
 use crate::plot::{line_chart, Series};
 use std::path::{Path, PathBuf};
@@ -20,48 +20,76 @@ pub fn write_geometry(
     dir: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let mut files = Vec::new();
-    // Sections in rack planes.
     for &offset in &gear.analysis.section_offsets {
-        let section = rack_plane_section(gear, geo, offset, 2).map_err(OutputError::Geometry)?;
-        let stem = format!("section_z{:+.3}mm", offset * MM);
-        let mut csv = Csv::new(&["member", "x_mm", "y_mm"]);
-        for c in &section.curves {
-            for &(x, y) in &c.points {
-                csv.labelled_row(c.member, &[x * MM, y * MM]);
-            }
-        }
-        let path = dir.join(format!("{stem}.csv"));
-        csv.write(&path)?;
-        files.push(path);
-        let series: Vec<Series> = section
-            .curves
-            .iter()
-            .map(|c| Series {
-                label: if c.member == "worm" {
-                    "worm thread".into()
-                } else {
-                    "wheel teeth".into()
-                },
-                points: c.points.iter().map(|&(x, y)| (x * MM, y * MM)).collect(),
-                color: if c.member == "worm" { 0 } else { 1 },
-                bold: false,
-            })
-            .collect();
-        let path = dir.join(format!("{stem}.svg"));
-        line_chart(
-            &path,
-            &format!(
-                "Rack-plane section at z = {:+.2} mm (worm frame, rotation 0)",
-                offset * MM
-            ),
-            "x1 along the worm axis (mm)",
-            "y1 towards the wheel centre (mm)",
-            &series,
-            true,
-        )?;
-        files.push(path);
+        section_files(gear, geo, offset, dir, &mut files)?;
     }
-    // Worm and hob axial profiles.
+    axial_profiles_csv(gear, geo, dir, &mut files)?;
+    for wf in &geo.wheel_flanks {
+        flank_grid_csv(wf, dir, &mut files)?;
+    }
+    flank_outline_svg(geo, dir, &mut files)?;
+    meshes(gear, geo, dir, &mut files)?;
+    write_geometry_summary(gear, geo, input_file, dir)?;
+    files.push(dir.join("summary.json"));
+    Ok(files)
+}
+
+/// The section in the rack plane at `offset` (m along the wheel axis): CSV and SVG.
+fn section_files(
+    gear: &GearSet,
+    geo: &Geometry,
+    offset: f64,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
+    let section = rack_plane_section(gear, geo, offset, 2).map_err(OutputError::Geometry)?;
+    let stem = format!("section_z{:+.3}mm", offset * MM);
+    let mut csv = Csv::new(&["member", "x_mm", "y_mm"]);
+    for c in &section.curves {
+        for &(x, y) in &c.points {
+            csv.labelled_row(c.member, &[x * MM, y * MM]);
+        }
+    }
+    let path = dir.join(format!("{stem}.csv"));
+    csv.write(&path)?;
+    files.push(path);
+    let series: Vec<Series> = section
+        .curves
+        .iter()
+        .map(|c| Series {
+            label: if c.member == "worm" {
+                "worm thread".into()
+            } else {
+                "wheel teeth".into()
+            },
+            points: c.points.iter().map(|&(x, y)| (x * MM, y * MM)).collect(),
+            color: if c.member == "worm" { 0 } else { 1 },
+            bold: false,
+        })
+        .collect();
+    let path = dir.join(format!("{stem}.svg"));
+    line_chart(
+        &path,
+        &format!(
+            "Rack-plane section at z = {:+.2} mm (worm frame, rotation 0)",
+            offset * MM
+        ),
+        "x1 along the worm axis (mm)",
+        "y1 towards the wheel centre (mm)",
+        &series,
+        true,
+    )?;
+    files.push(path);
+    Ok(())
+}
+
+/// The worm's and hob's axial profiles over the radius: CSV.
+fn axial_profiles_csv(
+    gear: &GearSet,
+    geo: &Geometry,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let mut csv = Csv::new(&[
         "rho_mm",
         "worm_left_x_mm",
@@ -86,65 +114,79 @@ pub fn write_geometry(
     let path = dir.join("axial_profiles.csv");
     csv.write(&path)?;
     files.push(path);
-    // Wheel flank grids.
-    for wf in &geo.wheel_flanks {
-        let name = wf.flank.name();
-        let mut nodes = Csv::new(&[
-            "i",
-            "j",
-            "r_mm",
-            "z_mm",
-            "theta_rad",
-            "x2_mm",
-            "y2_mm",
-            "nx",
-            "ny",
-            "nz",
-            "hob_radius_mm",
-        ]);
-        for j in 0..=wf.cells_face {
-            for i in 0..=wf.cells_height {
-                let n = wf.node(i, j);
-                let p = n.position();
-                nodes.row(&[
-                    i as f64,
-                    j as f64,
-                    n.r * MM,
-                    n.z * MM,
-                    n.theta,
-                    p.x * MM,
-                    p.y * MM,
-                    n.normal[0],
-                    n.normal[1],
-                    n.normal[2],
-                    n.hob_radius * MM,
-                ]);
-            }
+    Ok(())
+}
+
+/// A wheel flank's grid: nodes and cells, CSV.
+fn flank_grid_csv(
+    wf: &WheelFlank,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
+    let name = wf.flank.name();
+    let mut nodes = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "theta_rad",
+        "x2_mm",
+        "y2_mm",
+        "nx",
+        "ny",
+        "nz",
+        "hob_radius_mm",
+    ]);
+    for j in 0..=wf.cells_face {
+        for i in 0..=wf.cells_height {
+            let n = wf.node(i, j);
+            let p = n.position();
+            nodes.row(&[
+                i as f64,
+                j as f64,
+                n.r * MM,
+                n.z * MM,
+                n.theta,
+                p.x * MM,
+                p.y * MM,
+                n.normal[0],
+                n.normal[1],
+                n.normal[2],
+                n.hob_radius * MM,
+            ]);
         }
-        let path = dir.join(format!("wheel_flank_{name}_nodes.csv"));
-        nodes.write(&path)?;
-        files.push(path);
-        let mut cells = Csv::new(&["i", "j", "r_mm", "z_mm", "theta_rad", "area_mm2", "active"]);
-        for j in 0..wf.cells_face {
-            for i in 0..wf.cells_height {
-                let k = j * wf.cells_height + i;
-                let c = &wf.cells[k];
-                cells.row(&[
-                    i as f64,
-                    j as f64,
-                    c.r * MM,
-                    c.z * MM,
-                    c.theta,
-                    wf.cell_area[k] * MM * MM,
-                    if wf.active[k] { 1.0 } else { 0.0 },
-                ]);
-            }
-        }
-        let path = dir.join(format!("wheel_flank_{name}_cells.csv"));
-        cells.write(&path)?;
-        files.push(path);
     }
-    // Outline of the active flank in (z, r).
+    let path = dir.join(format!("wheel_flank_{name}_nodes.csv"));
+    nodes.write(&path)?;
+    files.push(path);
+    let mut cells = Csv::new(&["i", "j", "r_mm", "z_mm", "theta_rad", "area_mm2", "active"]);
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let k = j * wf.cells_height + i;
+            let c = &wf.cells[k];
+            cells.row(&[
+                i as f64,
+                j as f64,
+                c.r * MM,
+                c.z * MM,
+                c.theta,
+                wf.cell_area[k] * MM * MM,
+                if wf.active[k] { 1.0 } else { 0.0 },
+            ]);
+        }
+    }
+    let path = dir.join(format!("wheel_flank_{name}_cells.csv"));
+    cells.write(&path)?;
+    files.push(path);
+    Ok(())
+}
+
+/// Outline of the active flank in (z, r): SVG.
+fn flank_outline_svg(
+    geo: &Geometry,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let series: Vec<Series> = geo
         .wheel_flanks
         .iter()
@@ -163,6 +205,17 @@ pub fn write_geometry(
         false,
     )?;
     files.push(path);
+    Ok(())
+}
+
+/// STL of worm and wheel; VTK of both worm flanks and both wheel flanks of the reference
+/// tooth space.
+fn meshes(
+    gear: &GearSet,
+    geo: &Geometry,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     // STL.
     let path = dir.join("worm.stl");
     write_atomic(
@@ -192,9 +245,7 @@ pub fn write_geometry(
         "wheel flanks of the reference tooth space (mm)",
     )?;
     files.push(path);
-    write_geometry_summary(gear, geo, input_file, dir)?;
-    files.push(dir.join("summary.json"));
-    Ok(files)
+    Ok(())
 }
 
 /// Writes the `input` and `geometry` sections of `dir/summary.json` (every command does).
