@@ -243,11 +243,37 @@ pub fn write_ltca(
 ) -> Result<Vec<PathBuf>, OutputError> {
     let wf = geo.wheel_flank(tca.loaded_flank);
     let mut files = Vec::new();
-    let np = ltca.positions.len();
     let csv = positions_table(tca, ltca);
     let path = dir.join("ltca_positions.csv");
     csv.write(&path)?;
     files.push(path);
+    position_charts(tca, ltca, dir, &mut files)?;
+    let trace = tip_trace_series(tca);
+    pattern_files(wf, ltca, &trace, dir, &mut files)?;
+    pressure_maps(tca, ltca, wf, &trace, map_position, dir, &mut files)?;
+    // Local pressures of every position.
+    let csv = pressures_table(ltca);
+    let path = dir.join("ltca_pressures.csv");
+    csv.write(&path)?;
+    files.push(path);
+    update_summary(dir, "ltca", summary_value(tca, wf, ltca)?)?;
+    files.push(dir.join("summary.json"));
+    let path = dir.join("wheel_flank_ltca.vtp");
+    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
+    super::vtk::add_pressure_pattern(&mut surface, &ltca.pattern);
+    surface.write_vtp(&path, &[], "loaded wheel flank: loaded analysis (mm)")?;
+    files.push(path);
+    Ok(files)
+}
+
+/// Load sharing, transmission error and mesh stiffness over the positions: SVG.
+fn position_charts(
+    tca: &Tca,
+    ltca: &Ltca,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
+    let np = ltca.positions.len();
     let x = |n: usize| n as f64 / np as f64;
     // Load sharing.
     let series: Vec<Series> = tca
@@ -328,12 +354,21 @@ pub fn write_ltca(
         false,
     )?;
     files.push(path);
-    // Loaded pattern.
+    Ok(())
+}
+
+/// The loaded pattern: CSV and map.
+fn pattern_files(
+    wf: &WheelFlank,
+    ltca: &Ltca,
+    trace: &Series,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
     let csv = pattern_table(wf, ltca);
     let path = dir.join("ltca_pattern.csv");
     csv.write(&path)?;
     files.push(path);
-    let trace = tip_trace_series(tca);
     let path = dir.join("ltca_pattern.svg");
     pattern_map(
         &path,
@@ -344,10 +379,23 @@ pub fn write_ltca(
             ltca.max_pressure * MPA,
             ltca.s0
         ),
-        std::slice::from_ref(&trace),
+        std::slice::from_ref(trace),
     )?;
     files.push(path);
-    // Pressure maps of the engaged teeth at the chosen position.
+    Ok(())
+}
+
+/// Pressure maps of the engaged teeth at `map_position` (clamped to the last position).
+fn pressure_maps(
+    tca: &Tca,
+    ltca: &Ltca,
+    wf: &WheelFlank,
+    trace: &Series,
+    map_position: usize,
+    dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), OutputError> {
+    let np = ltca.positions.len();
     let n = map_position.min(np - 1);
     let pr = &ltca.positions[n];
     for (t, &k) in tca.teeth.iter().enumerate() {
@@ -380,19 +428,7 @@ pub fn write_ltca(
         )?;
         files.push(path);
     }
-    // Local pressures of every position.
-    let csv = pressures_table(ltca);
-    let path = dir.join("ltca_pressures.csv");
-    csv.write(&path)?;
-    files.push(path);
-    update_summary(dir, "ltca", summary_value(tca, wf, ltca)?)?;
-    files.push(dir.join("summary.json"));
-    let path = dir.join("wheel_flank_ltca.vtp");
-    let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
-    super::vtk::add_pressure_pattern(&mut surface, &ltca.pattern);
-    surface.write_vtp(&path, &[], "loaded wheel flank: loaded analysis (mm)")?;
-    files.push(path);
-    Ok(files)
+    Ok(())
 }
 
 /// The table of positions (`ltca_positions.csv`): torques, approach, TE, KE, stiffness,
