@@ -322,6 +322,37 @@ fn solve_assembled(
     springs: &[Spring],
     loads: &[Vec<Load>],
 ) -> Result<Solution, FeError> {
+    let system = assemble(mesh, elements, fixed, springs, loads);
+    let llt = system
+        .matrix
+        .sp_cholesky(Side::Lower)
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    Ok(Solution {
+        x: llt.solve(&system.rhs),
+        map: system.map,
+        prescribed: system.prescribed,
+    })
+}
+
+/// The assembled linear system of one run: the free-free stiffness (lower triangle, free-DOF
+/// numbering), the right-hand sides of the load cases (N), and the DOF bookkeeping.
+struct System {
+    matrix: SparseColMat<usize, f64>,
+    rhs: Mat<f64>,
+    /// Free-DOF index of every global DOF (usize::MAX where prescribed).
+    map: Vec<usize>,
+    prescribed: Vec<Option<f64>>,
+}
+
+/// Assembles the stiffness with the prescribed displacements eliminated (moved to the
+/// right-hand sides) and the springs added.
+fn assemble(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    fixed: &[Fixed],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+) -> System {
     let ndof = 3 * mesh.nodes.len();
     let mut prescribed = vec![None; ndof];
     for &(n, d, v) in fixed {
@@ -396,15 +427,177 @@ fn solve_assembled(
     }
     let symbolic =
         SymbolicSparseColMat::new_checked(free, free, pattern.col_ptr, None, pattern.row_idx);
-    let a = SparseColMat::<usize, f64>::new(symbolic, values);
-    let llt = a
-        .sp_cholesky(Side::Lower)
-        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
-    Ok(Solution {
-        x: llt.solve(&rhs),
+    System {
+        matrix: SparseColMat::<usize, f64>::new(symbolic, values),
+        rhs,
         map,
         prescribed,
+    }
+}
+
+/// The free run (`fixed` only) minus the blocked run (also the `blocked` nodes held at zero)
+/// of the same mesh and loads, from ONE Cholesky factorisation (MODEL §5.5 step 2). The
+/// blocked DOFs B are ordered last (AMD order for the others, R), so with A = L L^T the leading
+/// block L_RR of L is the Cholesky factor of the blocked run's matrix A_RR. Forward
+/// substitution y = L^-1 f serves both runs (its R part does not see f_B); the free run is
+/// L^-T y and the blocked run L^-T [y_R; 0] (x_R = A_RR^-1 f_R, x_B = 0, its loads on blocked
+/// nodes vanishing as they do for prescribed DOFs), so their difference is L^-T [0; y_B]: one
+/// factorisation and two triangular solves instead of two factorisations and four. The
+/// prescribed displacements are the same in both runs, so the difference is zero there.
+fn solve_free_minus_blocked(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    fixed: &[Fixed],
+    springs: &[Spring],
+    blocked: &[usize],
+    loads: &[Vec<Load>],
+) -> Result<Solution, FeError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+    };
+    let system = assemble(mesh, elements, fixed, springs, loads);
+    let free = system.rhs.nrows();
+    let mut is_blocked = vec![false; free];
+    for &n in blocked {
+        for d in 0..3 {
+            let g = 3 * n + d;
+            if system.map[g] != usize::MAX {
+                is_blocked[system.map[g]] = true;
+            }
+        }
+    }
+    let (forward, inverse, unblocked) = order_blocked_last(&system.matrix, &is_blocked)?;
+    let failed = |e: &dyn std::fmt::Debug| FeError::Factorisation(format!("{e:?}"));
+    let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
+    let symbolic = factorize_symbolic_cholesky(
+        system.matrix.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Custom(perm),
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|e| failed(&e))?;
+    let par = faer::get_global_parallelism();
+    let cases = loads.len();
+    let mut values = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(
+        symbolic
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(cases, par)),
+    );
+    symbolic
+        .factorize_numeric_llt(
+            &mut values,
+            system.matrix.as_ref(),
+            Side::Lower,
+            faer::linalg::cholesky::llt::factor::LltRegularization::default(),
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| failed(&e))?;
+    drop(system.matrix);
+    let mut y = Mat::<f64>::from_fn(free, cases, |i, c| system.rhs[(forward[i], c)]);
+    drop(system.rhs);
+    lower_solve(&symbolic, &values, y.as_mut(), false, par, &mut mem);
+    for c in 0..cases {
+        for i in 0..unblocked {
+            y[(i, c)] = 0.0;
+        }
+    }
+    lower_solve(&symbolic, &values, y.as_mut(), true, par, &mut mem);
+    let mut prescribed = system.prescribed;
+    for p in prescribed.iter_mut().flatten() {
+        *p = 0.0;
+    }
+    Ok(Solution {
+        x: Mat::<f64>::from_fn(free, cases, |i, c| y[(inverse[i], c)]),
+        map: system.map,
+        prescribed,
     })
+}
+
+/// Fill-reducing order with the `last` unknowns at the end: AMD on the matrix without them,
+/// then them in their own order. Returns (forward: new -> old, inverse: old -> new, the number
+/// of unknowns before the last ones).
+fn order_blocked_last(
+    matrix: &SparseColMat<usize, f64>,
+    last: &[bool],
+) -> Result<(Vec<usize>, Vec<usize>, usize), FeError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let n = last.len();
+    let mut local = vec![usize::MAX; n];
+    let kept: Vec<usize> = (0..n).filter(|&i| !last[i]).collect();
+    for (k, &i) in kept.iter().enumerate() {
+        local[i] = k;
+    }
+    let (col_ptr, row_idx) = (matrix.symbolic().col_ptr(), matrix.symbolic().row_idx());
+    let mut ptr = Vec::with_capacity(kept.len() + 1);
+    let mut rows = Vec::new();
+    ptr.push(0);
+    for &c in &kept {
+        rows.extend(
+            row_idx[col_ptr[c]..col_ptr[c + 1]]
+                .iter()
+                .filter(|&&r| !last[r])
+                .map(|&r| local[r]),
+        );
+        ptr.push(rows.len());
+    }
+    let m = kept.len();
+    let nnz = rows.len();
+    let pattern = SymbolicSparseColMat::new_checked(m, m, ptr, None, rows);
+    let (mut fwd, mut inv) = (vec![0usize; m], vec![0usize; m]);
+    let mut mem = MemBuffer::new(amd::order_scratch::<usize>(m, nnz));
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        pattern.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let mut forward: Vec<usize> = fwd.iter().map(|&k| kept[k]).collect();
+    forward.extend((0..n).filter(|&i| last[i]));
+    let mut inverse = vec![0; n];
+    for (new, &old) in forward.iter().enumerate() {
+        inverse[old] = new;
+    }
+    Ok((forward, inverse, m))
+}
+
+/// In place, on the permuted unknowns: rhs <- L^-1 rhs, or L^-T rhs when `transpose`.
+fn lower_solve(
+    symbolic: &faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+    values: &[f64],
+    rhs: faer::MatMut<'_, f64>,
+    transpose: bool,
+    par: faer::Par,
+    mem: &mut faer::dyn_stack::MemBuffer,
+) {
+    use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+    use faer::sparse::linalg::triangular_solve;
+    use faer::Conj;
+    let stack = faer::dyn_stack::MemStack::new(mem);
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let l = faer::sparse::SparseColMatRef::<'_, usize, f64>::new(s.factor(), values);
+            if transpose {
+                triangular_solve::solve_lower_triangular_transpose_in_place(l, Conj::No, rhs, par);
+            } else {
+                triangular_solve::solve_lower_triangular_in_place(l, Conj::No, rhs, par);
+            }
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let l = SupernodalLltRef::new(s, values);
+            if transpose {
+                l.l_transpose_solve_with_conj(Conj::No, rhs, par, stack);
+            } else {
+                l.l_solve_with_conj(Conj::No, rhs, par, stack);
+            }
+        }
+    }
 }
 
 /// Displacements of every load case in the free-DOF numbering of one run.
@@ -603,8 +796,8 @@ pub fn mirrored(e: [usize; 20]) -> [usize; 20] {
 /// Bending displacements by the free / blocked technique (MODEL §5.5 step 2): for each load
 /// case a unit force into the member (along -n) at a node; the displacement with the loaded
 /// tooth's opposite flank free minus that with its `blocked` nodes fixed (removes the local
-/// contact deformation, keeps the bending), at the `observed` nodes. The two runs share the
-/// element matrices and are factorised side by side. Index: [case][observed k], m/N.
+/// contact deformation, keeps the bending), at the `observed` nodes. Both runs come from one
+/// factorisation ([`solve_free_minus_blocked`]). Index: [case][observed k], m/N.
 pub fn free_minus_blocked(
     mesh: &Mesh,
     material: &Elastic,
@@ -618,27 +811,9 @@ pub fn free_minus_blocked(
         .iter()
         .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
         .collect();
-    let mut blocked_fixed = fixed.to_vec();
-    blocked_fixed.extend(
-        blocked
-            .iter()
-            .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0))),
-    );
     let elements = element_stiffnesses(mesh, material)?;
-    let (free, held) = rayon::join(
-        || solve_assembled(mesh, &elements, fixed, springs, &cases),
-        || solve_assembled(mesh, &elements, &blocked_fixed, springs, &cases),
-    );
-    let (free, held) = (free?, held?);
+    let difference = solve_free_minus_blocked(mesh, &elements, fixed, springs, blocked, &cases)?;
     Ok((0..cases.len())
-        .map(|c| {
-            observed
-                .iter()
-                .map(|&n| {
-                    let (a, b) = (free.at(c, n), held.at(c, n));
-                    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-                })
-                .collect()
-        })
+        .map(|c| observed.iter().map(|&n| difference.at(c, n)).collect())
         .collect())
 }
