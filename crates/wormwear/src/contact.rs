@@ -146,6 +146,7 @@ pub fn coefficient(pair: &ElasticPair, i: &ContactCell, j: &ContactCell) -> f64 
 
 /// Source cells of a block as structure of arrays (centres, normals, in-plane axes, half
 /// sides, 1 / (area lever)), for [`far_row`].
+#[derive(Debug, Clone)]
 struct SourceCells {
     c: [Vec<f64>; 3],
     n: [Vec<f64>; 3],
@@ -221,42 +222,10 @@ unsafe fn far_row_avx2(
 /// structure-of-arrays data (the compiler vectorises it), then the few near pairs are
 /// recomputed with Love's closed form.
 pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]) -> Vec<f64> {
-    const FAR: f64 = 6.0;
     let n = cells.len();
     assert_eq!(levers.len(), n);
-    let col = |f: &dyn Fn(&ContactCell) -> f64| -> Vec<f64> { cells.iter().map(f).collect() };
-    let soa = SourceCells {
-        c: [
-            col(&|c| c.centre.x),
-            col(&|c| c.centre.y),
-            col(&|c| c.centre.z),
-        ],
-        n: [
-            col(&|c| c.normal.x),
-            col(&|c| c.normal.y),
-            col(&|c| c.normal.z),
-        ],
-        u: [
-            col(&|c| c.axis_nu.x),
-            col(&|c| c.axis_nu.y),
-            col(&|c| c.axis_nu.z),
-        ],
-        v: [
-            col(&|c| c.axis_zeta.x),
-            col(&|c| c.axis_zeta.y),
-            col(&|c| c.axis_zeta.z),
-        ],
-        half_nu: col(&|c| c.half_nu),
-        half_zeta: col(&|c| c.half_zeta),
-        // 1 / (area lever) of each source cell.
-        inv: (0..n)
-            .map(|j| 1.0 / (cells[j].area() * levers[j]))
-            .collect(),
-    };
-    let far2: Vec<f64> = cells
-        .iter()
-        .map(|c| (FAR * c.half_nu.max(c.half_zeta)).powi(2))
-        .collect();
+    let soa = SourceCells::new(cells, levers);
+    let far2 = near_radii2(cells);
     #[cfg(target_arch = "x86_64")]
     let wide = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
     // Every entry is written below (the upper triangle row by row, then the mirror), so the
@@ -286,7 +255,228 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
             }
         }
     }
-    // Mirror the upper triangle, tile by tile (cache-friendly transpose).
+    mirror_upper(&mut matrix, n);
+    // SAFETY: rows wrote columns a..n (far_row writes all of `out`), the mirror columns 0..b
+    // of every row b.
+    unsafe { matrix.assume_init() }.into_vec()
+}
+
+/// Entries (k, j), k < j, of the block's row j, i.e. the upper triangle's column j (receiver
+/// k, source j), with the far-field form of Love's integral for every pair, and the in-plane
+/// squared distances. The same arithmetic, term for term, as [`far_row`] gives for row k at
+/// column j, so the values are identical to the mirrored ones of [`symmetric_block`].
+#[inline(always)]
+fn far_column(
+    pair: &ElasticPair,
+    s: &SourceCells,
+    j: usize,
+    scale: &[f64],
+    out: &mut [f64],
+    dist: &mut [f64],
+) {
+    let m = out.len();
+    let (xj, yj, zj) = (s.c[0][j], s.c[1][j], s.c[2][j]);
+    let (nxj, nyj, nzj) = (s.n[0][j], s.n[1][j], s.n[2][j]);
+    let (uxj, uyj, uzj) = (s.u[0][j], s.u[1][j], s.u[2][j]);
+    let (vxj, vyj, vzj) = (s.v[0][j], s.v[1][j], s.v[2][j]);
+    let (aa, bb, inv) = (s.half_nu[j], s.half_zeta[j], s.inv[j]);
+    let (rx, ry, rz) = (&s.c[0][..m], &s.c[1][..m], &s.c[2][..m]);
+    let (rnx, rny, rnz) = (&s.n[0][..m], &s.n[1][..m], &s.n[2][..m]);
+    let scale = &scale[..m];
+    assert!(dist.len() == m);
+    for k in 0..m {
+        let (dx, dy, dz) = (rx[k] - xj, ry[k] - yj, rz[k] - zj);
+        let nu = dx * uxj + dy * uyj + dz * uzj;
+        let zeta = dx * vxj + dy * vyj + dz * vzj;
+        let d2 = nu * nu + zeta * zeta;
+        dist[k] = d2;
+        let d = d2.sqrt();
+        let love = 4.0
+            * aa
+            * bb
+            * (1.0 / d
+                + (aa * aa * (2.0 * nu * nu - zeta * zeta)
+                    + bb * bb * (2.0 * zeta * zeta - nu * nu))
+                    / (6.0 * d2 * d2 * d));
+        let dot_n = nxj * rnx[k] + nyj * rny[k] + nzj * rnz[k];
+        let r2 = dx * dx + dy * dy + dz * dz;
+        let tangential =
+            pair.tangential * 4.0 * aa * bb * (dx * rnx[k] + dy * rny[k] + dz * rnz[k]) / r2;
+        out[k] = (pair.normal * love * dot_n + tangential) * inv * scale[k];
+    }
+}
+
+/// [`far_column`] compiled for AVX2 + FMA; chosen at run time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn far_column_avx2(
+    pair: &ElasticPair,
+    s: &SourceCells,
+    j: usize,
+    scale: &[f64],
+    out: &mut [f64],
+    dist: &mut [f64],
+) {
+    far_column(pair, s, j, scale, out, dist)
+}
+
+/// The symmetric influence block of [`symmetric_block`] assembled on demand (MODEL §5.5): a
+/// row the first time a solver reads it, or the sub-block of a set of cells. The solvers read
+/// the rows of the cells that carry load (the block is symmetric, so a product K x needs the
+/// rows of x's non-zero entries) and, in the screened solve, the sub-block of its candidate
+/// cells; over a wear life those are a fraction of the band. Every entry is the number
+/// [`symmetric_block`] gives (computed with the lower-index cell as the receiver).
+/// Thread-safe.
+#[derive(Debug, Clone)]
+pub struct InfluenceRows {
+    pair: ElasticPair,
+    cells: Vec<ContactCell>,
+    levers: Vec<f64>,
+    soa: SourceCells,
+    far2: Vec<f64>,
+    /// 1 / lever of each cell, 1/m.
+    scale: Vec<f64>,
+    rows: Vec<std::sync::OnceLock<Box<[f64]>>>,
+}
+
+impl InfluenceRows {
+    /// The block of a group of cells (one tooth) with their levers (m); nothing is assembled
+    /// yet.
+    pub fn new(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]) -> Self {
+        assert_eq!(levers.len(), cells.len());
+        Self {
+            pair: *pair,
+            cells: cells.to_vec(),
+            levers: levers.to_vec(),
+            soa: SourceCells::new(cells, levers),
+            far2: near_radii2(cells),
+            scale: levers.iter().map(|l| 1.0 / l).collect(),
+            rows: (0..cells.len())
+                .map(|_| std::sync::OnceLock::new())
+                .collect(),
+        }
+    }
+
+    /// Number of cells (rows and columns).
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// True for a block without cells.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// Row j (= column j), assembled on first use; units of [`symmetric_block`].
+    pub fn row(&self, j: usize) -> &[f64] {
+        self.rows[j].get_or_init(|| self.assemble_row(j))
+    }
+
+    /// Number of rows assembled so far.
+    pub fn assembled(&self) -> usize {
+        self.rows.iter().filter(|r| r.get().is_some()).count()
+    }
+
+    /// The block on the cells `set` (local indices, ascending): row-major set.len()^2, the
+    /// entries of [`symmetric_block`] of the whole group at those rows and columns.
+    pub fn sub_block(&self, set: &[usize]) -> Vec<f64> {
+        debug_assert!(set.windows(2).all(|w| w[0] < w[1]));
+        let cells: Vec<ContactCell> = set.iter().map(|&i| self.cells[i]).collect();
+        let levers: Vec<f64> = set.iter().map(|&i| self.levers[i]).collect();
+        symmetric_block(&self.pair, &cells, &levers)
+    }
+
+    fn assemble_row(&self, j: usize) -> Box<[f64]> {
+        let n = self.len();
+        let (pair, soa) = (&self.pair, &self.soa);
+        let mut out = vec![0.0; n];
+        let mut dist = vec![0.0; n];
+        {
+            let (lower, upper) = out.split_at_mut(j);
+            let (dist_lower, dist_upper) = dist.split_at_mut(j);
+            // SAFETY: MaybeUninit<f64> has the layout of f64; the values are initialised.
+            let upper: &mut [MaybeUninit<f64>] =
+                unsafe { std::slice::from_raw_parts_mut(upper.as_mut_ptr().cast(), upper.len()) };
+            #[cfg(target_arch = "x86_64")]
+            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+                // SAFETY: the CPU has AVX2 and FMA (checked here).
+                unsafe {
+                    far_row_avx2(pair, soa, j, self.scale[j], upper, dist_upper);
+                    far_column_avx2(pair, soa, j, &self.scale, lower, dist_lower);
+                }
+            } else {
+                far_row(pair, soa, j, self.scale[j], upper, dist_upper);
+                far_column(pair, soa, j, &self.scale, lower, dist_lower);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            {
+                far_row(pair, soa, j, self.scale[j], upper, dist_upper);
+                far_column(pair, soa, j, &self.scale, lower, dist_lower);
+            }
+        }
+        // Near pairs: Love's closed form, the lower index as the receiver.
+        let cells = &self.cells;
+        for k in 0..n {
+            let (receiver, source) = if k < j { (k, j) } else { (j, k) };
+            if dist[k] <= self.far2[source] {
+                out[k] = coefficient(pair, &cells[receiver], &cells[source])
+                    * soa.inv[source]
+                    * self.scale[receiver];
+            }
+        }
+        out.into_boxed_slice()
+    }
+}
+
+/// Squared in-plane radius around each source cell inside which its coefficients take Love's
+/// closed form (six times the larger half side; the far-field expansion beyond), m^2.
+fn near_radii2(cells: &[ContactCell]) -> Vec<f64> {
+    const FAR: f64 = 6.0;
+    cells
+        .iter()
+        .map(|c| (FAR * c.half_nu.max(c.half_zeta)).powi(2))
+        .collect()
+}
+
+impl SourceCells {
+    /// The cells' data as structure of arrays, with 1 / (area lever) of each cell.
+    fn new(cells: &[ContactCell], levers: &[f64]) -> Self {
+        let col = |f: &dyn Fn(&ContactCell) -> f64| -> Vec<f64> { cells.iter().map(f).collect() };
+        SourceCells {
+            c: [
+                col(&|c| c.centre.x),
+                col(&|c| c.centre.y),
+                col(&|c| c.centre.z),
+            ],
+            n: [
+                col(&|c| c.normal.x),
+                col(&|c| c.normal.y),
+                col(&|c| c.normal.z),
+            ],
+            u: [
+                col(&|c| c.axis_nu.x),
+                col(&|c| c.axis_nu.y),
+                col(&|c| c.axis_nu.z),
+            ],
+            v: [
+                col(&|c| c.axis_zeta.x),
+                col(&|c| c.axis_zeta.y),
+                col(&|c| c.axis_zeta.z),
+            ],
+            half_nu: col(&|c| c.half_nu),
+            half_zeta: col(&|c| c.half_zeta),
+            inv: cells
+                .iter()
+                .zip(levers)
+                .map(|(c, l)| 1.0 / (c.area() * l))
+                .collect(),
+        }
+    }
+}
+
+/// Mirrors the upper triangle of the n x n row-major `matrix` (rows written from their
+/// diagonal on) into the lower one, tile by tile (cache-friendly transpose).
+fn mirror_upper(matrix: &mut [MaybeUninit<f64>], n: usize) {
     const TILE: usize = 32;
     for b0 in (0..n).step_by(TILE) {
         for a0 in (0..b0 + TILE).step_by(TILE) {
@@ -306,9 +496,6 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
             }
         }
     }
-    // SAFETY: rows wrote columns a..n (far_row writes all of `out`), the mirror columns 0..b
-    // of every row b.
-    unsafe { matrix.assume_init() }.into_vec()
 }
 
 #[cfg(test)]
@@ -361,6 +548,20 @@ mod tests {
             far > n * n / 4,
             "the test must exercise the far-field branch: {far}"
         );
+        // Rows assembled on demand, in any order, and sub-blocks are the same numbers to the
+        // last bit.
+        let lazy = InfluenceRows::new(&pair, &cells, &levers);
+        for j in (0..n).rev().step_by(7).chain([0, n / 2, n - 1]) {
+            assert_eq!(lazy.row(j), &block[j * n..(j + 1) * n], "row {j}");
+        }
+        assert!(lazy.assembled() < n);
+        let set: Vec<usize> = (0..n).filter(|i| i % 3 != 1 && i % 5 != 0).collect();
+        let sub = lazy.sub_block(&set);
+        for (a, &i) in set.iter().enumerate() {
+            for (b, &j) in set.iter().enumerate() {
+                assert_eq!(sub[a * set.len() + b], block[i * n + j], "({i}, {j})");
+            }
+        }
     }
 
     #[test]

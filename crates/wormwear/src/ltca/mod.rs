@@ -12,14 +12,16 @@
 
 pub mod solver;
 
-use crate::contact::{hertz_half_width, symmetric_block, ContactCell, ElasticPair};
+use crate::contact::{hertz_half_width, ContactCell, ElasticPair, InfluenceRows};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
 use crate::kinematics::{GapEvaluator, Tca};
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use solver::{Block, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings};
+use solver::{
+    Block, BlockMatrix, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings,
+};
 use std::f64::consts::PI;
 
 /// Bending influence coefficients (worm and wheel), supplied by the bending stage.
@@ -848,20 +850,22 @@ fn solve_position(
             start = end;
         }
         let blocks: Vec<Block> = ranges
-            .into_par_iter()
+            .into_iter()
             .map(|(start, size)| {
                 // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
                 // of a tooth differ only slightly (line-aligned areas vary by the line's
                 // obliquity), and the tangential term's small asymmetry on curved flanks is
-                // dropped.
+                // dropped. Entries are assembled as the solver reads them: the rows of the
+                // cells that carry load, and the screened solve's candidate block.
                 let group = &cells[start..start + size];
                 let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
                 let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
-                let matrix = symmetric_block(pair, &contact, &levers);
                 Block {
                     start,
                     size,
-                    matrix,
+                    matrix: BlockMatrix::Lazy(Box::new(InfluenceRows::new(
+                        pair, &contact, &levers,
+                    ))),
                 }
             })
             .collect();

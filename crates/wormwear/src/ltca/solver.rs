@@ -30,14 +30,59 @@ unsafe fn axpy4_avx2(y: &mut [f64], a: [f64; 4], c: [&[f64]; 4]) {
     axpy4(y, a, c)
 }
 
-/// Dense symmetric block on a contiguous range of unknowns.
+/// Symmetric block on a contiguous range of unknowns.
 #[derive(Debug, Clone)]
 pub struct Block {
     pub start: usize,
     pub size: usize,
-    /// Row-major size x size. (Single precision was tried for speed: the rounding made a
-    /// near-singular worn-flank block indefinite and the CG failed late in case B.)
-    pub matrix: Vec<f64>,
+    pub matrix: BlockMatrix,
+}
+
+/// A block's entries: dense, or influence coefficients assembled as the solvers read them.
+/// (Single precision was tried for speed: the rounding made a near-singular worn-flank block
+/// indefinite and the CG failed late in case B.)
+#[derive(Debug, Clone)]
+pub enum BlockMatrix {
+    /// Row-major size x size.
+    Dense(Vec<f64>),
+    /// Rows and sub-blocks on demand, the same numbers as the dense block.
+    Lazy(Box<crate::contact::InfluenceRows>),
+}
+
+impl Block {
+    /// A dense block (row-major size x size).
+    pub fn dense(start: usize, size: usize, matrix: Vec<f64>) -> Self {
+        assert_eq!(matrix.len(), size * size);
+        Self {
+            start,
+            size,
+            matrix: BlockMatrix::Dense(matrix),
+        }
+    }
+
+    /// Row j of the block (= column j: symmetric), local index.
+    #[inline]
+    pub fn row(&self, j: usize) -> &[f64] {
+        match &self.matrix {
+            BlockMatrix::Dense(m) => &m[j * self.size..(j + 1) * self.size],
+            BlockMatrix::Lazy(rows) => rows.row(j),
+        }
+    }
+
+    /// The block on the local unknowns `inside` (ascending), row-major.
+    fn sub_block(&self, inside: &[usize]) -> Vec<f64> {
+        match &self.matrix {
+            BlockMatrix::Dense(_) => {
+                let mut matrix = Vec::with_capacity(inside.len() * inside.len());
+                for &r in inside {
+                    let row = self.row(r);
+                    matrix.extend(inside.iter().map(|&c| row[c]));
+                }
+                matrix
+            }
+            BlockMatrix::Lazy(rows) => rows.sub_block(inside),
+        }
+    }
 }
 
 /// Dot product with four independent partial sums (lets the compiler vectorise the
@@ -439,7 +484,7 @@ impl Problem {
             let size = b.size;
             // Columns of the non-zero loads, four at a time (one pass over y per four),
             // gathered as they come (no allocation per product).
-            let column = |j: usize| &b.matrix[j * size..(j + 1) * size];
+            let column = |j: usize| b.row(j);
             let flush = |ys: &mut [f64], coef: [f64; 4], cols: [&[f64]; 4]| {
                 #[cfg(target_arch = "x86_64")]
                 if wide {
@@ -451,7 +496,9 @@ impl Problem {
                 #[cfg(not(target_arch = "x86_64"))]
                 axpy4(ys, coef, cols);
             };
-            let mut cols = [column(0); 4];
+            // (Placeholders, never read: a flush has `filled` real columns and copies of the
+            // first; a lazy block must not assemble a row for them.)
+            let mut cols: [&[f64]; 4] = [&[]; 4];
             let mut coef = [0.0; 4];
             let mut filled = 0;
             for (j, &v) in x[b.start..b.start + size].iter().enumerate() {
@@ -534,16 +581,7 @@ impl Problem {
                 continue;
             }
             let m = inside.len();
-            let mut matrix = Vec::with_capacity(m * m);
-            for &r in &inside {
-                let row = &b.matrix[r * b.size..(r + 1) * b.size];
-                matrix.extend(inside.iter().map(|&c| row[c]));
-            }
-            blocks.push(Block {
-                start: at,
-                size: m,
-                matrix,
-            });
+            blocks.push(Block::dense(at, m, b.sub_block(&inside)));
             at += m;
         }
         debug_assert_eq!(at, set.len(), "every unknown lies in one contact block");
@@ -571,9 +609,10 @@ impl Problem {
                 .filter(|(_, &i)| i >= b.start && i < b.start + b.size)
                 .map(|(a, &i)| (a, i - b.start))
                 .collect();
-            for &(a, ia) in &inside {
-                for &(c, ic) in &inside {
-                    k[(a, c)] = b.matrix[ic * b.size + ia];
+            for &(c, ic) in &inside {
+                let row = b.row(ic);
+                for &(a, ia) in &inside {
+                    k[(a, c)] = row[ia];
                 }
             }
         }
@@ -1502,9 +1541,8 @@ impl BlockPreconditioner {
             .par_iter()
             .map(|b| {
                 let idx: Vec<usize> = (b.start..b.start + b.size).filter(|&i| set[i]).collect();
-                let m = faer::Mat::from_fn(idx.len(), idx.len(), |r, c| {
-                    b.matrix[(idx[r] - b.start) * b.size + (idx[c] - b.start)]
-                });
+                let rows: Vec<&[f64]> = idx.iter().map(|&i| b.row(i - b.start)).collect();
+                let m = faer::Mat::from_fn(idx.len(), idx.len(), |r, c| rows[r][idx[c] - b.start]);
                 let llt = (!idx.is_empty())
                     .then(|| m.llt(faer::Side::Lower).ok())
                     .flatten();
@@ -1569,7 +1607,7 @@ mod tests {
     /// uniform and a tilting mode (a "bending" of the whole plane).
     fn compliant_rank_two(cells: &[crate::contact::ContactCell], pb: &Problem, a: f64) -> LowRank {
         let rows: Vec<f64> = cells.iter().flat_map(|c| [1.0, c.centre.x / a]).collect();
-        let scale = 50.0 * pb.blocks[0].matrix[0];
+        let scale = 50.0 * pb.blocks[0].row(0)[0];
         LowRank::new(2, rows, vec![scale, 0.0, 0.0, 0.3 * scale], Vec::new())
     }
 
@@ -1689,7 +1727,7 @@ mod tests {
             rows[i * k + at + 1] = c.centre.y / (n as f64 * h);
             ranges.push([(at, at + 2), (0, 0), (0, 0)]);
         }
-        let s = 50.0 * pb.blocks[0].matrix[0];
+        let s = 50.0 * pb.blocks[0].row(0)[0];
         #[rustfmt::skip]
         let core = vec![
             s, 0.0, 0.4 * s, 0.0,

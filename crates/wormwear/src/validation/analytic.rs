@@ -61,11 +61,7 @@ pub fn flat_problem(
         }
     }
     Problem {
-        blocks: vec![Block {
-            start: 0,
-            size: n,
-            matrix,
-        }],
+        blocks: vec![Block::dense(0, n, matrix)],
         low_rank: None,
         separation: cells.iter().map(|c| gap(&c.centre)).collect(),
         load,
