@@ -180,25 +180,54 @@ fn far_row(
     let (sa, sb, sinv) = (&s.half_nu[a..], &s.half_zeta[a..], &s.inv[a..]);
     assert!(dist.len() == m && sx.len() == m && sinv.len() == m && svz.len() == m);
     for k in 0..m {
-        let (dx, dy, dz) = (xi - sx[k], yi - sy[k], zi - sz[k]);
-        let nu = dx * sux[k] + dy * suy[k] + dz * suz[k];
-        let zeta = dx * svx[k] + dy * svy[k] + dz * svz[k];
-        let (aa, bb) = (sa[k], sb[k]);
-        let d2 = nu * nu + zeta * zeta;
+        let d = [xi - sx[k], yi - sy[k], zi - sz[k]];
+        let source = FarSource {
+            u: [sux[k], suy[k], suz[k]],
+            v: [svx[k], svy[k], svz[k]],
+            n: [snx[k], sny[k], snz[k]],
+            half_nu: sa[k],
+            half_zeta: sb[k],
+        };
+        let (value, d2) = far_entry(pair, d, &source, [nxi, nyi, nzi]);
         dist[k] = d2;
-        let d = d2.sqrt();
-        let love = 4.0
-            * aa
-            * bb
-            * (1.0 / d
-                + (aa * aa * (2.0 * nu * nu - zeta * zeta)
-                    + bb * bb * (2.0 * zeta * zeta - nu * nu))
-                    / (6.0 * d2 * d2 * d));
-        let dot_n = snx[k] * nxi + sny[k] * nyi + snz[k] * nzi;
-        let r2 = dx * dx + dy * dy + dz * dz;
-        let tangential = pair.tangential * 4.0 * aa * bb * (dx * nxi + dy * nyi + dz * nzi) / r2;
-        out[k] = MaybeUninit::new((pair.normal * love * dot_n + tangential) * sinv[k] * scale_i);
+        out[k] = MaybeUninit::new(value * sinv[k] * scale_i);
     }
+}
+
+/// A source cell's in-plane axes, normal and half sides, for [`far_entry`].
+struct FarSource {
+    u: [f64; 3],
+    v: [f64; 3],
+    n: [f64; 3],
+    half_nu: f64,
+    half_zeta: f64,
+}
+
+/// Far-field coefficient of one pair before the 1 / (area lever) and 1 / lever scalings, and
+/// the in-plane squared distance: d = receiver centre - source centre (m), `receiver` its
+/// unit normal. Love's monopole and quadrupole terms along the normals plus the tangential
+/// Boussinesq term (MODEL §5.5). The one formula of [`far_row`] and [`far_column`], so their
+/// numbers agree to the last bit.
+#[inline(always)]
+fn far_entry(pair: &ElasticPair, d: [f64; 3], s: &FarSource, receiver: [f64; 3]) -> (f64, f64) {
+    let [dx, dy, dz] = d;
+    let nu = dx * s.u[0] + dy * s.u[1] + dz * s.u[2];
+    let zeta = dx * s.v[0] + dy * s.v[1] + dz * s.v[2];
+    let (aa, bb) = (s.half_nu, s.half_zeta);
+    let d2 = nu * nu + zeta * zeta;
+    let dist = d2.sqrt();
+    let love = 4.0
+        * aa
+        * bb
+        * (1.0 / dist
+            + (aa * aa * (2.0 * nu * nu - zeta * zeta) + bb * bb * (2.0 * zeta * zeta - nu * nu))
+                / (6.0 * d2 * d2 * dist));
+    let dot_n = s.n[0] * receiver[0] + s.n[1] * receiver[1] + s.n[2] * receiver[2];
+    let r2 = dx * dx + dy * dy + dz * dz;
+    let tangential =
+        pair.tangential * 4.0 * aa * bb * (dx * receiver[0] + dy * receiver[1] + dz * receiver[2])
+            / r2;
+    (pair.normal * love * dot_n + tangential, d2)
 }
 
 /// [`far_row`] compiled for AVX2 + FMA (4 doubles per instruction); chosen at run time.
@@ -284,25 +313,18 @@ fn far_column(
     let (rnx, rny, rnz) = (&s.n[0][..m], &s.n[1][..m], &s.n[2][..m]);
     let scale = &scale[..m];
     assert!(dist.len() == m);
+    let source = FarSource {
+        u: [uxj, uyj, uzj],
+        v: [vxj, vyj, vzj],
+        n: [nxj, nyj, nzj],
+        half_nu: aa,
+        half_zeta: bb,
+    };
     for k in 0..m {
-        let (dx, dy, dz) = (rx[k] - xj, ry[k] - yj, rz[k] - zj);
-        let nu = dx * uxj + dy * uyj + dz * uzj;
-        let zeta = dx * vxj + dy * vyj + dz * vzj;
-        let d2 = nu * nu + zeta * zeta;
+        let d = [rx[k] - xj, ry[k] - yj, rz[k] - zj];
+        let (value, d2) = far_entry(pair, d, &source, [rnx[k], rny[k], rnz[k]]);
         dist[k] = d2;
-        let d = d2.sqrt();
-        let love = 4.0
-            * aa
-            * bb
-            * (1.0 / d
-                + (aa * aa * (2.0 * nu * nu - zeta * zeta)
-                    + bb * bb * (2.0 * zeta * zeta - nu * nu))
-                    / (6.0 * d2 * d2 * d));
-        let dot_n = nxj * rnx[k] + nyj * rny[k] + nzj * rnz[k];
-        let r2 = dx * dx + dy * dy + dz * dz;
-        let tangential =
-            pair.tangential * 4.0 * aa * bb * (dx * rnx[k] + dy * rny[k] + dz * rnz[k]) / r2;
-        out[k] = (pair.normal * love * dot_n + tangential) * inv * scale[k];
+        out[k] = value * inv * scale[k];
     }
 }
 
