@@ -464,27 +464,14 @@ impl SourceCells {
     /// The cells' data as structure of arrays, with 1 / (area lever) of each cell.
     fn new(cells: &[ContactCell], levers: &[f64]) -> Self {
         let col = |f: &dyn Fn(&ContactCell) -> f64| -> Vec<f64> { cells.iter().map(f).collect() };
+        let xyz = |f: &dyn Fn(&ContactCell) -> Vector3<f64>| -> [Vec<f64>; 3] {
+            [0, 1, 2].map(|k| cells.iter().map(|c| f(c)[k]).collect())
+        };
         SourceCells {
-            c: [
-                col(&|c| c.centre.x),
-                col(&|c| c.centre.y),
-                col(&|c| c.centre.z),
-            ],
-            n: [
-                col(&|c| c.normal.x),
-                col(&|c| c.normal.y),
-                col(&|c| c.normal.z),
-            ],
-            u: [
-                col(&|c| c.axis_nu.x),
-                col(&|c| c.axis_nu.y),
-                col(&|c| c.axis_nu.z),
-            ],
-            v: [
-                col(&|c| c.axis_zeta.x),
-                col(&|c| c.axis_zeta.y),
-                col(&|c| c.axis_zeta.z),
-            ],
+            c: xyz(&|c| c.centre),
+            n: xyz(&|c| c.normal),
+            u: xyz(&|c| c.axis_nu),
+            v: xyz(&|c| c.axis_zeta),
             half_nu: col(&|c| c.half_nu),
             half_zeta: col(&|c| c.half_zeta),
             inv: cells
