@@ -68,6 +68,13 @@ pub struct WheelFlank {
     /// fitted to the active flank, so this is true everywhere unless the blank and hob leave
     /// holes; later stages must still honour it.
     pub active: Vec<bool>,
+    /// d theta_w / d r and d theta_w / d z at each node, from its normal (rad/m), computed
+    /// once ([`Self::theta_slope`]).
+    #[serde(skip)]
+    node_slopes: Vec<[f64; 2]>,
+    /// Orientation of each column's stored normals: +1 where n . e_theta < 0 at its first node.
+    #[serde(skip)]
+    column_sign: Vec<f64>,
 }
 
 impl WheelFlank {
@@ -97,11 +104,26 @@ impl WheelFlank {
     /// normal proportional to r theta_r e_r - e_theta + r theta_z e_z), rad/m.
     #[inline]
     pub fn theta_slope(&self, i: usize, j: usize) -> f64 {
-        let n = self.node(i, j);
+        self.node_slopes[j * (self.cells_height + 1) + i][0]
+    }
+
+    /// d theta_w / d r and d theta_w / d z at a node from its normal, rad/m.
+    fn slopes_of(n: &FlankPoint) -> [f64; 2] {
         let (s, c) = n.theta.sin_cos();
         let n_r = n.normal[0] * c - n.normal[1] * s;
         let n_t = -n.normal[0] * s - n.normal[1] * c;
-        -n_r / (n.r * n_t)
+        [-n_r / (n.r * n_t), -n.normal[2] / (n.r * n_t)]
+    }
+
+    /// Orientation of the stored normals of a column from its first node: n . e_theta has
+    /// the sign of -sign.
+    fn sign_of(first: &FlankPoint) -> f64 {
+        let (rs, rc) = first.theta.sin_cos();
+        if -first.normal[0] * rs - first.normal[1] * rc < 0.0 {
+            1.0
+        } else {
+            -1.0
+        }
     }
 
     /// theta_w and d theta_w / d r at radius r on node column j: cubic Hermite between the
@@ -150,12 +172,7 @@ impl WheelFlank {
         let (lo, hi) = (self.r_low[j], self.r_high[j]);
         let f = ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64 - 1e-12);
         let i = f as usize;
-        let theta_z = |i: usize| {
-            let n = self.node(i, j);
-            let (s, c) = n.theta.sin_cos();
-            let n_t = -n.normal[0] * s - n.normal[1] * c;
-            -n.normal[2] / (n.r * n_t)
-        };
+        let theta_z = |i: usize| self.node_slopes[j * (ni + 1) + i][1];
         // Cubic Lagrange through four neighbouring nodes (clamped at the column ends).
         let i0 = i.saturating_sub(1).min(ni.saturating_sub(3));
         let x = f - i0 as f64;
@@ -185,15 +202,7 @@ impl WheelFlank {
         let e_r = Vector3::new(c, -s, 0.0);
         let e_t = Vector3::new(-s, -c, 0.0);
         let v = e_r * (r * tr) - e_t + Vector3::new(0.0, 0.0, r * tz);
-        // Orientation of the stored normals: n . e_theta has the sign of -c.
-        let ref_n = self.node(0, j);
-        let (rs, rc) = ref_n.theta.sin_cos();
-        let sign = if -ref_n.normal[0] * rs - ref_n.normal[1] * rc < 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
-        v.normalize() * sign
+        v.normalize() * self.column_sign[j]
     }
 
     /// Node column interval [j, j + 1] holding z and the position t in it (0..1; outside
@@ -514,6 +523,10 @@ pub fn generate_flank(
         }
     }
     let active = vec![true; ni * nj];
+    let node_slopes = nodes.iter().map(WheelFlank::slopes_of).collect();
+    let column_sign = (0..=nj)
+        .map(|j| WheelFlank::sign_of(&nodes[j * (ni + 1)]))
+        .collect();
     Ok(WheelFlank {
         flank,
         cells_height: ni,
@@ -525,5 +538,7 @@ pub fn generate_flank(
         cells,
         cell_area,
         active,
+        node_slopes,
+        column_sign,
     })
 }

@@ -397,6 +397,10 @@ pub fn analyse_worn(
     let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.cos();
     let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
     let band0 = settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus);
+    let node_angle = removal.map(|w| Worn::node_angles(wf, w));
+    let worn = removal
+        .zip(node_angle.as_deref())
+        .map(|(depth, node_angle)| Worn { depth, node_angle });
 
     let positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
@@ -413,7 +417,7 @@ pub fn analyse_worn(
                 band0,
                 worm_torque,
                 wheel_torque_guess,
-                removal,
+                worn,
                 warm,
             )
         })
@@ -503,6 +507,27 @@ pub fn analyse_worn(
     })
 }
 
+/// A worn flank as the local meshes read it (MODEL §7.5): the depth worn off normal to the
+/// flank (m), and at each node of the global grid the same depth as an angle over the node's
+/// lever |(P x n)_z| (rad), computed once per analysis.
+#[derive(Clone, Copy)]
+struct Worn<'a> {
+    depth: &'a FlankField,
+    node_angle: &'a [f64],
+}
+
+impl Worn<'_> {
+    /// The depth at each node over the node's lever (the lever is rotation invariant about
+    /// the wheel axis), rad.
+    fn node_angles(wf: &WheelFlank, depth: &FlankField) -> Vec<f64> {
+        wf.nodes
+            .iter()
+            .zip(&depth.values)
+            .map(|(p, h)| h / GapEvaluator::lever(&p.position(), &p.normal_vec()))
+            .collect()
+    }
+}
+
 /// First j in 0..n for which `below(j)` is false (`below` true on a prefix of 0..n).
 fn partition_point(n: usize, below: impl Fn(usize) -> bool) -> usize {
     let (mut lo, mut hi) = (0, n);
@@ -544,7 +569,7 @@ fn local_mesh(
     teeth: u32,
     n: usize,
     band: f64,
-    removal: Option<&FlankField>,
+    worn: Option<Worn>,
 ) -> Vec<LocalCell> {
     let pos = tca.positions[n];
     let tau = 2.0 * PI / teeth as f64;
@@ -552,7 +577,7 @@ fn local_mesh(
     let base_dz = (wf.z[1] - wf.z[0]) * step as f64;
     // Separation threshold for slices whose minimum is not a crossing (flank edges); on a worn
     // flank the edges left standing can be the first to touch: raised by the deepest wear.
-    let edge_threshold = 50e-6 + removal.map_or(0.0, |w| w.max());
+    let edge_threshold = 50e-6 + worn.map_or(0.0, |w| w.depth.max());
     // Line crossings of every node column at this position, to follow the line.
     let crossings: std::collections::HashMap<(i32, usize), &crate::kinematics::SliceContact> = tca
         .contact_lines
@@ -579,7 +604,7 @@ fn local_mesh(
         (dz.abs() > 0.0).then(|| ev.placement.vector_wheel_to_worm(&((b - a) / dz)))
     };
     // Worn material exists only where the worm flank reaches (above the worm-tip trace).
-    let tip_floor: Vec<f64> = if removal.is_some() {
+    let tip_floor: Vec<f64> = if worn.is_some() {
         tca.tip_trace.iter().map(|t| t.1).collect()
     } else {
         Vec::new()
@@ -596,8 +621,8 @@ fn local_mesh(
         let tooth_index = tca.teeth.iter().position(|&k| k == line.tooth).unwrap_or(0);
         // On a worn flank the band goes where the worn gap is smallest on the column (the TCA
         // node gaps plus the removal over each node's lever), which need not be the unworn line.
-        let (r_line, at_end) = match removal {
-            Some(w) => worn_minimum(tca, wf, w, n, tooth_index, line),
+        let (r_line, at_end) = match worn {
+            Some(w) => worn_minimum(tca, wf, w.node_angle, n, tooth_index, line),
             None => (line.r, line.at_end),
         };
         base.push(Slice {
@@ -625,7 +650,7 @@ fn local_mesh(
                 n,
                 band,
                 offset_of(s.tooth),
-                removal,
+                worn,
                 &tip_floor,
             )
         })
@@ -639,7 +664,7 @@ fn local_mesh(
 fn worn_minimum(
     tca: &Tca,
     wf: &WheelFlank,
-    removal: &FlankField,
+    node_angle: &[f64],
     n: usize,
     t: usize,
     line: &crate::kinematics::SliceContact,
@@ -651,9 +676,7 @@ fn worn_minimum(
         (0..=ni)
             .map(|i| {
                 let k = j * (ni + 1) + i;
-                let p = &wf.nodes[k];
-                let lever = GapEvaluator::lever(&p.position(), &p.normal_vec());
-                tca.node_gaps[base + k] + if worn { removal.values[k] / lever } else { 0.0 }
+                tca.node_gaps[base + k] + if worn { node_angle[k] } else { 0.0 }
             })
             .collect()
     };
@@ -705,7 +728,7 @@ fn slice_cells(
     n: usize,
     band: f64,
     offset: f64,
-    removal: Option<&FlankField>,
+    worn: Option<Worn>,
     tip_floor: &[f64],
 ) -> Vec<LocalCell> {
     let pos = tca.positions[n];
@@ -787,7 +810,9 @@ fn slice_cells(
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error
-                + removal.map_or(0.0, |w| w.at_above(wf, r, z, Some(tip_floor)) / wheel_lever),
+                + worn.map_or(0.0, |w| {
+                    w.depth.at_above(wf, r, z, Some(tip_floor)) / wheel_lever
+                }),
             relief,
         });
     }
@@ -822,13 +847,13 @@ fn solve_position(
     band0: f64,
     worm_torque: Option<f64>,
     wheel_torque_guess: f64,
-    removal: Option<&FlankField>,
+    worn: Option<Worn>,
     seed: Option<&WarmStart>,
 ) -> Result<PositionResult, LtcaError> {
     let mut band = band0;
     let mut widenings = 0;
     loop {
-        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, removal);
+        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, worn);
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
         }
