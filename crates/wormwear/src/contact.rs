@@ -251,8 +251,23 @@ unsafe fn far_row_avx2(
 /// structure-of-arrays data (the compiler vectorises it), then the few near pairs are
 /// recomputed with Love's closed form.
 pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]) -> Vec<f64> {
+    symmetric_block_reusing(pair, cells, levers, &vec![None; cells.len()], &[])
+}
+
+/// [`symmetric_block`] of cells that are `set` (indices) of a larger group whose rows
+/// `known[a]` (the group's row of cell a, all its columns) may already be assembled: a known
+/// row is gathered and a near pair with a known row taken from it instead of recomputed
+/// (the same numbers). `set` is read only for the known rows.
+fn symmetric_block_reusing(
+    pair: &ElasticPair,
+    cells: &[ContactCell],
+    levers: &[f64],
+    known: &[Option<&[f64]>],
+    set: &[usize],
+) -> Vec<f64> {
     let n = cells.len();
     assert_eq!(levers.len(), n);
+    assert_eq!(known.len(), n);
     let soa = SourceCells::new(cells, levers);
     let far2 = near_radii2(cells);
     #[cfg(target_arch = "x86_64")]
@@ -264,6 +279,12 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
     for a in 0..n {
         let scale_i = 1.0 / levers[a];
         let out = &mut matrix[a * n + a..a * n + n];
+        if let Some(row) = known[a] {
+            for (o, &i) in out.iter_mut().zip(&set[a..]) {
+                *o = MaybeUninit::new(row[i]);
+            }
+            continue;
+        }
         let dist = &mut dist2[..n - a];
         #[cfg(target_arch = "x86_64")]
         if wide {
@@ -278,9 +299,10 @@ pub fn symmetric_block(pair: &ElasticPair, cells: &[ContactCell], levers: &[f64]
         let far2 = &far2[a..];
         for (k, (o, d)) in out.iter_mut().zip(dist.iter()).enumerate() {
             if *d <= far2[k] {
-                *o = MaybeUninit::new(
-                    coefficient(pair, &cells[a], &cells[a + k]) * soa.inv[a + k] * scale_i,
-                );
+                *o = MaybeUninit::new(match known[a + k] {
+                    Some(row) => row[set[a]],
+                    None => coefficient(pair, &cells[a], &cells[a + k]) * soa.inv[a + k] * scale_i,
+                });
             }
         }
     }
@@ -359,6 +381,27 @@ pub struct InfluenceRows {
     /// 1 / lever of each cell, 1/m.
     scale: Vec<f64>,
     rows: Vec<std::sync::OnceLock<Box<[f64]>>>,
+    /// The first sub-block handed out: rows assembled later take their near pairs inside it
+    /// from there instead of recomputing Love's closed form (the same numbers).
+    known: std::sync::OnceLock<KnownBlock>,
+}
+
+/// A sub-block of [`InfluenceRows`]: each cell's position in it (None: outside) and its
+/// entries, row-major, shared with the solver that reads it.
+#[derive(Debug, Clone)]
+struct KnownBlock {
+    position: Vec<Option<u32>>,
+    size: usize,
+    values: std::sync::Arc<Vec<f64>>,
+}
+
+impl KnownBlock {
+    /// Entry (a, b) in the group's indices, if both cells are in the sub-block.
+    #[inline]
+    fn entry(&self, a: usize, b: usize) -> Option<f64> {
+        let (pa, pb) = (self.position[a]?, self.position[b]?);
+        Some(self.values[pa as usize * self.size + pb as usize])
+    }
 }
 
 impl InfluenceRows {
@@ -376,6 +419,7 @@ impl InfluenceRows {
             rows: (0..cells.len())
                 .map(|_| std::sync::OnceLock::new())
                 .collect(),
+            known: std::sync::OnceLock::new(),
         }
     }
 
@@ -400,12 +444,32 @@ impl InfluenceRows {
     }
 
     /// The block on the cells `set` (local indices, ascending): row-major set.len()^2, the
-    /// entries of [`symmetric_block`] of the whole group at those rows and columns.
-    pub fn sub_block(&self, set: &[usize]) -> Vec<f64> {
+    /// entries of [`symmetric_block`] of the whole group at those rows and columns. Rows
+    /// assembled before are read, not recomputed; the first sub-block is kept, and rows
+    /// assembled afterwards read their near pairs inside it.
+    pub fn sub_block(&self, set: &[usize]) -> std::sync::Arc<Vec<f64>> {
         debug_assert!(set.windows(2).all(|w| w[0] < w[1]));
         let cells: Vec<ContactCell> = set.iter().map(|&i| self.cells[i]).collect();
         let levers: Vec<f64> = set.iter().map(|&i| self.levers[i]).collect();
-        symmetric_block(&self.pair, &cells, &levers)
+        let known: Vec<Option<&[f64]>> = set
+            .iter()
+            .map(|&i| self.rows[i].get().map(|row| &row[..]))
+            .collect();
+        let values = std::sync::Arc::new(symmetric_block_reusing(
+            &self.pair, &cells, &levers, &known, set,
+        ));
+        if self.known.get().is_none() {
+            let mut position = vec![None; self.len()];
+            for (p, &i) in set.iter().enumerate() {
+                position[i] = u32::try_from(p).ok();
+            }
+            let _ = self.known.set(KnownBlock {
+                position,
+                size: set.len(),
+                values: values.clone(),
+            });
+        }
+        values
     }
 
     fn assemble_row(&self, j: usize) -> Box<[f64]> {
@@ -436,14 +500,21 @@ impl InfluenceRows {
                 far_column(pair, soa, j, &self.scale, lower, dist_lower);
             }
         }
-        // Near pairs: Love's closed form, the lower index as the receiver.
+        // Near pairs: Love's closed form, the lower index as the receiver (as the sub-block
+        // handed out computed it, where both cells are in it).
         let cells = &self.cells;
+        let known = self.known.get().filter(|k| k.position[j].is_some());
         for k in 0..n {
             let (receiver, source) = if k < j { (k, j) } else { (j, k) };
             if dist[k] <= self.far2[source] {
-                out[k] = coefficient(pair, &cells[receiver], &cells[source])
-                    * soa.inv[source]
-                    * self.scale[receiver];
+                out[k] = match known.and_then(|b| b.entry(j, k)) {
+                    Some(value) => value,
+                    None => {
+                        coefficient(pair, &cells[receiver], &cells[source])
+                            * soa.inv[source]
+                            * self.scale[receiver]
+                    }
+                };
             }
         }
         out.into_boxed_slice()
@@ -570,6 +641,18 @@ mod tests {
             for (b, &j) in set.iter().enumerate() {
                 assert_eq!(sub[a * set.len() + b], block[i * n + j], "({i}, {j})");
             }
+        }
+        // The sub-block above was cut after some rows were assembled (it read those); rows
+        // assembled after a sub-block read their near pairs inside it: still the same numbers,
+        // for rows inside and outside the set.
+        let after = InfluenceRows::new(&pair, &cells, &levers);
+        let _ = after.sub_block(&set);
+        for j in 0..n {
+            assert_eq!(
+                after.row(j),
+                &block[j * n..(j + 1) * n],
+                "row {j} after a sub-block"
+            );
         }
     }
 

@@ -43,8 +43,8 @@ pub struct Block {
 /// indefinite and the CG failed late in case B.)
 #[derive(Debug, Clone)]
 pub enum BlockMatrix {
-    /// Row-major size x size.
-    Dense(Vec<f64>),
+    /// Row-major size x size (shared with the lazy block it was cut from, if any).
+    Dense(std::sync::Arc<Vec<f64>>),
     /// Rows and sub-blocks on demand, the same numbers as the dense block.
     Lazy(Box<crate::contact::InfluenceRows>),
 }
@@ -56,7 +56,7 @@ impl Block {
         Self {
             start,
             size,
-            matrix: BlockMatrix::Dense(matrix),
+            matrix: BlockMatrix::Dense(std::sync::Arc::new(matrix)),
         }
     }
 
@@ -70,7 +70,7 @@ impl Block {
     }
 
     /// The block on the local unknowns `inside` (ascending), row-major.
-    fn sub_block(&self, inside: &[usize]) -> Vec<f64> {
+    fn sub_block(&self, inside: &[usize]) -> std::sync::Arc<Vec<f64>> {
         match &self.matrix {
             BlockMatrix::Dense(_) => {
                 let mut matrix = Vec::with_capacity(inside.len() * inside.len());
@@ -78,7 +78,7 @@ impl Block {
                     let row = self.row(r);
                     matrix.extend(inside.iter().map(|&c| row[c]));
                 }
-                matrix
+                std::sync::Arc::new(matrix)
             }
             BlockMatrix::Lazy(rows) => rows.sub_block(inside),
         }
@@ -581,7 +581,11 @@ impl Problem {
                 continue;
             }
             let m = inside.len();
-            blocks.push(Block::dense(at, m, b.sub_block(&inside)));
+            blocks.push(Block {
+                start: at,
+                size: m,
+                matrix: BlockMatrix::Dense(b.sub_block(&inside)),
+            });
             at += m;
         }
         debug_assert_eq!(at, set.len(), "every unknown lies in one contact block");
