@@ -137,6 +137,40 @@ fn bench(c: &mut Criterion) {
             })
         },
     );
+    // A state of a wear life: the loaded analysis of a worn flank started from the previous
+    // state's loads (what the life loop does at every state after the first).
+    let previous =
+        wormwear::ltca::analyse_worn(&g140, &geo, &tca, &settings, None, Some(&removal), None)
+            .unwrap();
+    let warm = previous.warm_start();
+    let rate = wormwear::wear::per_cycle(
+        &g140,
+        &geo,
+        &tca,
+        &previous,
+        wormwear::input::FilmLoad::LoadedAnalysis,
+    );
+    let mut worn = removal.clone();
+    for (h, d) in worn.values.iter_mut().zip(&rate.depth.values) {
+        *h += 1000.0 * d;
+    }
+    group.bench_function(
+        "1x40 LTCA of a wear-life state (worn flank, warm start, 20 positions)",
+        |b| {
+            b.iter(|| {
+                wormwear::ltca::analyse_worn(
+                    black_box(&g140),
+                    &geo,
+                    &tca,
+                    &settings,
+                    None,
+                    Some(&worn),
+                    Some(&warm),
+                )
+                .unwrap()
+            })
+        },
+    );
     group.finish();
 }
 
