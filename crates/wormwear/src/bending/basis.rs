@@ -53,26 +53,64 @@ fn beam_eigenvalue_newton(k: usize) -> f64 {
 ///   A = e^(bx) (1 - s) / 2,  B = e^(-bx) (1 + s) / 2,
 /// where 1 - s = (cos b - sin b - e^-b) / (sinh b - sin b) is formed without subtracting the
 /// two nearly equal large terms (for the 12th mode cosh b ~ 1e15: the textbook form loses every
-/// digit). Returns (A, B, s).
-fn hyperbolic_parts(b: f64, x: f64) -> (f64, f64, f64) {
-    let em = (-b).exp();
-    // sinh b - sin b = e^b (1 - e^-2b - 2 sin b e^-b) / 2.
-    let scaled = 1.0 - em * em - 2.0 * b.sin() * em;
-    let one_minus_s = 2.0 * em * (b.cos() - b.sin() - em) / scaled;
-    let s = 1.0 - one_minus_s;
-    let a = 0.5 * (b * x).exp() * one_minus_s;
-    let bb = 0.5 * (-b * x).exp() * (1.0 + s);
-    (a, bb, s)
+/// digit). This function returns (1 - s, s) of mode k (computed once for the first 32).
+fn mode_s(k: usize) -> (f64, f64) {
+    static TABLE: std::sync::OnceLock<Vec<(f64, f64)>> = std::sync::OnceLock::new();
+    let of = |k: usize| {
+        let b = beam_eigenvalue(k);
+        let em = (-b).exp();
+        // sinh b - sin b = e^b (1 - e^-2b - 2 sin b e^-b) / 2.
+        let scaled = 1.0 - em * em - 2.0 * b.sin() * em;
+        let one_minus_s = 2.0 * em * (b.cos() - b.sin() - em) / scaled;
+        (one_minus_s, 1.0 - one_minus_s)
+    };
+    let table = TABLE.get_or_init(|| (0..32).map(of).collect());
+    table.get(k).copied().unwrap_or_else(|| of(k))
+}
+
+/// What the free-free and clamped-clamped modes k share at x: b, A, B and s of
+/// [`mode_s`], cos(bx), sin(bx).
+struct ModeParts {
+    b: f64,
+    a: f64,
+    bb: f64,
+    s: f64,
+    c: f64,
+    sn: f64,
+}
+
+impl ModeParts {
+    fn new(k: usize, x: f64) -> Self {
+        let b = beam_eigenvalue(k);
+        let (one_minus_s, s) = mode_s(k);
+        Self {
+            b,
+            a: 0.5 * (b * x).exp() * one_minus_s,
+            bb: 0.5 * (-b * x).exp() * (1.0 + s),
+            s,
+            c: (b * x).cos(),
+            sn: (b * x).sin(),
+        }
+    }
+
+    /// Free-free mode value.
+    fn free_free(&self) -> f64 {
+        (self.a + self.bb) + self.c - self.s * self.sn
+    }
+
+    /// Clamped-clamped mode value.
+    fn clamped_clamped(&self) -> f64 {
+        (self.a + self.bb) - self.c + self.s * self.sn
+    }
 }
 
 /// Free-free mode k >= 1 on [0, 1] and its first three derivatives (textbook form
 /// cosh + cos - s (sinh + sin), s = (cosh b - cos b) / (sinh b - sin b)).
 pub fn free_free(k: usize, x: f64) -> [f64; 4] {
-    let b = beam_eigenvalue(k);
-    let (a, bb, s) = hyperbolic_parts(b, x);
-    let (c, sn) = ((b * x).cos(), (b * x).sin());
+    let p = ModeParts::new(k, x);
+    let (b, a, bb, s, c, sn) = (p.b, p.a, p.bb, p.s, p.c, p.sn);
     [
-        (a + bb) + c - s * sn,
+        p.free_free(),
         b * ((a - bb) - sn - s * c),
         b * b * ((a + bb) - c + s * sn),
         b * b * b * ((a - bb) + sn + s * c),
@@ -82,11 +120,10 @@ pub fn free_free(k: usize, x: f64) -> [f64; 4] {
 /// Clamped-clamped mode k >= 1 on [0, 1] and its first three derivatives
 /// (cosh - cos - s (sinh - sin), same s).
 pub fn clamped_clamped(k: usize, x: f64) -> [f64; 4] {
-    let b = beam_eigenvalue(k);
-    let (a, bb, s) = hyperbolic_parts(b, x);
-    let (c, sn) = ((b * x).cos(), (b * x).sin());
+    let p = ModeParts::new(k, x);
+    let (b, a, bb, s, c, sn) = (p.b, p.a, p.bb, p.s, p.c, p.sn);
     [
-        (a + bb) - c + s * sn,
+        p.clamped_clamped(),
         b * ((a - bb) + sn + s * c),
         b * b * ((a + bb) + c - s * sn),
         b * b * b * ((a - bb) - sn - s * c),
@@ -118,9 +155,10 @@ impl Basis {
             0 => 1.0,
             1 => 1.0 - 2.0 * w,
             _ => match self.kind {
-                WidthFunctions::FreeFree => free_free(b - 1, w)[0],
+                WidthFunctions::FreeFree => ModeParts::new(b - 1, w).free_free(),
                 WidthFunctions::Averaged => {
-                    0.5 * (free_free(b - 1, w)[0] + clamped_clamped(b - 1, w)[0])
+                    let p = ModeParts::new(b - 1, w);
+                    0.5 * (p.free_free() + p.clamped_clamped())
                 }
             },
         }
@@ -128,13 +166,26 @@ impl Basis {
 
     /// Values of the K functions at (r~, w~), index a * Q2 + b.
     pub fn eval(&self, r: f64, w: f64) -> Vec<f64> {
-        let hw: Vec<f64> = (0..self.width).map(|b| self.width_function(b, w)).collect();
-        let mut out = Vec::with_capacity(self.len());
-        for a in 0..self.height {
-            let g = r.powi(a as i32);
-            out.extend(hw.iter().map(|h| g * h));
-        }
+        let mut out = vec![0.0; self.len()];
+        self.eval_into(r, &self.width_values(w), &mut out);
         out
+    }
+
+    /// The Q2 width functions at w~.
+    pub fn width_values(&self, w: f64) -> Vec<f64> {
+        (0..self.width).map(|b| self.width_function(b, w)).collect()
+    }
+
+    /// [`Self::eval`] at r~ from the width functions `hw` at w~ ([`Self::width_values`]),
+    /// written to `out` (K values): points that share w~ share `hw`.
+    pub fn eval_into(&self, r: f64, hw: &[f64], out: &mut [f64]) {
+        assert!(hw.len() == self.width && out.len() == self.len());
+        for (a, row) in out.chunks_exact_mut(self.width).enumerate() {
+            let g = r.powi(a as i32);
+            for (o, h) in row.iter_mut().zip(hw) {
+                *o = g * h;
+            }
+        }
     }
 
     /// The fitting points: a uniform Q1 x Q2 grid of (r~, w~) in [0, 1]^2 (index a * Q2 + b).

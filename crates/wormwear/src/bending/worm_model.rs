@@ -385,14 +385,31 @@ pub(crate) fn relation_rows(
     present.dedup();
     let k = basis.len();
     let mut ranges = Vec::with_capacity(groups.len());
+    // The width functions of the previous point, reused while w~ repeats (a slice's cells on
+    // the wheel share their face position).
+    let mut width: Option<(f64, Vec<f64>)> = None;
     for (i, (&g, &(r, w))) in groups.iter().zip(coords).enumerate() {
         let t = present.binary_search(&g).unwrap_or(0);
         let (a, b) = (offset + t * k, offset + (t + 1) * k);
         ranges.push((a, b));
         // Points outside the fitted zone take the value at its edge: the beam modes grow
         // exponentially outside [0, 1].
-        let values = basis.eval(r.clamp(0.0, 1.0), w.clamp(0.0, 1.0));
-        f[i * stride + a..i * stride + b].copy_from_slice(&values);
+        let w = w.clamp(0.0, 1.0);
+        if width
+            .as_ref()
+            .is_none_or(|(at, _)| at.to_bits() != w.to_bits())
+        {
+            width = Some((w, basis.width_values(w)));
+        }
+        let hw = width
+            .as_ref()
+            .map(|(_, hw)| hw.as_slice())
+            .unwrap_or_default();
+        basis.eval_into(
+            r.clamp(0.0, 1.0),
+            hw,
+            &mut f[i * stride + a..i * stride + b],
+        );
     }
     (present, ranges)
 }
