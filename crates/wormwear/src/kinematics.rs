@@ -85,12 +85,12 @@ impl<'a> GapEvaluator<'a> {
     /// the point's radius from the worm axis. m, m/rad, m.
     #[inline]
     pub fn linear(&self, r: f64, theta: f64, z: f64, theta2: f64, theta1: f64) -> (f64, f64, f64) {
-        let (e, de, rho, _) = self.linear_on(r, theta, z, theta2, theta1, None);
+        let (e, de, rho, _, _) = self.linear_on(r, theta, z, theta2, theta1, None);
         (e, de, rho)
     }
 
     /// [`Self::linear`] measured to worm thread `thread` (None: the nearest), also returning the
-    /// thread index.
+    /// thread index and the worm flank's axial-gap gradient (X_y, X_z) there.
     #[inline]
     fn linear_on(
         &self,
@@ -100,7 +100,7 @@ impl<'a> GapEvaluator<'a> {
         theta2: f64,
         theta1: f64,
         thread: Option<f64>,
-    ) -> (f64, f64, f64, f64) {
+    ) -> (f64, f64, f64, f64, [f64; 2]) {
         let p = wheel_point(r, theta, z, theta2);
         let q = self.frame.wheel_to_worm(&p);
         let (e, xy, xz, rho, k) = self
@@ -117,7 +117,7 @@ impl<'a> GapEvaluator<'a> {
         if relief > 0.0 {
             de += d_relief_drho * axial * (q.y * dq.y + q.z * dq.z) / rho;
         }
-        (e + relief * axial, de, rho, k)
+        (e + relief * axial, de, rho, k, [xy, xz])
     }
 
     /// Unit normal of the worm flank (worm frame) at the worm point axially opposite the wheel
@@ -137,7 +137,13 @@ impl<'a> GapEvaluator<'a> {
         let (_, xy, xz, _, _) = self
             .worm
             .axial_gap_with_gradient(self.flank, &q, theta1, None);
-        let n = Vector3::new(1.0, -xy, -xz).normalize();
+        Self::worm_normal_from([xy, xz], towards)
+    }
+
+    /// [`Self::worm_normal`] from the axial-gap gradient (X_y, X_z) that
+    /// [`Self::angular_with_gradient`] returns for the same point.
+    pub fn worm_normal_from(gradient: [f64; 2], towards: &Vector3<f64>) -> Vector3<f64> {
+        let n = Vector3::new(1.0, -gradient[0], -gradient[1]).normalize();
         if n.dot(towards) < 0.0 {
             -n
         } else {
@@ -165,8 +171,40 @@ impl<'a> GapEvaluator<'a> {
     /// when the point is outside the worm tip cylinder (the flank cannot reach it). rad.
     #[inline]
     pub fn angular(&self, r: f64, theta: f64, z: f64, theta2: f64, theta1: f64) -> f64 {
+        self.angular_with_gradient(r, theta, z, theta2, theta1).0
+    }
+
+    /// [`Self::angular`] and the worm flank's axial-gap gradient (X_y, X_z) at the point's
+    /// start (what [`Self::worm_normal`] reads: [`Self::worm_normal_from`]), from the same
+    /// surface evaluation.
+    #[inline]
+    pub fn angular_with_gradient(
+        &self,
+        r: f64,
+        theta: f64,
+        z: f64,
+        theta2: f64,
+        theta1: f64,
+    ) -> (f64, [f64; 2]) {
+        let (e, de, rho, k, gradient) = self.linear_on(r, theta, z, theta2, theta1, None);
+        (
+            self.angular_from(r, theta, z, theta2, theta1, (e, de, rho, k)),
+            gradient,
+        )
+    }
+
+    /// The Newton of [`Self::angular`] from the first evaluation (e, de, rho, thread).
+    #[inline]
+    fn angular_from(
+        &self,
+        r: f64,
+        theta: f64,
+        z: f64,
+        theta2: f64,
+        theta1: f64,
+        (e, de, rho, k): (f64, f64, f64, f64),
+    ) -> f64 {
         let tip = self.worm.def.tip_radius;
-        let (e, de, rho, k) = self.linear_on(r, theta, z, theta2, theta1, None);
         if rho > tip || de.abs() < 1e-12 {
             return f64::INFINITY;
         }
@@ -182,7 +220,7 @@ impl<'a> GapEvaluator<'a> {
             if !delta.is_finite() || delta.abs() > limit {
                 return f64::INFINITY;
             }
-            let (e, de, _, _) =
+            let (e, de, _, _, _) =
                 self.linear_on(r, theta, z, theta2 - self.sigma * delta, theta1, Some(k));
             if self.sigma * de <= 0.0 {
                 return f64::INFINITY;

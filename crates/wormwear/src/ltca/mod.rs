@@ -746,7 +746,8 @@ fn slice_cells(
             continue;
         }
         let (theta, slope) = wf.theta_at(r, z);
-        let e = ev.angular(r, theta + offset, z, pos.theta2, pos.theta1);
+        let (e, worm_gradient) =
+            ev.angular_with_gradient(r, theta + offset, z, pos.theta2, pos.theta1);
         if !e.is_finite() {
             continue;
         }
@@ -761,7 +762,7 @@ fn slice_cells(
         // A depth worn off the wheel flank is normal to it: its angle is over the wheel's lever.
         let wheel_lever = GapEvaluator::lever(&stat, &n_stat);
         if settings.pressure_direction == crate::input::PressureDirection::WormFlank {
-            (normal, n_stat) = worm_flank_direction(ev, r, theta + offset, z, &pos, &normal);
+            (normal, n_stat) = worm_flank_direction(ev, worm_gradient, &normal);
         }
         let lever = GapEvaluator::lever(&stat, &n_stat);
         // Radial direction of the flank: d P / d r in the body frame, to the worm frame.
@@ -819,18 +820,16 @@ fn slice_cells(
     cells
 }
 
-/// The pressure direction along the worm flank's normal where the gap of the wheel point
-/// (r, theta, z) is measured to (see `PressureDirection`): worm-frame and stationary
-/// wheel-frame components, oriented like the wheel normal `wheel_normal` (worm frame).
+/// The pressure direction along the worm flank's normal where the gap of a wheel point is
+/// measured to (see `PressureDirection`), from the worm flank's axial-gap gradient there
+/// ([`GapEvaluator::angular_with_gradient`]): worm-frame and stationary wheel-frame components,
+/// oriented like the wheel normal `wheel_normal` (worm frame).
 fn worm_flank_direction(
     ev: &GapEvaluator,
-    r: f64,
-    theta: f64,
-    z: f64,
-    pos: &crate::kinematics::Position,
+    gradient: [f64; 2],
     wheel_normal: &Vector3<f64>,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let n = ev.worm_normal(r, theta, z, pos.theta2, pos.theta1, wheel_normal);
+    let n = GapEvaluator::worm_normal_from(gradient, wheel_normal);
     (n, ev.placement.vector_worm_to_wheel(&n))
 }
 
