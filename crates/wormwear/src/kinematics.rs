@@ -120,28 +120,10 @@ impl<'a> GapEvaluator<'a> {
         (e + relief * axial, de, rho, k, [xy, xz])
     }
 
-    /// Unit normal of the worm flank (worm frame) at the worm point axially opposite the wheel
-    /// point (r, theta, z) (the point the axial gap is measured to), oriented like the
+    /// Unit normal of the worm flank (worm frame) at the worm point axially opposite a wheel
+    /// point (the point the axial gap is measured to), from the axial-gap gradient (X_y, X_z)
+    /// that [`Self::angular_with_gradient`] returns for the wheel point, oriented like the
     /// wheel flank normal `towards` (worm frame) there.
-    pub fn worm_normal(
-        &self,
-        r: f64,
-        theta: f64,
-        z: f64,
-        theta2: f64,
-        theta1: f64,
-        towards: &Vector3<f64>,
-    ) -> Vector3<f64> {
-        let p = wheel_point(r, theta, z, theta2);
-        let q = self.frame.wheel_to_worm(&p);
-        let (_, xy, xz, _, _) = self
-            .worm
-            .axial_gap_with_gradient(self.flank, &q, theta1, None);
-        Self::worm_normal_from([xy, xz], towards)
-    }
-
-    /// [`Self::worm_normal`] from the axial-gap gradient (X_y, X_z) that
-    /// [`Self::angular_with_gradient`] returns for the same point.
     pub fn worm_normal_from(gradient: [f64; 2], towards: &Vector3<f64>) -> Vector3<f64> {
         let n = Vector3::new(1.0, -gradient[0], -gradient[1]).normalize();
         if n.dot(towards) < 0.0 {
@@ -175,8 +157,7 @@ impl<'a> GapEvaluator<'a> {
     }
 
     /// [`Self::angular`] and the worm flank's axial-gap gradient (X_y, X_z) at the point's
-    /// start (what [`Self::worm_normal`] reads: [`Self::worm_normal_from`]), from the same
-    /// surface evaluation.
+    /// start (for [`Self::worm_normal_from`]), from the same surface evaluation.
     #[inline]
     pub fn angular_with_gradient(
         &self,

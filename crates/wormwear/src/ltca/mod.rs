@@ -765,30 +765,11 @@ fn slice_cells(
             (normal, n_stat) = worm_flank_direction(ev, worm_gradient, &normal);
         }
         let lever = GapEvaluator::lever(&stat, &n_stat);
-        // Radial direction of the flank: d P / d r in the body frame, to the worm frame.
-        let (st, ct) = (theta + offset).sin_cos();
-        let dpdr_body = Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0);
-        let dpdr = ev
-            .placement
-            .vector_wheel_to_worm(&from_wheel_body(&dpdr_body, pos.theta2));
-        let radial = (dpdr - normal * dpdr.dot(&normal)).normalize();
-        // The cell is the parallelogram of sides `ds` along the radial direction and the
-        // line's step along the line, taken as the rectangle of the same area aligned with the
-        // line (exact tiling of a band of straight lines).
-        let (axis_nu, axis_zeta, half_nu, half_zeta) = match slice.line_step {
-            Some(a) => {
-                let a = a - normal * a.dot(&normal);
-                let along = a.norm();
-                let zeta = a / along;
-                (
-                    zeta.cross(&normal),
-                    zeta,
-                    0.5 * ds * radial.cross(&zeta).norm(),
-                    0.5 * along,
-                )
-            }
-            None => (radial, normal.cross(&radial), 0.5 * ds, slice.half_dz),
-        };
+        let dpdr = ev.placement.vector_wheel_to_worm(&from_wheel_body(
+            &radial_tangent(r, theta + offset, slope),
+            pos.theta2,
+        ));
+        let (axis_nu, axis_zeta, half_nu, half_zeta) = cell_axes(slice, &normal, &dpdr, ds);
         cells.push(LocalCell {
             cell: ContactCell {
                 centre,
@@ -818,6 +799,41 @@ fn slice_cells(
         });
     }
     cells
+}
+
+/// d P / d r of the wheel flank point at radius r and body angle theta with d theta / d r =
+/// `slope` (body frame, m/m).
+fn radial_tangent(r: f64, theta: f64, slope: f64) -> Vector3<f64> {
+    let (st, ct) = theta.sin_cos();
+    Vector3::new(ct - r * st * slope, -st - r * ct * slope, 0.0)
+}
+
+/// In-plane axes (across, along the contact line) and half sides (m) of a local cell with unit
+/// normal `normal` and the flank's radial tangent `dpdr` (worm frame), `ds` wide across: the
+/// parallelogram of sides `ds` along the radial direction and the line's step along the line,
+/// taken as the rectangle of the same area aligned with the line (exact tiling of a band of
+/// straight lines); at a flank end (no line step) the radial rectangle of the slice.
+fn cell_axes(
+    slice: &Slice,
+    normal: &Vector3<f64>,
+    dpdr: &Vector3<f64>,
+    ds: f64,
+) -> (Vector3<f64>, Vector3<f64>, f64, f64) {
+    let radial = (dpdr - normal * dpdr.dot(normal)).normalize();
+    match slice.line_step {
+        Some(a) => {
+            let a = a - normal * a.dot(normal);
+            let along = a.norm();
+            let zeta = a / along;
+            (
+                zeta.cross(normal),
+                zeta,
+                0.5 * ds * radial.cross(&zeta).norm(),
+                0.5 * along,
+            )
+        }
+        None => (radial, normal.cross(&radial), 0.5 * ds, slice.half_dz),
+    }
 }
 
 /// The pressure direction along the worm flank's normal where the gap of a wheel point is
