@@ -373,8 +373,8 @@ pub struct Problem {
     pub separation: Vec<f64>,
     /// Total load W (sum of q).
     pub load: f64,
-    /// Optional caps q_i <= upper_i (a pressure cap times area and lever: elastic-perfectly-
-    /// plastic cells); honoured by the conjugate-gradient solver only.
+    /// Optional bounds q_i <= upper_i (the flow pressure times area and lever: elastic-
+    /// perfectly plastic cells, MODEL §5.7); honoured by both solvers.
     pub upper: Option<Vec<f64>>,
 }
 
@@ -655,9 +655,7 @@ pub fn solve(
 ) -> Result<Solution, SolverError> {
     problem.validate()?;
     match (settings.kind, warm) {
-        (SolverKind::ConjugateGradient, Some(w)) if problem.upper.is_none() => {
-            screened(problem, settings, w)
-        }
+        (SolverKind::ConjugateGradient, Some(w)) => screened(problem, settings, w),
         (SolverKind::ConjugateGradient, _) => conjugate_gradient(problem, settings, warm),
         (SolverKind::FixedPoint, _) => fixed_point(problem, settings, warm),
     }
@@ -865,18 +863,7 @@ fn conjugate_gradient(
             other => other,
         };
     };
-    let capacity: f64 = cap
-        .iter()
-        .zip(&problem.separation)
-        .filter(|(_, e)| e.is_finite())
-        .map(|(c, _)| c)
-        .sum();
-    if capacity <= problem.load {
-        return Err(SolverError::Invalid(format!(
-            "the pressure cap lets the reachable cells carry only {capacity:e} of the load {:e}",
-            problem.load
-        )));
-    }
+    check_capacity(problem, cap)?;
     let mut fixed = vec![false; n];
     let mut q = q0;
     let mut iterations = 0;
@@ -1152,7 +1139,15 @@ fn pk_inner(
         }
         delta = if overlap { 0.0 } else { 1.0 };
         if total <= 0.0 {
-            return Err(SolverError::Invalid("load vanished".into()));
+            // A projected step that unloads every free cell: a PK breakdown (seen with most of
+            // the load at the flow pressure), not a property of the problem; the callers'
+            // fallback (the active-set method) takes it from the start.
+            return Err(SolverError::NotConverged {
+                kind: SolverKind::ConjugateGradient,
+                iterations: it,
+                residual: f64::INFINITY,
+                tolerance: settings.tolerance,
+            });
         }
         let s = load / total;
         q.iter_mut().for_each(|v| *v *= s);
@@ -1307,6 +1302,10 @@ fn closed_gaps(problem: &Problem, set: &[usize]) -> Result<(Vec<f64>, f64), Solv
 /// The published fixed point (MODEL §5.4): with y0 = K q + e,
 /// alpha = W / sum(q_i / y0_i), q_i <- alpha q_i / y0_i. Cells start loaded where e is within
 /// the band of the starting point and stay loaded until their share falls below 1e-14 W.
+/// With bounds q_i <= c_i (MODEL §5.7) the update is q_i <- min(c_i, alpha q_i / y0_i) with
+/// alpha the root of sum min(c_i, alpha q_i / y0_i) = W ([`bounded_approach`]): at its fixed
+/// point the free cells have y0 = alpha (closed gaps) and a cell at its bound has
+/// y0 <= alpha (interference), the bounded complementarity of MODEL §5.7.
 fn fixed_point(
     problem: &Problem,
     settings: &SolverSettings,
@@ -1330,27 +1329,38 @@ fn fixed_point(
                 .collect()
         }
     };
+    if let Some(cap) = &problem.upper {
+        check_capacity(problem, cap)?;
+        q.iter_mut().zip(cap).for_each(|(v, c)| *v = v.min(*c));
+    }
     let mut y0 = vec![0.0; n];
+    let mut ratio = vec![0.0; n];
     let mut approach = 0.0;
     for it in 1..=settings.max_iterations {
         problem.apply(&q, &mut y0);
         for i in 0..n {
             y0[i] += e[i];
+            ratio[i] = if q[i] > 0.0 { q[i] / y0[i] } else { 0.0 };
         }
-        let denom: f64 = (0..n).filter(|&i| q[i] > 0.0).map(|i| q[i] / y0[i]).sum();
-        let new_approach = problem.load / denom;
+        let new_approach = match &problem.upper {
+            None => problem.load / ratio.iter().sum::<f64>(),
+            Some(cap) => bounded_approach(&ratio, cap, problem.load),
+        };
+        let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
         let mut change = 0.0;
         for i in 0..n {
             if q[i] > 0.0 {
-                let v = new_approach * q[i] / y0[i];
+                let v = (new_approach * ratio[i]).min(cap(i));
                 let v = if v < 1e-14 * problem.load { 0.0 } else { v };
                 change += (v - q[i]).abs();
                 q[i] = v;
             }
         }
-        let total: f64 = q.iter().sum();
-        let s = problem.load / total;
-        q.iter_mut().for_each(|v| *v *= s);
+        if problem.upper.is_none() {
+            let total: f64 = q.iter().sum();
+            let s = problem.load / total;
+            q.iter_mut().for_each(|v| *v *= s);
+        }
         let settled = (new_approach - approach).abs() <= settings.tolerance * new_approach.abs()
             && change / problem.load < settings.tolerance;
         approach = new_approach;
@@ -1371,6 +1381,48 @@ fn fixed_point(
         residual: f64::NAN,
         tolerance: settings.tolerance,
     })
+}
+
+/// The approach alpha of the bounded fixed point: the root of
+/// sum_i min(c_i, alpha r_i) = W (r_i = q_i / y0_i >= 0, c_i the bounds), a continuous,
+/// non-decreasing, piecewise-linear function of alpha; found exactly by sorting the kinks
+/// alpha_i = c_i / r_i. When the loaded cells cannot carry W at their bounds, the largest kink
+/// (every loaded cell at its bound; the others load on the next pass through the scaling of
+/// no cell, so the caller's capacity check must hold).
+fn bounded_approach(ratio: &[f64], cap: &[f64], load: f64) -> f64 {
+    let mut kinks: Vec<(f64, usize)> = (0..ratio.len())
+        .filter(|&i| ratio[i] > 0.0)
+        .map(|i| (cap[i] / ratio[i], i))
+        .collect();
+    kinks.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Below kink k: the cells of kinks before k are at their bounds, the others linear.
+    let mut at_bound = 0.0;
+    let mut slope: f64 = kinks.iter().map(|&(_, i)| ratio[i]).sum();
+    for &(kink, i) in &kinks {
+        if at_bound + slope * kink >= load {
+            return (load - at_bound) / slope;
+        }
+        at_bound += cap[i];
+        slope -= ratio[i];
+    }
+    kinks.last().map_or(f64::INFINITY, |k| k.0)
+}
+
+/// Refuses bounds that let the reachable cells carry no more than the load.
+fn check_capacity(problem: &Problem, cap: &[f64]) -> Result<(), SolverError> {
+    let capacity: f64 = cap
+        .iter()
+        .zip(&problem.separation)
+        .filter(|(_, e)| e.is_finite())
+        .map(|(c, _)| c)
+        .sum();
+    if capacity <= problem.load {
+        return Err(SolverError::Invalid(format!(
+            "the flow pressure lets the reachable cells carry only {capacity:e} of the load {:e}",
+            problem.load
+        )));
+    }
+    Ok(())
 }
 
 /// Exact change of the solution with the load while the loaded set stays the same
