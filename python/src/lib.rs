@@ -322,7 +322,9 @@ impl NativeResults {
                 .map(|(t, l)| wear::position_table(t, &l.end.records)),
             "wear_map" => wf
                 .zip(life.and_then(|l| l.maps.last().map(|m| (l, m))))
-                .map(|(w, (l, m))| wear::node_table(w, &l.end, &m.cycle)),
+                .map(|(w, (_, m))| {
+                    wear::node_table(w, &m.state, &m.cycle, &m.state.plastic_set_after(&m.ltca))
+                }),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "no table {name:?}: ltca_positions, ltca_pattern, ltca_pressures, \

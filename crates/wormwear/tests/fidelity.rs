@@ -59,14 +59,21 @@ fn life(
 }
 
 #[test]
-fn the_examples_have_no_relief_and_no_cap_unless_asked() {
-    // MODEL §12 i: sharp edges, elastic contact. The defaults and the examples agree; the
-    // options, when given, are in force.
+fn the_examples_have_no_relief_and_the_plastic_limit_at_the_hardness() {
+    // MODEL §12 i: sharp edges; the contact bounded by the bronze's flow pressure, the
+    // wheel's hardness (MODEL §5.7). The defaults and the examples agree; the options, when
+    // given, are in force.
     for name in common::EXAMPLES {
         let g = example(name);
         assert_eq!(g.worm.tip_relief.amount, 0.0, "{name}");
         assert_eq!(g.wheel.edge_relief.amount, 0.0, "{name}");
-        assert!(g.analysis.contact_pressure_cap.is_infinite(), "{name}");
+        assert_eq!(
+            g.analysis.contact,
+            wormwear::input::ContactLaw::Plastic {
+                flow_pressure: g.wheel_material.hardness
+            },
+            "{name}"
+        );
         if let Some(w) = &g.wear {
             assert_eq!(w.film_load, FilmLoad::LoadedAnalysis, "{name}");
             assert_eq!(w.pit_depth, PitDepth::Hertz, "{name}");
@@ -85,7 +92,9 @@ fn the_examples_have_no_relief_and_no_cap_unless_asked() {
 fn tip_relief_and_pressure_cap_are_options_that_act() {
     // On: the worm's tip relief and the wheel's edge relief ease the cells next to the edges
     // and lower the edge pressures; the cap bounds every pressure. Off (default): neither.
-    let g = design();
+    // The elastic law, where the sharp edges' pressures are the elastic ones.
+    let mut g = design();
+    g.analysis.contact = wormwear::input::ContactLaw::Elastic;
     let (geo, tca) = prepared(&g);
     let sharp = ltca::analyse(&g, &geo, &tca).unwrap();
     let mut relieved_gear = g.clone();
@@ -110,7 +119,7 @@ fn tip_relief_and_pressure_cap_are_options_that_act() {
     let cap = 800e6;
     assert!(sharp.max_pressure > cap);
     let mut s = LtcaSettings::from_gear(&g);
-    s.pressure_cap = cap;
+    s.flow_pressure = cap;
     let capped = ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap();
     let top = capped
         .positions
@@ -293,12 +302,14 @@ fn a_uniform_angular_recession_is_all_rigid_lag() {
 fn the_patch_pressure_converges_where_the_maximum_does_not() {
     // At the worm's sharp tip edge the local maximum grows like the square root of the
     // refinement across the line (an integrable edge singularity); the mean over the stated
-    // patch (0.5 mm across by 1 mm along) does not.
+    // patch (0.5 mm across by 1 mm along) does not. The elastic law: the plastic one bounds
+    // the edge (`the_plastic_limit_makes_the_peaks_mesh_converged`).
     let g = design();
     let (geo, tca) = prepared(&g);
     let run = |columns: usize| {
         let mut s = LtcaSettings::from_gear(&g);
         s.columns = columns;
+        s.flow_pressure = f64::INFINITY;
         ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap()
     };
     let (coarse, fine) = (run(11), run(41));

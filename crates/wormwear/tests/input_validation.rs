@@ -356,11 +356,35 @@ fn wear_and_rating_sections_are_checked() {
         &design(),
         "analysis",
         "positions",
-        "positions = 20\ncontact_pressure_cap_mpa = 1.0",
+        "positions = 20\ncontact_pressure_cap_mpa = 1000.0",
     );
     assert_mentions(
         &error_of(&text),
-        &["analysis.contact_pressure_cap_mpa = 1", "0 = no cap"],
+        &[
+            "analysis.contact_pressure_cap_mpa = 1000",
+            "analysis.flow_pressure_mpa",
+            "contact = \"elastic\"",
+        ],
+    );
+    let text = set(
+        &design(),
+        "analysis",
+        "positions",
+        "positions = 20\nflow_pressure_mpa = 1.0",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["analysis.flow_pressure_mpa = 1", "[10, 100000] MPa"],
+    );
+    let text = set(
+        &design(),
+        "analysis",
+        "positions",
+        "positions = 20\ncontact = \"rigid\"",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["analysis.contact = \"rigid\"", "plastic, elastic"],
     );
 }
 

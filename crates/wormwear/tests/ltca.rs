@@ -245,7 +245,7 @@ fn conjugate_line_contact_approach_scales_as_line_contact_theory() {
     let mut s = LtcaSettings::from_gear(&g);
     // The elastic law: no plastic cap (the sharp edges would reach the bronze's flow pressure
     // at the highest loads).
-    s.pressure_cap = f64::INFINITY;
+    s.flow_pressure = f64::INFINITY;
     let mut approach = Vec::new();
     let loads = [15.0, 30.0, 60.0, 120.0, 240.0];
     for &t in &loads {

@@ -179,7 +179,11 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
     );
     assert!(dir.path().join("wear_damage_map.svg").exists());
     let nodes = std::fs::read_to_string(dir.path().join("wear_map.csv")).unwrap();
-    assert!(nodes.lines().next().unwrap().ends_with(",damage"));
+    let header: Vec<&str> = nodes.lines().next().unwrap().split(',').collect();
+    assert!(
+        header.contains(&"damage") && header.contains(&"plastic_set_m"),
+        "{header:?}"
+    );
 }
 
 /// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life

@@ -173,8 +173,9 @@ fn a_sweep_records_failing_variants_goes_on_and_resumes_where_it_stopped() {
     ));
     assert!(dir.path().join("sweep.html").is_file());
     assert!(dir.path().join("variants/v4/ltca_positions.csv").is_file());
-    // Physics: in a line contact the peak pressure grows as the square root of the load, so
-    // four times the torque gives about twice the pressure (the pattern also lengthens: less).
+    // Physics: in an elastic line contact the peak pressure grows as the square root of the
+    // load, so four times the torque would give about twice v1's peak, above the bronze's
+    // flow pressure (the wheel hardness, 1 GPa, MODEL §5.7): v4 stops at it, v1 stays below.
     let p = |name: &str| {
         rows.iter()
             .find(|r| r.variant == name)
@@ -182,8 +183,13 @@ fn a_sweep_records_failing_variants_goes_on_and_resumes_where_it_stopped() {
             .max_pressure_pa
             .unwrap()
     };
-    let ratio = p("v4") / p("v1");
-    assert!((1.4..2.05).contains(&ratio), "P_max ratio {ratio}");
+    let flow = 1e9;
+    assert!(
+        p("v1") < flow && 1.4 * p("v1") > flow,
+        "P_max v1 {}",
+        p("v1")
+    );
+    assert!((p("v4") / flow - 1.0).abs() < 1e-9, "P_max v4 {}", p("v4"));
     // The roughness does not enter the loaded analysis.
     assert_eq!(p("v1"), p("v3"));
 }

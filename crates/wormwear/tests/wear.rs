@@ -63,6 +63,10 @@ fn per_cycle_wear_converges_with_the_positions() {
     // sharp edges (the default) the maximum sits at the worm's tip edge, an edge singularity
     // of the pressure whose passage needs 40 positions: the map converges there from 40 -> 80,
     // and everywhere else from 20 -> 40 (the 95th percentile of the nodes' rates, the volume).
+    // With the plastic limit (the default, MODEL §5.7) the edge's pressure is a plateau at the
+    // flow pressure whose passage 40 positions still sample unevenly (measured: 8.48 / 7.59 /
+    // 8.04 / 7.86 / 7.99e-10 m at 20 / 40 / 80 / 120 / 160 positions): the maximum converges
+    // from 80 -> 160.
     let mut removal = wormwear::geometry::FlankField::zeros(wf);
     for (h, dh) in removal.values.iter_mut().zip(&w20.depth.values) {
         *h = 1e5 * dh;
@@ -102,15 +106,15 @@ fn per_cycle_wear_converges_with_the_positions() {
         "worn: 20 -> 40 positions changes it by {:.2} %",
         100.0 * change(a.0, b.0)
     );
-    let (s20, s40, s80) = (worn(&g, 20), worn(&g, 40), worn(&g, 80));
+    let (s20, s40, s80, s160) = (worn(&g, 20), worn(&g, 40), worn(&g, 80), worn(&g, 160));
     eprintln!(
-        "worn, sharp edges: max {:.4e} / {:.4e} / {:.4e} m, 95th percentile {:.4e} / {:.4e} m, volume {:.4e} / {:.4e} m^3 (20 / 40 / 80 positions)",
-        s20.0, s40.0, s80.0, s20.1, s40.1, s20.2, s40.2
+        "worn, sharp edges: max {:.4e} / {:.4e} / {:.4e} / {:.4e} m, 95th percentile {:.4e} / {:.4e} m, volume {:.4e} / {:.4e} m^3 (20 / 40 / 80 / 160 positions)",
+        s20.0, s40.0, s80.0, s160.0, s20.1, s40.1, s20.2, s40.2
     );
     assert!(
-        change(s40.0, s80.0) < 0.05,
-        "max, 40 -> 80: {:.2} %",
-        100.0 * change(s40.0, s80.0)
+        change(s80.0, s160.0) < 0.05,
+        "max, 80 -> 160: {:.2} %",
+        100.0 * change(s80.0, s160.0)
     );
     assert!(
         change(s20.1, s40.1) < 0.05,

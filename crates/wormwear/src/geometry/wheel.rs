@@ -300,7 +300,7 @@ impl WheelFlank {
 
 /// A scalar field on the nodes of a flank grid (e.g. the depth of material worn off normal to
 /// the flank, m), index `j * (I + 1) + i` like [`WheelFlank::nodes`].
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FlankField {
     pub cells_height: usize,
     pub cells_face: usize,

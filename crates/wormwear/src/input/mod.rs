@@ -437,9 +437,9 @@ pub struct Analysis {
     pub contact_slice_step: usize,
     pub contact_columns: usize,
     pub contact_band_factor: f64,
-    /// Largest contact pressure of the loaded analysis (cells at it are plastic), Pa;
-    /// infinite (default, the published model): no cap.
-    pub contact_pressure_cap: f64,
+    /// Contact law of the loaded analysis (MODEL §5.7; default plastic at the wheel's
+    /// hardness).
+    pub contact: ContactLaw,
     /// Patch over which the converged pressure is reported (MODEL §12 i): across the contact
     /// line and along the face width, m.
     pub pressure_patch_across: f64,
@@ -448,6 +448,27 @@ pub struct Analysis {
     pub solver: crate::ltca::solver::SolverKind,
     /// Direction of the pressure on a contact cell (MODEL §5.2's n_i).
     pub pressure_direction: PressureDirection,
+}
+
+/// Contact law of the wheel's surface in the loaded analysis (MODEL §5.7, §12 i).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactLaw {
+    /// Elastic–perfectly plastic: no pressure exceeds the flow pressure, Pa; the interference
+    /// of the cells at it is plastic indentation, kept by a life run as running-in.
+    Plastic { flow_pressure: f64 },
+    /// Purely elastic (the published reading): no bound, singular at sharp edges.
+    Elastic,
+}
+
+impl ContactLaw {
+    /// The largest contact pressure, Pa (infinite for the elastic law).
+    pub fn pressure_bound(&self) -> f64 {
+        match *self {
+            ContactLaw::Plastic { flow_pressure } => flow_pressure,
+            ContactLaw::Elastic => f64::INFINITY,
+        }
+    }
 }
 
 /// Direction of the contact pressure on a cell of the loaded analysis: MODEL §5.2 writes n_i,

@@ -439,8 +439,16 @@ pub struct AnalysisSpec {
     /// line load (widened automatically when the load reaches the band edge).
     #[serde(default = "default_band_factor")]
     pub contact_band_factor: f64,
-    /// LTCA: largest contact pressure, MPa (cells at it are plastic); default none (the
-    /// published model, MODEL §12 i); 0 = none.
+    /// LTCA: contact law, "plastic" (default: pressures bounded by the wheel's flow pressure,
+    /// the interference there kept as running-in, MODEL §5.7) or "elastic" (no bound, the
+    /// published reading, MODEL §12 i).
+    #[serde(default)]
+    pub contact: Option<String>,
+    /// LTCA: flow pressure p_Y of the wheel's surface, MPa (default: the wheel's hardness).
+    #[serde(default)]
+    pub flow_pressure_mpa: Option<f64>,
+    /// Replaced by `contact` and `flow_pressure_mpa`; read only to refuse it with a message
+    /// naming them.
     #[serde(default)]
     pub contact_pressure_cap_mpa: Option<f64>,
     /// Patch of the reported mesh-converged pressure: mean pressure over a patch this wide
@@ -514,6 +522,8 @@ impl Default for AnalysisSpec {
             contact_slice_step: default_slice_step(),
             contact_columns: default_contact_columns(),
             contact_band_factor: default_band_factor(),
+            contact: None,
+            flow_pressure_mpa: None,
             contact_pressure_cap_mpa: None,
             pressure_patch_across_mm: default_patch_across(),
             pressure_patch_along_mm: default_patch_along(),

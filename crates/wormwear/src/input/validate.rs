@@ -151,9 +151,15 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     else {
         unreachable_input()?
     };
-    let (Some(wheel), Some(analysis), Some(bending)) = (wheel.blank(), analysis, bending) else {
+    let (Some(wheel), Some(mut analysis), Some(bending)) = (wheel.blank(), analysis, bending)
+    else {
         unreachable_input()?
     };
+    if let ContactLaw::Plastic { flow_pressure } = &mut analysis.contact {
+        if flow_pressure.is_nan() {
+            *flow_pressure = wheel_material.hardness;
+        }
+    }
     let gear = GearSet {
         title: f.title.clone().unwrap_or_default(),
         worm,
@@ -442,16 +448,35 @@ fn analysis_settings(
 fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
     let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
     let columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
-    if let Some(v) = a.contact_pressure_cap_mpa.filter(|v| *v != 0.0) {
-        let unit = "MPa (0 = no cap)";
-        ck.range(
+    if let Some(v) = a.contact_pressure_cap_mpa {
+        ck.fail(
             "analysis.contact_pressure_cap_mpa",
             v,
-            10.0,
-            100_000.0,
-            unit,
+            "is no longer read: the bronze's plastic limit is now the default (MODEL §5.7); \
+             set analysis.flow_pressure_mpa (default: the wheel's hardness) for another bound, \
+             or analysis.contact = \"elastic\" for none",
         );
     }
+    let flow = a
+        .flow_pressure_mpa
+        .map(|v| ck.range("analysis.flow_pressure_mpa", v, 10.0, 100_000.0, "MPa"));
+    let law = ck.choice(
+        "analysis.contact",
+        a.contact.as_deref().unwrap_or("plastic"),
+        &[("plastic", true), ("elastic", false)],
+    );
+    // The flow pressure's default, the wheel's hardness, is filled in by `validate` (NaN
+    // here).
+    let contact = match (law, flow) {
+        (Some(true), None) => Some(ContactLaw::Plastic {
+            flow_pressure: f64::NAN,
+        }),
+        (Some(true), Some(v)) => v.map(|v| ContactLaw::Plastic {
+            flow_pressure: v * 1e6,
+        }),
+        (Some(false), _) => Some(ContactLaw::Elastic),
+        (None, _) => None,
+    };
     let across = a.pressure_patch_across_mm;
     let across = ck.range(
         "analysis.pressure_patch_across_mm",
@@ -505,10 +530,7 @@ fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
         contact_slice_step: slice_step? as usize,
         contact_columns: columns? as usize,
         contact_band_factor: band?,
-        contact_pressure_cap: match a.contact_pressure_cap_mpa {
-            Some(v) if v != 0.0 => v * 1e6,
-            _ => f64::INFINITY,
-        },
+        contact: contact?,
         pressure_patch_across: across? * 1e-3,
         pressure_patch_along: along? * 1e-3,
         solver: solver?,

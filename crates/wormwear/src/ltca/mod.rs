@@ -48,8 +48,9 @@ pub struct LtcaSettings {
     pub columns: usize,
     /// Half-width of the band across the line, in Hertz half-widths at the mean line load.
     pub band_factor: f64,
-    /// Largest contact pressure (elastic-perfectly-plastic cells above it), Pa; infinite: none.
-    pub pressure_cap: f64,
+    /// Flow pressure p_Y of the wheel's surface: the largest contact pressure, cells at it
+    /// are in plastic flow (MODEL §5.7), Pa; infinite: the purely elastic contact.
+    pub flow_pressure: f64,
     /// Patch of the reported converged pressure: across the contact line and along the face
     /// width, m ([`max_patch_pressure`]).
     pub patch_across: f64,
@@ -66,7 +67,7 @@ impl LtcaSettings {
             slice_step: a.contact_slice_step,
             columns: a.contact_columns,
             band_factor: a.contact_band_factor,
-            pressure_cap: a.contact_pressure_cap,
+            flow_pressure: a.contact.pressure_bound(),
             patch_across: a.pressure_patch_across,
             patch_along: a.pressure_patch_along,
             solver: SolverSettings {
@@ -133,6 +134,9 @@ pub struct PositionResult {
     pub torque_residual: f64,
     /// Pressures of the local cells, Pa (same order as `cells`).
     pub pressure: Vec<f64>,
+    /// Plastic indentation of the local cells: the interference -y_i l_i of the cells at the
+    /// flow pressure, normal to the flank, m (0 elsewhere; MODEL §5.7).
+    pub plastic_depth: Vec<f64>,
     #[serde(skip)]
     pub cells: Vec<LocalCell>,
     /// Band widenings needed (load at the band edge).
@@ -166,6 +170,12 @@ pub struct Ltca {
     pub pressure_patch_max: f64,
     /// That patch: across the line and along the face width, m.
     pub pressure_patch_size: [f64; 2],
+    /// Plastic indentation of the wheel flank over the cycle: at each node of the loaded
+    /// flank's grid, the largest interference of the cells at the flow pressure over the
+    /// positions and teeth, normal to the flank, m (zeros for the elastic contact; MODEL §5.7).
+    pub plastic_indentation: FlankField,
+    /// Share of the active flank area where some position reaches the flow pressure.
+    pub yielded_area_fraction: f64,
     pub worm_torque: f64,
     pub wheel_torque: f64,
     /// Frictionless power balance over the pitch: mean wheel torque over u x the mean worm
@@ -423,42 +433,20 @@ pub fn analyse_worn(
         })
         .collect::<Result<_, _>>()?;
 
-    // Loaded pattern on the global grid (MODEL §5.6).
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
-    let mut pattern = vec![0.0f64; ni * nj];
-    let cell_z = |j: usize| 0.5 * (wf.z[j] + wf.z[j + 1]);
-    for pr in &positions {
-        for (c, &p) in pr.cells.iter().zip(&pr.pressure) {
-            if p <= 0.0 {
-                continue;
-            }
-            // Global cells whose centre lies in the local cell's face extent, and always the
-            // one holding its centre (sub-slices are narrower than global cells).
-            let holding =
-                (((c.z - wf.z[0]) / (wf.z[1] - wf.z[0])).floor().max(0.0) as usize).min(nj - 1);
-            // The global cells' centres increase with j: those in the extent are a run, found
-            // by bisection (the same test then decides, so the same cells as a full scan).
-            let first = partition_point(nj, |j| cell_z(j) < c.z - c.half_dz);
-            let last = partition_point(nj, |j| cell_z(j) <= c.z + c.half_dz);
-            let run = first..last.max(first);
-            let extra = (!run.contains(&holding)).then_some(holding);
-            for j in run.chain(extra) {
-                let zc = cell_z(j);
-                if j != holding && (zc < c.z - c.half_dz || zc > c.z + c.half_dz) {
-                    continue;
-                }
-                let lo = 0.5 * (wf.r_low[j] + wf.r_low[j + 1]);
-                let hi = 0.5 * (wf.r_high[j] + wf.r_high[j + 1]);
-                let s = (c.r - lo) / (hi - lo) * ni as f64;
-                if s < 0.0 || s >= ni as f64 {
-                    continue;
-                }
-                let k = j * ni + s as usize;
-                pattern[k] = pattern[k].max(p);
-            }
-        }
-    }
+    // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
+    // indentation (MODEL §5.7).
+    let ni = wf.cells_height;
+    let pattern = global_cell_max(wf, &positions, |p, i| p.pressure[i]);
+    let bound = settings.flow_pressure * (1.0 - 1e-12);
+    let yielded = global_cell_max(wf, &positions, |p, i| {
+        f64::from(u8::from(p.pressure[i] >= bound))
+    });
+    let plastic_indentation = node_indentation(wf, &positions);
     let active_area = wf.active_area();
+    let yielded_area: f64 = (0..yielded.len())
+        .filter(|&k| yielded[k] > 0.0)
+        .map(|k| wf.cell_area[k])
+        .sum();
     let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
     let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
     let max_pressure = pattern.iter().copied().fold(0.0, f64::max);
@@ -500,11 +488,153 @@ pub fn analyse_worn(
         },
         pressure_patch_max,
         pressure_patch_size: [settings.patch_across, settings.patch_along],
+        plastic_indentation,
+        yielded_area_fraction: yielded_area / active_area,
         worm_torque,
         wheel_torque,
         power_balance,
         warnings,
     })
+}
+
+/// The largest value of the local cells over the positions and teeth on each cell of the
+/// loaded flank's global grid (MODEL §5.6: the loaded pattern when the value is the pressure);
+/// cells valued 0 or less are skipped.
+fn global_cell_max(
+    wf: &WheelFlank,
+    positions: &[PositionResult],
+    value: impl Fn(&PositionResult, usize) -> f64,
+) -> Vec<f64> {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let mut out = vec![0.0f64; ni * nj];
+    let cell_z = |j: usize| 0.5 * (wf.z[j] + wf.z[j + 1]);
+    for pr in positions {
+        for (i, c) in pr.cells.iter().enumerate() {
+            let p = value(pr, i);
+            if p <= 0.0 {
+                continue;
+            }
+            // Global cells whose centre lies in the local cell's face extent, and always the
+            // one holding its centre (sub-slices are narrower than global cells).
+            let holding =
+                (((c.z - wf.z[0]) / (wf.z[1] - wf.z[0])).floor().max(0.0) as usize).min(nj - 1);
+            // The global cells' centres increase with j: those in the extent are a run, found
+            // by bisection (the same test then decides, so the same cells as a full scan).
+            let first = partition_point(nj, |j| cell_z(j) < c.z - c.half_dz);
+            let last = partition_point(nj, |j| cell_z(j) <= c.z + c.half_dz);
+            let run = first..last.max(first);
+            let extra = (!run.contains(&holding)).then_some(holding);
+            for j in run.chain(extra) {
+                let zc = cell_z(j);
+                if j != holding && (zc < c.z - c.half_dz || zc > c.z + c.half_dz) {
+                    continue;
+                }
+                let lo = 0.5 * (wf.r_low[j] + wf.r_low[j + 1]);
+                let hi = 0.5 * (wf.r_high[j] + wf.r_high[j + 1]);
+                let s = (c.r - lo) / (hi - lo) * ni as f64;
+                if s < 0.0 || s >= ni as f64 {
+                    continue;
+                }
+                let k = j * ni + s as usize;
+                out[k] = out[k].max(p);
+            }
+        }
+    }
+    out
+}
+
+/// Plastic indentation on the nodes of the loaded flank's grid (MODEL §5.7), m: on each slice
+/// (a node column), the cells' interference across the line interpolated linearly between
+/// cell centres at the nodes' radii (the end cells' values over their outer halves, zero
+/// beyond), the largest over positions and teeth; node columns between slices (slice step
+/// above 1) interpolated linearly along the face width.
+fn node_indentation(wf: &WheelFlank, positions: &[PositionResult]) -> FlankField {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let mut field = FlankField::zeros(wf);
+    let mut is_slice = vec![false; nj + 1];
+    for pr in positions {
+        let cells = &pr.cells;
+        let mut k = 0;
+        while k < cells.len() {
+            let (tooth, slice) = (cells[k].tooth_index, cells[k].slice);
+            let mut end = k + 1;
+            while end < cells.len() && cells[end].tooth_index == tooth && cells[end].slice == slice
+            {
+                end += 1;
+            }
+            is_slice[slice.min(nj)] = true;
+            let mut profile: Vec<(f64, f64)> = (k..end)
+                .map(|i| (cells[i].r, pr.plastic_depth[i]))
+                .collect();
+            k = end;
+            if profile.iter().all(|p| p.1 <= 0.0) {
+                continue;
+            }
+            profile.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let j = slice.min(nj);
+            for i in 0..=ni {
+                let node = j * (ni + 1) + i;
+                let v = profile_at(&profile, wf.nodes[node].r);
+                field.values[node] = field.values[node].max(v);
+            }
+        }
+    }
+    fill_between_slices(&mut field, &is_slice, wf);
+    field
+}
+
+/// Value at radius r of a profile across the line (cell centres ascending, values): linear
+/// between centres, the end values over half a spacing beyond the end centres, zero further.
+fn profile_at(profile: &[(f64, f64)], r: f64) -> f64 {
+    let (first, last) = (profile[0], profile[profile.len() - 1]);
+    let half = if profile.len() > 1 {
+        0.5 * (last.0 - first.0) / (profile.len() - 1) as f64
+    } else {
+        0.0
+    };
+    if r < first.0 - half || r > last.0 + half {
+        return 0.0;
+    }
+    if r <= first.0 {
+        return first.1;
+    }
+    if r >= last.0 {
+        return last.1;
+    }
+    let b = profile.partition_point(|p| p.0 < r).max(1);
+    let (lo, hi) = (profile[b - 1], profile[b]);
+    if hi.0 == lo.0 {
+        return lo.1.max(hi.1);
+    }
+    lo.1 + (hi.1 - lo.1) * (r - lo.0) / (hi.0 - lo.0)
+}
+
+/// Node columns that are no slice take the linear interpolation along the face width of the
+/// nearest slice columns on each side (the nearest one's values at the grid's ends).
+fn fill_between_slices(field: &mut FlankField, is_slice: &[bool], wf: &WheelFlank) {
+    let ni = wf.cells_height;
+    let slices: Vec<usize> = (0..is_slice.len()).filter(|&j| is_slice[j]).collect();
+    if slices.is_empty() || slices.len() == is_slice.len() {
+        return;
+    }
+    for j in (0..is_slice.len()).filter(|&j| !is_slice[j]) {
+        let after = slices.partition_point(|&s| s < j);
+        let (a, b) = match (after.checked_sub(1).map(|x| slices[x]), slices.get(after)) {
+            (Some(a), Some(&b)) => (a, b),
+            (Some(a), None) => (a, a),
+            (None, Some(&b)) => (b, b),
+            (None, None) => continue,
+        };
+        let t = if a == b {
+            0.0
+        } else {
+            (wf.z[j] - wf.z[a]) / (wf.z[b] - wf.z[a])
+        };
+        for i in 0..=ni {
+            let (va, vb) = (field.node(i, a), field.node(i, b));
+            field.values[j * (ni + 1) + i] = va + (vb - va) * t;
+        }
+    }
 }
 
 /// A worn flank as the local meshes read it (MODEL §7.5): the depth worn off normal to the
@@ -924,10 +1054,10 @@ fn solve_position(
             }
             s.signum()
         };
-        let upper = settings.pressure_cap.is_finite().then(|| {
+        let upper = settings.flow_pressure.is_finite().then(|| {
             cells
                 .iter()
-                .map(|c| settings.pressure_cap * c.cell.area() * c.lever)
+                .map(|c| settings.flow_pressure * c.cell.area() * c.lever)
                 .collect()
         });
         let mut problem = Problem {
@@ -945,7 +1075,10 @@ fn solve_position(
         let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
         // Outer update of the wheel torque until the worm torque balances (MODEL §5.2): with
         // the fast solver, one exact affine step on the loaded set after the first solve; the
-        // fixed-point solver (and any change of the loaded set) iterates.
+        // fixed-point solver (and any change of the loaded set) iterates, by secants on the
+        // (wheel torque, worm torque) pairs: with cells at the flow pressure (MODEL §5.7) the
+        // worm torque is not proportional to the wheel torque and a plain rescaling can cycle.
+        let mut previous = None;
         for it in 0..20 {
             let sol =
                 solver::solve(&problem, &settings.solver, warm.as_deref()).map_err(|source| {
@@ -982,7 +1115,9 @@ fn solve_position(
                     continue;
                 }
             }
-            problem.load *= ratio;
+            let next = next_wheel_torque(previous, (problem.load, worm), target);
+            previous = Some((problem.load, worm));
+            problem.load = next;
             warm = Some(sol.q.clone());
             solution = Some((sol, worm));
         }
@@ -1004,6 +1139,19 @@ fn solve_position(
             .iter()
             .zip(&forces)
             .map(|(c, f)| f / c.cell.area())
+            .collect();
+        let plastic_depth: Vec<f64> = cells
+            .iter()
+            .zip(&pressure)
+            .zip(&sol.gap)
+            .map(|((c, &p), &y)| {
+                let at_bound = p >= settings.flow_pressure * (1.0 - 1e-12);
+                if at_bound && y < 0.0 {
+                    -y * c.lever
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let mut tooth_load = vec![0.0; tca.teeth.len()];
         for (c, f) in cells.iter().zip(&forces) {
@@ -1037,9 +1185,28 @@ fn solve_position(
             residuals: sol.residuals,
             torque_residual: (worm - target).abs() / target,
             pressure,
+            plastic_depth,
             cells,
             band_widenings: widenings,
         });
+    }
+}
+
+/// The next wheel torque (N m) of the torque balance (MODEL §5.2) from the last two
+/// (wheel torque, worm torque) pairs: the secant through them where it rises (the worm torque
+/// grows with the wheel torque), else the rescaling by target / worm of the last one.
+fn next_wheel_torque(previous: Option<(f64, f64)>, last: (f64, f64), target: f64) -> f64 {
+    let (load, worm) = last;
+    let rescaled = load * target / worm;
+    let Some((load0, worm0)) = previous else {
+        return rescaled;
+    };
+    let slope = (worm - worm0) / (load - load0);
+    let secant = load + (target - worm) / slope;
+    if slope.is_finite() && slope > 0.0 && secant > 0.0 {
+        secant
+    } else {
+        rescaled
     }
 }
 

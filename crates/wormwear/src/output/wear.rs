@@ -33,6 +33,7 @@ struct CheckpointOut<'a> {
     step: usize,
     cycles: f64,
     removal: &'a FlankField,
+    plastic_set: &'a FlankField,
     pitted_phases: &'a [usize],
     pitted: &'a [bool],
     band_factor: Option<f64>,
@@ -50,6 +51,8 @@ struct CheckpointIn {
     step: usize,
     cycles: f64,
     removal: FlankField,
+    #[serde(default)]
+    plastic_set: FlankField,
     #[serde(default)]
     pitted_phases: Vec<usize>,
     #[serde(default)]
@@ -281,6 +284,7 @@ pub fn read_resume(
             step: c.step,
             cycles: c.cycles,
             removal: c.removal,
+            plastic_set: c.plastic_set,
             records,
             pitted_phases: c.pitted_phases,
             pitted: c.pitted,
@@ -509,6 +513,7 @@ impl LifeWriter {
             step: state.step,
             cycles: state.cycles,
             removal: &state.removal,
+            plastic_set: &state.plastic_set,
             pitted_phases: &state.pitted_phases,
             pitted: &state.pitted,
             band_factor: state.band_factor,
@@ -570,6 +575,12 @@ fn write_state(
     let mut surface = super::vtk::wheel_flank_tca(gear, geo, tca);
     super::vtk::add_pressure_pattern(&mut surface, &view.ltca.pattern);
     super::vtk::add_node_field(&mut surface, "wear_um", &state.removal, UM);
+    super::vtk::add_node_field(
+        &mut surface,
+        "plastic_set_um",
+        &view.state.plastic_set_after(view.ltca),
+        UM,
+    );
     super::vtk::add_node_field(&mut surface, "wear_per_cycle_um", &view.cycle.depth, UM);
     super::vtk::add_node_field(&mut surface, "film_thickness_um", &view.cycle.film, UM);
     super::vtk::add_node_field(&mut surface, "film_ratio", &view.cycle.lambda, 1.0);
@@ -745,6 +756,9 @@ pub fn steps_table(state: &WearState) -> Csv {
         "worn_through_loaded",
         "power_balance",
         "max_damage",
+        "max_plastic_set_m",
+        "max_plastic_indentation_m",
+        "yielded_area_fraction",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -778,6 +792,9 @@ pub fn steps_table(state: &WearState) -> Csv {
             f64::from(u8::from(r.worn_through_loaded)),
             r.power_balance,
             r.max_damage,
+            r.max_plastic_set_m,
+            r.max_plastic_indentation_m,
+            r.yielded_area_fraction,
         ]);
     }
     csv
@@ -862,11 +879,13 @@ fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series> {
 
 /// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j
 /// across the face) its (r, z) mm, cumulative wear m, wear per cycle m, film ratio and film
-/// thickness m.
+/// thickness m, damage, and the plastic set m once the state has run in
+/// ([`WearState::plastic_set_after`]).
 pub fn node_table(
     wf: &crate::geometry::WheelFlank,
     state: &WearState,
     cycle: &crate::wear::CycleWear,
+    plastic_set: &FlankField,
 ) -> Csv {
     let mut csv = Csv::new(&[
         "i",
@@ -878,6 +897,7 @@ pub fn node_table(
         "lambda",
         "film_m",
         "damage",
+        "plastic_set_m",
     ]);
     for j in 0..=wf.cells_face {
         for i in 0..=wf.cells_height {
@@ -893,6 +913,7 @@ pub fn node_table(
                 cycle.lambda.values[k],
                 cycle.film.values[k],
                 state.damage.get(k).copied().unwrap_or(0.0),
+                plastic_set.values.get(k).copied().unwrap_or(0.0),
             ]);
         }
     }
@@ -1038,7 +1059,24 @@ impl StateMaps<'_> {
             Some(1.0),
         )?;
         files.push(path);
-        let csv = node_table(wf, state, view.cycle);
+        let plastic = view.state.plastic_set_after(view.ltca);
+        let path = dir.join(format!("wear_plastic_set_map{suffix}.svg"));
+        map(
+            &path,
+            &format!(
+                "Plastic set (running-in) at {} cycles (max {:.2} um, yielded {:.1} % of the \
+                 flank; map: cell means)",
+                super::cycles_label(r.cycles),
+                r.max_plastic_set_m * UM,
+                100.0 * r.yielded_area_fraction
+            ),
+            &plastic,
+            UM,
+            "plastic set (um)",
+            None,
+        )?;
+        files.push(path);
+        let csv = node_table(wf, state, view.cycle, &plastic);
         let path = dir.join(format!("wear_map{suffix}.csv"));
         csv.write(&path)?;
         files.push(path);

@@ -451,10 +451,8 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         plan.clone(),
     ));
     out.push((
-        "c-pressure-cap".to_string(),
-        variant(c, |g| {
-            g.analysis.contact_pressure_cap = g.wheel_material.hardness
-        }),
+        "c-elastic".to_string(),
+        variant(c, |g| g.analysis.contact = input::ContactLaw::Elastic),
         plan.clone(),
     ));
     out.push((

@@ -694,7 +694,11 @@ fn section_c_d(m: &mut String, results: &Results) {
          stays one switch away (the option's input in the first column).\n"
     );
     head(m);
-    row(m, "default (published model)", "case-c");
+    row(
+        m,
+        "default (plastic limit at the wheel hardness, MODEL §5.7)",
+        "case-c",
+    );
     row(
         m,
         "reliefs: `tip_relief_um = 20`, `edge_relief_um = 20`",
@@ -702,8 +706,8 @@ fn section_c_d(m: &mut String, results: &Results) {
     );
     row(
         m,
-        "pressure cap at the bronze's hardness: `contact_pressure_cap_mpa = 1000`",
-        "c-pressure-cap",
+        "purely elastic contact (the published reading): `contact = \"elastic\"`",
+        "c-elastic",
     );
     row(
         m,

@@ -688,6 +688,11 @@ pub struct WearState {
     pub cycles: f64,
     /// Depth worn off the loaded flank so far, normal to it, m.
     pub removal: FlankField,
+    /// Plastic set of the loaded flank so far (running-in, MODEL §5.7): the permanent
+    /// indentation where the contact reached the flow pressure, normal to the flank, m
+    /// (empty: none yet).
+    #[serde(default)]
+    pub plastic_set: FlankField,
     /// Records of the states so far (the initial one and one per completed step).
     pub records: Vec<StepRecord>,
     /// Pitting phases (indices in the schedule) whose pits have been cut.
@@ -722,6 +727,7 @@ impl WearState {
             step: 0,
             cycles: 0.0,
             removal: FlankField::zeros(wf),
+            plastic_set: FlankField::zeros(wf),
             records: Vec::new(),
             pitted_phases: Vec::new(),
             pitted: Vec::new(),
@@ -731,6 +737,36 @@ impl WearState {
             damage: vec![0.0; wf.nodes.len()],
             found_phases: Vec::new(),
         }
+    }
+
+    /// The loaded flank's change so far, normal to it, m: the wear and the plastic set
+    /// (MODEL §7.5, §5.7), what the loaded analysis and the backlash see.
+    pub fn flank_change(&self) -> FlankField {
+        let mut change = self.removal.clone();
+        for (h, s) in change.values.iter_mut().zip(&self.plastic_set.values) {
+            *h += s;
+        }
+        change
+    }
+
+    /// The plastic set once the loaded analysis `l` of this state's flank has run in
+    /// (MODEL §5.7): the set plus the analysis' plastic indentation, m.
+    pub fn plastic_set_after(&self, l: &Ltca) -> FlankField {
+        let add = &l.plastic_indentation;
+        if self.plastic_set.values.len() != add.values.len() {
+            return add.clone();
+        }
+        let mut set = self.plastic_set.clone();
+        for (s, d) in set.values.iter_mut().zip(&add.values) {
+            *s += d;
+        }
+        set
+    }
+
+    /// Running-in (MODEL §5.7): the plastic indentation of a loaded analysis on this state's
+    /// flank becomes part of its plastic set.
+    pub fn run_in(&mut self, l: &Ltca) {
+        self.plastic_set = self.plastic_set_after(l);
     }
 }
 
@@ -823,6 +859,15 @@ pub struct StepRecord {
     /// pressure-life curve is spent; [`forecast`]).
     #[serde(default)]
     pub max_damage: f64,
+    /// Largest plastic set of the flank once this state's analysis has run in (MODEL §5.7),
+    /// m, and the largest indentation this state's analysis added, m.
+    #[serde(default)]
+    pub max_plastic_set_m: f64,
+    #[serde(default)]
+    pub max_plastic_indentation_m: f64,
+    /// Share of the active flank area where this state's contact reached the flow pressure.
+    #[serde(default)]
+    pub yielded_area_fraction: f64,
     /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -907,6 +952,9 @@ pub fn simulate(
     if state.damage.len() != wf.nodes.len() {
         state.damage = vec![0.0; wf.nodes.len()];
     }
+    if state.plastic_set.values.len() != wf.nodes.len() {
+        state.plastic_set = FlankField::zeros(wf);
+    }
     check_plan_can_end(gear, life)?;
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
@@ -938,6 +986,7 @@ pub fn simulate(
         // state's analysis used).
         state.band_factor = band;
         state.warm = Some(l.warm_start());
+        state.run_in(&l);
         (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
         state.step += 1;
     }
@@ -1176,14 +1225,15 @@ impl<'a> LifeLoop<'a> {
     fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
         let mut local = *self.settings;
         local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
-        let worn = state.removal.values.iter().any(|&h| h != 0.0);
+        let change = state.flank_change();
+        let worn = change.values.iter().any(|&h| h != 0.0);
         let l = crate::ltca::analyse_worn(
             self.gear,
             self.geo,
             self.tca,
             &local,
             self.bending,
-            worn.then_some(&state.removal),
+            worn.then_some(&change),
             state.warm.as_ref(),
         )
         .map_err(|source| WearError::Ltca {
@@ -1214,7 +1264,8 @@ impl<'a> LifeLoop<'a> {
         substeps: usize,
     ) -> StepRecord {
         let wf = self.wf;
-        let per_position = self.backlash.per_position(&state.removal);
+        let change = state.flank_change();
+        let per_position = self.backlash.per_position(&change);
         let lag: Vec<f64> = per_position
             .iter()
             .zip(&self.initial_backlash)
@@ -1230,7 +1281,7 @@ impl<'a> LifeLoop<'a> {
                 max_pressure_pa: p.max_pressure,
             })
             .collect();
-        let b = self.backlash.stats(&state.removal);
+        let b = self.backlash.stats(&change);
         let initial = self.initial_backlash.iter().sum::<f64>()
             / self.initial_backlash.len().max(1) as f64
             * self.backlash.reference_radius;
@@ -1295,6 +1346,9 @@ impl<'a> LifeLoop<'a> {
                 .is_some(),
             power_balance: l.power_balance,
             max_damage: state.damage.iter().copied().fold(0.0, f64::max),
+            max_plastic_set_m: state.plastic_set_after(l).max(),
+            max_plastic_indentation_m: l.plastic_indentation.max(),
+            yielded_area_fraction: l.yielded_area_fraction,
             positions,
         }
     }
@@ -1383,6 +1437,7 @@ impl<'a> LifeLoop<'a> {
             let (l, band) = self.analyse(state)?;
             state.band_factor = band;
             state.warm = Some(l.warm_start());
+            state.run_in(&l);
             rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
         }
     }
