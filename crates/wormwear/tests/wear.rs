@@ -416,6 +416,9 @@ fn a_resumed_life_run_gives_the_results_of_an_uninterrupted_one() {
     assert_eq!(resumed.records.len(), 5);
     assert_eq!(resumed.records, straight.records);
     assert_eq!(resumed.removal, straight.removal);
+    // The running-in (MODEL §5.7) resumes too: the tip edge of the design case yields.
+    assert!(straight.plastic_set.max() > 0.0);
+    assert_eq!(resumed.plastic_set, straight.plastic_set);
     // The summary on disk holds every state.
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())

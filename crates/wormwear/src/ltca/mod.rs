@@ -10,6 +10,7 @@
 //! sum q_i = C2 is MODEL §5.2 with R_i = 1/l_i (exact ratio, §5.3); the worm-torque equilibrium
 //! sum f_i (M_i x n_i)_x = C_m is closed by an outer update of the wheel torque C2.
 
+pub(crate) mod passage;
 pub mod solver;
 
 use crate::contact::{hertz_half_width, ContactCell, ElasticPair, InfluenceRows};
@@ -436,20 +437,18 @@ pub fn analyse_worn(
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
     // indentation (MODEL §5.7).
     let ni = wf.cells_height;
-    let pattern = global_cell_max(wf, &positions, |p, i| p.pressure[i]);
-    let bound = settings.flow_pressure * (1.0 - 1e-12);
-    let yielded = global_cell_max(wf, &positions, |p, i| {
-        f64::from(u8::from(p.pressure[i] >= bound))
-    });
-    let plastic_indentation = node_indentation(wf, &positions);
+    let (pattern, plastic_indentation) = swept_pattern(wf, tca, &positions, geo.teeth);
+    let bound = settings.flow_pressure * (1.0 - 1e-9);
     let active_area = wf.active_area();
-    let yielded_area: f64 = (0..yielded.len())
-        .filter(|&k| yielded[k] > 0.0)
+    let yielded_area: f64 = (0..pattern.len())
+        .filter(|&k| pattern[k] >= bound)
         .map(|k| wf.cell_area[k])
         .sum();
     let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
     let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
-    let max_pressure = pattern.iter().copied().fold(0.0, f64::max);
+    // The largest local cell (the published P_max): the pattern's cell centres read the
+    // profiles between cell centres, which can only be lower.
+    let max_pressure = positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
     let mean_pressure = if loaded.is_empty() {
         0.0
     } else {
@@ -497,122 +496,56 @@ pub fn analyse_worn(
     })
 }
 
-/// The largest value of the local cells over the positions and teeth on each cell of the
-/// loaded flank's global grid (MODEL §5.6: the loaded pattern when the value is the pressure);
-/// cells valued 0 or less are skipped.
-fn global_cell_max(
+/// The loaded pattern (MODEL §5.6) and the plastic indentation (MODEL §5.7) of the band's
+/// passage over the global grid: the largest pressure over the whole mesh cycle at each cell
+/// centre (Pa; the positions' instants and the band's continuous passage between them,
+/// [`passage`], so the pattern neither has holes between positions nor moves with their number),
+/// and the largest interference of the cells at the flow pressure at each node (m).
+fn swept_pattern(
     wf: &WheelFlank,
+    tca: &Tca,
     positions: &[PositionResult],
-    value: impl Fn(&PositionResult, usize) -> f64,
-) -> Vec<f64> {
+    teeth: u32,
+) -> (Vec<f64>, FlankField) {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
-    let mut out = vec![0.0f64; ni * nj];
-    let cell_z = |j: usize| 0.5 * (wf.z[j] + wf.z[j + 1]);
-    for pr in positions {
-        for (i, c) in pr.cells.iter().enumerate() {
-            let p = value(pr, i);
-            if p <= 0.0 {
-                continue;
-            }
-            // Global cells whose centre lies in the local cell's face extent, and always the
-            // one holding its centre (sub-slices are narrower than global cells).
-            let holding =
-                (((c.z - wf.z[0]) / (wf.z[1] - wf.z[0])).floor().max(0.0) as usize).min(nj - 1);
-            // The global cells' centres increase with j: those in the extent are a run, found
-            // by bisection (the same test then decides, so the same cells as a full scan).
-            let first = partition_point(nj, |j| cell_z(j) < c.z - c.half_dz);
-            let last = partition_point(nj, |j| cell_z(j) <= c.z + c.half_dz);
-            let run = first..last.max(first);
-            let extra = (!run.contains(&holding)).then_some(holding);
-            for j in run.chain(extra) {
-                let zc = cell_z(j);
-                if j != holding && (zc < c.z - c.half_dz || zc > c.z + c.half_dz) {
-                    continue;
-                }
-                let lo = 0.5 * (wf.r_low[j] + wf.r_low[j + 1]);
-                let hi = 0.5 * (wf.r_high[j] + wf.r_high[j + 1]);
-                let s = (c.r - lo) / (hi - lo) * ni as f64;
-                if s < 0.0 || s >= ni as f64 {
-                    continue;
-                }
-                let k = j * ni + s as usize;
-                out[k] = out[k].max(p);
-            }
-        }
-    }
-    out
-}
-
-/// Plastic indentation on the nodes of the loaded flank's grid (MODEL §5.7), m: on each slice
-/// (a node column), the cells' interference across the line interpolated linearly between
-/// cell centres at the nodes' radii (the end cells' values over their outer halves, zero
-/// beyond), the largest over positions and teeth; node columns between slices (slice step
-/// above 1) interpolated linearly along the face width.
-fn node_indentation(wf: &WheelFlank, positions: &[PositionResult]) -> FlankField {
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
-    let mut field = FlankField::zeros(wf);
-    let mut is_slice = vec![false; nj + 1];
-    for pr in positions {
-        let cells = &pr.cells;
-        let mut k = 0;
-        while k < cells.len() {
-            let (tooth, slice) = (cells[k].tooth_index, cells[k].slice);
-            let mut end = k + 1;
-            while end < cells.len() && cells[end].tooth_index == tooth && cells[end].slice == slice
-            {
-                end += 1;
-            }
-            is_slice[slice.min(nj)] = true;
-            let mut profile: Vec<(f64, f64)> = (k..end)
-                .map(|i| (cells[i].r, pr.plastic_depth[i]))
+    let tau = 2.0 * PI / teeth as f64;
+    let dt = tau / tca.positions.len() as f64;
+    let columns = passage::band_samples(wf, tca, positions, tau);
+    let is_slice: Vec<bool> = columns.iter().map(|c| !c.is_empty()).collect();
+    let node_r = |j: usize, i: usize| wf.nodes[j * (ni + 1) + i].r;
+    let swept: Vec<(Vec<f64>, Vec<f64>)> = columns
+        .par_iter()
+        .enumerate()
+        .map(|(j, samples)| {
+            let mid: Vec<f64> = (0..ni)
+                .map(|i| 0.5 * (node_r(j, i) + node_r(j, i + 1)))
                 .collect();
-            k = end;
-            if profile.iter().all(|p| p.1 <= 0.0) {
-                continue;
-            }
-            profile.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let j = slice.min(nj);
-            for i in 0..=ni {
-                let node = j * (ni + 1) + i;
-                let v = profile_at(&profile, wf.nodes[node].r);
-                field.values[node] = field.values[node].max(v);
-            }
-        }
-    }
-    fill_between_slices(&mut field, &is_slice, wf);
-    field
-}
-
-/// Value at radius r of a profile across the line (cell centres ascending, values): linear
-/// between centres, the end values over half a spacing beyond the end centres, zero further.
-fn profile_at(profile: &[(f64, f64)], r: f64) -> f64 {
-    let (first, last) = (profile[0], profile[profile.len() - 1]);
-    let half = if profile.len() > 1 {
-        0.5 * (last.0 - first.0) / (profile.len() - 1) as f64
-    } else {
-        0.0
-    };
-    if r < first.0 - half || r > last.0 + half {
-        return 0.0;
-    }
-    if r <= first.0 {
-        return first.1;
-    }
-    if r >= last.0 {
-        return last.1;
-    }
-    let b = profile.partition_point(|p| p.0 < r).max(1);
-    let (lo, hi) = (profile[b - 1], profile[b]);
-    if hi.0 == lo.0 {
-        return lo.1.max(hi.1);
-    }
-    lo.1 + (hi.1 - lo.1) * (r - lo.0) / (hi.0 - lo.0)
+            let nodes: Vec<f64> = (0..=ni).map(|i| node_r(j, i)).collect();
+            (
+                passage::swept_max(samples, &mid, dt, passage::Swept::Pressure),
+                passage::swept_max(samples, &nodes, dt, passage::Swept::Plastic),
+            )
+        })
+        .collect();
+    // Cell-centre radii on each node column (ni per column), then the cell between two.
+    let mut mid: Vec<f64> = swept.iter().flat_map(|c| c.0.iter().copied()).collect();
+    fill_between_slices(&mut mid, ni, &is_slice, wf);
+    let pattern = (0..nj)
+        .flat_map(|j| {
+            let mid = &mid;
+            (0..ni).map(move |i| 0.5 * (mid[j * ni + i] + mid[(j + 1) * ni + i]))
+        })
+        .collect();
+    let mut indentation = FlankField::zeros(wf);
+    indentation.values = swept.iter().flat_map(|c| c.1.iter().copied()).collect();
+    fill_between_slices(&mut indentation.values, ni + 1, &is_slice, wf);
+    (pattern, indentation)
 }
 
 /// Node columns that are no slice take the linear interpolation along the face width of the
-/// nearest slice columns on each side (the nearest one's values at the grid's ends).
-fn fill_between_slices(field: &mut FlankField, is_slice: &[bool], wf: &WheelFlank) {
-    let ni = wf.cells_height;
+/// nearest slice columns on each side (the nearest one's values at the grid's ends); `values`
+/// holds `rows` values per node column, column after column.
+fn fill_between_slices(values: &mut [f64], rows: usize, is_slice: &[bool], wf: &WheelFlank) {
     let slices: Vec<usize> = (0..is_slice.len()).filter(|&j| is_slice[j]).collect();
     if slices.is_empty() || slices.len() == is_slice.len() {
         return;
@@ -630,9 +563,9 @@ fn fill_between_slices(field: &mut FlankField, is_slice: &[bool], wf: &WheelFlan
         } else {
             (wf.z[j] - wf.z[a]) / (wf.z[b] - wf.z[a])
         };
-        for i in 0..=ni {
-            let (va, vb) = (field.node(i, a), field.node(i, b));
-            field.values[j * (ni + 1) + i] = va + (vb - va) * t;
+        for i in 0..rows {
+            let (va, vb) = (values[a * rows + i], values[b * rows + i]);
+            values[j * rows + i] = va + (vb - va) * t;
         }
     }
 }
@@ -656,20 +589,6 @@ impl Worn<'_> {
             .map(|(p, h)| h / GapEvaluator::lever(&p.position(), &p.normal_vec()))
             .collect()
     }
-}
-
-/// First j in 0..n for which `below(j)` is false (`below` true on a prefix of 0..n).
-fn partition_point(n: usize, below: impl Fn(usize) -> bool) -> usize {
-    let (mut lo, mut hi) = (0, n);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if below(mid) {
-            lo = mid + 1;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
 }
 
 /// One slice of a local mesh: a strip across the contact line of one tooth at face position
@@ -1138,7 +1057,8 @@ fn solve_position(
         let pressure: Vec<f64> = cells
             .iter()
             .zip(&forces)
-            .map(|(c, f)| f / c.cell.area())
+            // (The bound holds on q = p S lever; the division's round-off stays below it.)
+            .map(|(c, f)| (f / c.cell.area()).min(settings.flow_pressure))
             .collect();
         let plastic_depth: Vec<f64> = cells
             .iter()
@@ -1270,40 +1190,4 @@ fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64 {
         }
     }
     best
-}
-
-#[cfg(test)]
-mod tests {
-    use super::partition_point;
-
-    #[test]
-    fn partition_point_finds_the_run_a_full_scan_finds() {
-        // Increasing centres as the loaded pattern's global cells; every extent [lo, hi] gives
-        // the same cells as testing all of them.
-        let centres: Vec<f64> = (0..60)
-            .map(|j| -22.5 + 0.75 * j as f64 + 0.01 * j as f64)
-            .collect();
-        let n = centres.len();
-        for &(lo, hi) in &[
-            (-30.0, -25.0),
-            (-30.0, -22.0),
-            (-5.0, -4.9),
-            (-5.0, 5.0),
-            (22.0, 30.0),
-            (40.0, 50.0),
-            (0.0, 0.0),
-            (centres[10], centres[12]),
-        ] {
-            let scan: Vec<usize> = (0..n)
-                .filter(|&j| centres[j] >= lo && centres[j] <= hi)
-                .collect();
-            let first = partition_point(n, |j| centres[j] < lo);
-            let last = partition_point(n, |j| centres[j] <= hi);
-            let run: Vec<usize> = (first..last.max(first)).collect();
-            assert_eq!(run, scan, "[{lo}, {hi}]");
-        }
-        assert_eq!(partition_point(0, |_| true), 0);
-        assert_eq!(partition_point(5, |_| true), 5);
-        assert_eq!(partition_point(5, |_| false), 0);
-    }
 }

@@ -16,6 +16,7 @@
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{FilmLoad, GearSet, PitDepth};
 use crate::kinematics::{GapEvaluator, Tca};
+use crate::ltca::passage::Passage;
 use crate::ltca::{stats, Ltca};
 use crate::lubrication::{self, LineContact};
 use rayon::prelude::*;
@@ -46,74 +47,6 @@ pub struct CycleWear {
     pub hertz_half_width: FlankField,
 }
 
-/// One instant of the contact band's passage over a node column: the pressure profile across
-/// the line (cell centres' radii, ascending, and pressures), its centroid, line load and the
-/// band's curvature.
-#[derive(Debug, Clone)]
-struct Sample {
-    /// Time of the reference tooth, as driven wheel rotation (sigma theta2_ref), rad.
-    time: f64,
-    /// Pressure centroid (the TCA line crossing when unloaded), m.
-    centre: f64,
-    profile: Vec<(f64, f64)>,
-    /// How far below the first and above the last cell centre the end pressures hold: half a
-    /// cell, or, where the band was cut by the flank's edge (worm-tip trace, blank top), up to
-    /// that edge. m.
-    extend_low: f64,
-    extend_high: f64,
-    line_load: f64,
-    pressure: f64,
-    radius: f64,
-    /// Half of the loaded width across the line (cells with pressure), m.
-    half_width: f64,
-}
-
-impl Sample {
-    /// Pressure at radius r of the profile shifted by `shift`, Pa: linear between cell
-    /// centres, the end cells' values over their outer halves, zero beyond.
-    fn pressure_at(&self, r: f64, shift: f64) -> f64 {
-        let x = r - shift;
-        let p = &self.profile;
-        let (Some(first), Some(last)) = (p.first(), p.last()) else {
-            return 0.0;
-        };
-        if x < first.0 {
-            return if x >= first.0 - self.extend_low {
-                first.1
-            } else {
-                0.0
-            };
-        }
-        if x > last.0 {
-            return if x <= last.0 + self.extend_high {
-                last.1
-            } else {
-                0.0
-            };
-        }
-        if p.len() == 1 {
-            // x is the one cell's centre.
-            return first.1;
-        }
-        let k = p.partition_point(|q| q.0 <= x).clamp(1, p.len() - 1);
-        let (a, b) = (p[k - 1], p[k]);
-        if b.0 == a.0 {
-            return a.1.max(b.1);
-        }
-        a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
-    }
-
-    /// Half extent of the profile (cells included) around its centre, m.
-    fn reach(&self) -> f64 {
-        match (self.profile.first(), self.profile.last()) {
-            (Some(a), Some(b)) => (self.centre - a.0 + self.extend_low)
-                .abs()
-                .max((b.0 + self.extend_high - self.centre).abs()),
-            _ => 0.0,
-        }
-    }
-}
-
 /// Wear of one mesh cycle from the loaded analysis (MODEL §7.1-7.2), on the loaded flank.
 ///
 /// Between two consecutive instants a, b of the reference tooth on a node column, the loaded
@@ -138,113 +71,7 @@ pub fn per_cycle(
     let dt = tau / np as f64;
     // Wheel speed, rad/s: converts wheel rotation into time.
     let wheel_speed = gear.conditions.worm_speed / gear.ratio();
-    // Pressure profiles per (position, tooth, slice) from the local cells: (r, p, width across
-    // the line, column) of the cells. A slice's cells are consecutive in a position's list, so
-    // each (position, tooth, slice) is a list of runs of cells (one, in practice), kept in
-    // order in a table indexed by position, tooth index and node column (no hashing: this
-    // part runs on one thread between two parallel analyses).
-    type Profile = Vec<(f64, f64, f64, usize)>;
-    let teeth = tca.teeth.len();
-    let table = |position: usize, tooth_index: usize, slice: usize| {
-        (position * teeth + tooth_index) * (nj + 1) + slice
-    };
-    const NONE: usize = usize::MAX;
-    // Runs: (index in ltca.positions, first cell, end, next run of the same key).
-    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
-    let mut head = vec![NONE; np * teeth * (nj + 1)];
-    let mut tail = vec![NONE; np * teeth * (nj + 1)];
-    let mut last_column = 0;
-    for (at, pr) in ltca.positions.iter().enumerate() {
-        let cells = &pr.cells;
-        let mut k = 0;
-        while k < cells.len() {
-            let c = &cells[k];
-            let mut end = k + 1;
-            while end < cells.len()
-                && cells[end].tooth_index == c.tooth_index
-                && cells[end].slice == c.slice
-            {
-                end += 1;
-            }
-            last_column = cells[k..end]
-                .iter()
-                .map(|c| c.column)
-                .fold(last_column, usize::max);
-            let key = table(pr.position, c.tooth_index, c.slice);
-            runs.push((at, k, end, NONE));
-            let run = runs.len() - 1;
-            match tail[key] {
-                NONE => head[key] = run,
-                t => runs[t].3 = run,
-            }
-            tail[key] = run;
-            k = end;
-        }
-    }
-    // The profile of a key, once (a second line with the same key gets none).
-    let mut take = |position: usize, tooth: i32, slice: usize| -> Profile {
-        let Some(t) = tca.teeth.iter().position(|&k| k == tooth) else {
-            return Vec::new();
-        };
-        let key = table(position, t, slice);
-        let mut profile = Vec::new();
-        let mut run = std::mem::replace(&mut head[key], NONE);
-        while run != NONE {
-            let (at, start, end, next) = runs[run];
-            let pr = &ltca.positions[at];
-            for (c, &p) in pr.cells[start..end].iter().zip(&pr.pressure[start..end]) {
-                profile.push((c.r, p, 2.0 * c.cell.half_nu, c.column));
-            }
-            run = next;
-        }
-        profile
-    };
-    // Samples per node column.
-    let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); nj + 1];
-    for line in &tca.contact_lines {
-        let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
-        let mut cells = take(line.position, line.tooth, line.slice);
-        cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
-        let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
-        let centre = if load > 0.0 { moment / load } else { line.r };
-        let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
-            (Some(a), Some(b)) => {
-                let spacing = if b.3 > a.3 {
-                    (b.0 - a.0) / (b.3 - a.3) as f64
-                } else {
-                    a.2
-                };
-                let j = line.slice;
-                let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
-                let low = if a.3 > 0 {
-                    (a.0 - floor).max(0.5 * spacing)
-                } else {
-                    0.5 * spacing
-                };
-                let high = if b.3 < last_column {
-                    (wf.r_high[j] - b.0).max(0.5 * spacing)
-                } else {
-                    0.5 * spacing
-                };
-                (spacing, low, high)
-            }
-            _ => (0.0, 0.0, 0.0),
-        };
-        let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
-        let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
-        columns[line.slice].push(Sample {
-            half_width,
-            time: tca.sigma * theta2,
-            centre,
-            extend_low,
-            extend_high,
-            line_load: load,
-            pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
-            profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
-            radius: line.curvature_radius,
-        });
-    }
+    let mut columns = crate::ltca::passage::band_samples(wf, tca, &ltca.positions, tau);
     let e_prime = lubrication::reduced_modulus(
         gear.worm_material.youngs_modulus,
         gear.worm_material.poisson_ratio,
@@ -299,21 +126,13 @@ pub fn per_cycle(
             let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
             samples.sort_by(|a, b| a.time.total_cmp(&b.time));
             for pair in samples.windows(2) {
-                let (a, b) = (&pair[0], &pair[1]);
                 // Consecutive instants of the same engagement only.
-                if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
+                let Some(passage) = Passage::between(&pair[0], &pair[1], dt) else {
                     continue;
-                }
+                };
+                let (a, b) = (passage.a, passage.b);
                 let duration = (b.time - a.time) / wheel_speed;
-                let reach = a.reach().max(b.reach());
-                let (lo, hi) = (
-                    a.centre.min(b.centre) - reach,
-                    a.centre.max(b.centre) + reach,
-                );
-                // Sub-steps: the band moves at most a tenth of its width per sub-step.
-                let width = (2.0 * reach).max(1e-9);
-                let steps =
-                    ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400);
+                let (lo, hi, steps) = (passage.lo, passage.hi, passage.steps);
                 let w = 0.5 * (a.line_load + b.line_load);
                 let fill = |x: f64, y: f64| {
                     if !x.is_finite() {
@@ -334,11 +153,7 @@ pub fn per_cycle(
                     let (u1, u2) = rolling[k];
                     let mut integral = 0.0;
                     for m in 0..steps {
-                        let s = (m as f64 + 0.5) / steps as f64;
-                        let c = a.centre + s * (b.centre - a.centre);
-                        let p = (1.0 - s) * a.pressure_at(node.r, c - a.centre)
-                            + s * b.pressure_at(node.r, c - b.centre);
-                        integral += p;
+                        integral += passage.pressure(node.r, (m as f64 + 0.5) / steps as f64);
                     }
                     integral *= duration / steps as f64;
                     if integral <= 0.0 {
@@ -1533,37 +1348,4 @@ fn node_pattern_pressure(wf: &WheelFlank, pattern: &[f64], k: usize) -> f64 {
         }
     }
     p
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn sample(profile: Vec<(f64, f64)>) -> Sample {
-        Sample {
-            time: 0.0,
-            centre: 0.1,
-            profile,
-            extend_low: 1e-4,
-            extend_high: 1e-4,
-            line_load: 0.0,
-            pressure: 0.0,
-            radius: 0.01,
-            half_width: 0.0,
-        }
-    }
-
-    #[test]
-    fn a_band_profile_of_one_cell_holds_its_pressure_over_the_cell() {
-        // A slice cut to a single cell by the flank's edges (it happens on worn flanks): its
-        // pressure over its extent, zero beyond, and no panic at the centre.
-        let s = sample(vec![(0.1, 5e8)]);
-        assert_eq!(s.pressure_at(0.1, 0.0), 5e8);
-        assert_eq!(s.pressure_at(0.1 - 0.5e-4, 0.0), 5e8);
-        assert_eq!(s.pressure_at(0.1 + 0.5e-4, 0.0), 5e8);
-        assert_eq!(s.pressure_at(0.1 + 2e-4, 0.0), 0.0);
-        // Two cells: linear between their centres.
-        let s = sample(vec![(0.1, 4e8), (0.1002, 6e8)]);
-        assert!((s.pressure_at(0.1001, 0.0) - 5e8).abs() < 1e-3);
-    }
 }

@@ -1,0 +1,338 @@
+//! The loaded band's passage over the wheel flank (MODEL §5.6, §7.2): on each node column of
+//! the global grid, the pressure profiles across the contact line of every (position, tooth),
+//! as instants of the reference tooth's engagement (tooth k at wheel rotation theta2 is the
+//! reference tooth at theta2 + sigma k tau). Between consecutive instants the band is moved
+//! continuously from one centroid to the next with its shape blended: the per-cycle wear
+//! integrates the pressure over that passage, the loaded pattern takes its maximum, so neither
+//! depends on where the positions happen to fall.
+
+use super::PositionResult;
+use crate::geometry::WheelFlank;
+use crate::kinematics::Tca;
+
+/// One instant of the contact band's passage over a node column: the pressure profile across
+/// the line (cell centres' radii, ascending, and pressures), its centroid, line load and the
+/// band's curvature.
+#[derive(Debug, Clone)]
+pub(crate) struct Sample {
+    /// Time of the reference tooth, as driven wheel rotation (sigma theta2_ref), rad.
+    pub(crate) time: f64,
+    /// Pressure centroid (the TCA line crossing when unloaded), m.
+    pub(crate) centre: f64,
+    pub(crate) profile: Vec<(f64, f64)>,
+    /// Plastic indentation of the profile's cells (MODEL §5.7), m.
+    pub(crate) plastic: Vec<f64>,
+    /// How far below the first and above the last cell centre the end pressures hold: half a
+    /// cell, or, where the band was cut by the flank's edge (worm-tip trace, blank top), up to
+    /// that edge. m.
+    pub(crate) extend_low: f64,
+    pub(crate) extend_high: f64,
+    pub(crate) line_load: f64,
+    pub(crate) pressure: f64,
+    pub(crate) radius: f64,
+    /// Half of the loaded width across the line (cells with pressure), m.
+    pub(crate) half_width: f64,
+}
+
+impl Sample {
+    /// Pressure at radius r of the profile shifted by `shift`, Pa: linear between cell
+    /// centres, the end cells' values over their outer halves, zero beyond.
+    pub(crate) fn pressure_at(&self, r: f64, shift: f64) -> f64 {
+        self.value_at(r, shift, |k| self.profile[k].1)
+    }
+
+    /// Plastic indentation (MODEL §5.7) at radius r of the profile shifted by `shift`, m, as
+    /// [`Sample::pressure_at`].
+    pub(crate) fn plastic_at(&self, r: f64, shift: f64) -> f64 {
+        self.value_at(r, shift, |k| self.plastic.get(k).copied().unwrap_or(0.0))
+    }
+
+    /// The value of the profile's cell k (`value(k)`) read at radius r, shifted.
+    fn value_at(&self, r: f64, shift: f64, value: impl Fn(usize) -> f64) -> f64 {
+        let x = r - shift;
+        let p = &self.profile;
+        let (Some(first), Some(last)) = (p.first(), p.last()) else {
+            return 0.0;
+        };
+        if x < first.0 {
+            return if x >= first.0 - self.extend_low {
+                value(0)
+            } else {
+                0.0
+            };
+        }
+        if x > last.0 {
+            return if x <= last.0 + self.extend_high {
+                value(p.len() - 1)
+            } else {
+                0.0
+            };
+        }
+        if p.len() == 1 {
+            // x is the one cell's centre.
+            return value(0);
+        }
+        let k = p.partition_point(|q| q.0 <= x).clamp(1, p.len() - 1);
+        let (a, b) = ((p[k - 1].0, value(k - 1)), (p[k].0, value(k)));
+        if b.0 == a.0 {
+            return a.1.max(b.1);
+        }
+        a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+    }
+
+    /// Half extent of the profile (cells included) around its centre, m.
+    pub(crate) fn reach(&self) -> f64 {
+        match (self.profile.first(), self.profile.last()) {
+            (Some(a), Some(b)) => (self.centre - a.0 + self.extend_low)
+                .abs()
+                .max((b.0 + self.extend_high - self.centre).abs()),
+            _ => 0.0,
+        }
+    }
+}
+
+/// The band's instants on each node column of the loaded flank `wf` (index j = 0..=nj), from
+/// the loaded analysis' positions: unsorted; `tau` is the wheel's tooth pitch angle, rad.
+pub(crate) fn band_samples(
+    wf: &WheelFlank,
+    tca: &Tca,
+    positions: &[PositionResult],
+    tau: f64,
+) -> Vec<Vec<Sample>> {
+    let nj = wf.cells_face;
+    let np = tca.positions.len();
+    // Pressure profiles per (position, tooth, slice) from the local cells: (r, p, width across
+    // the line, column) of the cells. A slice's cells are consecutive in a position's list, so
+    // each (position, tooth, slice) is a list of runs of cells (one, in practice), kept in
+    // order in a table indexed by position, tooth index and node column (no hashing: this
+    // part runs on one thread between two parallel analyses).
+    type Profile = Vec<(f64, f64, f64, usize, f64)>;
+    let teeth = tca.teeth.len();
+    let table = |position: usize, tooth_index: usize, slice: usize| {
+        (position * teeth + tooth_index) * (nj + 1) + slice
+    };
+    const NONE: usize = usize::MAX;
+    // Runs: (index in positions, first cell, end, next run of the same key).
+    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
+    let mut head = vec![NONE; np * teeth * (nj + 1)];
+    let mut tail = vec![NONE; np * teeth * (nj + 1)];
+    let mut last_column = 0;
+    for (at, pr) in positions.iter().enumerate() {
+        let cells = &pr.cells;
+        let mut k = 0;
+        while k < cells.len() {
+            let c = &cells[k];
+            let mut end = k + 1;
+            while end < cells.len()
+                && cells[end].tooth_index == c.tooth_index
+                && cells[end].slice == c.slice
+            {
+                end += 1;
+            }
+            last_column = cells[k..end]
+                .iter()
+                .map(|c| c.column)
+                .fold(last_column, usize::max);
+            let key = table(pr.position, c.tooth_index, c.slice);
+            runs.push((at, k, end, NONE));
+            let run = runs.len() - 1;
+            match tail[key] {
+                NONE => head[key] = run,
+                t => runs[t].3 = run,
+            }
+            tail[key] = run;
+            k = end;
+        }
+    }
+    // The profile of a key, once (a second line with the same key gets none).
+    let mut take = |position: usize, tooth: i32, slice: usize| -> Profile {
+        let Some(t) = tca.teeth.iter().position(|&k| k == tooth) else {
+            return Vec::new();
+        };
+        let key = table(position, t, slice);
+        let mut profile = Vec::new();
+        let mut run = std::mem::replace(&mut head[key], NONE);
+        while run != NONE {
+            let (at, start, end, next) = runs[run];
+            let pr = &positions[at];
+            for (i, c) in (start..end).zip(&pr.cells[start..end]) {
+                let plastic = pr.plastic_depth.get(i).copied().unwrap_or(0.0);
+                profile.push((c.r, pr.pressure[i], 2.0 * c.cell.half_nu, c.column, plastic));
+            }
+            run = next;
+        }
+        profile
+    };
+    // Samples per node column.
+    let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); nj + 1];
+    for line in &tca.contact_lines {
+        let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
+        let mut cells = take(line.position, line.tooth, line.slice);
+        cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
+        let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
+        let centre = if load > 0.0 { moment / load } else { line.r };
+        let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
+            (Some(a), Some(b)) => {
+                let spacing = if b.3 > a.3 {
+                    (b.0 - a.0) / (b.3 - a.3) as f64
+                } else {
+                    a.2
+                };
+                let j = line.slice;
+                let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
+                let low = if a.3 > 0 {
+                    (a.0 - floor).max(0.5 * spacing)
+                } else {
+                    0.5 * spacing
+                };
+                let high = if b.3 < last_column {
+                    (wf.r_high[j] - b.0).max(0.5 * spacing)
+                } else {
+                    0.5 * spacing
+                };
+                (spacing, low, high)
+            }
+            _ => (0.0, 0.0, 0.0),
+        };
+        let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
+        let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
+        columns[line.slice].push(Sample {
+            half_width,
+            time: tca.sigma * theta2,
+            centre,
+            extend_low,
+            extend_high,
+            line_load: load,
+            pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
+            plastic: cells.iter().map(|c| c.4).collect(),
+            profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
+            radius: line.curvature_radius,
+        });
+    }
+    for samples in &mut columns {
+        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+    }
+    columns
+}
+
+/// The band's passage between two instants a, b of one engagement on a node column: the band
+/// translates from centroid c_a to c_b while its shape blends from a's to b's.
+pub(crate) struct Passage<'a> {
+    pub(crate) a: &'a Sample,
+    pub(crate) b: &'a Sample,
+    /// The radii the band covers on the way, m.
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
+    /// Sub-steps of the quadrature: the band moves at most a tenth of its width per step.
+    pub(crate) steps: usize,
+}
+
+impl<'a> Passage<'a> {
+    /// The passage between consecutive instants (sorted by time) a and b, when they are of one
+    /// engagement (at most 1.5 `dt` apart, rad of wheel rotation) and one of them is loaded.
+    pub(crate) fn between(a: &'a Sample, b: &'a Sample, dt: f64) -> Option<Self> {
+        if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
+            return None;
+        }
+        let reach = a.reach().max(b.reach());
+        let width = (2.0 * reach).max(1e-9);
+        Some(Passage {
+            a,
+            b,
+            lo: a.centre.min(b.centre) - reach,
+            hi: a.centre.max(b.centre) + reach,
+            steps: ((10.0 * (b.centre - a.centre).abs() / width).ceil() as usize).clamp(4, 400),
+        })
+    }
+
+    /// Pressure at radius r at the fraction s of the passage (0: a, 1: b), Pa.
+    pub(crate) fn pressure(&self, r: f64, s: f64) -> f64 {
+        let (a, b) = (self.a, self.b);
+        let c = a.centre + s * (b.centre - a.centre);
+        (1.0 - s) * a.pressure_at(r, c - a.centre) + s * b.pressure_at(r, c - b.centre)
+    }
+
+    /// Plastic indentation at radius r at the fraction s of the passage, m.
+    fn plastic(&self, r: f64, s: f64) -> f64 {
+        let (a, b) = (self.a, self.b);
+        let c = a.centre + s * (b.centre - a.centre);
+        (1.0 - s) * a.plastic_at(r, c - a.centre) + s * b.plastic_at(r, c - b.centre)
+    }
+}
+
+/// What [`swept_max`] takes the largest of.
+#[derive(Clone, Copy)]
+pub(crate) enum Swept {
+    Pressure,
+    Plastic,
+}
+
+/// The largest pressure or plastic indentation over the band's whole passage (the instants
+/// and the sub-steps between them, [`Passage`]) at the radii `radii` of one node column, from
+/// its instants sorted by time; `dt` the wheel rotation between positions, rad.
+pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept) -> Vec<f64> {
+    let mut out = vec![0.0f64; radii.len()];
+    let value = |passage: &Passage, r: f64, s: f64| match what {
+        Swept::Pressure => passage.pressure(r, s),
+        Swept::Plastic => passage.plastic(r, s),
+    };
+    for sample in samples {
+        for (o, &r) in out.iter_mut().zip(radii) {
+            let v = match what {
+                Swept::Pressure => sample.pressure_at(r, 0.0),
+                Swept::Plastic => sample.plastic_at(r, 0.0),
+            };
+            *o = o.max(v);
+        }
+    }
+    for pair in samples.windows(2) {
+        let Some(passage) = Passage::between(&pair[0], &pair[1], dt) else {
+            continue;
+        };
+        for (o, &r) in out.iter_mut().zip(radii) {
+            if r < passage.lo || r > passage.hi {
+                continue;
+            }
+            for m in 1..passage.steps {
+                let v = value(&passage, r, m as f64 / passage.steps as f64);
+                *o = o.max(v);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(profile: Vec<(f64, f64)>) -> Sample {
+        Sample {
+            time: 0.0,
+            centre: 0.1,
+            profile,
+            plastic: Vec::new(),
+            extend_low: 1e-4,
+            extend_high: 1e-4,
+            line_load: 0.0,
+            pressure: 0.0,
+            radius: 0.01,
+            half_width: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_band_profile_of_one_cell_holds_its_pressure_over_the_cell() {
+        // A slice cut to a single cell by the flank's edges (it happens on worn flanks): its
+        // pressure over its extent, zero beyond, and no panic at the centre.
+        let s = sample(vec![(0.1, 5e8)]);
+        assert_eq!(s.pressure_at(0.1, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 - 0.5e-4, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 + 0.5e-4, 0.0), 5e8);
+        assert_eq!(s.pressure_at(0.1 + 2e-4, 0.0), 0.0);
+        // Two cells: linear between their centres.
+        let s = sample(vec![(0.1, 4e8), (0.1002, 6e8)]);
+        assert!((s.pressure_at(0.1001, 0.0) - 5e8).abs() < 1e-3);
+    }
+}
