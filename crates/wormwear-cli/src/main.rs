@@ -683,13 +683,15 @@ fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating
     let first = end.records.first().expect("record");
     let last = end.records.last().expect("record");
     println!(
-        "wear: {} steps to {} cycles; max wear {:.2} um, worn volume {:.3} mm^3, backlash +{:.2} um; \
-         P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; results in {}",
+        "wear: {} steps to {} cycles; backlash +{:.2} um, mean wear {:.2} um, worn volume {:.3} \
+         mm^3, max wear {:.2} um (mesh-dependent); P_max {:.0} -> {:.0} MPa, S0 {:.2} -> {:.2}; \
+         results in {}",
         last.step,
         wormwear::output::cycles_label(last.cycles),
-        last.max_wear_m * 1e6,
-        last.worn_volume_m3 * 1e9,
         last.backlash_increase_m * 1e6,
+        last.mean_wear_m * 1e6,
+        last.worn_volume_m3 * 1e9,
+        last.max_wear_m * 1e6,
         first.max_pressure_pa / 1e6,
         last.max_pressure_pa / 1e6,
         first.contact_area_fraction,

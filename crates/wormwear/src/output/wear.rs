@@ -86,9 +86,12 @@ pub struct WearSummary<'a> {
     /// (a step split by the stability guard costs one per sub-step; MODEL §7.3 counts those).
     pub states: usize,
     pub loaded_analyses: usize,
-    /// What `max_pressure_pa` is: the largest cell of the loaded pattern (raw, grows with
-    /// refinement at a sharp edge); `pressure_patch_max_pa` is the mesh-converged companion.
+    /// What `max_pressure_pa` is ([`MAX_PRESSURE_DEFINITION`]).
     pub max_pressure_definition: &'static str,
+    /// The step fields that change by more than 5 % with the mesh ([`MESH_DEPENDENT`]): read
+    /// them as indications; compare designs on the converged ones (backlash, mean wear,
+    /// P_max, P_mean, S0).
+    pub mesh_dependent: &'static [&'static str],
     /// The wear limits and where the life reached them.
     pub limits: LimitsSummary,
     /// How pitting entered the life (schedule, off, forecast with its margin).
@@ -163,9 +166,22 @@ impl LimitsSummary {
 }
 
 /// What a summary's `max_pressure_pa` means.
-pub const MAX_PRESSURE_DEFINITION: &str = "largest pressure of the loaded pattern's cells \
-(raw maximum; at a sharp edge it grows with mesh refinement: see pressure_patch_max_pa, the \
-largest mean pressure over a patch of stated size, which converges)";
+pub const MAX_PRESSURE_DEFINITION: &str = "largest pressure of the local contact cells over \
+the positions (the published P_max; with the default plastic limit at most the flow pressure \
+and mesh-converged; with contact = elastic it grows with mesh refinement at a sharp edge: see \
+pressure_patch_max_pa, the largest mean pressure over a patch of stated size)";
+
+/// The per-state results that still change by more than 5 % with the mesh (issue 39's
+/// convergence study, VALIDATION.md "Mesh convergence"): largest values at one node of the
+/// worn worm-tip trace. Listed in the wear summary as `mesh_dependent`.
+pub const MESH_DEPENDENT: &[&str] = &[
+    "max_wear_m",
+    "max_plastic_set_m",
+    "max_plastic_indentation_m",
+    "max_damage",
+    "yielded_area_fraction",
+    "pressure_patch_max_pa (worn states)",
+];
 
 /// Reads a checkpoint written by [`LifeWriter`] with its records (lines of [`RECORDS`] beyond
 /// the checkpoint's count, e.g. from an interruption between the two writes, are ignored).
@@ -818,6 +834,7 @@ pub fn summary_value(
         states: state.records.len(),
         loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
         max_pressure_definition: MAX_PRESSURE_DEFINITION,
+        mesh_dependent: MESH_DEPENDENT,
         limits: LimitsSummary::new(gear, geo, tca, plan, state),
         pitting: plan.pitting,
         phases: crate::wear::forecast::phase_spans(&state.records),
@@ -982,7 +999,7 @@ impl StateMaps<'_> {
         map(
             &path,
             &format!(
-                "Cumulative wear after {} cycles (max {:.2} um; map: cell means)",
+                "Cumulative wear after {} cycles (max {:.2} um, mesh-dependent; map: cell means)",
                 super::cycles_label(r.cycles),
                 r.max_wear_m * UM
             ),
@@ -1046,7 +1063,7 @@ impl StateMaps<'_> {
         map(
             &path,
             &format!(
-                "Fatigue damage at {} cycles (max {:.3}; 1: pits; map: cell means)",
+                "Fatigue damage at {} cycles (max {:.3}, mesh-dependent; 1: pits; map: cell means)",
                 super::cycles_label(r.cycles),
                 r.max_damage
             ),
@@ -1064,7 +1081,7 @@ impl StateMaps<'_> {
         map(
             &path,
             &format!(
-                "Plastic set (running-in) at {} cycles (max {:.2} um, yielded {:.1} % of the \
+                "Plastic set (running-in) at {} cycles (max {:.2} um, mesh-dependent; yielded {:.1} % of the \
                  flank; map: cell means)",
                 super::cycles_label(r.cycles),
                 r.max_plastic_set_m * UM,
