@@ -100,7 +100,7 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             if e.pressure_patch_max_pa < s.pressure_patch_max_pa {
                 "so does ours"
             } else {
-                "ours stays at the bronze's flow pressure (1 GPa) at the sharp edges of the published set-up, the worm's tip edge and the rims of worn and pitted zones, where the plastic limit holds it (MODEL §5.7; with the elastic law these edges reached 13.7 GPa, see (d))"
+                "ours stays at the bronze's flow pressure (1 GPa) at the sharp edges of the published set-up, the worm's tip edge and the rims of worn and pitted zones, where the plastic limit holds it (MODEL §5.7; with the elastic law case B's edges reached 13.7 GPa in the previous validation, 30411c6; (d) shows the elastic reading on case C)"
             }
         );
     }
