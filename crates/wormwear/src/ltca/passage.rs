@@ -273,6 +273,10 @@ pub(crate) enum Swept {
 /// its instants sorted by time; `dt` the wheel rotation between positions, rad.
 pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept) -> Vec<f64> {
     let mut out = vec![0.0f64; radii.len()];
+    let yielded = |s: &Sample| s.plastic.iter().any(|&d| d > 0.0);
+    if matches!(what, Swept::Plastic) && !samples.iter().any(yielded) {
+        return out;
+    }
     let value = |passage: &Passage, r: f64, s: f64| match what {
         Swept::Pressure => passage.pressure(r, s),
         Swept::Plastic => passage.plastic(r, s),
@@ -290,6 +294,9 @@ pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept)
         let Some(passage) = Passage::between(&pair[0], &pair[1], dt) else {
             continue;
         };
+        if matches!(what, Swept::Plastic) && !yielded(passage.a) && !yielded(passage.b) {
+            continue;
+        }
         for (o, &r) in out.iter_mut().zip(radii) {
             if r < passage.lo || r > passage.hi {
                 continue;
