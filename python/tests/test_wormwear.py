@@ -276,6 +276,10 @@ def test_ctrl_c_interrupts_a_life(design_file, tmp_path):
     script = (
         "import faulthandler, signal, wormwear, sys\n"
         "faulthandler.register(signal.SIGUSR1, all_threads=True)\n"
+        # A shell that runs the suite in the background hands its children SIGINT ignored,
+        # and Python then installs no KeyboardInterrupt handler: install it (a user's Ctrl-C
+        # reaches an interactive Python that has it).
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         f"g = wormwear.load({str(design_file)!r}).with_(**{{'bending.model': 'none'}})\n"
         "print('start', flush=True)\n"
         "try:\n"
