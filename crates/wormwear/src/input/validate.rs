@@ -443,11 +443,10 @@ fn analysis_settings(
     Some(analysis)
 }
 
-/// The loaded analysis' settings of [analysis] (the grid and output fields left at zero for
-/// [`analysis_settings`] to fill).
-fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
-    let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
-    let columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
+/// The contact law of `[analysis]` (MODEL §5.7): `contact` plastic (default) or elastic,
+/// `flow_pressure_mpa`; the former `contact_pressure_cap_mpa` is refused naming them. The flow
+/// pressure's default, the wheel's hardness, is filled in by `validate` (NaN here).
+fn contact_law(ck: &mut Checker, a: &AnalysisSpec) -> Option<ContactLaw> {
     if let Some(v) = a.contact_pressure_cap_mpa {
         ck.fail(
             "analysis.contact_pressure_cap_mpa",
@@ -465,9 +464,7 @@ fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
         a.contact.as_deref().unwrap_or("plastic"),
         &[("plastic", true), ("elastic", false)],
     );
-    // The flow pressure's default, the wheel's hardness, is filled in by `validate` (NaN
-    // here).
-    let contact = match (law, flow) {
+    match (law, flow) {
         (Some(true), None) => Some(ContactLaw::Plastic {
             flow_pressure: f64::NAN,
         }),
@@ -476,7 +473,15 @@ fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
         }),
         (Some(false), _) => Some(ContactLaw::Elastic),
         (None, _) => None,
-    };
+    }
+}
+
+/// The loaded analysis' settings of [analysis] (the grid and output fields left at zero for
+/// [`analysis_settings`] to fill).
+fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
+    let slice_step = ck.int_range("analysis.contact_slice_step", a.contact_slice_step, 1, 20);
+    let columns = ck.int_range("analysis.contact_columns", a.contact_columns, 3, 200);
+    let contact = contact_law(ck, a);
     let across = a.pressure_patch_across_mm;
     let across = ck.range(
         "analysis.pressure_patch_across_mm",

@@ -1053,43 +1053,14 @@ fn solve_position(
             widenings += 1;
             continue;
         }
-        let forces: Vec<f64> = cells.iter().zip(&sol.q).map(|(c, q)| q / c.lever).collect();
-        let pressure: Vec<f64> = cells
-            .iter()
-            .zip(&forces)
-            // (The bound holds on q = p S lever; the division's round-off stays below it.)
-            .map(|(c, f)| (f / c.cell.area()).min(settings.flow_pressure))
-            .collect();
-        let plastic_depth: Vec<f64> = cells
-            .iter()
-            .zip(&pressure)
-            .zip(&sol.gap)
-            .map(|((c, &p), &y)| {
-                let at_bound = p >= settings.flow_pressure * (1.0 - 1e-12);
-                if at_bound && y < 0.0 {
-                    -y * c.lever
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let (forces, pressure, plastic_depth) =
+            cell_loads(&cells, &sol.q, &sol.gap, settings.flow_pressure);
         let mut tooth_load = vec![0.0; tca.teeth.len()];
         for (c, f) in cells.iter().zip(&forces) {
             tooth_load[c.tooth_index] += f;
         }
         let total_force: f64 = forces.iter().sum();
-        // Force barycentre and mean normal (MODEL §5.6) for the linear stiffness.
-        let mut b = Vector3::zeros();
-        let mut nsum = Vector3::zeros();
-        for (c, f) in cells.iter().zip(&forces) {
-            b += c.cell.centre * *f;
-            nsum += c.cell.normal * *f;
-        }
-        let b = b / total_force;
-        let nmean = nsum.normalize();
-        let b_wheel = ev.placement.worm_to_wheel(&b);
-        let n_wheel = ev.placement.vector_worm_to_wheel(&nmean);
-        let lever_b = GapEvaluator::lever(&b_wheel, &n_wheel);
+        let lever_b = barycentre_lever(&ev.placement, &cells, &forces, total_force);
         let approach = sol.approach;
         let target = worm_torque.unwrap_or(worm);
         return Ok(PositionResult {
@@ -1110,6 +1081,57 @@ fn solve_position(
             band_widenings: widenings,
         });
     }
+}
+
+/// Per local cell: the normal force (N), the pressure (Pa) and the plastic depth (m: the
+/// interference of a cell at the flow pressure, MODEL §5.7) from the solver's loads q (N m)
+/// and gaps (rad).
+fn cell_loads(
+    cells: &[LocalCell],
+    q: &[f64],
+    gap: &[f64],
+    flow_pressure: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let forces: Vec<f64> = cells.iter().zip(q).map(|(c, q)| q / c.lever).collect();
+    let pressure: Vec<f64> = cells
+        .iter()
+        .zip(&forces)
+        // (The bound holds on q = p S lever; the division's round-off stays below it.)
+        .map(|(c, f)| (f / c.cell.area()).min(flow_pressure))
+        .collect();
+    let plastic_depth: Vec<f64> = cells
+        .iter()
+        .zip(&pressure)
+        .zip(gap)
+        .map(|((c, &p), &y)| {
+            let at_bound = p >= flow_pressure * (1.0 - 1e-12);
+            if at_bound && y < 0.0 {
+                -y * c.lever
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    (forces, pressure, plastic_depth)
+}
+
+/// Lever |(B x n)_z| (m) of the force barycentre B with the force-weighted mean normal n
+/// (MODEL §5.6), for the linear mesh stiffness.
+fn barycentre_lever(
+    placement: &crate::input::Placement,
+    cells: &[LocalCell],
+    forces: &[f64],
+    total_force: f64,
+) -> f64 {
+    let mut b = Vector3::zeros();
+    let mut nsum = Vector3::zeros();
+    for (c, f) in cells.iter().zip(forces) {
+        b += c.cell.centre * *f;
+        nsum += c.cell.normal * *f;
+    }
+    let b_wheel = placement.worm_to_wheel(&(b / total_force));
+    let n_wheel = placement.vector_worm_to_wheel(&nsum.normalize());
+    GapEvaluator::lever(&b_wheel, &n_wheel)
 }
 
 /// The next wheel torque (N m) of the torque balance (MODEL §5.2) from the last two

@@ -169,51 +169,66 @@ pub(crate) fn band_samples(
         let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
         let mut cells = take(line.position, line.tooth, line.slice);
         cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
-        let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
-        let centre = if load > 0.0 { moment / load } else { line.r };
-        let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
-            (Some(a), Some(b)) => {
-                let spacing = if b.3 > a.3 {
-                    (b.0 - a.0) / (b.3 - a.3) as f64
-                } else {
-                    a.2
-                };
-                let j = line.slice;
-                let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
-                let low = if a.3 > 0 {
-                    (a.0 - floor).max(0.5 * spacing)
-                } else {
-                    0.5 * spacing
-                };
-                let high = if b.3 < last_column {
-                    (wf.r_high[j] - b.0).max(0.5 * spacing)
-                } else {
-                    0.5 * spacing
-                };
-                (spacing, low, high)
-            }
-            _ => (0.0, 0.0, 0.0),
-        };
-        let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
-        let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
-        columns[line.slice].push(Sample {
-            half_width,
-            time: tca.sigma * theta2,
-            centre,
-            extend_low,
-            extend_high,
-            line_load: load,
-            pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
-            plastic: cells.iter().map(|c| c.4).collect(),
-            profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
-            radius: line.curvature_radius,
-        });
+        let time = tca.sigma * theta2;
+        columns[line.slice].push(sample_of(cells, line, time, wf, tca, last_column));
     }
     for samples in &mut columns {
         samples.sort_by(|a, b| a.time.total_cmp(&b.time));
     }
     columns
+}
+
+/// One instant of the band on a node column from its cells across the line (radius,
+/// pressure, width, column, plastic depth; ascending radii) at the contact line `line` of the
+/// reference tooth's time `time` (rad); `last_column` the band's last column index.
+fn sample_of(
+    cells: Vec<(f64, f64, f64, usize, f64)>,
+    line: &crate::kinematics::SliceContact,
+    time: f64,
+    wf: &WheelFlank,
+    tca: &Tca,
+    last_column: usize,
+) -> Sample {
+    let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
+    let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
+    let centre = if load > 0.0 { moment / load } else { line.r };
+    let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
+        (Some(a), Some(b)) => {
+            let spacing = if b.3 > a.3 {
+                (b.0 - a.0) / (b.3 - a.3) as f64
+            } else {
+                a.2
+            };
+            let j = line.slice;
+            let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
+            let low = if a.3 > 0 {
+                (a.0 - floor).max(0.5 * spacing)
+            } else {
+                0.5 * spacing
+            };
+            let high = if b.3 < last_column {
+                (wf.r_high[j] - b.0).max(0.5 * spacing)
+            } else {
+                0.5 * spacing
+            };
+            (spacing, low, high)
+        }
+        _ => (0.0, 0.0, 0.0),
+    };
+    let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
+    let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
+    Sample {
+        half_width,
+        time,
+        centre,
+        extend_low,
+        extend_high,
+        line_load: load,
+        pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
+        plastic: cells.iter().map(|c| c.4).collect(),
+        profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
+        radius: line.curvature_radius,
+    }
 }
 
 /// The band's passage between two instants a, b of one engagement on a node column: the band

@@ -277,6 +277,69 @@ pub fn checks(design: &crate::input::GearSet) -> Vec<Check> {
     out
 }
 
+/// Mesh convergence of the pressures at the worm's sharp tip edge (11 -> 41 cells across the
+/// line, no bending): bounded by the flow pressure (the default, MODEL §5.7) and purely
+/// elastic; `unworn` is the default analysis.
+fn peak_convergence(
+    g: &crate::input::GearSet,
+    geo: &crate::geometry::Geometry,
+    tca: &crate::kinematics::Tca,
+    settings: &crate::ltca::LtcaSettings,
+    unworn: &crate::ltca::Ltca,
+) -> Vec<Check> {
+    let mut out = Vec::new();
+    let settings = *settings;
+    // Mesh convergence of the pressures at the worm's sharp tip edge: bounded by the
+    // flow pressure (the default, MODEL §5.7) and purely elastic.
+    let mut fine = settings;
+    fine.columns = 41;
+    if let Ok(f) = crate::ltca::analyse_with(g, geo, tca, &fine, None) {
+        out.push(Check {
+            what: "1/40 (no bending), P_max with the plastic limit (default), 11 -> 41 cells across the line".into(),
+            computed: format!(
+                "{:.0} -> {:.0} MPa",
+                unworn.max_pressure * 1e-6,
+                f.max_pressure * 1e-6
+            ),
+            reference: "converged: ratio 1".into(),
+            error: relative(f.max_pressure, unworn.max_pressure),
+            bound: 0.05,
+            test: "plastic::the_plastic_limit_makes_the_peaks_mesh_converged".into(),
+        });
+        out.push(Check {
+            what: "1/40 (no bending), P_patch (0.5 x 1 mm mean), 11 -> 41 cells across the line"
+                .into(),
+            computed: format!(
+                "{:.0} -> {:.0} MPa",
+                unworn.pressure_patch_max * 1e-6,
+                f.pressure_patch_max * 1e-6
+            ),
+            reference: "converged: ratio 1".into(),
+            error: relative(f.pressure_patch_max, unworn.pressure_patch_max),
+            bound: 0.03,
+            test: "fidelity::the_patch_pressure_converges_where_the_maximum_does_not".into(),
+        });
+    }
+    let (mut coarse, mut fine) = (settings, fine);
+    coarse.flow_pressure = f64::INFINITY;
+    fine.flow_pressure = f64::INFINITY;
+    let elastic = (
+        crate::ltca::analyse_with(g, geo, tca, &coarse, None),
+        crate::ltca::analyse_with(g, geo, tca, &fine, None),
+    );
+    if let (Ok(c), Ok(f)) = elastic {
+        out.push(Check {
+            what: "1/40 (no bending), raw P_max with the elastic law, 11 -> 41 cells across the line (edge singularity: grows)".into(),
+            computed: format!("{:.0} -> {:.0} MPa", c.max_pressure * 1e-6, f.max_pressure * 1e-6),
+            reference: "converged: ratio 1".into(),
+            error: relative(f.max_pressure, c.max_pressure),
+            bound: f64::NAN,
+            test: "fidelity::the_patch_pressure_converges_where_the_maximum_does_not".into(),
+        });
+    }
+    out
+}
+
 /// Checks on the 1/40 gear (design case without bending: these are the contact model's
 /// properties): conjugacy, the uniform angular
 /// recession (rigid lag), the backlash law of a uniform removal, the mesh-converged pressure.
@@ -350,55 +413,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             bound: 1e-4,
             test: "fidelity::a_uniform_angular_recession_is_all_rigid_lag".into(),
         });
-        // Mesh convergence of the pressures at the worm's sharp tip edge: bounded by the
-        // flow pressure (the default, MODEL §5.7) and purely elastic.
-        let mut fine = settings;
-        fine.columns = 41;
-        if let Ok(f) = crate::ltca::analyse_with(&g, &geo, &tca, &fine, None) {
-            out.push(Check {
-                what: "1/40 (no bending), P_max with the plastic limit (default), 11 -> 41 cells across the line".into(),
-                computed: format!(
-                    "{:.0} -> {:.0} MPa",
-                    unworn.max_pressure * 1e-6,
-                    f.max_pressure * 1e-6
-                ),
-                reference: "converged: ratio 1".into(),
-                error: relative(f.max_pressure, unworn.max_pressure),
-                bound: 0.05,
-                test: "plastic::the_plastic_limit_makes_the_peaks_mesh_converged".into(),
-            });
-            out.push(Check {
-                what:
-                    "1/40 (no bending), P_patch (0.5 x 1 mm mean), 11 -> 41 cells across the line"
-                        .into(),
-                computed: format!(
-                    "{:.0} -> {:.0} MPa",
-                    unworn.pressure_patch_max * 1e-6,
-                    f.pressure_patch_max * 1e-6
-                ),
-                reference: "converged: ratio 1".into(),
-                error: relative(f.pressure_patch_max, unworn.pressure_patch_max),
-                bound: 0.03,
-                test: "fidelity::the_patch_pressure_converges_where_the_maximum_does_not".into(),
-            });
-        }
-        let (mut coarse, mut fine) = (settings, fine);
-        coarse.flow_pressure = f64::INFINITY;
-        fine.flow_pressure = f64::INFINITY;
-        let elastic = (
-            crate::ltca::analyse_with(&g, &geo, &tca, &coarse, None),
-            crate::ltca::analyse_with(&g, &geo, &tca, &fine, None),
-        );
-        if let (Ok(c), Ok(f)) = elastic {
-            out.push(Check {
-                what: "1/40 (no bending), raw P_max with the elastic law, 11 -> 41 cells across the line (edge singularity: grows)".into(),
-                computed: format!("{:.0} -> {:.0} MPa", c.max_pressure * 1e-6, f.max_pressure * 1e-6),
-                reference: "converged: ratio 1".into(),
-                error: relative(f.max_pressure, c.max_pressure),
-                bound: f64::NAN,
-                test: "fidelity::the_patch_pressure_converges_where_the_maximum_does_not".into(),
-            });
-        }
+        out.extend(peak_convergence(&g, &geo, &tca, &settings, &unworn));
         // Hertz half-width against the loaded band's on the unworn flank (the pits' depth).
         let cw = crate::wear::per_cycle(
             &g,
