@@ -673,3 +673,61 @@ fn a_life_ends_at_the_first_state_past_its_wear_limit() {
     assert_eq!(first.thinnest_tooth_m, limits.thinnest(&unworn).0);
     assert!(first.thinnest_tooth_m > 0.0 && !first.worn_through_loaded);
 }
+
+#[test]
+fn the_patch_mean_of_a_wear_ridge_is_its_analytic_mean_on_any_grid() {
+    // FlankField::patch_mean_max (the converged peak wear, issue 39): a Gaussian ridge of
+    // depth h and width s along the face, on the design flank's grid of 40 and of 80 rows.
+    // Its mean over a window of height a centred on the ridge is
+    // h s sqrt(2 pi) erf(a / (2 sqrt(2) s)) / a, which the patch mean reaches at second order
+    // in the row height (the field linear between nodes); a uniform depth is itself;
+    // a ridge at the blank top is averaged over a window moved inside the flank.
+    let erf = |x: f64| {
+        // Abramowitz-Stegun 7.1.26, |error| < 1.5e-7.
+        let t = 1.0 / (1.0 + 0.3275911 * x.abs());
+        let y = 1.0
+            - t * (0.254829592
+                + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))))
+                * (-x * x).exp();
+        y.copysign(x)
+    };
+    let (h, s, a, along) = (50e-6, 0.3e-3, 0.5e-3, 1e-3);
+    let analytic =
+        h * s * (2.0 * std::f64::consts::PI).sqrt() * erf(a / (2.0 * 2f64.sqrt() * s)) / a;
+    let mut errors = Vec::new();
+    for rows in [40, 80] {
+        let mut g = example("gear-1x40-design.toml");
+        g.analysis.flank_cells_height = rows;
+        let geo = Geometry::build(&g).unwrap();
+        let wf = geo.wheel_flank(wormwear::geometry::Flank::Right);
+        let mid = 0.5 * (wf.r_low[0] + wf.r_high[0]);
+        let field = |f: &dyn Fn(f64) -> f64| {
+            let mut d = wormwear::geometry::FlankField::zeros(wf);
+            for (v, n) in d.values.iter_mut().zip(&wf.nodes) {
+                *v = f(n.r);
+            }
+            d
+        };
+        let ridge = field(&|r| h * (-(r - mid).powi(2) / (2.0 * s * s)).exp());
+        let patch = ridge.patch_mean_max(wf, a, along);
+        eprintln!(
+            "{rows} rows: ridge patch mean {:.4} um, analytic {:.4} um",
+            patch * 1e6,
+            analytic * 1e6
+        );
+        errors.push((patch / analytic - 1.0).abs());
+        let uniform = field(&|_| h);
+        assert!((uniform.patch_mean_max(wf, a, along) / h - 1.0).abs() < 1e-12);
+        // At the top of the lowest column: the window ends at the edge, its mean is the
+        // half-ridge's over the window's full height.
+        let top = wf.r_high.iter().copied().fold(f64::INFINITY, f64::min);
+        let edge = field(&|r| h * (-(r - top).powi(2) / (2.0 * s * s)).exp());
+        let half =
+            0.5 * h * s * (2.0 * std::f64::consts::PI).sqrt() * erf(a / (2f64.sqrt() * s)) / a;
+        assert!(edge.patch_mean_max(wf, a, along) >= 0.99 * half);
+        assert!(edge.patch_mean_max(wf, a, along) < h);
+    }
+    // The field linear between nodes: second order in the row height.
+    eprintln!("errors {errors:?}");
+    assert!(errors[1] < 0.01 && errors[1] < errors[0] / 3.0);
+}

@@ -323,6 +323,85 @@ impl FlankField {
         self.values[j * (self.cells_height + 1) + i]
     }
 
+    /// The zero field on the node columns of `wf` with `rows_per_row` rows for each of the
+    /// grid's (the same height parameter, `rows_per_row` times finer: a field that holds what
+    /// varies across a row, e.g. the plastic set at a sharp edge, MODEL §5.7).
+    pub fn zeros_refined(wf: &WheelFlank, rows_per_row: usize) -> Self {
+        let cells_height = wf.cells_height * rows_per_row.max(1);
+        Self {
+            cells_height,
+            cells_face: wf.cells_face,
+            values: vec![0.0; (cells_height + 1) * (wf.cells_face + 1)],
+        }
+    }
+
+    /// This field on `cells_height` rows of the same node columns: each row's value read at its
+    /// height parameter, linear between this field's rows (the rows themselves where one grid
+    /// is a whole number of times finer than the other).
+    pub fn with_rows(&self, cells_height: usize) -> Self {
+        let (from, to) = (self.cells_height, cells_height.max(1));
+        if from == to || from == 0 {
+            return self.clone();
+        }
+        let mut values = Vec::with_capacity((to + 1) * (self.cells_face + 1));
+        for j in 0..=self.cells_face {
+            for i in 0..=to {
+                let value = if (i * from) % to == 0 {
+                    self.node(i * from / to, j)
+                } else {
+                    let g = i as f64 * from as f64 / to as f64;
+                    let k = (g as usize).min(from - 1);
+                    let t = g - k as f64;
+                    (1.0 - t) * self.node(k, j) + t * self.node(k + 1, j)
+                };
+                values.push(value);
+            }
+        }
+        Self {
+            cells_height: to,
+            cells_face: self.cells_face,
+            values,
+        }
+    }
+
+    /// Whether the field lies on the node columns of `wf` (its rows the grid's or a whole
+    /// number of times finer).
+    pub fn fits(&self, wf: &WheelFlank) -> bool {
+        self.cells_face == wf.cells_face
+            && self.cells_height >= wf.cells_height
+            && self.cells_height.is_multiple_of(wf.cells_height.max(1))
+            && self.values.len() == (self.cells_height + 1) * (self.cells_face + 1)
+    }
+
+    /// Largest mean of the field over a patch `across` high along the profile (radially) and
+    /// `along` long along the face width (m) on the flank `wf` (the field on its nodes): the
+    /// field linear between nodes, patches centred on the nodes and at quarters of the rows
+    /// between them, moved inside the flank where
+    /// they would cross its edges. Unlike the largest node value, which at a sharp feature
+    /// narrower than a row (e.g. the wear at the worm-tip trace) moves with the grid, the patch
+    /// mean converges as the grid is refined (issue 39). Same unit as the field.
+    pub fn patch_mean_max(&self, wf: &WheelFlank, across: f64, along: f64) -> f64 {
+        let field = self.with_rows(wf.cells_height);
+        let (ni, nj) = (wf.cells_height, wf.cells_face);
+        let columns: Vec<ColumnIntegral> = (0..=nj)
+            .map(|j| ColumnIntegral::new((0..=ni).map(|i| (wf.node(i, j).r, field.node(i, j)))))
+            .collect();
+        let mut best = 0.0f64;
+        for j in 0..=nj {
+            let (z0, z1) = window(wf.z[j], along, wf.z[0], wf.z[nj]);
+            // Centres on the nodes and at quarters between them.
+            for i in 0..=ni {
+                for q in 0..if i < ni { 4 } else { 1 } {
+                    let (a, b) = (wf.node(i, j).r, wf.node((i + 1).min(ni), j).r);
+                    let rc = a + (b - a) * q as f64 / 4.0;
+                    let mean_at = |k: usize| columns[k].mean(rc, across);
+                    best = best.max(face_mean(&wf.z, z0, z1, mean_at));
+                }
+            }
+        }
+        best
+    }
+
     /// Value at (r, z) of the flank `wf` (the field's grid): linear along the node columns in
     /// the grid's height parameter, linear between the two neighbouring columns; clamped at the
     /// grid's edges.
@@ -346,8 +425,15 @@ impl FlankField {
             let i = (g as usize).min(ni - 1);
             let t = g - i as f64;
             let (a, b) = (self.node(i, j), self.node(i + 1, j));
+            // The node's radius: the grid's own, or on a finer field's rows the same height
+            // parameter's.
+            let node_r = if ni == wf.cells_height {
+                wf.node(i, j).r
+            } else {
+                wf.r_low[j] + (wf.r_high[j] - wf.r_low[j]) * i as f64 / ni as f64
+            };
             match floor {
-                Some(fl) if wf.node(i, j).r < fl[j] && r >= fl[j] => b,
+                Some(fl) if node_r < fl[j] && r >= fl[j] => b,
                 _ => (1.0 - t) * a + t * b,
             }
         };
@@ -541,4 +627,86 @@ pub fn generate_flank(
         node_slopes,
         column_sign,
     })
+}
+
+/// The window of width `width` centred on `centre`, moved inside [lo, hi] (all of it when it
+/// is narrower), m.
+fn window(centre: f64, width: f64, lo: f64, hi: f64) -> (f64, f64) {
+    if hi - lo <= width {
+        return (lo, hi);
+    }
+    let a = (centre - 0.5 * width).clamp(lo, hi - width);
+    (a, a + width)
+}
+
+/// Mean over z in [z0, z1] of a quantity given on the node columns at `z` (ascending) by
+/// `at(j)`, linear between them.
+fn face_mean(z: &[f64], z0: f64, z1: f64, at: impl Fn(usize) -> f64) -> f64 {
+    if z1 <= z0 {
+        let j = z.partition_point(|&x| x < z0).min(z.len() - 1);
+        return at(j);
+    }
+    let value = |x: f64| {
+        let k = z.partition_point(|&v| v <= x).clamp(1, z.len() - 1);
+        let t = ((x - z[k - 1]) / (z[k] - z[k - 1])).clamp(0.0, 1.0);
+        (1.0 - t) * at(k - 1) + t * at(k)
+    };
+    // Trapezoids between the window's ends and the columns inside it.
+    let mut points = vec![(z0, value(z0))];
+    points.extend(
+        (0..z.len())
+            .filter(|&j| z[j] > z0 && z[j] < z1)
+            .map(|j| (z[j], at(j))),
+    );
+    points.push((z1, value(z1)));
+    let area: f64 = points
+        .windows(2)
+        .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1))
+        .sum();
+    area / (z1 - z0)
+}
+
+/// A field along one node column, linear between its nodes, with its running integral: the
+/// mean over any radial window in O(log n).
+struct ColumnIntegral {
+    r: Vec<f64>,
+    value: Vec<f64>,
+    integral: Vec<f64>,
+}
+
+impl ColumnIntegral {
+    fn new(points: impl Iterator<Item = (f64, f64)>) -> Self {
+        let (r, value): (Vec<f64>, Vec<f64>) = points.unzip();
+        let mut integral = vec![0.0; r.len()];
+        for k in 1..r.len() {
+            integral[k] = integral[k - 1] + 0.5 * (r[k] - r[k - 1]) * (value[k] + value[k - 1]);
+        }
+        Self { r, value, integral }
+    }
+
+    /// Integral from the first node to x.
+    fn integral_to(&self, x: f64) -> f64 {
+        let k = self
+            .r
+            .partition_point(|&v| v <= x)
+            .clamp(1, self.r.len() - 1);
+        let (a, b) = (self.r[k - 1], self.r[k]);
+        let d = (x - a).clamp(0.0, b - a);
+        let t = if b > a { d / (b - a) } else { 0.0 };
+        let at_x = self.value[k - 1] + t * (self.value[k] - self.value[k - 1]);
+        self.integral[k - 1] + 0.5 * d * (self.value[k - 1] + at_x)
+    }
+
+    /// Mean over the window `width` wide centred on `centre`, moved inside the column.
+    fn mean(&self, centre: f64, width: f64) -> f64 {
+        let n = self.r.len();
+        if n < 2 {
+            return self.value.first().copied().unwrap_or(0.0);
+        }
+        let (a, b) = window(centre, width, self.r[0], self.r[n - 1]);
+        if b <= a {
+            return self.value[0];
+        }
+        (self.integral_to(b) - self.integral_to(a)) / (b - a)
+    }
 }

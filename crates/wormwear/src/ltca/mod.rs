@@ -368,6 +368,34 @@ pub fn analyse_worn(
     removal: Option<&FlankField>,
     warm: Option<&WarmStart>,
 ) -> Result<Ltca, LtcaError> {
+    let change = FlankChange {
+        removal,
+        plastic_set: None,
+    };
+    analyse_changed(gear, geo, tca, settings, bending, change, warm)
+}
+
+/// How the loaded wheel flank differs from the flank as cut, normal to it, m (MODEL §7.5,
+/// §5.7): what a loaded analysis adds to the initial separations.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FlankChange<'a> {
+    /// Depth worn off (wear and pits) on the flank's node grid; None: unworn.
+    pub removal: Option<&'a FlankField>,
+    /// Plastic set (running-in) on the flank's node columns, on rows a whole number of times
+    /// finer than the grid's ([`Ltca::plastic_indentation`]); None: none.
+    pub plastic_set: Option<&'a FlankField>,
+}
+
+/// [`analyse_worn`] on a flank changed by wear and by a plastic set ([`FlankChange`]).
+pub fn analyse_changed(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    change: FlankChange,
+    warm: Option<&WarmStart>,
+) -> Result<Ltca, LtcaError> {
     let pair = ElasticPair::new(
         gear.worm_material.youngs_modulus,
         gear.worm_material.poisson_ratio,
@@ -408,10 +436,15 @@ pub fn analyse_worn(
     let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.cos();
     let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
     let band0 = settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus);
-    let node_angle = removal.map(|w| Worn::node_angles(wf, w));
-    let worn = removal
-        .zip(node_angle.as_deref())
-        .map(|(depth, node_angle)| Worn { depth, node_angle });
+    let rows_per_row = change
+        .plastic_set
+        .filter(|s| s.fits(wf) && s.cells_height > wf.cells_height)
+        .map_or_else(
+            || plastic_rows_per_row(wf, settings, band0),
+            |s| s.cells_height / wf.cells_height,
+        );
+    let changed = FlankShape::new(wf, change);
+    let worn = changed.as_ref().map(|c| c.worn(change.plastic_set));
 
     let positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
@@ -437,7 +470,8 @@ pub fn analyse_worn(
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
     // indentation (MODEL §5.7).
     let ni = wf.cells_height;
-    let (pattern, plastic_indentation) = swept_pattern(wf, tca, &positions, geo.teeth);
+    let (pattern, plastic_indentation) =
+        swept_pattern(wf, tca, &positions, geo.teeth, rows_per_row);
     let bound = settings.flow_pressure * (1.0 - 1e-9);
     let active_area = wf.active_area();
     let yielded_area: f64 = (0..pattern.len())
@@ -506,6 +540,7 @@ fn swept_pattern(
     tca: &Tca,
     positions: &[PositionResult],
     teeth: u32,
+    rows_per_row: usize,
 ) -> (Vec<f64>, FlankField) {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let tau = 2.0 * PI / teeth as f64;
@@ -520,10 +555,15 @@ fn swept_pattern(
             let mid: Vec<f64> = (0..ni)
                 .map(|i| 0.5 * (node_r(j, i) + node_r(j, i + 1)))
                 .collect();
-            let nodes: Vec<f64> = (0..=ni).map(|i| node_r(j, i)).collect();
+            // The plastic set's rows (MODEL §5.7): the grid's, rows_per_row times finer.
+            let rows = ni * rows_per_row;
+            let (low, high) = (node_r(j, 0), node_r(j, ni));
+            let fine: Vec<f64> = (0..=rows)
+                .map(|i| low + (high - low) * i as f64 / rows as f64)
+                .collect();
             (
                 passage::swept_max(samples, &mid, dt, passage::Swept::Pressure),
-                passage::swept_max(samples, &nodes, dt, passage::Swept::Plastic),
+                passage::swept_max(samples, &fine, dt, passage::Swept::Plastic),
             )
         })
         .collect();
@@ -536,9 +576,14 @@ fn swept_pattern(
             (0..ni).map(move |i| 0.5 * (mid[j * ni + i] + mid[(j + 1) * ni + i]))
         })
         .collect();
-    let mut indentation = FlankField::zeros(wf);
+    let mut indentation = FlankField::zeros_refined(wf, rows_per_row);
     indentation.values = swept.iter().flat_map(|c| c.1.iter().copied()).collect();
-    fill_between_slices(&mut indentation.values, ni + 1, &is_slice, wf);
+    fill_between_slices(
+        &mut indentation.values,
+        ni * rows_per_row + 1,
+        &is_slice,
+        wf,
+    );
     (pattern, indentation)
 }
 
@@ -570,13 +615,77 @@ fn fill_between_slices(values: &mut [f64], rows: usize, is_slice: &[bool], wf: &
     }
 }
 
-/// A worn flank as the local meshes read it (MODEL §7.5): the depth worn off normal to the
-/// flank (m), and at each node of the global grid the same depth as an angle over the node's
-/// lever |(P x n)_z| (rad), computed once per analysis.
+/// Rows of the plastic set for each row of the flank's grid (MODEL §5.7): enough for four
+/// rows across a local cell of the band `band` (m), so that the set a running-in leaves is
+/// read back by the next state's cells as they left it (sampled on the grid's own rows, a
+/// yielded band narrower than a row was missed and indented again at every state, and the set
+/// grew with the cells across the line). 1 for the purely elastic contact.
+fn plastic_rows_per_row(wf: &WheelFlank, settings: &LtcaSettings, band: f64) -> usize {
+    if !settings.flow_pressure.is_finite() {
+        return 1;
+    }
+    let row = (0..=wf.cells_face)
+        .map(|j| (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64)
+        .fold(0.0, f64::max);
+    let cell = 2.0 * band / settings.columns.max(1) as f64;
+    (4.0 * row / cell).ceil().clamp(1.0, 64.0) as usize
+}
+
+/// The changed flank on the global grid's nodes (MODEL §7.5, §5.7): the depth worn off and
+/// the whole change (wear and plastic set) normal to the flank, m.
+struct FlankShape {
+    removal: FlankField,
+    node_angle: Vec<f64>,
+    deepest: f64,
+}
+
+impl FlankShape {
+    /// None for an unchanged flank.
+    fn new(wf: &WheelFlank, change: FlankChange) -> Option<Self> {
+        if change.removal.is_none() && change.plastic_set.is_none() {
+            return None;
+        }
+        let removal = change
+            .removal
+            .cloned()
+            .unwrap_or_else(|| FlankField::zeros(wf));
+        let mut whole = removal.clone();
+        if let Some(set) = change.plastic_set {
+            for (h, s) in whole
+                .values
+                .iter_mut()
+                .zip(&set.with_rows(wf.cells_height).values)
+            {
+                *h += s;
+            }
+        }
+        Some(Self {
+            node_angle: Worn::node_angles(wf, &whole),
+            deepest: whole.max(),
+            removal,
+        })
+    }
+
+    fn worn<'a>(&'a self, plastic_set: Option<&'a FlankField>) -> Worn<'a> {
+        Worn {
+            depth: &self.removal,
+            plastic_set,
+            node_angle: &self.node_angle,
+            deepest: self.deepest,
+        }
+    }
+}
+
+/// A changed flank as the local meshes read it (MODEL §7.5, §5.7): the depth worn off normal
+/// to the flank (m, above the worm-tip trace), the plastic set on its finer rows (m), at each
+/// node of the global grid the whole change as an angle over the node's lever |(P x n)_z|
+/// (rad), and the largest change, computed once per analysis.
 #[derive(Clone, Copy)]
 struct Worn<'a> {
     depth: &'a FlankField,
+    plastic_set: Option<&'a FlankField>,
     node_angle: &'a [f64],
+    deepest: f64,
 }
 
 impl Worn<'_> {
@@ -626,7 +735,7 @@ fn local_mesh(
     let base_dz = (wf.z[1] - wf.z[0]) * step as f64;
     // Separation threshold for slices whose minimum is not a crossing (flank edges); on a worn
     // flank the edges left standing can be the first to touch: raised by the deepest wear.
-    let edge_threshold = 50e-6 + worn.map_or(0.0, |w| w.depth.max());
+    let edge_threshold = 50e-6 + worn.map_or(0.0, |w| w.deepest);
     // Line crossings of every node column at this position, to follow the line.
     let crossings: std::collections::HashMap<(i32, usize), &crate::kinematics::SliceContact> = tca
         .contact_lines
@@ -842,7 +951,10 @@ fn slice_cells(
             separation: e
                 + pos.kinematic_error
                 + worn.map_or(0.0, |w| {
-                    w.depth.at_above(wf, r, z, Some(tip_floor)) / wheel_lever
+                    // The plastic set also below the worm-tip trace: the tip's edge indents
+                    // the cells it crosses.
+                    let set = w.plastic_set.map_or(0.0, |s| s.at(wf, r, z));
+                    (w.depth.at_above(wf, r, z, Some(tip_floor)) + set) / wheel_lever
                 }),
             relief,
         });

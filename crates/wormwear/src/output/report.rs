@@ -262,7 +262,7 @@ fn key_results(h: &mut String, summary: &serde_json::Value) {
         .and_then(|s| s.last())
         .cloned()
         .unwrap_or(serde_json::Value::Null);
-    let key_results: [(&str, &serde_json::Value, f64, &str); 13] = [
+    let key_results: [(&str, &serde_json::Value, f64, &str); 14] = [
         ("Ratio", &summary["geometry"]["ratio"], 1.0, ""),
         (
             "Lead angle",
@@ -313,7 +313,18 @@ fn key_results(h: &mut String, summary: &serde_json::Value) {
             "cycles",
         ),
         ("Life simulated", &last_step["cycles"], 1.0, "cycles"),
-        ("Max wear at the end", &last_step["max_wear_m"], 1e6, "um"),
+        (
+            "Max wear at the end (patch mean)",
+            &last_step["wear_patch_max_m"],
+            1e6,
+            "um",
+        ),
+        (
+            "Max wear at the end (one node)",
+            &last_step["max_wear_m"],
+            1e6,
+            "um",
+        ),
         (
             "Backlash increase at the end",
             &last_step["backlash_increase_m"],

@@ -594,7 +594,7 @@ fn write_state(
     super::vtk::add_node_field(
         &mut surface,
         "plastic_set_um",
-        &view.state.plastic_set_after(view.ltca),
+        &view.state.plastic_set_nodes_after(view.ltca),
         UM,
     );
     super::vtk::add_node_field(&mut surface, "wear_per_cycle_um", &view.cycle.depth, UM);
@@ -656,7 +656,8 @@ fn write_tables(
             "Wear depth",
             "depth (um)",
             vec![
-                curve(&|r| r.max_wear_m * UM, "max", 1),
+                curve(&|r| r.max_wear_m * UM, "max (one node, mesh-dependent)", 1),
+                curve(&|r| r.wear_patch_max_m * UM, "max over a patch", 2),
                 curve(&|r| r.mean_wear_m * UM, "mean over the flank", 0),
             ],
         ),
@@ -746,6 +747,7 @@ pub fn steps_table(state: &WearState) -> Csv {
         "cycles",
         "step_cycles",
         "max_wear_m",
+        "wear_patch_max_m",
         "mean_wear_m",
         "worn_volume_m3",
         "backlash_m",
@@ -782,6 +784,7 @@ pub fn steps_table(state: &WearState) -> Csv {
             r.cycles,
             r.step_cycles,
             r.max_wear_m,
+            r.wear_patch_max_m,
             r.mean_wear_m,
             r.worn_volume_m3,
             r.backlash_m,
@@ -897,13 +900,14 @@ fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series> {
 /// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j
 /// across the face) its (r, z) mm, cumulative wear m, wear per cycle m, film ratio and film
 /// thickness m, damage, and the plastic set m once the state has run in
-/// ([`WearState::plastic_set_after`]).
+/// ([`WearState::plastic_set_after`], read at the nodes).
 pub fn node_table(
     wf: &crate::geometry::WheelFlank,
     state: &WearState,
     cycle: &crate::wear::CycleWear,
     plastic_set: &FlankField,
 ) -> Csv {
+    let plastic_set = plastic_set.with_rows(wf.cells_height);
     let mut csv = Csv::new(&[
         "i",
         "j",
@@ -1076,7 +1080,7 @@ impl StateMaps<'_> {
             Some(1.0),
         )?;
         files.push(path);
-        let plastic = view.state.plastic_set_after(view.ltca);
+        let plastic = view.state.plastic_set_nodes_after(view.ltca);
         let path = dir.join(format!("wear_plastic_set_map{suffix}.svg"));
         map(
             &path,

@@ -554,28 +554,36 @@ impl WearState {
         }
     }
 
-    /// The loaded flank's change so far, normal to it, m: the wear and the plastic set
-    /// (MODEL §7.5, §5.7), what the loaded analysis and the backlash see.
+    /// The loaded flank's change so far on the grid's nodes, normal to it, m: the wear and the
+    /// plastic set (MODEL §7.5, §5.7), what the backlash sees.
     pub fn flank_change(&self) -> FlankField {
         let mut change = self.removal.clone();
-        for (h, s) in change.values.iter_mut().zip(&self.plastic_set.values) {
+        let set = self.plastic_set.with_rows(change.cells_height);
+        for (h, s) in change.values.iter_mut().zip(&set.values) {
             *h += s;
         }
         change
     }
 
     /// The plastic set once the loaded analysis `l` of this state's flank has run in
-    /// (MODEL §5.7): the set plus the analysis' plastic indentation, m.
+    /// (MODEL §5.7): the set plus the analysis' plastic indentation, m, on the rows of the
+    /// indentation (finer than the grid's, [`crate::ltca::Ltca::plastic_indentation`]).
     pub fn plastic_set_after(&self, l: &Ltca) -> FlankField {
         let add = &l.plastic_indentation;
-        if self.plastic_set.values.len() != add.values.len() {
+        let mut set = self.plastic_set.with_rows(add.cells_height);
+        if set.values.len() != add.values.len() {
             return add.clone();
         }
-        let mut set = self.plastic_set.clone();
         for (s, d) in set.values.iter_mut().zip(&add.values) {
             *s += d;
         }
         set
+    }
+
+    /// [`Self::plastic_set_after`] on the grid's nodes, m.
+    pub fn plastic_set_nodes_after(&self, l: &Ltca) -> FlankField {
+        self.plastic_set_after(l)
+            .with_rows(self.removal.cells_height)
     }
 
     /// Running-in (MODEL §5.7): the plastic indentation of a loaded analysis on this state's
@@ -607,6 +615,12 @@ pub struct StepRecord {
     pub max_wear_r_m: f64,
     #[serde(default)]
     pub max_wear_z_m: f64,
+    /// Largest mean wear depth over a patch of the pressure patch's size (`[analysis]
+    /// pressure_patch_*`, default 0.5 mm along the profile by 1 mm along the face), m: the
+    /// peak wear that converges with the mesh (`max_wear_m`, one node, follows a band
+    /// narrower than a grid row at the worm-tip trace; [`FlankField::patch_mean_max`]).
+    #[serde(default)]
+    pub wear_patch_max_m: f64,
     /// Worn volume / active flank area (mean depth over the flank), m.
     pub mean_wear_m: f64,
     /// Worn volume of one tooth flank, m^3.
@@ -767,7 +781,7 @@ pub fn simulate(
     if state.damage.len() != wf.nodes.len() {
         state.damage = vec![0.0; wf.nodes.len()];
     }
-    if state.plastic_set.values.len() != wf.nodes.len() {
+    if !state.plastic_set.fits(wf) {
         state.plastic_set = FlankField::zeros(wf);
     }
     check_plan_can_end(gear, life)?;
@@ -1040,15 +1054,18 @@ impl<'a> LifeLoop<'a> {
     fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
         let mut local = *self.settings;
         local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
-        let change = state.flank_change();
-        let worn = change.values.iter().any(|&h| h != 0.0);
-        let l = crate::ltca::analyse_worn(
+        let changed = |f: &FlankField| f.values.iter().any(|&h| h != 0.0);
+        let change = crate::ltca::FlankChange {
+            removal: Some(&state.removal).filter(|f| changed(f)),
+            plastic_set: Some(&state.plastic_set).filter(|f| changed(f)),
+        };
+        let l = crate::ltca::analyse_changed(
             self.gear,
             self.geo,
             self.tca,
             &local,
             self.bending,
-            worn.then_some(&change),
+            change,
             state.warm.as_ref(),
         )
         .map_err(|source| WearError::Ltca {
@@ -1125,6 +1142,11 @@ impl<'a> LifeLoop<'a> {
             max_wear_m: state.removal.max(),
             max_wear_r_m: worst_node.map_or(f64::NAN, |n| n.r),
             max_wear_z_m: worst_node.map_or(f64::NAN, |n| n.z),
+            wear_patch_max_m: state.removal.patch_mean_max(
+                wf,
+                self.settings.patch_across,
+                self.settings.patch_along,
+            ),
             mean_wear_m: volume / self.active_area,
             worn_volume_m3: volume,
             backlash_m: b.linear_mean_m,
