@@ -173,7 +173,10 @@ pressure_patch_max_pa, the largest mean pressure over a patch of stated size)";
 
 /// The per-state results that still change by more than 5 % with the mesh (issue 39's
 /// convergence study, VALIDATION.md "Mesh convergence"): largest values at one node of the
-/// worn worm-tip trace. Listed in the wear summary as `mesh_dependent`.
+/// worn worm-tip trace or the wheel's tip edge (the peak wear's converged counterpart is
+/// `wear_patch_max_m`). Listed in the wear summary as `mesh_dependent`; no other stage reads
+/// them (the pitting forecast reads the damage field's share at its onset, the step control
+/// the largest per-cycle wear as a step size).
 pub const MESH_DEPENDENT: &[&str] = &[
     "max_wear_m",
     "max_plastic_set_m",
