@@ -136,20 +136,7 @@ fn relative_rms(pairs: impl Iterator<Item = (f64, f64)>) -> f64 {
     }
 }
 
-/// Backlash increase of the records at `cycles`, linear between records (m); None beyond them.
-pub fn backlash_at(records: &[StepRecord], cycles: f64) -> Option<f64> {
-    let k = records.iter().position(|r| r.cycles >= cycles)?;
-    if k == 0 {
-        return Some(records[0].backlash_increase_m);
-    }
-    let (a, b) = (&records[k - 1], &records[k]);
-    let t = if b.cycles > a.cycles {
-        (cycles - a.cycles) / (b.cycles - a.cycles)
-    } else {
-        1.0
-    };
-    Some(a.backlash_increase_m + t * (b.backlash_increase_m - a.backlash_increase_m))
-}
+pub use crate::wear::backlash_at;
 
 /// K from a measured backlash increase curve, `measured` = (wheel cycles, backlash increase m,
 /// tangential at r2 as on test rigs), by the inverse problem: `simulate(K)` runs the life (to at

@@ -29,7 +29,7 @@ pub mod ltca;
 pub mod lubrication;
 pub mod output;
 pub mod pitting;
-pub mod plot;
+pub use output::plot;
 pub mod rating;
 pub mod rexs;
 pub mod runner;

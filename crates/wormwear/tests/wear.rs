@@ -759,7 +759,10 @@ fn the_peak_wear_converges_with_the_global_grid() {
         })
         .collect();
     let change = |f: &dyn Fn(&wear::StepRecord) -> f64| (f(&ends[1]) / f(&ends[0]) - 1.0).abs();
-    assert!(ends[0].wear_patch_max_m > 1.5 * ends[0].mean_wear_m, "no peak to converge");
+    assert!(
+        ends[0].wear_patch_max_m > 1.5 * ends[0].mean_wear_m,
+        "no peak to converge"
+    );
     assert!(change(&|r| r.wear_patch_max_m) < 0.05);
     assert!(change(&|r| r.mean_wear_m) < 0.05);
 }

@@ -38,7 +38,7 @@ pub struct WheelBending {
     /// (sector clamped at the rim or at the hub).
     pub shaft_compliance: Option<Vec<f64>>,
     #[serde(skip)]
-    cores: super::worm_model::CoreCache,
+    cores: super::relation::CoreCache,
 }
 
 impl WheelBending {
@@ -209,7 +209,7 @@ impl BendingModel for WheelBending {
         let (groups, coords) = self.groups(cells);
         // Symmetrised core (reciprocity; the before/after fits are each other's transposes up to
         // the sector's end effects).
-        let teeth = super::worm_model::relation_low_rank(
+        let teeth = super::relation::relation_low_rank(
             &self.basis,
             &self.same,
             &self.before,
@@ -243,7 +243,7 @@ impl WheelBending {
 
     /// Core of the teeth present (cached).
     pub(crate) fn teeth_core(&self, present: &[i64]) -> std::sync::Arc<Vec<f64>> {
-        super::worm_model::cached_core(&self.same, &self.before, &self.after, present, &self.cores)
+        super::relation::cached_core(&self.same, &self.before, &self.after, present, &self.cores)
     }
 
     /// Writes each cell's wrench g_i = (n_i, M_i x n_i) (fixed wheel frame) at columns

@@ -16,6 +16,12 @@ const UM: f64 = 1e6;
 const MPA: f64 = 1e-6;
 
 /// Summary of the loaded analysis (units in the names).
+/// What a summary's `max_pressure_pa` means.
+pub const MAX_PRESSURE_DEFINITION: &str = "largest pressure of the local contact cells over \
+the positions (the published P_max; with the default plastic limit at most the flow pressure \
+and mesh-converged; with contact = elastic it grows with mesh refinement at a sharp edge: see \
+pressure_patch_max_pa, the largest mean pressure over a patch of stated size)";
+
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LtcaSummary {
     pub bending_model: String,
@@ -100,7 +106,7 @@ impl LtcaSummary {
             pressure_patch_max_pa: ltca.pressure_patch_max,
             pressure_patch_across_mm: ltca.pressure_patch_size[0] * MM,
             pressure_patch_along_mm: ltca.pressure_patch_size[1] * MM,
-            max_pressure_definition: crate::output::wear::MAX_PRESSURE_DEFINITION,
+            max_pressure_definition: MAX_PRESSURE_DEFINITION,
             mean_pressure_pa: ltca.mean_pressure,
             contact_area_fraction: ltca.s0,
             s1: ltca.s1,

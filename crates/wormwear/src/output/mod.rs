@@ -6,8 +6,8 @@
 
 pub mod geometry;
 pub mod ltca;
+pub mod plot;
 pub mod report;
-pub mod sweep;
 pub mod tca;
 pub mod vtk;
 pub mod wear;
@@ -98,31 +98,7 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     }
 }
 
-/// A number of cycles for titles and messages: "180 000" below a million (thin groups of
-/// three digits), "1.25 million" above.
-pub fn cycles_label(cycles: f64) -> String {
-    if !cycles.is_finite() {
-        return format!("{cycles}");
-    }
-    if cycles.abs() >= 1e6 {
-        let m = cycles / 1e6;
-        let s = format!("{m:.3}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        return format!("{s} million");
-    }
-    let digits = format!("{}", cycles.round().abs() as u64);
-    let mut out = String::new();
-    for (k, ch) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k) % 3 == 0 {
-            out.push(' ');
-        }
-        out.push(ch);
-    }
-    if cycles < 0.0 {
-        out.insert(0, '-');
-    }
-    out
-}
+pub use crate::wear::cycles_label;
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
@@ -315,7 +291,7 @@ pub fn write_calibration_curves(
 ) -> Result<(), OutputError> {
     let mut csv = Csv::new(&["cycles", "measured_um", "simulated_um"]);
     for &(c, b) in measured {
-        let sim = crate::calibration::backlash_at(records, c).unwrap_or(f64::NAN);
+        let sim = crate::wear::backlash_at(records, c).unwrap_or(f64::NAN);
         csv.row(&[c, b * 1e6, sim * 1e6]);
     }
     csv.write(&dir.join("calibration_backlash.csv"))?;

@@ -165,11 +165,7 @@ impl LimitsSummary {
     }
 }
 
-/// What a summary's `max_pressure_pa` means.
-pub const MAX_PRESSURE_DEFINITION: &str = "largest pressure of the local contact cells over \
-the positions (the published P_max; with the default plastic limit at most the flow pressure \
-and mesh-converged; with contact = elastic it grows with mesh refinement at a sharp edge: see \
-pressure_patch_max_pa, the largest mean pressure over a patch of stated size)";
+pub use super::ltca::MAX_PRESSURE_DEFINITION;
 
 /// The per-state results that still change by more than 5 % with the mesh (issue 39's
 /// convergence study, VALIDATION.md "Mesh convergence"): largest values at one node of the

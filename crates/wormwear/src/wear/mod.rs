@@ -417,10 +417,7 @@ impl WearLimits {
 
     /// Why the life ends at this state (its record), if a limit it stops at is passed.
     pub fn passed(&self, record: &StepRecord) -> Option<String> {
-        let end = format!(
-            "the life ends at {} cycles",
-            crate::output::cycles_label(record.cycles)
-        );
+        let end = format!("the life ends at {} cycles", cycles_label(record.cycles));
         let loss = record.backlash_increase_m * self.flank_loss_per_backlash;
         let at = |what: &str, limit: f64| {
             format!(
@@ -492,6 +489,47 @@ fn tooth_thickness(geo: &Geometry, loaded: crate::geometry::Flank) -> Vec<f64> {
             delta * node_lever(wf, k)
         })
         .collect()
+}
+
+/// A number of cycles for titles and messages: "180 000" below a million (thin groups of
+/// three digits), "1.25 million" above.
+pub fn cycles_label(cycles: f64) -> String {
+    if !cycles.is_finite() {
+        return format!("{cycles}");
+    }
+    if cycles.abs() >= 1e6 {
+        let m = cycles / 1e6;
+        let s = format!("{m:.3}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        return format!("{s} million");
+    }
+    let digits = format!("{}", cycles.round().abs() as u64);
+    let mut out = String::new();
+    for (k, ch) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(ch);
+    }
+    if cycles < 0.0 {
+        out.insert(0, '-');
+    }
+    out
+}
+
+/// Backlash increase of the records at `cycles`, linear between records (m); None beyond them.
+pub fn backlash_at(records: &[StepRecord], cycles: f64) -> Option<f64> {
+    let k = records.iter().position(|r| r.cycles >= cycles)?;
+    if k == 0 {
+        return Some(records[0].backlash_increase_m);
+    }
+    let (a, b) = (&records[k - 1], &records[k]);
+    let t = if b.cycles > a.cycles {
+        (cycles - a.cycles) / (b.cycles - a.cycles)
+    } else {
+        1.0
+    };
+    Some(a.backlash_increase_m + t * (b.backlash_increase_m - a.backlash_increase_m))
 }
 
 /// State of a life run after a completed step: what a checkpoint holds.

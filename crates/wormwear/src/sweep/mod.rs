@@ -26,6 +26,8 @@ use crate::{Request, Results, RunError, Source, Stage};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+pub mod html;
+
 /// Why a sweep could not start or finish (a failing variant is a row, not an error).
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
@@ -722,7 +724,7 @@ pub fn run(
         .flatten()
         .collect();
     write_summary(sweep, &rows, dir)?;
-    crate::output::sweep::write_html(dir, sweep, &rows)?;
+    html::write_html(dir, sweep, &rows)?;
     Ok(rows)
 }
 

@@ -2,9 +2,9 @@
 //! numeric varied parameter, each key result against it (`plots/*.svg`), one curve per
 //! combination of the other parameters' values.
 
-use super::OutputError;
+use super::{Row, Sweep};
+use crate::output::OutputError;
 use crate::plot::{line_chart, Series};
-use crate::sweep::{Row, Sweep};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -213,7 +213,7 @@ pub fn write_html(dir: &Path, sweep: &Sweep, rows: &[Row]) -> Result<PathBuf, Ou
     }
     h.push_str("</body></html>\n");
     let path = dir.join("sweep.html");
-    super::write_atomic(&path, h.as_bytes())?;
+    crate::output::write_atomic(&path, h.as_bytes())?;
     Ok(path)
 }
 

@@ -1,7 +1,7 @@
 //! SVG charts (plotters, SVG backend only: no system font library needed). One consistent
 //! style for every stage: white background, labelled axes with units, legend when useful.
 
-use crate::output::{write_atomic, OutputError};
+use super::{write_atomic, OutputError};
 use plotters::prelude::*;
 use std::path::Path;
 
