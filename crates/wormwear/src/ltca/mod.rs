@@ -408,34 +408,7 @@ pub fn analyse_changed(
         Torque::Worm(t) => (Some(t), t * gear.ratio()),
         Torque::Wheel(t) => (None, t),
     };
-    // Line-load estimate for the band width: wheel torque / lever / line length.
-    let step = settings.slice_step.max(1);
-    let slice_dz = wf.z[1] - wf.z[0];
-    let mut lengths = Vec::new();
-    for n in 0..tca.positions.len() {
-        let count = tca
-            .contact_lines
-            .iter()
-            .filter(|c| c.position == n && !c.at_end && c.slice % step == 0)
-            .count();
-        lengths.push(count as f64 * slice_dz * step as f64);
-    }
-    let mean_length = lengths.iter().sum::<f64>() / lengths.len() as f64;
-    let radii: Vec<f64> = tca
-        .contact_lines
-        .iter()
-        .filter(|c| !c.at_end && c.curvature_radius.is_finite())
-        .map(|c| c.curvature_radius)
-        .collect();
-    let radius = if radii.is_empty() {
-        0.03
-    } else {
-        radii.iter().sum::<f64>() / radii.len() as f64
-    };
-    // Lever of the normal about the wheel axis, |(P x n)_z| ~ r2 cos(alpha_n).
-    let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.cos();
-    let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
-    let band0 = settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus);
+    let band0 = initial_band(gear, tca, wf, settings, &pair, wheel_torque_guess);
     let rows_per_row = change
         .plastic_set
         .filter(|s| s.fits(wf) && s.cells_height > wf.cells_height)
@@ -469,41 +442,17 @@ pub fn analyse_changed(
 
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
     // indentation (MODEL §5.7).
-    let ni = wf.cells_height;
     let (pattern, plastic_indentation) =
         swept_pattern(wf, tca, &positions, geo.teeth, rows_per_row);
-    let bound = settings.flow_pressure * (1.0 - 1e-9);
-    let active_area = wf.active_area();
-    let yielded_area: f64 = (0..pattern.len())
-        .filter(|&k| pattern[k] >= bound)
-        .map(|k| wf.cell_area[k])
-        .sum();
-    let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
-    let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
+    let stats = PatternStats::of(wf, &pattern, settings.flow_pressure);
     // The largest local cell (the published P_max): the pattern's cell centres read the
     // profiles between cell centres, which can only be lower.
     let max_pressure = positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
-    let mean_pressure = if loaded.is_empty() {
-        0.0
-    } else {
-        loaded.iter().map(|&k| pattern[k]).sum::<f64>() / loaded.len() as f64
-    };
-    let above: f64 = loaded
-        .iter()
-        .filter(|&&k| pattern[k] > mean_pressure)
-        .map(|&k| wf.cell_area[k])
-        .sum();
     let pressure_patch_max =
         max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
-    let wheel_torque =
-        positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
-    let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
     let ratio = geo.teeth as f64 / gear.worm.starts as f64;
-    let power_balance = wheel_torque / (ratio * worm_torque) - 1.0;
-    let peak = (0..pattern.len())
-        .max_by(|&a, &b| pattern[a].total_cmp(&pattern[b]))
-        .map_or(0.0, |k| 0.5 * (wf.z[k / ni] + wf.z[k / ni + 1]));
-    let warnings = power_balance_warnings(power_balance, wheel_torque, ratio, worm_torque, peak);
+    let (worm_torque, wheel_torque, power_balance, warnings) =
+        torque_balance(&positions, ratio, wf, &pattern);
     Ok(Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -511,23 +460,127 @@ pub fn analyse_changed(
         positions,
         pattern,
         max_pressure,
-        mean_pressure,
-        s0: contact_area / active_area,
-        s1: above / active_area,
-        s2: if contact_area > 0.0 {
-            above / contact_area
-        } else {
-            0.0
-        },
+        mean_pressure: stats.mean_pressure,
+        s0: stats.s0,
+        s1: stats.s1,
+        s2: stats.s2,
         pressure_patch_max,
         pressure_patch_size: [settings.patch_across, settings.patch_along],
         plastic_indentation,
-        yielded_area_fraction: yielded_area / active_area,
+        yielded_area_fraction: stats.yielded_area_fraction,
         worm_torque,
         wheel_torque,
         power_balance,
         warnings,
     })
+}
+
+/// The positions' mean worm and wheel torques (N m), the frictionless power balance
+/// wheel torque / (ratio x worm torque) - 1 and its warnings, which name the face position
+/// (m) of the pattern's peak.
+fn torque_balance(
+    positions: &[PositionResult],
+    ratio: f64,
+    wf: &WheelFlank,
+    pattern: &[f64],
+) -> (f64, f64, f64, Vec<String>) {
+    let ni = wf.cells_height;
+    let wheel_torque =
+        positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
+    let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
+    let power_balance = wheel_torque / (ratio * worm_torque) - 1.0;
+    let peak = (0..pattern.len())
+        .max_by(|&a, &b| pattern[a].total_cmp(&pattern[b]))
+        .map_or(0.0, |k| 0.5 * (wf.z[k / ni] + wf.z[k / ni + 1]));
+    let warnings = power_balance_warnings(power_balance, wheel_torque, ratio, worm_torque, peak);
+    (worm_torque, wheel_torque, power_balance, warnings)
+}
+
+/// The loaded pattern's statistics (MODEL §5.6, §5.7): the mean pressure of the loaded cells
+/// (Pa), the loaded share of the active flank S0, the share above the mean S1 (of the active
+/// flank) and S2 (of the loaded area), and the share at the flow pressure `flow_pressure`.
+struct PatternStats {
+    mean_pressure: f64,
+    s0: f64,
+    s1: f64,
+    s2: f64,
+    yielded_area_fraction: f64,
+}
+
+impl PatternStats {
+    fn of(wf: &WheelFlank, pattern: &[f64], flow_pressure: f64) -> Self {
+        let bound = flow_pressure * (1.0 - 1e-9);
+        let active_area = wf.active_area();
+        let yielded_area: f64 = (0..pattern.len())
+            .filter(|&k| pattern[k] >= bound)
+            .map(|k| wf.cell_area[k])
+            .sum();
+        let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
+        let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
+        let mean_pressure = if loaded.is_empty() {
+            0.0
+        } else {
+            loaded.iter().map(|&k| pattern[k]).sum::<f64>() / loaded.len() as f64
+        };
+        let above: f64 = loaded
+            .iter()
+            .filter(|&&k| pattern[k] > mean_pressure)
+            .map(|&k| wf.cell_area[k])
+            .sum();
+        Self {
+            mean_pressure,
+            s0: contact_area / active_area,
+            s1: above / active_area,
+            s2: if contact_area > 0.0 {
+                above / contact_area
+            } else {
+                0.0
+            },
+            yielded_area_fraction: yielded_area / active_area,
+        }
+    }
+}
+
+/// Half-width of the local meshes' band across the line before any widening (MODEL §5.1), m:
+/// `band_factor` Hertz half-widths at the mean line load (the wheel torque `wheel_torque` N m
+/// over the normal's lever and the mean line length of the TCA's positions) and the lines'
+/// mean curvature radius.
+fn initial_band(
+    gear: &GearSet,
+    tca: &Tca,
+    wf: &WheelFlank,
+    settings: &LtcaSettings,
+    pair: &ElasticPair,
+    wheel_torque_guess: f64,
+) -> f64 {
+    // Line-load estimate for the band width: wheel torque / lever / line length.
+    let step = settings.slice_step.max(1);
+    let slice_dz = wf.z[1] - wf.z[0];
+    let mut lengths = Vec::new();
+    for n in 0..tca.positions.len() {
+        let count = tca
+            .contact_lines
+            .iter()
+            .filter(|c| c.position == n && !c.at_end && c.slice % step == 0)
+            .count();
+        lengths.push(count as f64 * slice_dz * step as f64);
+    }
+    let mean_length = lengths.iter().sum::<f64>() / lengths.len() as f64;
+    let radii: Vec<f64> = tca
+        .contact_lines
+        .iter()
+        .filter(|c| !c.at_end && c.curvature_radius.is_finite())
+        .map(|c| c.curvature_radius)
+        .collect();
+    let radius = if radii.is_empty() {
+        0.03
+    } else {
+        radii.iter().sum::<f64>() / radii.len() as f64
+    };
+    // Lever of the normal about the wheel axis, |(P x n)_z| ~ r2 cos(alpha_n).
+    let lever_est = gear.wheel_reference_radius() * gear.worm.normal_pressure_angle.cos();
+    let w_mean = wheel_torque_guess / lever_est / mean_length.max(1e-6);
+    settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus)
 }
 
 /// The loaded pattern (MODEL §5.6) and the plastic indentation (MODEL §5.7) of the band's
