@@ -47,6 +47,132 @@ pub struct CycleWear {
     pub hertz_half_width: FlankField,
 }
 
+/// Rolling velocities of every node of the loaded flank (u1, u2; m/s); where the TCA has
+/// none (nodes at the border of the region the worm flank reaches, whose surface gradient is
+/// undefined), the nearest node of the same column that has them.
+fn rolling_velocities(wf: &WheelFlank, tca: &Tca) -> Vec<(f64, f64)> {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    (0..=nj)
+        .flat_map(|j| {
+            let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
+            let valid: Vec<usize> = column
+                .iter()
+                .copied()
+                .filter(|&k| tca.node_contact[k].u2.is_finite())
+                .collect();
+            column
+                .iter()
+                .map(|&k| {
+                    let src = valid
+                        .iter()
+                        .copied()
+                        .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
+                        .unwrap_or(k);
+                    let c = &tca.node_contact[src];
+                    (c.u1, c.u2)
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// What the wear of one cycle reads at every passage of the band over a node ([`per_cycle`]):
+/// the gear, the flank, the TCA's sliding, the rolling velocities, the time between positions
+/// (rad of wheel rotation) and the wheel speed (rad/s), E' (Pa), the dry wear coefficient,
+/// the hardness (Pa) and the film load's reading.
+struct PassageWear<'a> {
+    gear: &'a GearSet,
+    wf: &'a WheelFlank,
+    tca: &'a Tca,
+    rolling: Vec<(f64, f64)>,
+    dt: f64,
+    wheel_speed: f64,
+    e_prime: f64,
+    k_dry: f64,
+    hardness: f64,
+    film_load: FilmLoad,
+}
+
+impl PassageWear<'_> {
+    /// Per node of column j, from the band's instants on it: depth per cycle, lambda, film,
+    /// line load, band half-width, and the relative radius at the passage of the largest line
+    /// load (MODEL §7.2, §6).
+    fn column(&self, j: usize, samples: &mut [crate::ltca::passage::Sample]) -> Vec<[f64; 6]> {
+        let ni = self.wf.cells_height;
+        let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
+        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+        for pair in samples.windows(2) {
+            // Consecutive instants of the same engagement only.
+            let Some(passage) = Passage::between(&pair[0], &pair[1], self.dt) else {
+                continue;
+            };
+            for (i, o) in out.iter_mut().enumerate() {
+                self.node(j * (ni + 1) + i, &passage, o);
+            }
+        }
+        out
+    }
+
+    /// Adds one passage over node k to its entry `o` ([`Self::column`]).
+    fn node(&self, k: usize, passage: &Passage, o: &mut [f64; 6]) {
+        let (a, b) = (passage.a, passage.b);
+        let duration = (b.time - a.time) / self.wheel_speed;
+        let (lo, hi, steps) = (passage.lo, passage.hi, passage.steps);
+        let w = 0.5 * (a.line_load + b.line_load);
+        let fill = |x: f64, y: f64| {
+            if !x.is_finite() {
+                y
+            } else if !y.is_finite() {
+                x
+            } else {
+                0.5 * (x + y)
+            }
+        };
+        let node = &self.wf.nodes[k];
+        if node.r < lo || node.r > hi {
+            return;
+        }
+        let nc = &self.tca.node_contact[k];
+        let (u1, u2) = self.rolling[k];
+        let mut integral = 0.0;
+        for m in 0..steps {
+            integral += passage.pressure(node.r, (m as f64 + 0.5) / steps as f64);
+        }
+        integral *= duration / steps as f64;
+        if integral <= 0.0 {
+            return;
+        }
+        // The film of the line contact with the local line load (MODEL §6, §12 h), or, as a
+        // refinement, with at least the Hertz load of the band's peak pressure
+        // (w = 2 pi R p0^2 / E').
+        let radius = fill(a.radius, b.radius);
+        let peak = a.pressure.max(b.pressure);
+        let film_line_load = match self.film_load {
+            FilmLoad::LoadedAnalysis => w,
+            FilmLoad::HertzPeakFloor => w.max(2.0 * PI * radius * peak * peak / self.e_prime),
+        };
+        let contact = LineContact {
+            radius,
+            u1,
+            u2,
+            line_load: film_line_load,
+            pressure: peak,
+        };
+        let fl = lubrication::film(&self.gear.lubricant, self.e_prime, &contact);
+        let kw = lubrication::wear_coefficient(self.k_dry, fl.lambda);
+        o[0] += kw / self.hardness * nc.sliding_speed * integral;
+        if o[1].is_nan() || fl.lambda < o[1] {
+            o[1] = fl.lambda;
+            o[2] = fl.h_min * fl.thermal_factor;
+        }
+        if w > o[3] {
+            o[3] = w;
+            o[5] = radius;
+        }
+        o[4] = o[4].max(a.half_width.max(b.half_width));
+    }
+}
+
 /// Wear of one mesh cycle from the loaded analysis (MODEL §7.1-7.2), on the loaded flank.
 ///
 /// Between two consecutive instants a, b of the reference tooth on a node column, the loaded
@@ -65,7 +191,7 @@ pub fn per_cycle(
     film_load: FilmLoad,
 ) -> CycleWear {
     let wf = geo.wheel_flank(tca.loaded_flank);
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let ni = wf.cells_height;
     let tau = 2.0 * PI / geo.teeth as f64;
     let np = tca.positions.len();
     let dt = tau / np as f64;
@@ -91,108 +217,23 @@ pub fn per_cycle(
     let mut contact_radius = FlankField::zeros(wf);
     lambda.values.fill(f64::NAN);
     film.values.fill(f64::NAN);
-    // Rolling velocities per node; where the TCA has none (nodes at the border of the region
-    // the worm flank reaches, whose surface gradient is undefined), the nearest node of the
-    // same column that has them.
-    let rolling: Vec<(f64, f64)> = (0..=nj)
-        .flat_map(|j| {
-            let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
-            let valid: Vec<usize> = column
-                .iter()
-                .copied()
-                .filter(|&k| tca.node_contact[k].u2.is_finite())
-                .collect();
-            column
-                .iter()
-                .map(|&k| {
-                    let src = valid
-                        .iter()
-                        .copied()
-                        .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
-                        .unwrap_or(k);
-                    let c = &tca.node_contact[src];
-                    (c.u1, c.u2)
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect();
+    let context = PassageWear {
+        gear,
+        wf,
+        tca,
+        rolling: rolling_velocities(wf, tca),
+        dt,
+        wheel_speed,
+        e_prime,
+        k_dry,
+        hardness,
+        film_load,
+    };
     // Node columns are independent (each writes its own nodes): in parallel, then gathered.
-    // Per node of a column: depth, lambda, film, line load, band half-width, and the relative
-    // radius at the passage of the largest line load.
     let per_column: Vec<Vec<[f64; 6]>> = columns
         .par_iter_mut()
         .enumerate()
-        .map(|(j, samples)| {
-            let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
-            samples.sort_by(|a, b| a.time.total_cmp(&b.time));
-            for pair in samples.windows(2) {
-                // Consecutive instants of the same engagement only.
-                let Some(passage) = Passage::between(&pair[0], &pair[1], dt) else {
-                    continue;
-                };
-                let (a, b) = (passage.a, passage.b);
-                let duration = (b.time - a.time) / wheel_speed;
-                let (lo, hi, steps) = (passage.lo, passage.hi, passage.steps);
-                let w = 0.5 * (a.line_load + b.line_load);
-                let fill = |x: f64, y: f64| {
-                    if !x.is_finite() {
-                        y
-                    } else if !y.is_finite() {
-                        x
-                    } else {
-                        0.5 * (x + y)
-                    }
-                };
-                for (i, o) in out.iter_mut().enumerate() {
-                    let k = j * (ni + 1) + i;
-                    let node = &wf.nodes[k];
-                    if node.r < lo || node.r > hi {
-                        continue;
-                    }
-                    let nc = &tca.node_contact[k];
-                    let (u1, u2) = rolling[k];
-                    let mut integral = 0.0;
-                    for m in 0..steps {
-                        integral += passage.pressure(node.r, (m as f64 + 0.5) / steps as f64);
-                    }
-                    integral *= duration / steps as f64;
-                    if integral <= 0.0 {
-                        continue;
-                    }
-                    // The film of the line contact with the local line load (MODEL §6, §12 h),
-                    // or, as a refinement, with at least the Hertz load of the band's peak
-                    // pressure (w = 2 pi R p0^2 / E').
-                    let radius = fill(a.radius, b.radius);
-                    let peak = a.pressure.max(b.pressure);
-                    let film_line_load = match film_load {
-                        FilmLoad::LoadedAnalysis => w,
-                        FilmLoad::HertzPeakFloor => {
-                            w.max(2.0 * PI * radius * peak * peak / e_prime)
-                        }
-                    };
-                    let contact = LineContact {
-                        radius,
-                        u1,
-                        u2,
-                        line_load: film_line_load,
-                        pressure: peak,
-                    };
-                    let fl = lubrication::film(&gear.lubricant, e_prime, &contact);
-                    let kw = lubrication::wear_coefficient(k_dry, fl.lambda);
-                    o[0] += kw / hardness * nc.sliding_speed * integral;
-                    if o[1].is_nan() || fl.lambda < o[1] {
-                        o[1] = fl.lambda;
-                        o[2] = fl.h_min * fl.thermal_factor;
-                    }
-                    if w > o[3] {
-                        o[3] = w;
-                        o[5] = radius;
-                    }
-                    o[4] = o[4].max(a.half_width.max(b.half_width));
-                }
-            }
-            out
-        })
+        .map(|(j, samples)| context.column(j, samples))
         .collect();
     for (j, out) in per_column.iter().enumerate() {
         for (i, o) in out.iter().enumerate() {
