@@ -651,18 +651,21 @@ fn face_mean(z: &[f64], z0: f64, z1: f64, at: impl Fn(usize) -> f64) -> f64 {
         let t = ((x - z[k - 1]) / (z[k] - z[k - 1])).clamp(0.0, 1.0);
         (1.0 - t) * at(k - 1) + t * at(k)
     };
-    // Trapezoids between the window's ends and the columns inside it.
-    let mut points = vec![(z0, value(z0))];
-    points.extend(
-        (0..z.len())
-            .filter(|&j| z[j] > z0 && z[j] < z1)
-            .map(|j| (z[j], at(j))),
-    );
-    points.push((z1, value(z1)));
-    let area: f64 = points
-        .windows(2)
-        .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1))
-        .sum();
+    // Trapezoids between the window's ends and the columns inside it (no allocation: one
+    // call per candidate patch).
+    let first = z.partition_point(|&x| x <= z0);
+    let mut previous = (z0, value(z0));
+    let mut area = 0.0;
+    for (j, &zj) in z.iter().enumerate().skip(first) {
+        if zj >= z1 {
+            break;
+        }
+        let here = (zj, at(j));
+        area += 0.5 * (here.0 - previous.0) * (previous.1 + here.1);
+        previous = here;
+    }
+    let end = (z1, value(z1));
+    area += 0.5 * (end.0 - previous.0) * (previous.1 + end.1);
     area / (z1 - z0)
 }
 
