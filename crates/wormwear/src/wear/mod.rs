@@ -1164,19 +1164,10 @@ impl<'a> LifeLoop<'a> {
         Ok((l, band))
     }
 
-    /// The record of a state (MODEL §7.7, §12 j, §12 k).
-    fn record(
-        &self,
-        state: &WearState,
-        l: &Ltca,
-        cw: &CycleWear,
-        phase: Option<(usize, Phase, f64)>,
-        step_cycles: f64,
-        substeps: usize,
-    ) -> StepRecord {
-        let wf = self.wf;
-        let change = state.flank_change();
-        let per_position = self.backlash.per_position(&change);
+    /// The rigid lag the flank change `change` adds at each position (rad, MODEL §12 j) and
+    /// each position's TE, TE relative to that lag, tooth loads and largest pressure.
+    fn position_states(&self, l: &Ltca, change: &FlankField) -> (Vec<f64>, Vec<PositionState>) {
+        let per_position = self.backlash.per_position(change);
         let lag: Vec<f64> = per_position
             .iter()
             .zip(&self.initial_backlash)
@@ -1192,6 +1183,22 @@ impl<'a> LifeLoop<'a> {
                 max_pressure_pa: p.max_pressure,
             })
             .collect();
+        (lag, positions)
+    }
+
+    /// The record of a state (MODEL §7.7, §12 j, §12 k).
+    fn record(
+        &self,
+        state: &WearState,
+        l: &Ltca,
+        cw: &CycleWear,
+        phase: Option<(usize, Phase, f64)>,
+        step_cycles: f64,
+        substeps: usize,
+    ) -> StepRecord {
+        let wf = self.wf;
+        let change = state.flank_change();
+        let (lag, positions) = self.position_states(l, &change);
         let b = self.backlash.stats(&change);
         let initial = self.initial_backlash.iter().sum::<f64>()
             / self.initial_backlash.len().max(1) as f64
