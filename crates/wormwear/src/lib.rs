@@ -33,6 +33,7 @@ pub use output::plot;
 pub mod rating;
 pub mod rexs;
 pub mod runner;
+pub mod subsurface;
 pub mod sweep;
 pub mod validation;
 pub mod wear;

@@ -1,0 +1,494 @@
+//! Sub-surface stress below the wheel flank and the equivalent pressure of the fatigue
+//! criterion (MODEL §8.1).
+//!
+//! **Field.** A uniform pressure on a rectangle of half sides (a, b) over the elastic half-space
+//! has a closed-form stress field (Love 1929; K. L. Johnson, Contact Mechanics, 1985, §3.2 and
+//! §3.3): with Love's potentials psi1 = integral of p ln(rho + z) and psi = d psi1/dz = integral
+//! of p / rho over the loaded area (rho the distance from a surface point to the field point,
+//! z the depth), the stresses are (tension positive)
+//!
+//!   sigma_x  = (1/2pi) [2 nu psi_z - z psi_xx - (1 - 2 nu) psi1_xx]
+//!   sigma_y  = (1/2pi) [2 nu psi_z - z psi_yy - (1 - 2 nu) psi1_yy]
+//!   sigma_z  = (1/2pi) [psi_z - z psi_zz]
+//!   tau_xy   = -(1/2pi) [(1 - 2 nu) psi1_xy + z psi_xy]
+//!   tau_xz   = -(1/2pi) z psi_xz,      tau_yz = -(1/2pi) z psi_yz
+//!
+//! and every derivative of psi and psi1 over a rectangle is a sum over its four corners of a
+//! corner function of the offsets (X, Y) from the corner and the depth ([`corner`]; the second
+//! derivatives psi1_yy and psi_yy follow from Laplace's equation). The field of the loaded
+//! flank is the sum over its cells, each in its own tangent plane, rotated into the frame of
+//! the cell below which the stress is read (x across the contact line, y along it, z into the
+//! wheel). The tangential traction is zero: friction is not modelled yet (MODEL §13).
+//!
+//! **Criterion.** p_eq = max over depth of tau_1 / 0.300, tau_1 = (sigma_1 - sigma_3) / 2 the
+//! principal shear stress: p0 below a Hertz line contact (tau_1 = 0.300 p0 at z = 0.786 a, any
+//! nu), so the bronze's pressure–life curve applies unchanged; the depth of that maximum is the
+//! pit depth. Option: the orthogonal shear |tau_xz| / 0.25 (0.25 p0 at z = 0.5 a, line contact).
+
+use crate::contact::ContactCell;
+use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::ops::Range;
+
+/// The largest principal shear stress below a Hertz line contact over its peak pressure, any
+/// Poisson ratio (Johnson 1985, §4.2): tau_1 = 0.300 p0 at z = 0.786 a.
+pub const LINE_CONTACT_PRINCIPAL_SHEAR: f64 = 0.300;
+/// The largest orthogonal shear |tau_xz| below a Hertz line contact over p0 (0.25 p0 at
+/// z = 0.5 a, x = +-0.87 a; Johnson 1985, §4.2).
+pub const LINE_CONTACT_ORTHOGONAL_SHEAR: f64 = 0.25;
+
+/// A symmetric stress tensor [xx, yy, zz, xy, xz, yz], Pa (tension positive).
+pub type Stress = [f64; 6];
+
+/// The stress the fatigue criterion reads (MODEL §8.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Criterion {
+    /// Principal shear tau_1 = (sigma_1 - sigma_3) / 2, over 0.300.
+    PrincipalShear,
+    /// Orthogonal shear |tau_xz| (x across the contact line), over 0.25.
+    OrthogonalShear,
+}
+
+impl Criterion {
+    /// The criterion's stress of a tensor (Pa) and its value below a Hertz line contact per
+    /// unit peak pressure.
+    fn read(self, s: &Stress) -> f64 {
+        match self {
+            Criterion::PrincipalShear => principal_shear(s) / LINE_CONTACT_PRINCIPAL_SHEAR,
+            Criterion::OrthogonalShear => s[4].abs() / LINE_CONTACT_ORTHOGONAL_SHEAR,
+        }
+    }
+}
+
+/// How the equivalent pressure is evaluated (MODEL §8.1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubsurfaceSettings {
+    /// Poisson's ratio of the body below the surface (the wheel's bronze).
+    pub poisson: f64,
+    pub criterion: Criterion,
+    /// Depths of the search: `depth_levels` (at least 3) from `depth_from` to `depth_to` times
+    /// the loaded half-width a of the row. The layer above `depth_from` is left out: there a
+    /// stress raiser narrower than a (an edge ridge, a one-cell spike) sets the stress, which is
+    /// the plastic limit's and the wear's (MODEL §5.7, §7), not sub-surface fatigue's; the
+    /// maxima of the Hertz line (0.786 a) and point (0.48 a) contacts lie inside.
+    pub depth_levels: usize,
+    pub depth_from: f64,
+    pub depth_to: f64,
+    /// Sources farther than this many loaded half-widths (in the surface) from the field point
+    /// are left out of its sum.
+    pub reach: f64,
+}
+
+impl SubsurfaceSettings {
+    /// Principal shear, depths every 0.125 a from 0.25 a to 2 a, sources within 12 a.
+    pub fn new(poisson: f64) -> Self {
+        Self {
+            poisson,
+            criterion: Criterion::PrincipalShear,
+            depth_levels: 15,
+            depth_from: 0.25,
+            depth_to: 2.0,
+            reach: 12.0,
+        }
+    }
+}
+
+/// Corner sums of Love's potentials' derivatives for a unit pressure on one rectangle.
+#[derive(Debug, Clone, Copy, Default)]
+struct Potentials {
+    psi_z: f64,
+    psi_xx: f64,
+    psi_zz: f64,
+    psi_xy: f64,
+    psi_xz: f64,
+    psi_yz: f64,
+    psi1_xx: f64,
+    psi1_xy: f64,
+}
+
+/// t + R with R = sqrt(t^2 + s2), without cancellation for t < 0 (t + R = s2 / (R - t)).
+#[inline]
+fn t_plus_r(t: f64, s2: f64, r: f64) -> f64 {
+    if t >= 0.0 {
+        t + r
+    } else {
+        s2 / (r - t)
+    }
+}
+
+/// The corner functions at offsets (X, Y) from a corner and depth z > 0: for each derivative
+/// D of psi or psi1, a function whose mixed derivative d^2/dXdY is D's integrand (module doc).
+#[inline]
+fn corner(x: f64, y: f64, z: f64) -> Potentials {
+    let (x2, y2, z2) = (x * x, y * y, z * z);
+    let rho = (x2 + y2 + z2).sqrt();
+    let y_plus = t_plus_r(y, x2 + z2, rho);
+    let x_plus = t_plus_r(x, y2 + z2, rho);
+    let xy = x * y;
+    // rho - z = (x^2 + y^2) / (rho + z), free of cancellation deep below the surface.
+    let rho_minus_z = (x2 + y2) / (rho + z);
+    let psi1_xx = if xy == 0.0 {
+        0.0
+    } else {
+        (xy * rho_minus_z / (x2 * rho + z * y2)).atan()
+    };
+    Potentials {
+        psi_z: -(xy / (z * rho)).atan(),
+        psi_xx: x / (rho * y_plus),
+        psi_zz: xy / rho * (1.0 / (x2 + z2) + 1.0 / (y2 + z2)),
+        psi_xy: 1.0 / rho,
+        psi_xz: z / (rho * y_plus),
+        psi_yz: z / (rho * x_plus),
+        psi1_xx,
+        psi1_xy: (rho + z).ln(),
+    }
+}
+
+/// The potentials' derivatives of a unit pressure on the rectangle |x'| <= a, |y'| <= b at the
+/// point (x, y) of its plane and depth z > 0: the corners with signs.
+fn rectangle_potentials(x: f64, y: f64, z: f64, a: f64, b: f64) -> Potentials {
+    let mut sum = Potentials::default();
+    for (cx, cy, sign) in [
+        (x + a, y + b, 1.0),
+        (x - a, y + b, -1.0),
+        (x + a, y - b, -1.0),
+        (x - a, y - b, 1.0),
+    ] {
+        let c = corner(cx, cy, z);
+        sum.psi_z += sign * c.psi_z;
+        sum.psi_xx += sign * c.psi_xx;
+        sum.psi_zz += sign * c.psi_zz;
+        sum.psi_xy += sign * c.psi_xy;
+        sum.psi_xz += sign * c.psi_xz;
+        sum.psi_yz += sign * c.psi_yz;
+        sum.psi1_xx += sign * c.psi1_xx;
+        sum.psi1_xy += sign * c.psi1_xy;
+    }
+    sum
+}
+
+/// Stress at (x, y, z) (m; z the depth into the body, > 0) of a uniform pressure `p` (Pa,
+/// pressing on the body) on the rectangle |x'| <= a, |y'| <= b of the surface, in the
+/// rectangle's frame, for Poisson's ratio `nu` (Love's closed form, module doc). Pa.
+pub fn rectangle_stress(x: f64, y: f64, z: f64, a: f64, b: f64, nu: f64, p: f64) -> Stress {
+    let d = rectangle_potentials(x, y, z, a, b);
+    // Laplace's equation: psi_yy = -psi_xx - psi_zz, psi1_yy = -psi1_xx - psi1_zz with
+    // psi1_zz = psi_z.
+    let psi_yy = -d.psi_xx - d.psi_zz;
+    let psi1_yy = -d.psi1_xx - d.psi_z;
+    let k = p / (2.0 * PI);
+    let m = 1.0 - 2.0 * nu;
+    [
+        k * (2.0 * nu * d.psi_z - z * d.psi_xx - m * d.psi1_xx),
+        k * (2.0 * nu * d.psi_z - z * psi_yy - m * psi1_yy),
+        k * (d.psi_z - z * d.psi_zz),
+        -k * (m * d.psi1_xy + z * d.psi_xy),
+        -k * z * d.psi_xz,
+        -k * z * d.psi_yz,
+    ]
+}
+
+/// Principal stresses of a symmetric tensor, descending (Pa): the closed-form roots of its
+/// characteristic cubic (trigonometric form).
+pub fn principal_stresses(s: &Stress) -> [f64; 3] {
+    let [xx, yy, zz, xy, xz, yz] = *s;
+    let off = xy * xy + xz * xz + yz * yz;
+    let mean = (xx + yy + zz) / 3.0;
+    let (dx, dy, dz) = (xx - mean, yy - mean, zz - mean);
+    let q2 = (dx * dx + dy * dy + dz * dz + 2.0 * off) / 6.0;
+    if q2 <= 1e-30 * mean * mean || q2 == 0.0 {
+        return [mean; 3];
+    }
+    let q = q2.sqrt();
+    // det of the deviator over q^3, halved: cos(3 phi).
+    let det = dx * (dy * dz - yz * yz) - xy * (xy * dz - yz * xz) + xz * (xy * yz - dy * xz);
+    let r = (0.5 * det / (q2 * q)).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    let s1 = mean + 2.0 * q * phi.cos();
+    let s3 = mean + 2.0 * q * (phi + 2.0 * PI / 3.0).cos();
+    [s1, 3.0 * mean - s1 - s3, s3]
+}
+
+/// Principal shear stress tau_1 = (sigma_1 - sigma_3) / 2 of a tensor, Pa.
+pub fn principal_shear(s: &Stress) -> f64 {
+    let p = principal_stresses(s);
+    0.5 * (p[0] - p[2])
+}
+
+/// The frame of a cell: columns across the line, along it, and into the body (-normal).
+fn frame(c: &ContactCell) -> Matrix3<f64> {
+    Matrix3::from_columns(&[c.axis_nu, c.axis_zeta, -c.normal])
+}
+
+/// The frame of a source rectangle, as [`frame`].
+fn source_frame(s: &Source) -> Matrix3<f64> {
+    Matrix3::from_columns(&[s.axis_nu, s.axis_zeta, -s.normal])
+}
+
+/// A tensor given in frame `from` (columns) rotated into frame `to`: R S R^T, R = to^T from.
+fn rotate(s: &Stress, rotation: &Matrix3<f64>) -> Stress {
+    let m = Matrix3::new(s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2]);
+    let r = rotation * m * rotation.transpose();
+    [
+        r[(0, 0)],
+        r[(1, 1)],
+        r[(2, 2)],
+        r[(0, 1)],
+        r[(0, 2)],
+        r[(1, 2)],
+    ]
+}
+
+/// Stress at depth `depth` (m) below the centre of `at`, in its frame (x across the line, y
+/// along it, z into the body), from the pressures (Pa) of the cells `sources` of `cells` (one
+/// body's surface). Pa.
+pub fn stress_below(
+    cells: &[ContactCell],
+    pressure: &[f64],
+    sources: &[usize],
+    at: &ContactCell,
+    depth: f64,
+    nu: f64,
+) -> Stress {
+    let to = frame(at).transpose();
+    let sources: Vec<Source> = sources
+        .iter()
+        .filter(|&&j| pressure[j] != 0.0)
+        .map(|&j| Source {
+            rotation: to * frame(&cells[j]),
+            ..Source::of(&cells[j], pressure[j])
+        })
+        .collect();
+    field(at, &sources, depth, nu)
+}
+
+/// The equivalent pressure below one cell (MODEL §8.1): the criterion's largest value over
+/// depth (Pa) and the depth of that maximum (m).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Equivalent {
+    pub pressure: f64,
+    pub depth: f64,
+}
+
+/// One source rectangle seen from a row's field points: centre, frame, half sides, pressure.
+#[derive(Debug, Clone)]
+struct Source {
+    centre: Vector3<f64>,
+    axis_nu: Vector3<f64>,
+    axis_zeta: Vector3<f64>,
+    normal: Vector3<f64>,
+    half_nu: f64,
+    half_zeta: f64,
+    pressure: f64,
+    /// Rotation of its frame into the field row's (that row's first loaded cell's frame).
+    rotation: Matrix3<f64>,
+}
+
+impl Source {
+    fn of(c: &ContactCell, pressure: f64) -> Self {
+        Self {
+            centre: c.centre,
+            axis_nu: c.axis_nu,
+            axis_zeta: c.axis_zeta,
+            normal: c.normal,
+            half_nu: c.half_nu,
+            half_zeta: c.half_zeta,
+            pressure,
+            rotation: Matrix3::identity(),
+        }
+    }
+}
+
+/// A row's load as one rectangle, for field points far from it: its loaded width and length
+/// at the mean pressure, centred on the force centroid, in the frame of its first loaded cell.
+/// None for an unloaded row.
+fn lumped_row(cells: &[ContactCell], pressure: &[f64], range: &Range<usize>) -> Option<Source> {
+    let first = range.clone().find(|&k| pressure[k] > 0.0)?;
+    let (mut force, mut area, mut moment) = (0.0, 0.0, Vector3::zeros());
+    let mut half_zeta: f64 = 0.0;
+    for k in range.clone().filter(|&k| pressure[k] > 0.0) {
+        let f = pressure[k] * cells[k].area();
+        force += f;
+        area += cells[k].area();
+        moment += cells[k].centre * f;
+        half_zeta = half_zeta.max(cells[k].half_zeta);
+    }
+    let half_nu = 0.25 * area / half_zeta;
+    Some(Source {
+        centre: moment / force,
+        half_nu,
+        half_zeta,
+        pressure: force / area,
+        ..Source::of(&cells[first], 0.0)
+    })
+}
+
+/// The equivalent pressure below every cell of one body's loaded surface (MODEL §8.1), from
+/// the cells' pressures (Pa). `rows` are the ranges of cells that form rows across the contact
+/// line (a slice of the local mesh) and `surface[r]` the surface (tooth) of row r: a cell's
+/// field sums the loaded cells of the rows of its surface within `settings.reach` loaded
+/// half-widths exactly, and each farther row as one rectangle ([`lumped_row`]; the in-plane
+/// stresses of a line load reach far). Depths: `depth_levels` from `depth_from` to `depth_to`
+/// times the row's loaded half-width (half the width of its loaded cells), the maximum refined
+/// by a parabola. Unloaded cells and rows get zero.
+pub fn equivalent_pressures(
+    cells: &[ContactCell],
+    pressure: &[f64],
+    rows: &[Range<usize>],
+    surface: &[usize],
+    settings: &SubsurfaceSettings,
+) -> Vec<Equivalent> {
+    let lumps: Vec<Option<Source>> = rows
+        .iter()
+        .map(|r| lumped_row(cells, pressure, r))
+        .collect();
+    let load = Load {
+        cells,
+        pressure,
+        rows,
+        surface,
+        lumps: &lumps,
+    };
+    let per_row: Vec<Vec<Equivalent>> = (0..rows.len())
+        .into_par_iter()
+        .map(|r| load.row_equivalents(r, settings))
+        .collect();
+    let mut out = vec![Equivalent::default(); cells.len()];
+    for (range, values) in rows.iter().zip(per_row) {
+        out[range.clone()].copy_from_slice(&values);
+    }
+    out
+}
+
+/// The loaded surface of [`equivalent_pressures`] with its rows' lumps.
+struct Load<'a> {
+    cells: &'a [ContactCell],
+    pressure: &'a [f64],
+    rows: &'a [Range<usize>],
+    surface: &'a [usize],
+    lumps: &'a [Option<Source>],
+}
+
+impl Load<'_> {
+    /// [`equivalent_pressures`] of row r.
+    fn row_equivalents(&self, r: usize, settings: &SubsurfaceSettings) -> Vec<Equivalent> {
+        let range = &self.rows[r];
+        let mut out = vec![Equivalent::default(); range.len()];
+        let Some(lump) = &self.lumps[r] else {
+            return out;
+        };
+        let a = lump.half_nu;
+        let sources = self.sources_of(r, settings.reach * a);
+        let levels = settings.depth_levels.max(3);
+        let (from, to) = (settings.depth_from * a, settings.depth_to * a);
+        let depths: Vec<f64> = (0..levels)
+            .map(|k| (from + (to - from) * k as f64 / (levels - 1) as f64).max(1e-3 * a))
+            .collect();
+        for (o, k) in out.iter_mut().zip(range.clone()) {
+            if self.pressure[k] > 0.0 {
+                *o = cell_equivalent(&self.cells[k], &sources, &depths, settings);
+            }
+        }
+        out
+    }
+
+    /// The sources of row r's field, rotated into its frame: the loaded cells of the rows of its
+    /// surface whose lump lies within `near` (m, in the surface) of its own, the other rows'
+    /// lumps.
+    fn sources_of(&self, r: usize, near: f64) -> Vec<Source> {
+        let Some(own) = &self.lumps[r] else {
+            return Vec::new();
+        };
+        let to = source_frame(own).transpose();
+        let rotated = |mut s: Source| {
+            s.rotation = to * source_frame(&s);
+            s
+        };
+        let mut sources = Vec::new();
+        for (other, lump) in
+            self.rows
+                .iter()
+                .zip(self.lumps)
+                .enumerate()
+                .filter_map(|(o, (range, lump))| {
+                    (self.surface[o] == self.surface[r]).then_some((range, lump.as_ref()?))
+                })
+        {
+            let gap = (lump.centre - own.centre).norm()
+                - lump.half_nu.hypot(lump.half_zeta)
+                - own.half_nu.hypot(own.half_zeta);
+            if gap > near {
+                sources.push(rotated(lump.clone()));
+                continue;
+            }
+            for k in other.clone().filter(|&k| self.pressure[k] > 0.0) {
+                sources.push(rotated(Source::of(&self.cells[k], self.pressure[k])));
+            }
+        }
+        sources
+    }
+}
+
+/// The equivalent pressure below cell `at`: the criterion on the depth grid, its maximum
+/// refined by the parabola through it and its neighbours.
+fn cell_equivalent(
+    at: &ContactCell,
+    sources: &[Source],
+    depths: &[f64],
+    settings: &SubsurfaceSettings,
+) -> Equivalent {
+    let value = |z: f64| {
+        settings
+            .criterion
+            .read(&field(at, sources, z, settings.poisson))
+    };
+    let values: Vec<f64> = depths.iter().map(|&z| value(z)).collect();
+    let best = (0..values.len())
+        .max_by(|&a, &b| values[a].total_cmp(&values[b]))
+        .unwrap_or(0);
+    let mut result = Equivalent {
+        pressure: values[best],
+        depth: depths[best],
+    };
+    if best > 0 && best + 1 < values.len() {
+        let (l, c, r) = (values[best - 1], values[best], values[best + 1]);
+        let den = l - 2.0 * c + r;
+        if den < 0.0 {
+            let h = depths[best + 1] - depths[best];
+            let z = depths[best] + (0.5 * (l - r) / den).clamp(-1.0, 1.0) * h;
+            let v = value(z);
+            if v > result.pressure {
+                result = Equivalent {
+                    pressure: v,
+                    depth: z,
+                };
+            }
+        }
+    }
+    result
+}
+
+/// Stress at depth z below the centre of `at` from `sources`, in the row's frame. Pa.
+fn field(at: &ContactCell, sources: &[Source], z: f64, nu: f64) -> Stress {
+    let point = at.centre - at.normal * z;
+    let mut sum = [0.0; 6];
+    for s in sources {
+        let d = point - s.centre;
+        let local = rectangle_stress(
+            d.dot(&s.axis_nu),
+            d.dot(&s.axis_zeta),
+            (-d.dot(&s.normal)).max(1e-6 * s.half_nu),
+            s.half_nu,
+            s.half_zeta,
+            nu,
+            s.pressure,
+        );
+        let rotated = rotate(&local, &s.rotation);
+        for (a, b) in sum.iter_mut().zip(rotated) {
+            *a += b;
+        }
+    }
+    sum
+}
