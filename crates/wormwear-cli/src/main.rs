@@ -657,7 +657,7 @@ fn wear(
 /// The end of a life: warnings, and the result paragraph unless quiet.
 fn finish_life(results: &wormwear::Results, dir: &Path, quiet: bool) {
     let Some(life) = &results.life else { return };
-    warn_about_the_life(&life.end);
+    warn_about_the_life(results, &life.end);
     if let (Some(rating), false) = (&results.rating, quiet) {
         print_life(&life.end, rating, dir);
     }
@@ -706,32 +706,10 @@ fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating
 
 /// Warnings on a finished life: the wear limit it stopped at, loaded analyses off the
 /// frictionless power balance, contact on worn-through material.
-fn warn_about_the_life(end: &wormwear::wear::WearState) {
-    if let Some(why) = &end.stopped {
-        eprintln!("warning: wear limit: {why}");
-    }
-    if let Some(r) = end
-        .records
-        .iter()
-        .find(|r| r.power_balance.abs() > wormwear::ltca::POWER_BALANCE_LIMIT)
-    {
-        eprintln!(
-            "warning: wear: from {} cycles the loaded analyses depart from the frictionless \
-             power balance by {:+.1} % (more than {} %): the load sits at non-conjugate points \
-             (the wheel's face edge under a misalignment) and the model's torques, TE and wear \
-             there are unreliable (power_balance in wear_steps.csv)",
-            wormwear::output::cycles_label(r.cycles),
-            100.0 * r.power_balance,
-            100.0 * wormwear::ltca::POWER_BALANCE_LIMIT
-        );
-    }
-    if let Some(r) = end.records.iter().find(|r| r.worn_through_loaded) {
-        eprintln!(
-            "warning: wear: from {} cycles the loaded pattern reaches flank nodes whose tooth is \
-             worn through (contact computed on material that is gone; see wear.limits in \
-             summary.json)",
-            wormwear::output::cycles_label(r.cycles)
-        );
+fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearState) {
+    let Some(tca) = &results.tca else { return };
+    for w in end.warnings(results.geometry.wheel_flank(tca.loaded_flank)) {
+        eprintln!("warning: wear: {w}");
     }
 }
 

@@ -51,6 +51,22 @@ fn bench(c: &mut Criterion) {
             })
         },
     );
+    // The sub-surface equivalent pressure of those 20 positions (MODEL §8.1; issue 32's
+    // target: under 20 % of the LTCA).
+    let loaded = wormwear::ltca::analyse(&g140, &geo, &tca).unwrap();
+    let subsurface = wormwear::ltca::LtcaSettings::from_gear(&g140).subsurface;
+    group.bench_function(
+        "1x40 equivalent pressure below the flank, 20 positions",
+        |b| {
+            b.iter(|| {
+                loaded
+                    .positions
+                    .iter()
+                    .map(|p| wormwear::ltca::position_equivalents(black_box(p), &subsurface).len())
+                    .sum::<usize>()
+            })
+        },
+    );
     let mut one = g140.clone();
     one.analysis.positions = 1;
     let tca1 = wormwear::kinematics::analyse(&one, &geo).unwrap();

@@ -46,7 +46,8 @@ pub struct Rating {
     /// Profile shift coefficient x2 and the lead angle at the reference diameter used.
     pub profile_shift: f64,
     pub lead_angle_deg: f64,
-    /// Why a quantity above is null (outside its formula's range).
+    /// Why a quantity above is null (outside its formula's range), and a pitting safety
+    /// below 1 (first).
     pub warnings: Vec<String>,
 }
 
@@ -232,6 +233,12 @@ impl Rating {
     fn within_ranges(mut self) -> Self {
         let w = &mut self.warnings;
         let sigma_hm = self.sigma_hm_mpa;
+        if self.pitting_safety < 1.0 {
+            w.push(format!(
+                "pitting safety S_H = {:.2} below 1 (ISO/TR 14521 sigma_Hm {sigma_hm:.0} N/mm^2)",
+                self.pitting_safety
+            ));
+        }
         if self.efficiency.is_nan() || self.efficiency < EFFICIENCY_FLOOR {
             w.push(format!(
                 "efficiency {:.3e} below {EFFICIENCY_FLOOR}: the no-load losses (churning {:.0} W, \

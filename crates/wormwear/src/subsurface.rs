@@ -82,15 +82,16 @@ pub struct SubsurfaceSettings {
 }
 
 impl SubsurfaceSettings {
-    /// Principal shear, depths every 0.125 a from 0.25 a to 2 a, sources within 12 a.
+    /// Principal shear, depths every 0.35 a from 0.25 a to 2 a (then refined), the loaded
+    /// cells of the row and its neighbours exactly, the farther rows lumped.
     pub fn new(poisson: f64) -> Self {
         Self {
             poisson,
             criterion: Criterion::PrincipalShear,
-            depth_levels: 15,
+            depth_levels: 6,
             depth_from: 0.25,
             depth_to: 2.0,
-            reach: 12.0,
+            reach: 0.5,
         }
     }
 }
@@ -395,8 +396,9 @@ impl Load<'_> {
     }
 
     /// The sources of row r's field, rotated into its frame: the loaded cells of the rows of its
-    /// surface whose lump lies within `near` (m, in the surface) of its own, the other rows'
-    /// lumps.
+    /// surface whose lump lies within `near` (m, in the surface) of its own; beyond, the rows'
+    /// lumps, merged in blocks of consecutive rows up to half as long as their distance from r
+    /// in rows ([`merge`]; the rows of a surface are given in their order along the line).
     fn sources_of(&self, r: usize, near: f64) -> Vec<Source> {
         let Some(own) = &self.lumps[r] else {
             return Vec::new();
@@ -406,33 +408,82 @@ impl Load<'_> {
             s.rotation = to * source_frame(&s);
             s
         };
+        let same: Vec<usize> = (0..self.rows.len())
+            .filter(|&o| self.surface[o] == self.surface[r])
+            .collect();
+        let at = same.iter().position(|&o| o == r).unwrap_or(0);
         let mut sources = Vec::new();
-        for (other, lump) in
-            self.rows
-                .iter()
-                .zip(self.lumps)
-                .enumerate()
-                .filter_map(|(o, (range, lump))| {
-                    (self.surface[o] == self.surface[r]).then_some((range, lump.as_ref()?))
-                })
-        {
+        // Far rows on each side, ordered outward from r: (distance in rows, lump).
+        let mut sides: [Vec<(usize, &Source)>; 2] = [Vec::new(), Vec::new()];
+        for (index, &o) in same.iter().enumerate() {
+            let Some(lump) = &self.lumps[o] else {
+                continue;
+            };
             let gap = (lump.centre - own.centre).norm()
                 - lump.half_nu.hypot(lump.half_zeta)
                 - own.half_nu.hypot(own.half_zeta);
             if gap > near {
-                sources.push(rotated(lump.clone()));
+                sides[usize::from(index > at)].push((index.abs_diff(at), lump));
                 continue;
             }
-            for k in other.clone().filter(|&k| self.pressure[k] > 0.0) {
+            for k in self.rows[o].clone().filter(|&k| self.pressure[k] > 0.0) {
                 sources.push(rotated(Source::of(&self.cells[k], self.pressure[k])));
+            }
+        }
+        sides[0].reverse();
+        for side in &sides {
+            let mut block: Vec<&Source> = Vec::new();
+            let mut first = 0;
+            for &(distance, lump) in side {
+                if block.is_empty() {
+                    first = distance;
+                }
+                block.push(lump);
+                if block.len() >= (first / 2).max(1) {
+                    sources.push(rotated(merge(&block)));
+                    block.clear();
+                }
+            }
+            if !block.is_empty() {
+                sources.push(rotated(merge(&block)));
             }
         }
         sources
     }
 }
 
+/// Lumps of consecutive rows as one rectangle: their force at its centroid over their area,
+/// as long as the rows together, in the frame of the first.
+fn merge(block: &[&Source]) -> Source {
+    if let [one] = block {
+        return (*one).clone();
+    }
+    let (mut force, mut area, mut moment, mut half_zeta) = (0.0, 0.0, Vector3::zeros(), 0.0);
+    for s in block {
+        let (a, f) = (
+            4.0 * s.half_nu * s.half_zeta,
+            s.pressure * 4.0 * s.half_nu * s.half_zeta,
+        );
+        force += f;
+        area += a;
+        moment += s.centre * f;
+        half_zeta += s.half_zeta;
+    }
+    Source {
+        centre: moment / force,
+        half_nu: 0.25 * area / half_zeta,
+        half_zeta,
+        pressure: force / area,
+        ..block[0].clone()
+    }
+}
+
+/// Parabolic refinements of the depth search.
+const REFINEMENTS: usize = 3;
+
 /// The equivalent pressure below cell `at`: the criterion on the depth grid, its maximum
-/// refined by the parabola through it and its neighbours.
+/// refined [`REFINEMENTS`] times by the parabola through the best depth so far and its nearest evaluated
+/// neighbours (successive parabolic interpolation).
 fn cell_equivalent(
     at: &ContactCell,
     sources: &[Source],
@@ -444,30 +495,34 @@ fn cell_equivalent(
             .criterion
             .read(&field(at, sources, z, settings.poisson))
     };
-    let values: Vec<f64> = depths.iter().map(|&z| value(z)).collect();
-    let best = (0..values.len())
-        .max_by(|&a, &b| values[a].total_cmp(&values[b]))
-        .unwrap_or(0);
-    let mut result = Equivalent {
-        pressure: values[best],
-        depth: depths[best],
-    };
-    if best > 0 && best + 1 < values.len() {
-        let (l, c, r) = (values[best - 1], values[best], values[best + 1]);
-        let den = l - 2.0 * c + r;
-        if den < 0.0 {
-            let h = depths[best + 1] - depths[best];
-            let z = depths[best] + (0.5 * (l - r) / den).clamp(-1.0, 1.0) * h;
-            let v = value(z);
-            if v > result.pressure {
-                result = Equivalent {
-                    pressure: v,
-                    depth: z,
-                };
-            }
+    let mut points: Vec<(f64, f64)> = depths.iter().map(|&z| (z, value(z))).collect();
+    for _ in 0..REFINEMENTS {
+        let best = (0..points.len())
+            .max_by(|&a, &b| points[a].1.total_cmp(&points[b].1))
+            .unwrap_or(0);
+        if best == 0 || best + 1 == points.len() {
+            break;
         }
+        let ((z0, l), (z1, c), (z2, r)) = (points[best - 1], points[best], points[best + 1]);
+        // Vertex of the parabola through three points.
+        let (d0, d2) = (z1 - z0, z1 - z2);
+        let num = d0 * d0 * (c - r) - d2 * d2 * (c - l);
+        let den = d0 * (c - r) - d2 * (c - l);
+        if den == 0.0 {
+            break;
+        }
+        let z = (z1 - 0.5 * num / den).clamp(z0, z2);
+        if (z - z1).abs() < 1e-6 * (z2 - z0) {
+            break;
+        }
+        let at = points.partition_point(|p| p.0 < z);
+        points.insert(at, (z, value(z)));
     }
-    result
+    let (depth, pressure) = points
+        .into_iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or_default();
+    Equivalent { pressure, depth }
 }
 
 /// Stress at depth z below the centre of `at` from `sources`, in the row's frame. Pa.

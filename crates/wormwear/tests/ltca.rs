@@ -54,7 +54,12 @@ fn equilibrium_and_complementarity_hold() {
         assert!((mean_c2 / 2400.0 - 1.0).abs() < 0.005, "mean C2 {mean_c2}");
         // (The worm torque balances to the solver tolerance, 1e-9.)
         assert!((res.power_balance - (mean_c2 / 2400.0 - 1.0)).abs() < 1e-8);
-        assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+        // No power-balance warning (a flow-pressure one may stand: MODEL §5.7).
+        assert!(
+            res.warnings.iter().all(|w| w.contains("flow pressure")),
+            "{:?}",
+            res.warnings
+        );
     }
 }
 
@@ -106,13 +111,19 @@ fn misalignments_at_the_ends_of_their_ranges_solve_and_keep_the_power_balance() 
             assert!((z - z0) * offset.signum() > 5e-3, "{z} vs {z0}");
         }
         assert!(l.power_balance.abs() < 0.01, "{}", l.power_balance);
-        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let balance = |w: &[String]| -> Vec<String> {
+            w.iter()
+                .filter(|w| !w.contains("flow pressure"))
+                .cloned()
+                .collect()
+        };
+        assert!(balance(&l.warnings).is_empty(), "{:?}", l.warnings);
         assert!(wheel.power_balance.abs() > 0.1, "{}", wheel.power_balance);
-        assert_eq!(wheel.warnings.len(), 1);
+        assert_eq!(balance(&wheel.warnings).len(), 1);
         assert!(
-            wheel.warnings[0].contains("pressure direction"),
-            "{}",
-            wheel.warnings[0]
+            balance(&wheel.warnings)[0].contains("pressure direction"),
+            "{:?}",
+            wheel.warnings
         );
     }
 }

@@ -287,6 +287,32 @@ pub enum PitDepth {
     LoadedBand,
 }
 
+/// The stress the fatigue damage of the `damage` and `forecast` pitting modes reads
+/// (MODEL §8.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PittingStress {
+    /// The equivalent pressure max tau_1 / 0.300 below the flank, pits as deep as its
+    /// maximum (default).
+    PrincipalShear,
+    /// The orthogonal shear max |tau_xz| / 0.25 below the flank, pits as deep as its maximum.
+    OrthogonalShear,
+    /// The surface pressure of the loaded pattern, pits `pit_depth` deep (the criterion before
+    /// MODEL §8.1).
+    SurfacePressure,
+}
+
+impl PittingStress {
+    /// The sub-surface criterion of the loaded analysis (principal shear for the surface
+    /// pressure, whose equivalent pressure is then only reported).
+    pub fn criterion(self) -> crate::subsurface::Criterion {
+        match self {
+            PittingStress::OrthogonalShear => crate::subsurface::Criterion::OrthogonalShear,
+            _ => crate::subsurface::Criterion::PrincipalShear,
+        }
+    }
+}
+
 /// How pitting enters a life (MODEL §8 beyond the schedule).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -339,6 +365,8 @@ pub struct WearPlan {
     pub film_load: FilmLoad,
     /// Depth of the pits of a pitting phase.
     pub pit_depth: PitDepth,
+    /// The stress of the fatigue damage (`damage`, `forecast`).
+    pub pitting_stress: PittingStress,
     /// Cycles at which the life stops for a state whose maps are written (steps are cut
     /// there); None: the states 0, 1, 2, 4, 8, ...
     pub map_cycles: Option<Vec<f64>>,
@@ -363,6 +391,7 @@ impl WearPlan {
             endurance: Endurance::DEFAULT,
             film_load: FilmLoad::LoadedAnalysis,
             pit_depth: PitDepth::Hertz,
+            pitting_stress: PittingStress::PrincipalShear,
             map_cycles: None,
             stop_at: LifeStop::PointedTip,
             backlash_limit: None,

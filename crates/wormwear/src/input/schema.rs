@@ -128,6 +128,10 @@ pub struct WearSpec {
     /// or "loaded-band" (0.78 x the loaded band's half-width).
     #[serde(default)]
     pub pit_depth: Option<String>,
+    /// The stress of the fatigue damage of the "damage" and "forecast" pitting modes:
+    /// "principal-shear" (default, MODEL §8.1), "orthogonal-shear" or "surface-pressure".
+    #[serde(default)]
+    pub pitting_stress: Option<String>,
     /// Wheel cycles at which a state is computed and its maps written (increasing; default
     /// the states 0, 1, 2, 4, 8, ...).
     #[serde(default)]

@@ -1551,6 +1551,15 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             ("loaded-band", PitDepth::LoadedBand),
         ],
     );
+    let pitting_stress = ck.choice(
+        "wear.pitting_stress",
+        w.pitting_stress.as_deref().unwrap_or("principal-shear"),
+        &[
+            ("principal-shear", PittingStress::PrincipalShear),
+            ("orthogonal-shear", PittingStress::OrthogonalShear),
+            ("surface-pressure", PittingStress::SurfacePressure),
+        ],
+    );
     let map_cycles = map_cycles(ck, w.map_cycles.as_ref());
     let stop_at = ck.choice(
         "wear.stop_at",
@@ -1576,6 +1585,7 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         endurance: endurance?,
         film_load: film_load?,
         pit_depth: pit_depth?,
+        pitting_stress: pitting_stress?,
         map_cycles: map_cycles?,
         stop_at: stop_at?,
         backlash_limit: backlash_limit?,

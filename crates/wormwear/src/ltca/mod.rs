@@ -18,6 +18,7 @@ use crate::geometry::placement::{from_wheel_body, wheel_point};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
 use crate::kinematics::{GapEvaluator, Tca};
+use crate::subsurface::{Criterion, Equivalent, SubsurfaceSettings};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use solver::{
@@ -59,6 +60,8 @@ pub struct LtcaSettings {
     pub solver: SolverSettings,
     /// Direction of the pressure on a cell (MODEL §5.2's n_i).
     pub pressure_direction: crate::input::PressureDirection,
+    /// The sub-surface stress criterion of the equivalent pressure (MODEL §8.1).
+    pub subsurface: SubsurfaceSettings,
 }
 
 impl LtcaSettings {
@@ -76,6 +79,13 @@ impl LtcaSettings {
                 ..SolverSettings::default()
             },
             pressure_direction: a.pressure_direction,
+            subsurface: SubsurfaceSettings {
+                criterion: gear
+                    .wear
+                    .as_ref()
+                    .map_or(Criterion::PrincipalShear, |w| w.pitting_stress.criterion()),
+                ..SubsurfaceSettings::new(gear.wheel_material.poisson_ratio)
+            },
         }
     }
 }
@@ -138,6 +148,10 @@ pub struct PositionResult {
     /// Plastic indentation of the local cells: the interference -y_i l_i of the cells at the
     /// flow pressure, normal to the flank, m (0 elsewhere; MODEL §5.7).
     pub plastic_depth: Vec<f64>,
+    /// Equivalent pressure of the local cells and the depth of its maximum, from the stress
+    /// below the wheel flank (MODEL §8.1; zero on unloaded cells).
+    #[serde(skip)]
+    pub equivalent: Vec<Equivalent>,
     #[serde(skip)]
     pub cells: Vec<LocalCell>,
     /// Band widenings needed (load at the band edge).
@@ -177,6 +191,13 @@ pub struct Ltca {
     pub plastic_indentation: FlankField,
     /// Share of the active flank area where some position reaches the flow pressure.
     pub yielded_area_fraction: f64,
+    /// Equivalent pressure of the fatigue criterion over the cycle (MODEL §8.1): at each cell
+    /// of the global grid, the largest over the band's passage, Pa.
+    pub equivalent_pattern: Vec<f64>,
+    /// Depth below the flank where that largest value is reached, per global cell, m.
+    pub equivalent_depth: Vec<f64>,
+    /// Largest equivalent pressure of any local cell, Pa.
+    pub equivalent_pressure_max: f64,
     pub worm_torque: f64,
     pub wheel_torque: f64,
     /// Frictionless power balance over the pitch: mean wheel torque over u x the mean worm
@@ -419,7 +440,7 @@ pub fn analyse_changed(
     let changed = FlankShape::new(wf, change);
     let worn = changed.as_ref().map(|c| c.worn(change.plastic_set));
 
-    let positions: Vec<PositionResult> = (0..tca.positions.len())
+    let mut positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
         .map(|n| {
             solve_position(
@@ -439,11 +460,22 @@ pub fn analyse_changed(
             )
         })
         .collect::<Result<_, _>>()?;
+    positions
+        .par_iter_mut()
+        .for_each(|p| p.equivalent = position_equivalents(p, &settings.subsurface));
 
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
-    // indentation (MODEL §5.7).
-    let (pattern, plastic_indentation) =
-        swept_pattern(wf, tca, &positions, geo.teeth, rows_per_row);
+    // indentation (MODEL §5.7); the equivalent pressure's (MODEL §8.1).
+    let Swept {
+        pattern,
+        plastic_indentation,
+        equivalent_pattern,
+        equivalent_depth,
+    } = swept_pattern(wf, tca, &positions, geo.teeth, rows_per_row);
+    let equivalent_pressure_max = positions
+        .iter()
+        .flat_map(|p| p.equivalent.iter().map(|e| e.pressure))
+        .fold(0.0, f64::max);
     let stats = PatternStats::of(wf, &pattern, settings.flow_pressure);
     // The largest local cell (the published P_max): the pattern's cell centres read the
     // profiles between cell centres, which can only be lower.
@@ -451,8 +483,12 @@ pub fn analyse_changed(
     let pressure_patch_max =
         max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
     let ratio = geo.teeth as f64 / gear.worm.starts as f64;
-    let (worm_torque, wheel_torque, power_balance, warnings) =
+    let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
+    warnings.extend(flow_pressure_warning(
+        stats.yielded_area_fraction,
+        settings.flow_pressure,
+    ));
     Ok(Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -468,10 +504,27 @@ pub fn analyse_changed(
         pressure_patch_size: [settings.patch_across, settings.patch_along],
         plastic_indentation,
         yielded_area_fraction: stats.yielded_area_fraction,
+        equivalent_pattern,
+        equivalent_depth,
+        equivalent_pressure_max,
         worm_torque,
         wheel_torque,
         power_balance,
         warnings,
+    })
+}
+
+/// A warning when some of the flank reaches the flow pressure (MODEL §5.7): what share, and
+/// that its pressures are the plastic limit's.
+fn flow_pressure_warning(yielded_area_fraction: f64, flow_pressure: f64) -> Option<String> {
+    (yielded_area_fraction > 0.0).then(|| {
+        format!(
+            "{:.2} % of the active flank reaches the flow pressure {:.0} MPa (MODEL §5.7): the \
+             pressures there are the bronze's plastic limit, not an elastic solution, and the \
+             flank takes a plastic set",
+            100.0 * yielded_area_fraction,
+            flow_pressure * 1e-6
+        )
     })
 }
 
@@ -583,25 +636,39 @@ fn initial_band(
     settings.band_factor * hertz_half_width(w_mean, radius, pair.effective_modulus)
 }
 
-/// The loaded pattern (MODEL §5.6) and the plastic indentation (MODEL §5.7) of the band's
-/// passage over the global grid: the largest pressure over the whole mesh cycle at each cell
-/// centre (Pa; the positions' instants and the band's continuous passage between them,
-/// [`passage`], so the pattern neither has holes between positions nor moves with their number),
-/// and the largest interference of the cells at the flow pressure at each node (m).
+/// What the band's passage leaves on the global grid ([`swept_pattern`]).
+struct Swept {
+    /// Largest pressure at each cell centre, Pa (MODEL §5.6).
+    pattern: Vec<f64>,
+    /// Largest plastic interference at each node of the plastic set's rows, m (MODEL §5.7).
+    plastic_indentation: FlankField,
+    /// Largest equivalent pressure at each cell centre (Pa) and the depth where it is reached
+    /// (m; MODEL §8.1).
+    equivalent_pattern: Vec<f64>,
+    equivalent_depth: Vec<f64>,
+}
+
+/// The loaded pattern (MODEL §5.6), the plastic indentation (MODEL §5.7) and the equivalent
+/// pressure (MODEL §8.1) of the band's passage over the global grid: the largest pressure over
+/// the whole mesh cycle at each cell centre (the positions' instants and the band's continuous
+/// passage between them, [`passage`], so the pattern neither has holes between positions nor
+/// moves with their number), the largest interference of the cells at the flow pressure at
+/// each node, and the largest equivalent pressure at each cell centre with its depth.
 fn swept_pattern(
     wf: &WheelFlank,
     tca: &Tca,
     positions: &[PositionResult],
     teeth: u32,
     rows_per_row: usize,
-) -> (Vec<f64>, FlankField) {
+) -> Swept {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let tau = 2.0 * PI / teeth as f64;
     let dt = tau / tca.positions.len() as f64;
     let columns = passage::band_samples(wf, tca, positions, tau);
     let is_slice: Vec<bool> = columns.iter().map(|c| !c.is_empty()).collect();
     let node_r = |j: usize, i: usize| wf.nodes[j * (ni + 1) + i].r;
-    let swept: Vec<(Vec<f64>, Vec<f64>)> = columns
+    type Column = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);
+    let swept: Vec<Column> = columns
         .par_iter()
         .enumerate()
         .map(|(j, samples)| {
@@ -617,27 +684,66 @@ fn swept_pattern(
             (
                 passage::swept_max(samples, &mid, dt, passage::Swept::Pressure),
                 passage::swept_max(samples, &fine, dt, passage::Swept::Plastic),
+                passage::swept_equivalent(samples, &mid, dt),
             )
         })
         .collect();
-    // Cell-centre radii on each node column (ni per column), then the cell between two.
+    // Cell-centre values on each node column (ni per column), then the cell between two.
+    let between = |values: &mut Vec<f64>| {
+        fill_between_slices(values, ni, &is_slice, wf);
+        (0..nj)
+            .flat_map(|j| (0..ni).map(move |i| (j, i)))
+            .map(|(j, i)| 0.5 * (values[j * ni + i] + values[(j + 1) * ni + i]))
+            .collect::<Vec<f64>>()
+    };
     let mut mid: Vec<f64> = swept.iter().flat_map(|c| c.0.iter().copied()).collect();
-    fill_between_slices(&mut mid, ni, &is_slice, wf);
-    let pattern = (0..nj)
-        .flat_map(|j| {
-            let mid = &mid;
-            (0..ni).map(move |i| 0.5 * (mid[j * ni + i] + mid[(j + 1) * ni + i]))
-        })
+    let pattern = between(&mut mid);
+    let mut equivalent: Vec<f64> = swept.iter().flat_map(|c| c.2.iter().map(|e| e.0)).collect();
+    // The depth as the equivalent pressure's moments (a cell between a loaded and an
+    // unloaded column takes the loaded one's depth).
+    let mut moment: Vec<f64> = swept
+        .iter()
+        .flat_map(|c| c.2.iter().map(|e| e.0 * e.1))
         .collect();
-    let mut indentation = FlankField::zeros_refined(wf, rows_per_row);
-    indentation.values = swept.iter().flat_map(|c| c.1.iter().copied()).collect();
+    let equivalent_pattern = between(&mut equivalent);
+    let equivalent_depth = between(&mut moment)
+        .iter()
+        .zip(&equivalent_pattern)
+        .map(|(m, p)| if *p > 0.0 { m / p } else { 0.0 })
+        .collect();
+    let mut plastic_indentation = FlankField::zeros_refined(wf, rows_per_row);
+    plastic_indentation.values = swept.iter().flat_map(|c| c.1.iter().copied()).collect();
     fill_between_slices(
-        &mut indentation.values,
+        &mut plastic_indentation.values,
         ni * rows_per_row + 1,
         &is_slice,
         wf,
     );
-    (pattern, indentation)
+    Swept {
+        pattern,
+        plastic_indentation,
+        equivalent_pattern,
+        equivalent_depth,
+    }
+}
+
+/// The equivalent pressure of the local cells of one position (MODEL §8.1): the rows across
+/// the line are its slices, the surfaces its teeth.
+pub fn position_equivalents(p: &PositionResult, settings: &SubsurfaceSettings) -> Vec<Equivalent> {
+    let mut rows = Vec::new();
+    let mut start = 0;
+    for k in 1..=p.cells.len() {
+        let (a, b) = (&p.cells[start], p.cells.get(k));
+        if b.is_none_or(|b| b.tooth_index != a.tooth_index || b.slice != a.slice) {
+            rows.push(start..k);
+            start = k;
+        }
+    }
+    // The rows of a tooth in their order along the line (node columns).
+    rows.sort_by_key(|r| (p.cells[r.start].tooth_index, p.cells[r.start].slice));
+    let surface: Vec<usize> = rows.iter().map(|r| p.cells[r.start].tooth_index).collect();
+    let cells: Vec<ContactCell> = p.cells.iter().map(|c| c.cell).collect();
+    crate::subsurface::equivalent_pressures(&cells, &p.pressure, &rows, &surface, settings)
 }
 
 /// Node columns that are no slice take the linear interpolation along the face width of the
@@ -1242,6 +1348,7 @@ fn solve_position(
             torque_residual: (worm - target).abs() / target,
             pressure,
             plastic_depth,
+            equivalent: Vec::new(),
             cells,
             band_widenings: widenings,
         });

@@ -22,6 +22,9 @@ pub(crate) struct Sample {
     pub(crate) profile: Vec<(f64, f64)>,
     /// Plastic indentation of the profile's cells (MODEL §5.7), m.
     pub(crate) plastic: Vec<f64>,
+    /// Equivalent pressure of the profile's cells (Pa) and the depth of its maximum (m),
+    /// MODEL §8.1 ([`crate::subsurface`]).
+    pub(crate) equivalent: Vec<(f64, f64)>,
     /// How far below the first and above the last cell centre the end pressures hold: half a
     /// cell, or, where the band was cut by the flank's edge (worm-tip trace, blank top), up to
     /// that edge. m.
@@ -45,6 +48,16 @@ impl Sample {
     /// [`Sample::pressure_at`].
     pub(crate) fn plastic_at(&self, r: f64, shift: f64) -> f64 {
         self.value_at(r, shift, |k| self.plastic.get(k).copied().unwrap_or(0.0))
+    }
+
+    /// Equivalent pressure (Pa) and its depth (m) at radius r of the profile shifted, as
+    /// [`Sample::pressure_at`].
+    pub(crate) fn equivalent_at(&self, r: f64, shift: f64) -> (f64, f64) {
+        let cell = |k: usize| self.equivalent.get(k).copied().unwrap_or_default();
+        (
+            self.value_at(r, shift, |k| cell(k).0),
+            self.value_at(r, shift, |k| cell(k).1),
+        )
     }
 
     /// The value of the profile's cell k (`value(k)`) read at radius r, shifted.
@@ -106,7 +119,7 @@ pub(crate) fn band_samples(
     // each (position, tooth, slice) is a list of runs of cells (one, in practice), kept in
     // order in a table indexed by position, tooth index and node column (no hashing: this
     // part runs on one thread between two parallel analyses).
-    type Profile = Vec<(f64, f64, f64, usize, f64)>;
+    type Profile = Vec<ProfileCell>;
     let teeth = tca.teeth.len();
     let table = |position: usize, tooth_index: usize, slice: usize| {
         (position * teeth + tooth_index) * (nj + 1) + slice
@@ -156,8 +169,17 @@ pub(crate) fn band_samples(
             let (at, start, end, next) = runs[run];
             let pr = &positions[at];
             for (i, c) in (start..end).zip(&pr.cells[start..end]) {
-                let plastic = pr.plastic_depth.get(i).copied().unwrap_or(0.0);
-                profile.push((c.r, pr.pressure[i], 2.0 * c.cell.half_nu, c.column, plastic));
+                profile.push(ProfileCell {
+                    r: c.r,
+                    pressure: pr.pressure[i],
+                    width: 2.0 * c.cell.half_nu,
+                    column: c.column,
+                    plastic: pr.plastic_depth.get(i).copied().unwrap_or(0.0),
+                    equivalent: pr
+                        .equivalent
+                        .get(i)
+                        .map_or((0.0, 0.0), |e| (e.pressure, e.depth)),
+                });
             }
             run = next;
         }
@@ -168,7 +190,7 @@ pub(crate) fn band_samples(
     for line in &tca.contact_lines {
         let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
         let mut cells = take(line.position, line.tooth, line.slice);
-        cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+        cells.sort_by(|a, b| a.r.total_cmp(&b.r));
         let time = tca.sigma * theta2;
         columns[line.slice].push(sample_of(cells, line, time, wf, tca, last_column));
     }
@@ -178,36 +200,47 @@ pub(crate) fn band_samples(
     columns
 }
 
-/// One instant of the band on a node column from its cells across the line (radius,
-/// pressure, width, column, plastic depth; ascending radii) at the contact line `line` of the
-/// reference tooth's time `time` (rad); `last_column` the band's last column index.
+/// A cell of a band's profile across the line: radius (m), pressure (Pa), width across the
+/// line (m), column, plastic depth (m), equivalent pressure (Pa) and its depth (m).
+struct ProfileCell {
+    r: f64,
+    pressure: f64,
+    width: f64,
+    column: usize,
+    plastic: f64,
+    equivalent: (f64, f64),
+}
+
+/// One instant of the band on a node column from its cells across the line (ascending radii)
+/// at the contact line `line` of the reference tooth's time `time` (rad); `last_column` the
+/// band's last column index.
 fn sample_of(
-    cells: Vec<(f64, f64, f64, usize, f64)>,
+    cells: Vec<ProfileCell>,
     line: &crate::kinematics::SliceContact,
     time: f64,
     wf: &WheelFlank,
     tca: &Tca,
     last_column: usize,
 ) -> Sample {
-    let load: f64 = cells.iter().map(|c| c.1 * c.2).sum();
-    let moment: f64 = cells.iter().map(|c| c.0 * c.1 * c.2).sum();
+    let load: f64 = cells.iter().map(|c| c.pressure * c.width).sum();
+    let moment: f64 = cells.iter().map(|c| c.r * c.pressure * c.width).sum();
     let centre = if load > 0.0 { moment / load } else { line.r };
     let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
         (Some(a), Some(b)) => {
-            let spacing = if b.3 > a.3 {
-                (b.0 - a.0) / (b.3 - a.3) as f64
+            let spacing = if b.column > a.column {
+                (b.r - a.r) / (b.column - a.column) as f64
             } else {
-                a.2
+                a.width
             };
             let j = line.slice;
             let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
-            let low = if a.3 > 0 {
-                (a.0 - floor).max(0.5 * spacing)
+            let low = if a.column > 0 {
+                (a.r - floor).max(0.5 * spacing)
             } else {
                 0.5 * spacing
             };
-            let high = if b.3 < last_column {
-                (wf.r_high[j] - b.0).max(0.5 * spacing)
+            let high = if b.column < last_column {
+                (wf.r_high[j] - b.r).max(0.5 * spacing)
             } else {
                 0.5 * spacing
             };
@@ -215,8 +248,8 @@ fn sample_of(
         }
         _ => (0.0, 0.0, 0.0),
     };
-    let loaded = cells.iter().filter(|c| c.1 > 0.0).count() as f64;
-    let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.2);
+    let loaded = cells.iter().filter(|c| c.pressure > 0.0).count() as f64;
+    let half_width = 0.5 * loaded * cells.first().map_or(0.0, |c| c.width);
     Sample {
         half_width,
         time,
@@ -224,9 +257,10 @@ fn sample_of(
         extend_low,
         extend_high,
         line_load: load,
-        pressure: cells.iter().map(|c| c.1).fold(0.0, f64::max),
-        plastic: cells.iter().map(|c| c.4).collect(),
-        profile: cells.into_iter().map(|c| (c.0, c.1)).collect(),
+        pressure: cells.iter().map(|c| c.pressure).fold(0.0, f64::max),
+        plastic: cells.iter().map(|c| c.plastic).collect(),
+        equivalent: cells.iter().map(|c| c.equivalent).collect(),
+        profile: cells.into_iter().map(|c| (c.r, c.pressure)).collect(),
         radius: line.curvature_radius,
     }
 }
@@ -274,6 +308,54 @@ impl<'a> Passage<'a> {
         let c = a.centre + s * (b.centre - a.centre);
         (1.0 - s) * a.plastic_at(r, c - a.centre) + s * b.plastic_at(r, c - b.centre)
     }
+}
+
+impl Passage<'_> {
+    /// Equivalent pressure (Pa) and its depth (m) at radius r at the fraction s of the
+    /// passage, as [`Passage::pressure`].
+    fn equivalent(&self, r: f64, s: f64) -> (f64, f64) {
+        let (a, b) = (self.a, self.b);
+        let c = a.centre + s * (b.centre - a.centre);
+        let (pa, da) = a.equivalent_at(r, c - a.centre);
+        let (pb, db) = b.equivalent_at(r, c - b.centre);
+        ((1.0 - s) * pa + s * pb, (1.0 - s) * da + s * db)
+    }
+}
+
+/// The largest equivalent pressure over the band's whole passage at the radii `radii` of one
+/// node column (Pa) and the depth where it is reached (m), as [`swept_max`] (MODEL §8.1).
+pub(crate) fn swept_equivalent(samples: &[Sample], radii: &[f64], dt: f64) -> Vec<(f64, f64)> {
+    let mut out = vec![(0.0f64, 0.0f64); radii.len()];
+    let keep = |o: &mut (f64, f64), v: (f64, f64)| {
+        if v.0 > o.0 {
+            *o = v;
+        }
+    };
+    if !samples
+        .iter()
+        .any(|s| s.equivalent.iter().any(|e| e.0 > 0.0))
+    {
+        return out;
+    }
+    for sample in samples {
+        for (o, &r) in out.iter_mut().zip(radii) {
+            keep(o, sample.equivalent_at(r, 0.0));
+        }
+    }
+    for pair in samples.windows(2) {
+        let Some(passage) = Passage::between(&pair[0], &pair[1], dt) else {
+            continue;
+        };
+        for (o, &r) in out.iter_mut().zip(radii) {
+            if r < passage.lo || r > passage.hi {
+                continue;
+            }
+            for m in 1..passage.steps {
+                keep(o, passage.equivalent(r, m as f64 / passage.steps as f64));
+            }
+        }
+    }
+    out
 }
 
 /// What [`swept_max`] takes the largest of.
@@ -335,6 +417,7 @@ mod tests {
             centre: 0.1,
             profile,
             plastic: Vec::new(),
+            equivalent: Vec::new(),
             extend_low: 1e-4,
             extend_high: 1e-4,
             line_load: 0.0,

@@ -42,6 +42,11 @@ pub struct LtcaSummary {
     pub max_pressure_definition: &'static str,
     /// Mean of the loaded pattern's non-zero cells (MODEL §5.6).
     pub mean_pressure_pa: f64,
+    /// Largest equivalent pressure below the flank (MODEL §8.1: max over depth of tau_1 /
+    /// 0.300, or the orthogonal shear's, `[wear] pitting_stress`) and its depth, over the
+    /// pattern's cells; what the fatigue damage reads.
+    pub equivalent_pressure_max_pa: f64,
+    pub equivalent_pressure_depth_mm: f64,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
     pub s1: f64,
@@ -108,6 +113,13 @@ impl LtcaSummary {
             pressure_patch_along_mm: ltca.pressure_patch_size[1] * MM,
             max_pressure_definition: MAX_PRESSURE_DEFINITION,
             mean_pressure_pa: ltca.mean_pressure,
+            equivalent_pressure_max_pa: ltca.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            equivalent_pressure_depth_mm: ltca
+                .equivalent_pattern
+                .iter()
+                .zip(&ltca.equivalent_depth)
+                .max_by(|a, b| a.0.total_cmp(b.0))
+                .map_or(f64::NAN, |(_, d)| d * MM),
             contact_area_fraction: ltca.s0,
             s1: ltca.s1,
             s2: ltca.s2,

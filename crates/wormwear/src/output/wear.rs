@@ -101,6 +101,8 @@ pub struct WearSummary<'a> {
     /// The schedule a forecast found (its phases with their pressure limits; run it as a
     /// `[wear] phases` schedule to repeat the life); empty without a forecast.
     pub found_phases: &'a [crate::wear::Phase],
+    /// What an engineer must see about the life ([`crate::wear::WearState::warnings`]).
+    pub warnings: Vec<String>,
     /// One record per state: the start and after each step (per-position curves in
     /// `wear_positions.csv`).
     pub steps: Vec<crate::wear::StepRecord>,
@@ -841,6 +843,7 @@ pub fn summary_value(
         pitting: plan.pitting,
         phases: crate::wear::forecast::phase_spans(&state.records),
         found_phases: &state.found_phases,
+        warnings: state.warnings(geo.wheel_flank(tca.loaded_flank)),
         steps: state
             .records
             .iter()

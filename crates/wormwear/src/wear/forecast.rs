@@ -1,9 +1,12 @@
 //! Fatigue damage of every node of the loaded wheel flank over life, the pits it makes, and
 //! the pitting phases a forecast finds from them (MODEL §8, "beyond the schedule-driven version"; the law is ours, stated here).
 //!
-//! Each node carries the damage law of [`crate::pitting`]: its loaded-pattern pressure (the
-//! largest of its cells, as the published pits are cut) on the pressure–life curve, its wear
-//! per cycle, and a damaged layer as deep as its pit would be (0.78 a, [`super::pit_depths`]).
+//! Each node carries the damage law of [`crate::pitting`]: its equivalent pressure from the
+//! stress below the flank (MODEL §8.1, [`crate::subsurface`]; the largest of its cells'
+//! patterns) on the pressure–life curve, its wear per cycle, and a damaged layer as deep as
+//! the maximum of that stress. With `[wear] pitting_stress = "surface-pressure"` the node
+//! reads its loaded-pattern pressure instead (as the published pits are cut) and its layer is
+//! as deep as its pit would be (0.78 a, [`super::pit_depths`]).
 //! Over a wear step the loads of the state that starts it hold, as the wear rates do (MODEL
 //! §7.3); in a pitting phase, which the published coupling models as the incubation of the
 //! pits cut at its start and nothing else, the damage holds. The damage is tracked in every
@@ -19,9 +22,10 @@
 //! duration and its limit, p_lim(D) = limit (the curve's scatter, the published +10 %, is the
 //! life factor's to carry). Then wear resumes on the pitted flank.
 
-use super::{node_pattern_pressure, pit_depths, CycleWear};
+use super::{node_cells, node_pattern_pressure, pit_depths, CycleWear};
 use crate::geometry::WheelFlank;
-use crate::input::{Endurance, PitDepth};
+use crate::input::{Endurance, PitDepth, PittingStress};
+use crate::ltca::Ltca;
 use crate::pitting::CellLoad;
 
 /// Damage at or above which a node has reached its life (round-off of the exact step end).
@@ -30,7 +34,8 @@ pub const REACHED: f64 = 1.0 - 1e-9;
 /// The damage loads of the loaded flank's nodes in one state.
 #[derive(Debug, Clone)]
 pub struct NodeLoads {
-    /// Loaded-pattern pressure of every node (the largest of its cells), Pa.
+    /// The damage law's pressure of every node: the equivalent pressure (MODEL §8.1) or the
+    /// loaded-pattern pressure, the largest of its cells, Pa.
     pub pressure: Vec<f64>,
     /// The damage law's load of every node the contact loads (pressure and pit depth > 0);
     /// None where it does not, whose damage stays as it is.
@@ -40,18 +45,32 @@ pub struct NodeLoads {
 }
 
 impl NodeLoads {
-    /// Loads of every node from a state's loaded pattern (Pa per cell) and wear of one cycle.
+    /// Loads of every node from a state's loaded analysis and wear of one cycle: the stress
+    /// the damage reads (`stress`), the depth of its maximum as the damaged layer (the pits'
+    /// `rule` for the surface pressure, and where the depth is not known).
     pub fn new(
         wf: &WheelFlank,
-        pattern: &[f64],
+        l: &Ltca,
         cw: &CycleWear,
         curve: &Endurance,
         rule: PitDepth,
+        stress: PittingStress,
     ) -> Self {
-        let layer = pit_depths(cw, rule);
-        let pressure: Vec<f64> = (0..wf.nodes.len())
-            .map(|k| node_pattern_pressure(wf, pattern, k))
-            .collect();
+        let mut layer = pit_depths(cw, rule);
+        let pressure: Vec<f64> = match stress {
+            PittingStress::SurfacePressure => (0..wf.nodes.len())
+                .map(|k| node_pattern_pressure(wf, &l.pattern, k))
+                .collect(),
+            _ => (0..wf.nodes.len())
+                .map(|k| {
+                    let (p, depth) = node_equivalent(wf, l, k);
+                    if depth > 0.0 {
+                        layer.values[k] = depth;
+                    }
+                    p
+                })
+                .collect(),
+        };
         let ni = wf.cells_height;
         let mut share = vec![0.0; wf.nodes.len()];
         let total = wf.active_area();
@@ -189,6 +208,14 @@ impl NodeLoads {
         }
         due
     }
+}
+
+/// The equivalent pressure of node k (the largest of its cells' patterns, Pa) and the depth
+/// of that cell's maximum (m; MODEL §8.1).
+pub fn node_equivalent(wf: &WheelFlank, l: &Ltca, k: usize) -> (f64, f64) {
+    node_cells(wf, k)
+        .filter_map(|c| Some((*l.equivalent_pattern.get(c)?, *l.equivalent_depth.get(c)?)))
+        .fold((0.0, 0.0), |best, v| if v.0 > best.0 { v } else { best })
 }
 
 /// A phase of a life as it happened: kind ("wear" or "pitting"), start and end cycles, and

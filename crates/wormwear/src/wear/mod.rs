@@ -870,7 +870,14 @@ pub fn simulate(
     loop {
         let (l, band) = life_loop.analyse(&state)?;
         let cw = per_cycle(gear, geo, tca, &l, life.film_load);
-        let loads = forecast::NodeLoads::new(wf, &l.pattern, &cw, &life.endurance, life.pit_depth);
+        let loads = forecast::NodeLoads::new(
+            wf,
+            &l,
+            &cw,
+            &life.endurance,
+            life.pit_depth,
+            life.pitting_stress,
+        );
         life_loop.start_forecast_phase(&mut state, &loads);
         let phase = life_loop.phase_at(&state, state.cycles);
         let record = life_loop.record(&state, &l, &cw, phase, step_cycles, substeps);
@@ -1383,6 +1390,81 @@ fn argmax(values: &[f64]) -> Option<usize> {
         .map(|(k, _)| k)
 }
 
+impl WearState {
+    /// What an engineer must see about this life at its last state (summary.json, stderr, the
+    /// top of report.html): why it stopped early, loaded analyses off the power balance,
+    /// contact on worn-through teeth, flank nodes whose fatigue damage has reached 1 (MODEL
+    /// §8.1), and pressures at the flow pressure (MODEL §5.7).
+    pub fn warnings(&self, wf: &WheelFlank) -> Vec<String> {
+        let mut w = Vec::new();
+        if let Some(why) = &self.stopped {
+            w.push(format!("wear limit: {why}"));
+        }
+        let balance = self
+            .records
+            .iter()
+            .find(|r| r.power_balance.abs() > crate::ltca::POWER_BALANCE_LIMIT);
+        if let Some(r) = balance {
+            w.push(format!(
+                "from {} cycles the loaded analyses depart from the frictionless power balance \
+                 by {:+.1} % (more than {} %): the load sits at non-conjugate points (the \
+                 wheel's face edge under a misalignment) and the model's torques, TE and wear \
+                 there are unreliable (power_balance in wear_steps.csv)",
+                cycles_label(r.cycles),
+                100.0 * r.power_balance,
+                100.0 * crate::ltca::POWER_BALANCE_LIMIT
+            ));
+        }
+        if let Some(r) = self.records.iter().find(|r| r.worn_through_loaded) {
+            w.push(format!(
+                "from {} cycles the loaded pattern reaches flank nodes whose tooth is worn \
+                 through (contact computed on material that is gone; see wear.limits)",
+                cycles_label(r.cycles)
+            ));
+        }
+        w.extend(self.damage_warning(wf));
+        if let Some(r) = self
+            .records
+            .last()
+            .filter(|r| r.yielded_area_fraction > 0.0)
+        {
+            w.push(format!(
+                "at {} cycles {:.2} % of the active flank reaches the flow pressure (MODEL §5.7): \
+                 the pressures there are the bronze's plastic limit, and the flank takes a \
+                 plastic set",
+                cycles_label(r.cycles),
+                100.0 * r.yielded_area_fraction
+            ));
+        }
+        w
+    }
+
+    /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
+    /// many, their share of the active flank, the largest damage.
+    fn damage_warning(&self, wf: &WheelFlank) -> Option<String> {
+        let due: Vec<usize> = (0..self.damage.len())
+            .filter(|&k| self.damage[k] >= forecast::REACHED)
+            .collect();
+        if due.is_empty() || self.damage.len() != wf.nodes.len() {
+            return None;
+        }
+        let mut pitted = vec![false; wf.nodes.len()];
+        for &k in &due {
+            pitted[k] = true;
+        }
+        let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
+        Some(format!(
+            "{} flank nodes (about {:.2} % of the active flank) have reached a fatigue damage of \
+             1 at {} cycles (largest {:.3}): the model expects pits there (damage map; MODEL \
+             §8.1)",
+            due.len(),
+            100.0 * pitted_fraction(wf, &pitted),
+            cycles_label(self.cycles),
+            largest
+        ))
+    }
+}
+
 /// Depth of the pits at every node (MODEL §8, §12 g): 0.78 a, a the local Hertz half-width
 /// (published) or the loaded band's half-width (refinement), m.
 pub fn pit_depths(cw: &CycleWear, rule: PitDepth) -> FlankField {
@@ -1439,21 +1521,23 @@ pub fn cut_pits(
     cut
 }
 
-/// Loaded-pattern pressure at node k of the flank grid: the largest of the (up to four)
-/// cells around it, Pa.
-fn node_pattern_pressure(wf: &WheelFlank, pattern: &[f64], k: usize) -> f64 {
+/// The (up to four) cells of the flank grid around node k, as indices of a cell pattern.
+fn node_cells(wf: &WheelFlank, k: usize) -> impl Iterator<Item = usize> {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let (i, j) = (k % (ni + 1), k / (ni + 1));
-    let mut p: f64 = 0.0;
-    for (ci, cj) in [
+    [
         (i, j),
         (i.wrapping_sub(1), j),
         (i, j.wrapping_sub(1)),
         (i.wrapping_sub(1), j.wrapping_sub(1)),
-    ] {
-        if ci < ni && cj < nj {
-            p = p.max(pattern[cj * ni + ci]);
-        }
-    }
-    p
+    ]
+    .into_iter()
+    .filter(move |&(ci, cj)| ci < ni && cj < nj)
+    .map(move |(ci, cj)| cj * ni + ci)
+}
+
+/// Loaded-pattern pressure at node k of the flank grid: the largest of the (up to four)
+/// cells around it, Pa.
+fn node_pattern_pressure(wf: &WheelFlank, pattern: &[f64], k: usize) -> f64 {
+    node_cells(wf, k).map(|c| pattern[c]).fold(0.0, f64::max)
 }
