@@ -704,12 +704,12 @@ fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating
     );
 }
 
-/// Warnings on a finished life: the wear limit it stopped at, loaded analyses off the
-/// frictionless power balance, contact on worn-through material.
+/// Warnings on a finished life ([`wormwear::wear::WearState::warnings`], each tagged by
+/// its subject: wear limit, wear, pitting, contact).
 fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearState) {
     let Some(tca) = &results.tca else { return };
     for w in end.warnings(results.geometry.wheel_flank(tca.loaded_flank)) {
-        eprintln!("warning: wear: {w}");
+        eprintln!("warning: {w}");
     }
 }
 

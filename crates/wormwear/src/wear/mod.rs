@@ -1406,8 +1406,8 @@ impl WearState {
             .find(|r| r.power_balance.abs() > crate::ltca::POWER_BALANCE_LIMIT);
         if let Some(r) = balance {
             w.push(format!(
-                "from {} cycles the loaded analyses depart from the frictionless power balance \
-                 by {:+.1} % (more than {} %): the load sits at non-conjugate points (the \
+                "wear: from {} cycles the loaded analyses depart from the frictionless power \
+                 balance by {:+.1} % (more than {} %): the load sits at non-conjugate points (the \
                  wheel's face edge under a misalignment) and the model's torques, TE and wear \
                  there are unreliable (power_balance in wear_steps.csv)",
                 cycles_label(r.cycles),
@@ -1417,7 +1417,7 @@ impl WearState {
         }
         if let Some(r) = self.records.iter().find(|r| r.worn_through_loaded) {
             w.push(format!(
-                "from {} cycles the loaded pattern reaches flank nodes whose tooth is worn \
+                "wear: from {} cycles the loaded pattern reaches flank nodes whose tooth is worn \
                  through (contact computed on material that is gone; see wear.limits)",
                 cycles_label(r.cycles)
             ));
@@ -1429,7 +1429,8 @@ impl WearState {
             .filter(|r| r.yielded_area_fraction > 0.0)
         {
             w.push(format!(
-                "at {} cycles {:.2} % of the active flank reaches the flow pressure (MODEL §5.7): \
+                "contact: at {} cycles {:.2} % of the active flank reaches the flow pressure (MODEL \
+                 §5.7): \
                  the pressures there are the bronze's plastic limit, and the flank takes a \
                  plastic set",
                 cycles_label(r.cycles),
@@ -1454,8 +1455,8 @@ impl WearState {
         }
         let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
         Some(format!(
-            "{} flank nodes (about {:.2} % of the active flank) have reached a fatigue damage of \
-             1 at {} cycles (largest {:.3}): the model expects pits there (damage map; MODEL \
+            "pitting: {} flank nodes (about {:.2} % of the active flank) have reached a fatigue \
+             damage of 1 at {} cycles (largest {:.3}): the model expects pits there (damage map; MODEL \
              §8.1)",
             due.len(),
             100.0 * pitted_fraction(wf, &pitted),
