@@ -463,6 +463,27 @@ pub fn analyse_changed(
     positions
         .par_iter_mut()
         .for_each(|p| p.equivalent = position_equivalents(p, &settings.subsurface));
+    let ratio = geo.teeth as f64 / gear.worm.starts as f64;
+    Ok(over_the_cycle(
+        positions,
+        (wf, tca, geo.teeth, ratio),
+        settings,
+        bending,
+        rows_per_row,
+    ))
+}
+
+/// The loaded analysis over the mesh cycle from its positions (MODEL §5.6, §5.7, §8.1): the
+/// swept patterns, their statistics, the torques and the warnings. `gear_set` holds the loaded
+/// flank, the TCA, the wheel's teeth and the ratio u.
+fn over_the_cycle(
+    positions: Vec<PositionResult>,
+    gear_set: (&WheelFlank, &Tca, u32, f64),
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    rows_per_row: usize,
+) -> Ltca {
+    let (wf, tca, teeth, ratio) = gear_set;
 
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
     // indentation (MODEL §5.7); the equivalent pressure's (MODEL §8.1).
@@ -471,7 +492,7 @@ pub fn analyse_changed(
         plastic_indentation,
         equivalent_pattern,
         equivalent_depth,
-    } = swept_pattern(wf, tca, &positions, geo.teeth, rows_per_row);
+    } = swept_pattern(wf, tca, &positions, teeth, rows_per_row);
     let equivalent_pressure_max = positions
         .iter()
         .flat_map(|p| p.equivalent.iter().map(|e| e.pressure))
@@ -482,14 +503,13 @@ pub fn analyse_changed(
     let max_pressure = positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
     let pressure_patch_max =
         max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
-    let ratio = geo.teeth as f64 / gear.worm.starts as f64;
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
     warnings.extend(flow_pressure_warning(
         stats.yielded_area_fraction,
         settings.flow_pressure,
     ));
-    Ok(Ltca {
+    Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
         solver: settings.solver.kind,
@@ -511,7 +531,7 @@ pub fn analyse_changed(
         wheel_torque,
         power_balance,
         warnings,
-    })
+    }
 }
 
 /// A warning when some of the flank reaches the flow pressure (MODEL §5.7): what share, and
