@@ -344,9 +344,14 @@ impl NativeResults {
             .collect()
     }
 
-    /// The warnings of the stages (and of the ratings).
+    /// The warnings of the stages, of the life (its last state) and of the ratings.
     fn warnings(&self) -> Vec<String> {
-        let mut w = self.results.warnings.clone();
+        let r = &self.results;
+        let mut w = r.warnings.clone();
+        if let (Some(life), Some(tca)) = (&r.life, &r.tca) {
+            let wf = r.geometry.wheel_flank(tca.loaded_flank);
+            w.extend(life.end.warnings(wf));
+        }
         if let Some(r) = &self.results.rating {
             w.extend(r.warnings.iter().map(|x| format!("rating: {x}")));
         }

@@ -83,6 +83,9 @@ def test_ltca_equals_the_cli_in_numbers_and_files(cli, design_file, tmp_path):
     assert pattern.values.shape == (40, 60) and np.nanmax(pattern.values) == r.ltca.max_pressure_pa
     # The radius grows up the tooth, z across the face.
     assert np.all(np.diff(pattern.r_mm[:, 30]) > 0) and np.all(np.diff(pattern.z_mm[20, :]) != 0)
+    # The equivalent pressure below the flank (MODEL §8.1) as a map and per cell.
+    assert np.nanmax(r.ltca.equivalent.values) == r.ltca.equivalent_pressure_max_pa
+    assert r.ltca.pressures["equivalent_pressure_pa"].max() > 0
     r.write(tmp_path / "py")
     assert_same_files(tmp_path / "cli", tmp_path / "py")
 

@@ -183,8 +183,9 @@ class Results:
     - ``ltca``: the ``ltca`` section's values (``max_pressure_pa``, ``contact_area_fraction``,
       ``te_p2p_rad``, ``power_balance``...) and the DataFrames ``positions`` (per position:
       torques N m, TE rad, stiffness, tooth loads N), ``pressures`` (every loaded cell:
-      position, tooth, r_mm, z_mm, pressure_pa) and the map ``pattern`` (largest pressure
-      over the cycle, Pa);
+      position, tooth, r_mm, z_mm, pressure_pa, equivalent_pressure_pa and
+      equivalent_depth_mm below it, MODEL §8.1), the map ``pattern`` (largest pressure over the
+      cycle, Pa) and the map ``equivalent`` (largest equivalent pressure below the flank, Pa);
     - ``wear``: the ``wear`` section's values and the DataFrames ``records`` (one row per
       state: cycles, max_wear_m, backlash_increase_m, max_pressure_pa, ...), ``positions``
       (TE and loads per state and position) and the map ``depth`` (wear depth at the end, m);
@@ -211,6 +212,7 @@ class Results:
                 positions=self.table("ltca_positions"),
                 pressures=self.table("ltca_pressures"),
                 pattern=FlankMap._from_table(pattern, "max_pressure_pa", "Pa"),
+                equivalent=FlankMap._from_table(pattern, "equivalent_pressure_pa", "Pa"),
             )
         wear = self.summary.get("wear")
         self.wear = None

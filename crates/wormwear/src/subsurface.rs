@@ -52,6 +52,14 @@ pub enum Criterion {
 }
 
 impl Criterion {
+    /// What the equivalent pressure is, in words (titles, summary).
+    pub fn definition(self) -> &'static str {
+        match self {
+            Criterion::PrincipalShear => "max over depth of tau_1 / 0.300",
+            Criterion::OrthogonalShear => "max over depth of |tau_xz| / 0.25",
+        }
+    }
+
     /// The criterion's stress of a tensor (Pa) and its value below a Hertz line contact per
     /// unit peak pressure.
     fn read(self, s: &Stress) -> f64 {
@@ -82,13 +90,13 @@ pub struct SubsurfaceSettings {
 }
 
 impl SubsurfaceSettings {
-    /// Principal shear, depths every 0.35 a from 0.25 a to 2 a (then refined), the loaded
+    /// Principal shear, depths every 0.44 a from 0.25 a to 2 a (then refined), the loaded
     /// cells of the row and its neighbours exactly, the farther rows lumped.
     pub fn new(poisson: f64) -> Self {
         Self {
             poisson,
             criterion: Criterion::PrincipalShear,
-            depth_levels: 6,
+            depth_levels: 5,
             depth_from: 0.25,
             depth_to: 2.0,
             reach: 0.5,
@@ -121,8 +129,11 @@ fn t_plus_r(t: f64, s2: f64, r: f64) -> f64 {
 
 /// The corner functions at offsets (X, Y) from a corner and depth z > 0: for each derivative
 /// D of psi or psi1, a function whose mixed derivative d^2/dXdY is D's integrand (module doc).
+/// The transcendental ones are left as their arguments, combined over the corners by
+/// [`rectangle_potentials`]: psi_z's is -atan(`psi_z_tan`), psi1_xx's atan(`psi1_xx_tan`),
+/// psi1_xy's ln(`psi1_xy_exp`).
 #[inline]
-fn corner(x: f64, y: f64, z: f64) -> Potentials {
+fn corner(x: f64, y: f64, z: f64) -> Corner {
     let (x2, y2, z2) = (x * x, y * y, z * z);
     let rho = (x2 + y2 + z2).sqrt();
     let y_plus = t_plus_r(y, x2 + z2, rho);
@@ -130,44 +141,77 @@ fn corner(x: f64, y: f64, z: f64) -> Potentials {
     let xy = x * y;
     // rho - z = (x^2 + y^2) / (rho + z), free of cancellation deep below the surface.
     let rho_minus_z = (x2 + y2) / (rho + z);
-    let psi1_xx = if xy == 0.0 {
-        0.0
+    Corner {
+        rational: Potentials {
+            psi_z: 0.0,
+            psi_xx: x / (rho * y_plus),
+            psi_zz: xy / rho * (1.0 / (x2 + z2) + 1.0 / (y2 + z2)),
+            psi_xy: 1.0 / rho,
+            psi_xz: z / (rho * y_plus),
+            psi_yz: z / (rho * x_plus),
+            psi1_xx: 0.0,
+            psi1_xy: 0.0,
+        },
+        psi_z_tan: xy / (z * rho),
+        psi1_xx_tan: if xy == 0.0 {
+            0.0
+        } else {
+            xy * rho_minus_z / (x2 * rho + z * y2)
+        },
+        psi1_xy_exp: rho + z,
+    }
+}
+
+/// A corner's functions ([`corner`]): the rational ones, and the arguments of the others.
+struct Corner {
+    rational: Potentials,
+    psi_z_tan: f64,
+    psi1_xx_tan: f64,
+    psi1_xy_exp: f64,
+}
+
+/// atan(u) - atan(v) for any u, v as one arctangent (the difference lies in (-pi, pi)):
+/// atan((u - v) / (1 + uv)), shifted by pi where 1 + uv < 0 (a plain arctangent with the
+/// quadrant by hand: glibc's atan2 costs twice its atan).
+#[inline]
+fn atan_difference(u: f64, v: f64) -> f64 {
+    let (num, den) = (u - v, 1.0 + u * v);
+    if den > 0.0 {
+        (num / den).atan()
+    } else if den < 0.0 {
+        (num / den).atan() + PI.copysign(num)
     } else {
-        (xy * rho_minus_z / (x2 * rho + z * y2)).atan()
-    };
-    Potentials {
-        psi_z: -(xy / (z * rho)).atan(),
-        psi_xx: x / (rho * y_plus),
-        psi_zz: xy / rho * (1.0 / (x2 + z2) + 1.0 / (y2 + z2)),
-        psi_xy: 1.0 / rho,
-        psi_xz: z / (rho * y_plus),
-        psi_yz: z / (rho * x_plus),
-        psi1_xx,
-        psi1_xy: (rho + z).ln(),
+        (0.5 * PI).copysign(num)
     }
 }
 
 /// The potentials' derivatives of a unit pressure on the rectangle |x'| <= a, |y'| <= b at the
-/// point (x, y) of its plane and depth z > 0: the corners with signs.
+/// point (x, y) of its plane and depth z > 0: the corners with signs (+ - - +), the
+/// arctangents of each pair of corners with one X combined into one, the logarithms into one.
 fn rectangle_potentials(x: f64, y: f64, z: f64, a: f64, b: f64) -> Potentials {
-    let mut sum = Potentials::default();
-    for (cx, cy, sign) in [
-        (x + a, y + b, 1.0),
-        (x - a, y + b, -1.0),
-        (x + a, y - b, -1.0),
-        (x - a, y - b, 1.0),
-    ] {
-        let c = corner(cx, cy, z);
-        sum.psi_z += sign * c.psi_z;
-        sum.psi_xx += sign * c.psi_xx;
-        sum.psi_zz += sign * c.psi_zz;
-        sum.psi_xy += sign * c.psi_xy;
-        sum.psi_xz += sign * c.psi_xz;
-        sum.psi_yz += sign * c.psi_yz;
-        sum.psi1_xx += sign * c.psi1_xx;
-        sum.psi1_xy += sign * c.psi1_xy;
+    let c = [
+        corner(x + a, y + b, z),
+        corner(x - a, y + b, z),
+        corner(x + a, y - b, z),
+        corner(x - a, y - b, z),
+    ];
+    let sum = |f: fn(&Potentials) -> f64| {
+        f(&c[0].rational) - f(&c[1].rational) - f(&c[2].rational) + f(&c[3].rational)
+    };
+    let atans = |f: fn(&Corner) -> f64| {
+        atan_difference(f(&c[0]), f(&c[1])) + atan_difference(f(&c[3]), f(&c[2]))
+    };
+    Potentials {
+        psi_z: -atans(|c| c.psi_z_tan),
+        psi_xx: sum(|p| p.psi_xx),
+        psi_zz: sum(|p| p.psi_zz),
+        psi_xy: sum(|p| p.psi_xy),
+        psi_xz: sum(|p| p.psi_xz),
+        psi_yz: sum(|p| p.psi_yz),
+        psi1_xx: atans(|c| c.psi1_xx_tan),
+        psi1_xy: ((c[0].psi1_xy_exp * c[3].psi1_xy_exp) / (c[1].psi1_xy_exp * c[2].psi1_xy_exp))
+            .ln(),
     }
-    sum
 }
 
 /// Stress at (x, y, z) (m; z the depth into the body, > 0) of a uniform pressure `p` (Pa,
@@ -381,27 +425,43 @@ impl Load<'_> {
             return out;
         };
         let a = lump.half_nu;
-        let sources = self.sources_of(r, settings.reach * a);
+        let (near, far) = self.sources_of(r, settings.reach * a);
         let levels = settings.depth_levels.max(3);
         let (from, to) = (settings.depth_from * a, settings.depth_to * a);
         let depths: Vec<f64> = (0..levels)
             .map(|k| (from + (to - from) * k as f64 / (levels - 1) as f64).max(1e-3 * a))
             .collect();
+        // The far rows' field varies over distances of their distance: read once per depth
+        // below the row's load centre, linear between the depths.
+        let below = ContactCell {
+            centre: lump.centre,
+            normal: lump.normal,
+            axis_nu: lump.axis_nu,
+            axis_zeta: lump.axis_zeta,
+            half_nu: lump.half_nu,
+            half_zeta: lump.half_zeta,
+        };
+        let far_field: Vec<Stress> = depths
+            .iter()
+            .map(|&z| field(&below, &far, z, settings.poisson))
+            .collect();
+        let far_at = |z: f64| interpolate(&depths, &far_field, z);
         for (o, k) in out.iter_mut().zip(range.clone()) {
             if self.pressure[k] > 0.0 {
-                *o = cell_equivalent(&self.cells[k], &sources, &depths, settings);
+                *o = cell_equivalent(&self.cells[k], &near, &far_at, &depths, settings);
             }
         }
         out
     }
 
-    /// The sources of row r's field, rotated into its frame: the loaded cells of the rows of its
-    /// surface whose lump lies within `near` (m, in the surface) of its own; beyond, the rows'
-    /// lumps, merged in blocks of consecutive rows up to half as long as their distance from r
-    /// in rows ([`merge`]; the rows of a surface are given in their order along the line).
-    fn sources_of(&self, r: usize, near: f64) -> Vec<Source> {
+    /// The sources of row r's field, rotated into its frame, near and far: the loaded cells of
+    /// the rows of its surface whose lump lies within `near` (m, in the surface) of its own;
+    /// beyond, the rows' lumps, merged in blocks of consecutive rows up to half as long as their
+    /// distance from r in rows ([`merge`]; the rows of a surface are given in their order along
+    /// the line).
+    fn sources_of(&self, r: usize, near: f64) -> (Vec<Source>, Vec<Source>) {
         let Some(own) = &self.lumps[r] else {
-            return Vec::new();
+            return (Vec::new(), Vec::new());
         };
         let to = source_frame(own).transpose();
         let rotated = |mut s: Source| {
@@ -431,6 +491,7 @@ impl Load<'_> {
             }
         }
         sides[0].reverse();
+        let mut far = Vec::new();
         for side in &sides {
             let mut block: Vec<&Source> = Vec::new();
             let mut first = 0;
@@ -440,15 +501,15 @@ impl Load<'_> {
                 }
                 block.push(lump);
                 if block.len() >= (first / 2).max(1) {
-                    sources.push(rotated(merge(&block)));
+                    far.push(rotated(merge(&block)));
                     block.clear();
                 }
             }
             if !block.is_empty() {
-                sources.push(rotated(merge(&block)));
+                far.push(rotated(merge(&block)));
             }
         }
-        sources
+        (sources, far)
     }
 }
 
@@ -487,13 +548,16 @@ const REFINEMENTS: usize = 3;
 fn cell_equivalent(
     at: &ContactCell,
     sources: &[Source],
+    far: &dyn Fn(f64) -> Stress,
     depths: &[f64],
     settings: &SubsurfaceSettings,
 ) -> Equivalent {
     let value = |z: f64| {
-        settings
-            .criterion
-            .read(&field(at, sources, z, settings.poisson))
+        let mut s = field(at, sources, z, settings.poisson);
+        for (a, b) in s.iter_mut().zip(far(z)) {
+            *a += b;
+        }
+        settings.criterion.read(&s)
     };
     let mut points: Vec<(f64, f64)> = depths.iter().map(|&z| (z, value(z))).collect();
     for _ in 0..REFINEMENTS {
@@ -525,6 +589,20 @@ fn cell_equivalent(
     Equivalent { pressure, depth }
 }
 
+/// The tensor at depth z, linear between the `depths` (ascending) of `values`, the end
+/// values beyond.
+fn interpolate(depths: &[f64], values: &[Stress], z: f64) -> Stress {
+    let k = depths
+        .partition_point(|&d| d <= z)
+        .clamp(1, depths.len() - 1);
+    let t = ((z - depths[k - 1]) / (depths[k] - depths[k - 1])).clamp(0.0, 1.0);
+    let mut out = values[k - 1];
+    for (o, v) in out.iter_mut().zip(values[k]) {
+        *o += t * (v - *o);
+    }
+    out
+}
+
 /// Stress at depth z below the centre of `at` from `sources`, in the row's frame. Pa.
 fn field(at: &ContactCell, sources: &[Source], z: f64, nu: f64) -> Stress {
     let point = at.centre - at.normal * z;
@@ -546,4 +624,20 @@ fn field(at: &ContactCell, sources: &[Source], z: f64, nu: f64) -> Stress {
         }
     }
     sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_combined_arctangent_is_the_difference_of_two_in_every_quadrant() {
+        let values = [-1e6, -3.0, -1.0, -0.2, 0.0, 0.2, 1.0, 3.0, 1e6];
+        for u in values {
+            for v in values {
+                let d = atan_difference(u, v);
+                assert!((d - (u.atan() - v.atan())).abs() < 1e-12, "{u} {v}: {d}");
+            }
+        }
+    }
 }

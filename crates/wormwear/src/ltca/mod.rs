@@ -198,6 +198,8 @@ pub struct Ltca {
     pub equivalent_depth: Vec<f64>,
     /// Largest equivalent pressure of any local cell, Pa.
     pub equivalent_pressure_max: f64,
+    /// The stress the equivalent pressure reads.
+    pub equivalent_criterion: Criterion,
     pub worm_torque: f64,
     pub wheel_torque: f64,
     /// Frictionless power balance over the pitch: mean wheel torque over u x the mean worm
@@ -527,6 +529,7 @@ fn over_the_cycle(
         equivalent_pattern,
         equivalent_depth,
         equivalent_pressure_max,
+        equivalent_criterion: settings.subsurface.criterion,
         worm_torque,
         wheel_torque,
         power_balance,

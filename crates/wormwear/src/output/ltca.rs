@@ -47,6 +47,7 @@ pub struct LtcaSummary {
     /// pattern's cells; what the fatigue damage reads.
     pub equivalent_pressure_max_pa: f64,
     pub equivalent_pressure_depth_mm: f64,
+    pub equivalent_pressure_definition: &'static str,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
     pub s1: f64,
@@ -120,6 +121,7 @@ impl LtcaSummary {
                 .zip(&ltca.equivalent_depth)
                 .max_by(|a, b| a.0.total_cmp(b.0))
                 .map_or(f64::NAN, |(_, d)| d * MM),
+            equivalent_pressure_definition: ltca.equivalent_criterion.definition(),
             contact_area_fraction: ltca.s0,
             s1: ltca.s1,
             s2: ltca.s2,
@@ -232,8 +234,19 @@ pub fn pattern_map(
     title: &str,
     overlays: &[Series],
 ) -> Result<(), OutputError> {
-    let values: Vec<f64> = ltca
-        .pattern
+    pressure_map(path, wf, &ltca.pattern, ltca.max_pressure, title, overlays)
+}
+
+/// Map of a pressure per flank cell (Pa, drawn in MPa from 0 to `top`; grey where zero).
+fn pressure_map(
+    path: &Path,
+    wf: &WheelFlank,
+    pressure: &[f64],
+    top: f64,
+    title: &str,
+    overlays: &[Series],
+) -> Result<(), OutputError> {
+    let values: Vec<f64> = pressure
         .iter()
         .map(|&p| if p > 0.0 { p * MPA } else { f64::NAN })
         .collect();
@@ -242,7 +255,7 @@ pub fn pattern_map(
         title,
         wf,
         &values,
-        (0.0, ltca.max_pressure * MPA),
+        (0.0, top * MPA),
         "pressure (MPa)",
         overlays,
         &[],
@@ -375,7 +388,7 @@ fn position_charts(
     Ok(())
 }
 
-/// The loaded pattern: CSV and map.
+/// The loaded pattern: CSV and maps (pressure, equivalent pressure below the flank).
 fn pattern_files(
     wf: &WheelFlank,
     ltca: &Ltca,
@@ -400,7 +413,34 @@ fn pattern_files(
         std::slice::from_ref(trace),
     )?;
     files.push(path);
+    let path = dir.join("ltca_equivalent_pressure.svg");
+    equivalent_map(&path, wf, ltca, std::slice::from_ref(trace))?;
+    files.push(path);
     Ok(())
+}
+
+/// Map of the equivalent pressure below the flank over the cycle (MODEL §8.1), MPa.
+fn equivalent_map(
+    path: &Path,
+    wf: &WheelFlank,
+    ltca: &Ltca,
+    overlays: &[Series],
+) -> Result<(), OutputError> {
+    let (k, top) = ltca
+        .equivalent_pattern
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, 0.0), |b, v| if v.1 > b.1 { v } else { b });
+    let depth = ltca.equivalent_depth.get(k).copied().unwrap_or(0.0);
+    let title = format!(
+        "Equivalent pressure below the flank, {} (largest {:.0} MPa at {:.3} mm deep); grey: \
+         no contact",
+        ltca.equivalent_criterion.definition(),
+        top * MPA,
+        depth * MM
+    );
+    pressure_map(path, wf, &ltca.equivalent_pattern, top, &title, overlays)
 }
 
 /// Pressure maps of the engaged teeth at `map_position` (clamped to the last position).
@@ -489,16 +529,27 @@ pub fn positions_table(tca: &Tca, ltca: &Ltca) -> Csv {
 /// The loaded pattern per flank cell (`ltca_pattern.csv`): the largest pressure over the
 /// cycle, Pa, at the cell's (r, z), mm.
 pub fn pattern_table(wf: &WheelFlank, ltca: &Ltca) -> Csv {
-    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "max_pressure_pa"]);
+    let mut csv = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "max_pressure_pa",
+        "equivalent_pressure_pa",
+        "equivalent_depth_mm",
+    ]);
     for j in 0..wf.cells_face {
         for i in 0..wf.cells_height {
-            let c = &wf.cells[j * wf.cells_height + i];
+            let k = j * wf.cells_height + i;
+            let c = &wf.cells[k];
             csv.row(&[
                 i as f64,
                 j as f64,
                 c.r * MM,
                 c.z * MM,
-                ltca.pattern[j * wf.cells_height + i],
+                ltca.pattern[k],
+                ltca.equivalent_pattern.get(k).copied().unwrap_or(0.0),
+                ltca.equivalent_depth.get(k).copied().unwrap_or(0.0) * MM,
             ]);
         }
     }
@@ -506,7 +557,8 @@ pub fn pattern_table(wf: &WheelFlank, ltca: &Ltca) -> Csv {
 }
 
 /// The local pressures of every position (`ltca_pressures.csv`): per contact cell its tooth,
-/// slice, column, (r, z) mm, pressure Pa, initial separation rad and relief um.
+/// slice, column, (r, z) mm, pressure Pa, initial separation rad, relief um, and the
+/// equivalent pressure below it (Pa) with its depth (mm; MODEL §8.1).
 pub fn pressures_table(ltca: &Ltca) -> Csv {
     let mut csv = Csv::new(&[
         "position",
@@ -518,9 +570,12 @@ pub fn pressures_table(ltca: &Ltca) -> Csv {
         "pressure_pa",
         "separation_rad",
         "relief_um",
+        "equivalent_pressure_pa",
+        "equivalent_depth_mm",
     ]);
     for p in &ltca.positions {
-        for (c, pr) in p.cells.iter().zip(&p.pressure) {
+        for (k, (c, pr)) in p.cells.iter().zip(&p.pressure).enumerate() {
+            let e = p.equivalent.get(k).copied().unwrap_or_default();
             csv.row(&[
                 p.position as f64,
                 c.tooth as f64,
@@ -531,6 +586,8 @@ pub fn pressures_table(ltca: &Ltca) -> Csv {
                 *pr,
                 c.separation,
                 c.relief * UM,
+                e.pressure,
+                e.depth * MM,
             ]);
         }
     }
