@@ -7,18 +7,19 @@
 //! the maximum of that stress. With `[wear] pitting_stress = "surface-pressure"` the node
 //! reads its loaded-pattern pressure instead (as the published pits are cut) and its layer is
 //! as deep as its pit would be (0.78 a, [`super::pit_depths`]).
+//!
 //! Over a wear step the loads of the state that starts it hold, as the wear rates do (MODEL
 //! §7.3); in a pitting phase, which the published coupling models as the incubation of the
 //! pits cut at its start and nothing else, the damage holds. The damage is tracked in every
 //! life (maps and records compare); it acts with pits from the damage
 //! (`[wear] pitting = "damage"` or `"forecast"`): at the start of a pitting phase the pits are
-//! cut where a loaded node's damage has reached 1 (0.78 a removed; the node starts again
+//! cut where a loaded node's damage has reached 1 (its damaged layer removed; the node starts again
 //! undamaged, its damaged layer gone with the flakes), not above a pressure limit.
 //!
 //! A forecast also finds the phases. A wear step ends where the next loaded node's damage
 //! reaches 1; at a state of a wear phase (after its first) with such a node a pitting phase
-//! starts. It lasts the life on the curve at the lowest pattern pressure among its pits, the
-//! incubation of the least loaded pit: the published coupling's relation between a phase's
+//! starts. It lasts the life on the curve at the median damage-law pressure of its pits
+//! ([`NodeLoads::median_due_pressure`]): the published coupling's relation between a phase's
 //! duration and its limit, p_lim(D) = limit (the curve's scatter, the published +10 %, is the
 //! life factor's to carry). Then wear resumes on the pitted flank.
 
@@ -172,7 +173,7 @@ impl NodeLoads {
         None
     }
 
-    /// The median pattern pressure of the nodes due to pit, weighted by their flank shares
+    /// The median damage-law pressure (equivalent or pattern) of the nodes due to pit, weighted by their flank shares
     /// (Pa; None: none is due). A median, not the lowest: a damaged node that the moving
     /// pattern now barely touches does not stand for the pressure that damaged it.
     pub fn median_due_pressure(&self, damage: &[f64]) -> Option<f64> {
