@@ -576,7 +576,9 @@ fn cell_equivalent(
             break;
         }
         let z = (z1 - 0.5 * num / den).clamp(z0, z2);
-        if (z - z1).abs() < 1e-6 * (z2 - z0) {
+        // No threshold on the step (a discrete choice would turn round-off in the pressures
+        // into a different depth): only a vertex on a point already there ends the search.
+        if points.iter().any(|p| p.0 == z) {
             break;
         }
         let at = points.partition_point(|p| p.0 < z);
@@ -624,6 +626,57 @@ fn field(at: &ContactCell, sources: &[Source], z: f64, nu: f64) -> Stress {
         }
     }
     sum
+}
+
+/// The principal shear stress tau_1 on a section below one row of cells (MODEL §8.1): across
+/// the line over the row's extent and down to `depth_to` times its loaded half-width, on
+/// `across` x `depths` points (Pa; `tau1[d * across + i]` at `x[i]`, `z[d]`, m, x from the row's
+/// first cell's outer edge along its axis across the line).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Section {
+    pub x: Vec<f64>,
+    pub z: Vec<f64>,
+    pub tau1: Vec<f64>,
+}
+
+/// [`Section`] below `row` (cells of `cells`, consecutive, in order across the line) from
+/// the pressures of the cells `sources` (Pa) of one body's surface, Poisson's ratio `nu`.
+pub fn section(
+    cells: &[ContactCell],
+    pressure: &[f64],
+    row: Range<usize>,
+    sources: &[usize],
+    (across, depths, depth_to): (usize, usize, f64),
+    nu: f64,
+) -> Section {
+    let first = cells[row.start];
+    let last = cells[row.end - 1];
+    let width = (last.centre - first.centre).dot(&first.axis_nu) + first.half_nu + last.half_nu;
+    let a = row
+        .clone()
+        .filter(|&k| pressure[k] > 0.0)
+        .map(|k| cells[k].half_nu)
+        .sum::<f64>()
+        .max(first.half_nu);
+    let x: Vec<f64> = (0..across)
+        .map(|i| (i as f64 + 0.5) / across as f64 * width)
+        .collect();
+    let z: Vec<f64> = (0..depths)
+        .map(|d| (d as f64 + 0.5) / depths as f64 * depth_to * a)
+        .collect();
+    let origin = first.centre - first.axis_nu * first.half_nu;
+    let tau1 = z
+        .iter()
+        .flat_map(|&depth| x.iter().map(move |&xi| (depth, xi)))
+        .map(|(depth, xi)| {
+            let at = ContactCell {
+                centre: origin + first.axis_nu * xi,
+                ..first
+            };
+            principal_shear(&stress_below(cells, pressure, sources, &at, depth, nu))
+        })
+        .collect();
+    Section { x, z, tau1 }
 }
 
 #[cfg(test)]

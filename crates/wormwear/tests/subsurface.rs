@@ -397,3 +397,26 @@ fn lumping_the_far_rows_changes_the_equivalent_pressure_by_less_than_half_a_perc
         }
     }
 }
+
+#[test]
+fn the_section_below_a_hertz_line_contact_peaks_at_0_300_p0_at_0_786_a_below_its_centre() {
+    let (a, p0) = (1e-4, 1e9);
+    let (cells, pressure) = hertz_line(101, a, p0, 1e3 * a);
+    let all: Vec<usize> = (0..cells.len()).collect();
+    let s =
+        wormwear::subsurface::section(&cells, &pressure, 0..cells.len(), &all, (60, 40, 2.0), 0.3);
+    let (k, top) = s
+        .tau1
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, 0.0), |b, v| if v.1 > b.1 { v } else { b });
+    let (x, z) = (s.x[k % 60], s.z[k / 60]);
+    assert!((top / p0 - 0.300).abs() < 2e-3, "tau_1 max {}", top / p0);
+    // The section starts at the row's outer edge (-a): the centre is at x = a.
+    assert!(
+        (x - a).abs() < 0.05 * a && (z / a - 0.786).abs() < 0.05,
+        "at x {x}, z {}",
+        z / a
+    );
+}

@@ -769,6 +769,43 @@ pub fn position_equivalents(p: &PositionResult, settings: &SubsurfaceSettings) -
     crate::subsurface::equivalent_pressures(&cells, &p.pressure, &rows, &surface, settings)
 }
 
+/// Where the equivalent pressure peaks and the principal shear stress on the section below
+/// it (MODEL §8.1): the position, the tooth, the face position z (m) and the section across
+/// the line below that cell's row (60 x 40 points down to 2 loaded half-widths). None when no
+/// cell is loaded.
+pub fn equivalent_section(
+    l: &Ltca,
+    nu: f64,
+) -> Option<(usize, i32, f64, crate::subsurface::Section)> {
+    let (p, k) = l
+        .positions
+        .iter()
+        .flat_map(|p| (0..p.equivalent.len()).map(move |k| (p, k)))
+        .max_by(|a, b| {
+            a.0.equivalent[a.1]
+                .pressure
+                .total_cmp(&b.0.equivalent[b.1].pressure)
+        })
+        .filter(|(p, k)| p.equivalent[*k].pressure > 0.0)?;
+    let peak = &p.cells[k];
+    let same_row = |c: &LocalCell| c.tooth_index == peak.tooth_index && c.slice == peak.slice;
+    let start = (0..=k)
+        .rev()
+        .take_while(|&i| same_row(&p.cells[i]))
+        .last()?;
+    let end = (k..p.cells.len())
+        .take_while(|&i| same_row(&p.cells[i]))
+        .last()?
+        + 1;
+    let sources: Vec<usize> = (0..p.cells.len())
+        .filter(|&i| p.cells[i].tooth_index == peak.tooth_index)
+        .collect();
+    let cells: Vec<ContactCell> = p.cells.iter().map(|c| c.cell).collect();
+    let section =
+        crate::subsurface::section(&cells, &p.pressure, start..end, &sources, (60, 40, 2.0), nu);
+    Some((p.position, peak.tooth, peak.z, section))
+}
+
 /// Node columns that are no slice take the linear interpolation along the face width of the
 /// nearest slice columns on each side (the nearest one's values at the grid's ends); `values`
 /// holds `rows` values per node column, column after column.

@@ -282,6 +282,10 @@ pub fn write_ltca(
     let trace = tip_trace_series(tca);
     pattern_files(wf, ltca, &trace, dir, &mut files)?;
     pressure_maps(tca, ltca, wf, &trace, map_position, dir, &mut files)?;
+    let path = dir.join("ltca_subsurface_section.svg");
+    if subsurface_section(&path, ltca, gear.wheel_material.poisson_ratio)? {
+        files.push(path);
+    }
     // Local pressures of every position.
     let csv = pressures_table(ltca);
     let path = dir.join("ltca_pressures.csv");
@@ -441,6 +445,49 @@ fn equivalent_map(
         depth * MM
     );
     pressure_map(path, wf, &ltca.equivalent_pattern, top, &title, overlays)
+}
+
+/// The principal shear stress below the flank where the equivalent pressure peaks (MODEL
+/// §8.1; [`crate::ltca::equivalent_section`]): across the line x depth, MPa. Returns whether
+/// it was drawn (nothing loaded: not).
+fn subsurface_section(path: &Path, ltca: &Ltca, nu: f64) -> Result<bool, OutputError> {
+    let Some((position, tooth, z, section)) = crate::ltca::equivalent_section(ltca, nu) else {
+        return Ok(false);
+    };
+    let (nx, nz) = (section.x.len(), section.z.len());
+    let edges = |v: &[f64], k: usize| {
+        let h = if v.len() > 1 { v[1] - v[0] } else { v[0] };
+        (v[k] - 0.5 * h, v[k] + 0.5 * h)
+    };
+    let cells: Vec<MapCell> = (0..nz)
+        .flat_map(|d| (0..nx).map(move |i| (d, i)))
+        .map(|(d, i)| {
+            let ((x0, x1), (z0, z1)) = (edges(&section.x, i), edges(&section.z, d));
+            let (x0, x1, y0, y1) = (x0 * MM, x1 * MM, -z0 * MM, -z1 * MM);
+            MapCell {
+                corners: [(x0, y0), (x1, y0), (x1, y1), (x0, y1)],
+                value: section.tau1[d * nx + i] * MPA,
+            }
+        })
+        .collect();
+    let top = section.tau1.iter().copied().fold(0.0, f64::max) * MPA;
+    flank_map(
+        path,
+        &format!(
+            "Principal shear stress tau_1 below the flank where the equivalent pressure peaks \
+             (position {position}, tooth {tooth}, z = {:.2} mm; largest {top:.0} MPa)",
+            z * MM
+        ),
+        "across the contact line (mm)",
+        "depth (mm, below the flank)",
+        &cells,
+        (0.0, top),
+        "tau_1 (MPa)",
+        &[],
+        &[],
+        None,
+    )?;
+    Ok(true)
 }
 
 /// Pressure maps of the engaged teeth at `map_position` (clamped to the last position).
