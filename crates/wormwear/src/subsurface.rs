@@ -71,7 +71,7 @@ impl Criterion {
 }
 
 /// How the equivalent pressure is evaluated (MODEL §8.1).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct SubsurfaceSettings {
     /// Poisson's ratio of the body below the surface (the wheel's bronze).
     pub poisson: f64,

@@ -198,8 +198,8 @@ pub struct Ltca {
     pub equivalent_depth: Vec<f64>,
     /// Largest equivalent pressure of any local cell, Pa.
     pub equivalent_pressure_max: f64,
-    /// The stress the equivalent pressure reads.
-    pub equivalent_criterion: Criterion,
+    /// How the equivalent pressure was evaluated (its criterion, the wheel's Poisson ratio).
+    pub subsurface: SubsurfaceSettings,
     pub worm_torque: f64,
     pub wheel_torque: f64,
     /// Frictionless power balance over the pitch: mean wheel torque over u x the mean worm
@@ -529,7 +529,7 @@ fn over_the_cycle(
         equivalent_pattern,
         equivalent_depth,
         equivalent_pressure_max,
-        equivalent_criterion: settings.subsurface.criterion,
+        subsurface: settings.subsurface,
         worm_torque,
         wheel_torque,
         power_balance,
@@ -771,22 +771,35 @@ pub fn position_equivalents(p: &PositionResult, settings: &SubsurfaceSettings) -
 
 /// Where the equivalent pressure peaks and the principal shear stress on the section below
 /// it (MODEL §8.1): the position, the tooth, the face position z (m) and the section across
-/// the line below that cell's row (60 x 40 points down to 2 loaded half-widths). None when no
-/// cell is loaded.
+/// the line below that cell's row (60 x 40 points down to 2 loaded half-widths). `near`
+/// (flank radius and face position of the reference tooth, m): the peak among the cells over
+/// that point (within their half extents), over the whole flank when none is loaded there.
+/// None when no cell is loaded.
 pub fn equivalent_section(
     l: &Ltca,
-    nu: f64,
+    near: Option<(f64, f64)>,
 ) -> Option<(usize, i32, f64, crate::subsurface::Section)> {
-    let (p, k) = l
-        .positions
-        .iter()
-        .flat_map(|p| (0..p.equivalent.len()).map(move |k| (p, k)))
-        .max_by(|a, b| {
-            a.0.equivalent[a.1]
-                .pressure
-                .total_cmp(&b.0.equivalent[b.1].pressure)
-        })
-        .filter(|(p, k)| p.equivalent[*k].pressure > 0.0)?;
+    let over = |c: &LocalCell, (r, z): (f64, f64)| {
+        (c.z - z).abs() <= c.half_dz && (c.r - r).abs() <= c.cell.half_nu.max(c.cell.half_zeta)
+    };
+    let loaded = |p: &&PositionResult, k: &usize| p.equivalent[*k].pressure > 0.0;
+    let cells = || {
+        l.positions
+            .iter()
+            .flat_map(|p| (0..p.equivalent.len()).map(move |k| (p, k)))
+            .filter(|(p, k)| loaded(p, k))
+    };
+    let mut candidates: Vec<(&PositionResult, usize)> = near
+        .map(|at| cells().filter(|(p, k)| over(&p.cells[*k], at)).collect())
+        .unwrap_or_default();
+    if candidates.is_empty() {
+        candidates = cells().collect();
+    }
+    let (p, k) = candidates.into_iter().max_by(|a, b| {
+        a.0.equivalent[a.1]
+            .pressure
+            .total_cmp(&b.0.equivalent[b.1].pressure)
+    })?;
     let peak = &p.cells[k];
     let same_row = |c: &LocalCell| c.tooth_index == peak.tooth_index && c.slice == peak.slice;
     let start = (0..=k)
@@ -801,8 +814,14 @@ pub fn equivalent_section(
         .filter(|&i| p.cells[i].tooth_index == peak.tooth_index)
         .collect();
     let cells: Vec<ContactCell> = p.cells.iter().map(|c| c.cell).collect();
-    let section =
-        crate::subsurface::section(&cells, &p.pressure, start..end, &sources, (60, 40, 2.0), nu);
+    let section = crate::subsurface::section(
+        &cells,
+        &p.pressure,
+        start..end,
+        &sources,
+        (60, 40, 2.0),
+        l.subsurface.poisson,
+    );
     Some((p.position, peak.tooth, peak.z, section))
 }
 

@@ -121,7 +121,7 @@ impl LtcaSummary {
                 .zip(&ltca.equivalent_depth)
                 .max_by(|a, b| a.0.total_cmp(b.0))
                 .map_or(f64::NAN, |(_, d)| d * MM),
-            equivalent_pressure_definition: ltca.equivalent_criterion.definition(),
+            equivalent_pressure_definition: ltca.subsurface.criterion.definition(),
             contact_area_fraction: ltca.s0,
             s1: ltca.s1,
             s2: ltca.s2,
@@ -283,7 +283,7 @@ pub fn write_ltca(
     pattern_files(wf, ltca, &trace, dir, &mut files)?;
     pressure_maps(tca, ltca, wf, &trace, map_position, dir, &mut files)?;
     let path = dir.join("ltca_subsurface_section.svg");
-    if subsurface_section(&path, ltca, gear.wheel_material.poisson_ratio)? {
+    if subsurface_section(&path, ltca, None, "where the equivalent pressure peaks")? {
         files.push(path);
     }
     // Local pressures of every position.
@@ -440,18 +440,24 @@ fn equivalent_map(
     let title = format!(
         "Equivalent pressure below the flank, {} (largest {:.0} MPa at {:.3} mm deep); grey: \
          no contact",
-        ltca.equivalent_criterion.definition(),
+        ltca.subsurface.criterion.definition(),
         top * MPA,
         depth * MM
     );
     pressure_map(path, wf, &ltca.equivalent_pattern, top, &title, overlays)
 }
 
-/// The principal shear stress below the flank where the equivalent pressure peaks (MODEL
-/// §8.1; [`crate::ltca::equivalent_section`]): across the line x depth, MPa. Returns whether
-/// it was drawn (nothing loaded: not).
-fn subsurface_section(path: &Path, ltca: &Ltca, nu: f64) -> Result<bool, OutputError> {
-    let Some((position, tooth, z, section)) = crate::ltca::equivalent_section(ltca, nu) else {
+/// The principal shear stress below the flank where the equivalent pressure peaks, over the
+/// flank point `near` (r, z, m) when given (MODEL §8.1; [`crate::ltca::equivalent_section`]):
+/// across the line x depth, MPa; `place` says where in the title. Returns whether it was drawn
+/// (nothing loaded: not).
+pub(crate) fn subsurface_section(
+    path: &Path,
+    ltca: &Ltca,
+    near: Option<(f64, f64)>,
+    place: &str,
+) -> Result<bool, OutputError> {
+    let Some((position, tooth, z, section)) = crate::ltca::equivalent_section(ltca, near) else {
         return Ok(false);
     };
     let (nx, nz) = (section.x.len(), section.z.len());
@@ -474,8 +480,8 @@ fn subsurface_section(path: &Path, ltca: &Ltca, nu: f64) -> Result<bool, OutputE
     flank_map(
         path,
         &format!(
-            "Principal shear stress tau_1 below the flank where the equivalent pressure peaks \
-             (position {position}, tooth {tooth}, z = {:.2} mm; largest {top:.0} MPa)",
+            "Principal shear stress tau_1 below the flank {place} (position {position}, tooth \
+             {tooth}, z = {:.2} mm; largest {top:.0} MPa)",
             z * MM
         ),
         "across the contact line (mm)",

@@ -988,6 +988,27 @@ impl StateMaps<'_> {
         )
     }
 
+    /// The principal shear stress below the most damaged node (MODEL §8.1), from this state's
+    /// loaded analysis: `wear_subsurface_section.svg` (None: no node is damaged or loaded).
+    fn damage_section(&self) -> Result<Option<PathBuf>, OutputError> {
+        let (state, wf) = (self.view.state, self.geo.wheel_flank(self.tca.loaded_flank));
+        let Some((k, _)) = state
+            .damage
+            .iter()
+            .enumerate()
+            .filter(|(_, &d)| d > 0.0)
+            .max_by(|a, b| a.1.total_cmp(b.1))
+        else {
+            return Ok(None);
+        };
+        let node = wf.nodes[k];
+        let path = self.dir.join("wear_subsurface_section.svg");
+        let place = format!("at the most damaged node (r = {:.2} mm)", node.r * 1e3);
+        let drawn =
+            super::ltca::subsurface_section(&path, self.view.ltca, Some((node.r, node.z)), &place)?;
+        Ok(drawn.then_some(path))
+    }
+
     /// Writes the maps (cumulative wear, wear per cycle, film ratio and thickness, fatigue
     /// damage, loaded pattern) and the node table, their names ending with `suffix` before
     /// the extension.
@@ -1082,6 +1103,9 @@ impl StateMaps<'_> {
             Some(1.0),
         )?;
         files.push(path);
+        if suffix.is_empty() {
+            files.extend(self.damage_section()?);
+        }
         let plastic = view.state.plastic_set_nodes_after(view.ltca);
         let path = dir.join(format!("wear_plastic_set_map{suffix}.svg"));
         map(

@@ -499,29 +499,33 @@ fn forecast_table(m: &mut String, results: &Results) {
         m,
         "### Pitting forecast against the observed schedules\n\n\
          The same cases with their schedules dropped: `[wear] pitting = \"forecast\"` finds the \
-         phases from the fatigue damage of every flank node (README, \"Pitting forecast\"; the default curve, life \
-         factor 1, onset share 2 %, nothing fitted per case). Pitting phases in millions of \
-         cycles; the pitted share at the end of life.
+         phases from the fatigue damage of every flank node (README, \"Pitting forecast\"; the \
+         damage reads the equivalent pressure below the flank, max over depth of tau_1 / 0.300, \
+         MODEL §8.1; the default curve, life factor 1, onset share 2 %, nothing fitted per \
+         case). Pitting phases in millions of cycles; the pitted share at the end of life; \
+         first pitting against the observed (the schedule's first pitting phase; B pits from \
+         the start, no ratio).
 "
     );
     let _ = writeln!(
         m,
-        "| case | observed pitting phases | forecast pitting phases | forecast first pitting | pitted share: schedule / forecast | states: schedule / forecast |"
+        "| case | observed pitting phases | forecast pitting phases | forecast first pitting | forecast / observed first pitting | pitted share: schedule / forecast | states: schedule / forecast |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|---|");
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|");
     for (name, id) in cases {
         let (Some(s), Some(f)) = (results.get(id), results.get(&format!("{id}-forecast"))) else {
             continue;
         };
-        let first = f
-            .phases
-            .iter()
-            .find(|p| p.0 == "pitting")
-            .map_or("-".to_string(), |p| format!("{:.3}", p.1 * 1e-6));
+        let first_of = |r: &JobResult| r.phases.iter().find(|p| p.0 == "pitting").map(|p| p.1);
+        let first = first_of(f).map_or("-".to_string(), |c| format!("{:.3}", c * 1e-6));
+        let ratio = match (first_of(f), first_of(s)) {
+            (Some(f), Some(o)) if o > 0.0 => format!("{:.2}", f / o),
+            _ => "-".to_string(),
+        };
         let share = |r: &JobResult| last(r).map_or(f64::NAN, |x| x.pitted_area_fraction);
         let _ = writeln!(
             m,
-            "| {name} | {} | {} | {first} | {:.3} / {:.3} | {} / {} |",
+            "| {name} | {} | {} | {first} | {ratio} | {:.3} / {:.3} | {} / {} |",
             pitting_phases(&s.phases),
             pitting_phases(&f.phases),
             share(s),
