@@ -778,6 +778,7 @@ pub fn steps_table(state: &WearState) -> Csv {
         "max_plastic_set_m",
         "max_plastic_indentation_m",
         "yielded_area_fraction",
+        "equivalent_pressure_max_pa",
     ]);
     for r in &state.records {
         csv.row(&[
@@ -815,6 +816,7 @@ pub fn steps_table(state: &WearState) -> Csv {
             r.max_plastic_set_m,
             r.max_plastic_indentation_m,
             r.yielded_area_fraction,
+            r.equivalent_pressure_max_pa,
         ]);
     }
     csv

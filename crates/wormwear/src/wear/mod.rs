@@ -776,6 +776,10 @@ pub struct StepRecord {
     /// Share of the active flank area where this state's contact reached the flow pressure.
     #[serde(default)]
     pub yielded_area_fraction: f64,
+    /// Largest equivalent pressure below the flank over the pattern (MODEL §8.1), Pa (0 in
+    /// records of earlier versions).
+    #[serde(default)]
+    pub equivalent_pressure_max_pa: f64,
     /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -1279,6 +1283,7 @@ impl<'a> LifeLoop<'a> {
             max_plastic_set_m: state.plastic_set_after(l).max(),
             max_plastic_indentation_m: l.plastic_indentation.max(),
             yielded_area_fraction: l.yielded_area_fraction,
+            equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             positions,
         }
     }
