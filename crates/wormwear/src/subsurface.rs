@@ -374,10 +374,11 @@ fn lumped_row(cells: &[ContactCell], pressure: &[f64], range: &Range<usize>) -> 
 /// the cells' pressures (Pa). `rows` are the ranges of cells that form rows across the contact
 /// line (a slice of the local mesh) and `surface[r]` the surface (tooth) of row r: a cell's
 /// field sums the loaded cells of the rows of its surface within `settings.reach` loaded
-/// half-widths exactly, and each farther row as one rectangle ([`lumped_row`]; the in-plane
-/// stresses of a line load reach far). Depths: `depth_levels` from `depth_from` to `depth_to`
-/// times the row's loaded half-width (half the width of its loaded cells), the maximum refined
-/// by a parabola. Unloaded cells and rows get zero.
+/// half-widths exactly, and the farther rows as rectangles ([`lumped_row`], merged in blocks
+/// that grow with their distance; the in-plane stresses of a line load reach far), their field
+/// read once per row and depth below the row's load centre. Depths: `depth_levels` from
+/// `depth_from` to `depth_to` times the row's loaded half-width (half the width of its loaded
+/// cells), the maximum refined by successive parabolas. Unloaded cells and rows get zero.
 pub fn equivalent_pressures(
     cells: &[ContactCell],
     pressure: &[f64],
