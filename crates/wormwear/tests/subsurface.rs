@@ -281,6 +281,26 @@ fn principal_stresses_are_the_eigenvalues() {
     );
     let d = principal_stresses(&[-1.0, 2.0, -5.0, 0.0, 0.0, 0.0]);
     assert!((d[0] - 2.0).abs() < 1e-12 && (d[1] + 1.0).abs() < 1e-12 && (d[2] + 5.0).abs() < 1e-12);
+    // The principal shear (its own closed form) is half the eigenvalues' spread, also where
+    // two principal stresses coincide (cos 3 phi = +-1) or all three do.
+    for t in [
+        s,
+        [-1.0, 2.0, -5.0, 0.0, 0.0, 0.0],
+        [-1.0, -1.0, -5.0, 0.0, 0.0, 0.0],
+        [-1.0, -5.0, -5.0, 0.0, 0.0, 0.0],
+        [-2.0, -2.0, -2.0, 0.0, 0.0, 0.0],
+        [1e8, -3e8, 2e7, -5e7, 3e7, 9e7],
+    ] {
+        let m = nalgebra::Matrix3::new(t[0], t[3], t[4], t[3], t[1], t[5], t[4], t[5], t[2]);
+        let e = m.symmetric_eigenvalues();
+        let spread = 0.5 * (e.max() - e.min());
+        let size = t.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(
+            (principal_shear(&t) - spread).abs() < 1e-7 * size,
+            "{t:?}: {} vs {spread}",
+            principal_shear(&t)
+        );
+    }
 }
 
 /// Rows along the line of the bands of these tests (4 a each: 164 a in all).

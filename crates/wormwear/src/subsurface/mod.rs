@@ -25,6 +25,12 @@
 //! nu), so the bronze's pressure–life curve applies unchanged; the depth of that maximum is the
 //! pit depth. Option: the orthogonal shear |tau_xz| / 0.25 (0.25 p0 at z = 0.5 a, line contact).
 
+mod lanes;
+use lanes::Batch;
+mod love;
+
+pub use love::rectangle_stress;
+
 use crate::contact::ContactCell;
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -104,162 +110,43 @@ impl SubsurfaceSettings {
     }
 }
 
-/// Corner sums of Love's potentials' derivatives for a unit pressure on one rectangle.
-#[derive(Debug, Clone, Copy, Default)]
-struct Potentials {
-    psi_z: f64,
-    psi_xx: f64,
-    psi_zz: f64,
-    psi_xy: f64,
-    psi_xz: f64,
-    psi_yz: f64,
-    psi1_xx: f64,
-    psi1_xy: f64,
-}
-
-/// t + R with R = sqrt(t^2 + s2), without cancellation for t < 0 (t + R = s2 / (R - t)).
-#[inline]
-fn t_plus_r(t: f64, s2: f64, r: f64) -> f64 {
-    if t >= 0.0 {
-        t + r
-    } else {
-        s2 / (r - t)
-    }
-}
-
-/// The corner functions at offsets (X, Y) from a corner and depth z > 0: for each derivative
-/// D of psi or psi1, a function whose mixed derivative d^2/dXdY is D's integrand (module doc).
-/// The transcendental ones are left as their arguments, combined over the corners by
-/// [`rectangle_potentials`]: psi_z's is -atan(`psi_z_tan`), psi1_xx's atan(`psi1_xx_tan`),
-/// psi1_xy's ln(`psi1_xy_exp`).
-#[inline]
-fn corner(x: f64, y: f64, z: f64) -> Corner {
-    let (x2, y2, z2) = (x * x, y * y, z * z);
-    let rho = (x2 + y2 + z2).sqrt();
-    let y_plus = t_plus_r(y, x2 + z2, rho);
-    let x_plus = t_plus_r(x, y2 + z2, rho);
-    let xy = x * y;
-    // rho - z = (x^2 + y^2) / (rho + z), free of cancellation deep below the surface.
-    let rho_minus_z = (x2 + y2) / (rho + z);
-    Corner {
-        rational: Potentials {
-            psi_z: 0.0,
-            psi_xx: x / (rho * y_plus),
-            psi_zz: xy / rho * (1.0 / (x2 + z2) + 1.0 / (y2 + z2)),
-            psi_xy: 1.0 / rho,
-            psi_xz: z / (rho * y_plus),
-            psi_yz: z / (rho * x_plus),
-            psi1_xx: 0.0,
-            psi1_xy: 0.0,
-        },
-        psi_z_tan: xy / (z * rho),
-        psi1_xx_tan: if xy == 0.0 {
-            0.0
-        } else {
-            xy * rho_minus_z / (x2 * rho + z * y2)
-        },
-        psi1_xy_exp: rho + z,
-    }
-}
-
-/// A corner's functions ([`corner`]): the rational ones, and the arguments of the others.
-struct Corner {
-    rational: Potentials,
-    psi_z_tan: f64,
-    psi1_xx_tan: f64,
-    psi1_xy_exp: f64,
-}
-
-/// atan(u) - atan(v) for any u, v as one arctangent (the difference lies in (-pi, pi)):
-/// atan((u - v) / (1 + uv)), shifted by pi where 1 + uv < 0 (a plain arctangent with the
-/// quadrant by hand: glibc's atan2 costs twice its atan).
-#[inline]
-fn atan_difference(u: f64, v: f64) -> f64 {
-    let (num, den) = (u - v, 1.0 + u * v);
-    if den > 0.0 {
-        (num / den).atan()
-    } else if den < 0.0 {
-        (num / den).atan() + PI.copysign(num)
-    } else {
-        (0.5 * PI).copysign(num)
-    }
-}
-
-/// The potentials' derivatives of a unit pressure on the rectangle |x'| <= a, |y'| <= b at the
-/// point (x, y) of its plane and depth z > 0: the corners with signs (+ - - +), the
-/// arctangents of each pair of corners with one X combined into one, the logarithms into one.
-fn rectangle_potentials(x: f64, y: f64, z: f64, a: f64, b: f64) -> Potentials {
-    let c = [
-        corner(x + a, y + b, z),
-        corner(x - a, y + b, z),
-        corner(x + a, y - b, z),
-        corner(x - a, y - b, z),
-    ];
-    let sum = |f: fn(&Potentials) -> f64| {
-        f(&c[0].rational) - f(&c[1].rational) - f(&c[2].rational) + f(&c[3].rational)
-    };
-    let atans = |f: fn(&Corner) -> f64| {
-        atan_difference(f(&c[0]), f(&c[1])) + atan_difference(f(&c[3]), f(&c[2]))
-    };
-    Potentials {
-        psi_z: -atans(|c| c.psi_z_tan),
-        psi_xx: sum(|p| p.psi_xx),
-        psi_zz: sum(|p| p.psi_zz),
-        psi_xy: sum(|p| p.psi_xy),
-        psi_xz: sum(|p| p.psi_xz),
-        psi_yz: sum(|p| p.psi_yz),
-        psi1_xx: atans(|c| c.psi1_xx_tan),
-        psi1_xy: ((c[0].psi1_xy_exp * c[3].psi1_xy_exp) / (c[1].psi1_xy_exp * c[2].psi1_xy_exp))
-            .ln(),
-    }
-}
-
-/// Stress at (x, y, z) (m; z the depth into the body, > 0) of a uniform pressure `p` (Pa,
-/// pressing on the body) on the rectangle |x'| <= a, |y'| <= b of the surface, in the
-/// rectangle's frame, for Poisson's ratio `nu` (Love's closed form, module doc). Pa.
-pub fn rectangle_stress(x: f64, y: f64, z: f64, a: f64, b: f64, nu: f64, p: f64) -> Stress {
-    let d = rectangle_potentials(x, y, z, a, b);
-    // Laplace's equation: psi_yy = -psi_xx - psi_zz, psi1_yy = -psi1_xx - psi1_zz with
-    // psi1_zz = psi_z.
-    let psi_yy = -d.psi_xx - d.psi_zz;
-    let psi1_yy = -d.psi1_xx - d.psi_z;
-    let k = p / (2.0 * PI);
-    let m = 1.0 - 2.0 * nu;
-    [
-        k * (2.0 * nu * d.psi_z - z * d.psi_xx - m * d.psi1_xx),
-        k * (2.0 * nu * d.psi_z - z * psi_yy - m * psi1_yy),
-        k * (d.psi_z - z * d.psi_zz),
-        -k * (m * d.psi1_xy + z * d.psi_xy),
-        -k * z * d.psi_xz,
-        -k * z * d.psi_yz,
-    ]
-}
-
-/// Principal stresses of a symmetric tensor, descending (Pa): the closed-form roots of its
-/// characteristic cubic (trigonometric form).
-pub fn principal_stresses(s: &Stress) -> [f64; 3] {
+/// The mean stress, q = sqrt(J2 / 3) and cos(3 phi) = det(deviator) / (2 q^3) of a symmetric
+/// tensor (Pa, Pa, -): the principal stresses are mean + 2 q cos(phi + 2 pi k / 3). None when
+/// the deviator vanishes (to round-off).
+fn deviator_invariants(s: &Stress) -> (f64, Option<(f64, f64)>) {
     let [xx, yy, zz, xy, xz, yz] = *s;
     let off = xy * xy + xz * xz + yz * yz;
     let mean = (xx + yy + zz) / 3.0;
     let (dx, dy, dz) = (xx - mean, yy - mean, zz - mean);
     let q2 = (dx * dx + dy * dy + dz * dz + 2.0 * off) / 6.0;
     if q2 <= 1e-30 * mean * mean || q2 == 0.0 {
-        return [mean; 3];
+        return (mean, None);
     }
     let q = q2.sqrt();
-    // det of the deviator over q^3, halved: cos(3 phi).
     let det = dx * (dy * dz - yz * yz) - xy * (xy * dz - yz * xz) + xz * (xy * yz - dy * xz);
-    let r = (0.5 * det / (q2 * q)).clamp(-1.0, 1.0);
+    (mean, Some((q, (0.5 * det / (q2 * q)).clamp(-1.0, 1.0))))
+}
+
+/// Principal stresses of a symmetric tensor, descending (Pa): the closed-form roots of its
+/// characteristic cubic (trigonometric form).
+pub fn principal_stresses(s: &Stress) -> [f64; 3] {
+    let (mean, invariants) = deviator_invariants(s);
+    let Some((q, r)) = invariants else {
+        return [mean; 3];
+    };
     let phi = r.acos() / 3.0;
     let s1 = mean + 2.0 * q * phi.cos();
     let s3 = mean + 2.0 * q * (phi + 2.0 * PI / 3.0).cos();
     [s1, 3.0 * mean - s1 - s3, s3]
 }
 
-/// Principal shear stress tau_1 = (sigma_1 - sigma_3) / 2 of a tensor, Pa.
+/// Principal shear stress tau_1 = (sigma_1 - sigma_3) / 2 of a tensor, Pa: from the
+/// invariants of [`deviator_invariants`], sigma_1 - sigma_3 = 2 sqrt(3) q sin(phi + pi / 3).
 pub fn principal_shear(s: &Stress) -> f64 {
-    let p = principal_stresses(s);
-    0.5 * (p[0] - p[2])
+    match deviator_invariants(s) {
+        (_, Some((q, r))) => 3f64.sqrt() * q * (r.acos() / 3.0 + PI / 3.0).sin(),
+        (_, None) => 0.0,
+    }
 }
 
 /// The frame of a cell: columns across the line, along it, and into the body (-normal).
@@ -270,20 +157,6 @@ fn frame(c: &ContactCell) -> Matrix3<f64> {
 /// The frame of a source rectangle, as [`frame`].
 fn source_frame(s: &Source) -> Matrix3<f64> {
     Matrix3::from_columns(&[s.axis_nu, s.axis_zeta, -s.normal])
-}
-
-/// A tensor given in frame `from` (columns) rotated into frame `to`: R S R^T, R = to^T from.
-fn rotate(s: &Stress, rotation: &Matrix3<f64>) -> Stress {
-    let m = Matrix3::new(s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2]);
-    let r = rotation * m * rotation.transpose();
-    [
-        r[(0, 0)],
-        r[(1, 1)],
-        r[(2, 2)],
-        r[(0, 1)],
-        r[(0, 2)],
-        r[(1, 2)],
-    ]
 }
 
 /// Stress at depth `depth` (m) below the centre of `at`, in its frame (x across the line, y
@@ -306,7 +179,7 @@ pub fn stress_below(
             ..Source::of(&cells[j], pressure[j])
         })
         .collect();
-    field(at, &sources, depth, nu)
+    field(at, &Batch::new(&sources), depth, nu)
 }
 
 /// The equivalent pressure below one cell (MODEL §8.1): the criterion's largest value over
@@ -390,12 +263,29 @@ pub fn equivalent_pressures(
         .iter()
         .map(|r| lumped_row(cells, pressure, r))
         .collect();
+    // The rows of each surface in their order, and each row's place among them.
+    let mut surfaces: Vec<Vec<usize>> = Vec::new();
+    let mut place = vec![0; rows.len()];
+    for (r, &s) in surface.iter().enumerate() {
+        if surfaces.len() <= s {
+            surfaces.resize(s + 1, Vec::new());
+        }
+        place[r] = surfaces[s].len();
+        surfaces[s].push(r);
+    }
+    let radius: Vec<f64> = lumps
+        .iter()
+        .map(|l| l.as_ref().map_or(0.0, |l| l.half_nu.hypot(l.half_zeta)))
+        .collect();
     let load = Load {
         cells,
         pressure,
         rows,
         surface,
         lumps: &lumps,
+        surfaces: &surfaces,
+        place: &place,
+        radius: &radius,
     };
     let per_row: Vec<Vec<Equivalent>> = (0..rows.len())
         .into_par_iter()
@@ -408,13 +298,18 @@ pub fn equivalent_pressures(
     out
 }
 
-/// The loaded surface of [`equivalent_pressures`] with its rows' lumps.
+/// The loaded surface of [`equivalent_pressures`] with its rows' lumps: the rows of each
+/// surface in order (`surfaces`), each row's place in its surface's list, and the radius of
+/// each lump's circumscribed circle (m).
 struct Load<'a> {
     cells: &'a [ContactCell],
     pressure: &'a [f64],
     rows: &'a [Range<usize>],
     surface: &'a [usize],
     lumps: &'a [Option<Source>],
+    surfaces: &'a [Vec<usize>],
+    place: &'a [usize],
+    radius: &'a [f64],
 }
 
 impl Load<'_> {
@@ -426,14 +321,14 @@ impl Load<'_> {
             return out;
         };
         let a = lump.half_nu;
-        let (near, far) = self.sources_of(r, settings.reach * a);
+        let sources = self.sources_of(r, settings.reach * a);
         let levels = settings.depth_levels.max(3);
         let (from, to) = (settings.depth_from * a, settings.depth_to * a);
         let depths: Vec<f64> = (0..levels)
             .map(|k| (from + (to - from) * k as f64 / (levels - 1) as f64).max(1e-3 * a))
             .collect();
         // The far rows' field varies over distances of their distance: read once per depth
-        // below the row's load centre, linear between the depths.
+        // below the row's load centre.
         let below = ContactCell {
             centre: lump.centre,
             normal: lump.normal,
@@ -444,12 +339,11 @@ impl Load<'_> {
         };
         let far_field: Vec<Stress> = depths
             .iter()
-            .map(|&z| field(&below, &far, z, settings.poisson))
+            .map(|&z| field(&below, &sources.far, z, settings.poisson))
             .collect();
-        let far_at = |z: f64| interpolate(&depths, &far_field, z);
         for (o, k) in out.iter_mut().zip(range.clone()) {
             if self.pressure[k] > 0.0 {
-                *o = cell_equivalent(&self.cells[k], &near, &far_at, &depths, settings);
+                *o = cell_equivalent(&self.cells[k], &sources.near, &far_field, &depths, settings);
             }
         }
         out
@@ -460,35 +354,31 @@ impl Load<'_> {
     /// beyond, the rows' lumps, merged in blocks of consecutive rows up to half as long as their
     /// distance from r in rows ([`merge`]; the rows of a surface are given in their order along
     /// the line).
-    fn sources_of(&self, r: usize, near: f64) -> (Vec<Source>, Vec<Source>) {
+    fn sources_of(&self, r: usize, reach: f64) -> Sources {
         let Some(own) = &self.lumps[r] else {
-            return (Vec::new(), Vec::new());
+            return Sources::default();
         };
         let to = source_frame(own).transpose();
         let rotated = |mut s: Source| {
             s.rotation = to * source_frame(&s);
             s
         };
-        let same: Vec<usize> = (0..self.rows.len())
-            .filter(|&o| self.surface[o] == self.surface[r])
-            .collect();
-        let at = same.iter().position(|&o| o == r).unwrap_or(0);
-        let mut sources = Vec::new();
+        let same = &self.surfaces[self.surface[r]];
+        let at = self.place[r];
+        let mut near = Vec::new();
         // Far rows on each side, ordered outward from r: (distance in rows, lump).
         let mut sides: [Vec<(usize, &Source)>; 2] = [Vec::new(), Vec::new()];
         for (index, &o) in same.iter().enumerate() {
             let Some(lump) = &self.lumps[o] else {
                 continue;
             };
-            let gap = (lump.centre - own.centre).norm()
-                - lump.half_nu.hypot(lump.half_zeta)
-                - own.half_nu.hypot(own.half_zeta);
-            if gap > near {
+            let gap = (lump.centre - own.centre).norm() - self.radius[o] - self.radius[r];
+            if gap > reach {
                 sides[usize::from(index > at)].push((index.abs_diff(at), lump));
                 continue;
             }
             for k in self.rows[o].clone().filter(|&k| self.pressure[k] > 0.0) {
-                sources.push(rotated(Source::of(&self.cells[k], self.pressure[k])));
+                near.push(rotated(Source::of(&self.cells[k], self.pressure[k])));
             }
         }
         sides[0].reverse();
@@ -510,8 +400,19 @@ impl Load<'_> {
                 far.push(rotated(merge(&block)));
             }
         }
-        (sources, far)
+        Sources {
+            near: Batch::new(&near),
+            far: Batch::new(&far),
+        }
     }
+}
+
+/// The sources of one row's field ([`Load::sources_of`]), rotated into its frame: the
+/// loaded cells of the row and of the rows near it, and the farther rows' merged lumps.
+#[derive(Default)]
+struct Sources {
+    near: Batch,
+    far: Batch,
 }
 
 /// Lumps of consecutive rows as one rectangle: their force at its centroid over their area,
@@ -543,32 +444,38 @@ fn merge(block: &[&Source]) -> Source {
 /// Parabolic refinements of the depth search.
 const REFINEMENTS: usize = 3;
 
-/// The equivalent pressure below cell `at`: the criterion on the depth grid, its maximum
-/// refined [`REFINEMENTS`] times by the parabola through the best depth so far and its nearest evaluated
-/// neighbours (successive parabolic interpolation).
+/// The equivalent pressure below cell `at`: the criterion on the depth grid of the stress
+/// of the `near` sources plus the far rows' field `far` (at `depths`), its maximum refined
+/// [`REFINEMENTS`] times by the parabola through the best depth so far and its nearest
+/// evaluated neighbours (successive parabolic interpolation), the near sources' field exact at
+/// each new depth, the far one interpolated ([`cubic_at`]).
 fn cell_equivalent(
     at: &ContactCell,
-    sources: &[Source],
-    far: &dyn Fn(f64) -> Stress,
+    near: &Batch,
+    far: &[Stress],
     depths: &[f64],
     settings: &SubsurfaceSettings,
 ) -> Equivalent {
-    let value = |z: f64| {
-        let mut s = field(at, sources, z, settings.poisson);
-        for (a, b) in s.iter_mut().zip(far(z)) {
-            *a += b;
-        }
-        settings.criterion.read(&s)
+    let value = |z: f64, far: Stress| {
+        settings
+            .criterion
+            .read(&add(field(at, near, z, settings.poisson), &far))
     };
-    let mut points: Vec<(f64, f64)> = depths.iter().map(|&z| (z, value(z))).collect();
+    let mut points = [(0.0, 0.0); MAX_DEPTHS];
+    let mut count = depths.len().min(MAX_DEPTHS - REFINEMENTS);
+    for (p, (&z, s)) in points.iter_mut().zip(depths.iter().zip(far)).take(count) {
+        *p = (z, value(z, *s));
+    }
     for _ in 0..REFINEMENTS {
-        let best = (0..points.len())
-            .max_by(|&a, &b| points[a].1.total_cmp(&points[b].1))
+        let evaluated = &points[..count];
+        let best = (0..count)
+            .max_by(|&a, &b| evaluated[a].1.total_cmp(&evaluated[b].1))
             .unwrap_or(0);
-        if best == 0 || best + 1 == points.len() {
+        if best == 0 || best + 1 == count {
             break;
         }
-        let ((z0, l), (z1, c), (z2, r)) = (points[best - 1], points[best], points[best + 1]);
+        let ((z0, l), (z1, c), (z2, r)) =
+            (evaluated[best - 1], evaluated[best], evaluated[best + 1]);
         // Vertex of the parabola through three points.
         let (d0, d2) = (z1 - z0, z1 - z2);
         let num = d0 * d0 * (c - r) - d2 * d2 * (c - l);
@@ -579,54 +486,59 @@ fn cell_equivalent(
         let z = (z1 - 0.5 * num / den).clamp(z0, z2);
         // No threshold on the step (a discrete choice would turn round-off in the pressures
         // into a different depth): only a vertex on a point already there ends the search.
-        if points.iter().any(|p| p.0 == z) {
+        if evaluated.iter().any(|p| p.0 == z) {
             break;
         }
-        let at = points.partition_point(|p| p.0 < z);
-        points.insert(at, (z, value(z)));
+        let at = evaluated.partition_point(|p| p.0 < z);
+        points.copy_within(at..count, at + 1);
+        points[at] = (z, value(z, cubic_at(depths, far, z)));
+        count += 1;
     }
-    let (depth, pressure) = points
-        .into_iter()
+    let (depth, pressure) = points[..count]
+        .iter()
+        .copied()
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap_or_default();
     Equivalent { pressure, depth }
 }
 
-/// The tensor at depth z, linear between the `depths` (ascending) of `values`, the end
-/// values beyond.
-fn interpolate(depths: &[f64], values: &[Stress], z: f64) -> Stress {
-    let k = depths
-        .partition_point(|&d| d <= z)
-        .clamp(1, depths.len() - 1);
-    let t = ((z - depths[k - 1]) / (depths[k] - depths[k - 1])).clamp(0.0, 1.0);
-    let mut out = values[k - 1];
-    for (o, v) in out.iter_mut().zip(values[k]) {
-        *o += t * (v - *o);
+/// The most depths a search evaluates (grid and refinements).
+const MAX_DEPTHS: usize = 32;
+
+/// The sum of two tensors.
+fn add(mut a: Stress, b: &Stress) -> Stress {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+    a
+}
+
+/// The tensor at depth z from its values at `depths` (ascending, evenly spaced, at least 3):
+/// the cubic through the four depths around z (the parabola through three when there are
+/// three), componentwise.
+fn cubic_at(depths: &[f64], values: &[Stress], z: f64) -> Stress {
+    let n = depths.len();
+    let order = n.min(4);
+    let k = depths.partition_point(|&d| d <= z).clamp(1, n - 1);
+    let first = (k - 1).saturating_sub((order - 2) / 2).min(n - order);
+    let nodes = first..first + order;
+    let mut out = [0.0; 6];
+    for i in nodes.clone() {
+        let weight: f64 = nodes
+            .clone()
+            .filter(|&j| j != i)
+            .map(|j| (z - depths[j]) / (depths[i] - depths[j]))
+            .product();
+        for (o, v) in out.iter_mut().zip(values[i]) {
+            *o += weight * v;
+        }
     }
     out
 }
 
 /// Stress at depth z below the centre of `at` from `sources`, in the row's frame. Pa.
-fn field(at: &ContactCell, sources: &[Source], z: f64, nu: f64) -> Stress {
-    let point = at.centre - at.normal * z;
-    let mut sum = [0.0; 6];
-    for s in sources {
-        let d = point - s.centre;
-        let local = rectangle_stress(
-            d.dot(&s.axis_nu),
-            d.dot(&s.axis_zeta),
-            (-d.dot(&s.normal)).max(1e-6 * s.half_nu),
-            s.half_nu,
-            s.half_zeta,
-            nu,
-            s.pressure,
-        );
-        let rotated = rotate(&local, &s.rotation);
-        for (a, b) in sum.iter_mut().zip(rotated) {
-            *a += b;
-        }
-    }
-    sum
+fn field(at: &ContactCell, sources: &Batch, z: f64, nu: f64) -> Stress {
+    sources.stress_at(&(at.centre - at.normal * z), nu)
 }
 
 /// The principal shear stress tau_1 on a section below one row of cells (MODEL §8.1): across
@@ -678,20 +590,4 @@ pub fn section(
         })
         .collect();
     Section { x, z, tau1 }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_combined_arctangent_is_the_difference_of_two_in_every_quadrant() {
-        let values = [-1e6, -3.0, -1.0, -0.2, 0.0, 0.2, 1.0, 3.0, 1e6];
-        for u in values {
-            for v in values {
-                let d = atan_difference(u, v);
-                assert!((d - (u.atan() - v.atan())).abs() < 1e-12, "{u} {v}: {d}");
-            }
-        }
-    }
 }

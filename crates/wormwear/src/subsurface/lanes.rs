@@ -1,0 +1,547 @@
+//! The stress below many loaded rectangles at one field point (MODEL §8.1), the rectangles
+//! [`LANES`] at a time: the same closed form as [`super::love`] (Love's corner functions),
+//! written branch-free over structure-of-arrays data so that the compiler evaluates one
+//! rectangle per vector lane (compiled for AVX2 + FMA when the CPU has them, chosen at run
+//! time, there with fused multiply-adds; the same numbers to round-off either way).
+//!
+//! Per rectangle the work is arranged for few divisions: each corner's reciprocals share one
+//! division where they can, the arctangents of a pair of corners are combined into one from
+//! their numerators and denominators, and the arctangent itself is a polynomial ([`atan_reduced`]),
+//! not a library call, so that it vectorises. Coordinates are scaled by the rectangle's half
+//! side across the line: the potentials' derivatives that enter the stresses are
+//! dimensionless, and the scaled numbers stay near 1.
+
+use super::{Source, Stress};
+use nalgebra::Vector3;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+/// Rectangles per pass (four doubles per AVX2 register).
+pub(super) const LANES: usize = 4;
+
+/// The smallest depth of a field point below a source, in half sides across the line (the
+/// closed form is singular on the surface).
+const MIN_DEPTH: f64 = 1e-6;
+
+/// tan(pi / 8) and tan(3 pi / 8): the bounds of the arctangent's argument reduction
+/// ([`atan_difference`]).
+const TAN_PI_8: f64 = 0.414_213_562_373_095_03;
+const TAN_3PI_8: f64 = 2.414_213_562_373_095;
+
+/// Coefficients c_k of atan(r) = r + r s sum_k c_k s^k, s = r^2, |r| <= tan(pi / 8): the
+/// degree-10 polynomial interpolating (atan(r) - r) / r^3 at the Chebyshev nodes of
+/// s in [0, tan^2(pi / 8)] (computed with 50-digit arithmetic; the unit test checks the
+/// arctangent against the library's to 2 ulp).
+const ATAN_COEFFICIENTS: [f64; 11] = [
+    -0.333_333_333_333_333_3,
+    0.199_999_999_999_955_2,
+    -0.142_857_142_846_665_42,
+    0.111_111_110_152_563_61,
+    -0.090_909_045_781_239_03,
+    0.076_921_831_908_260_87,
+    -0.066_645_114_473_819_48,
+    0.058_581_489_128_022_1,
+    -0.050_854_497_379_402_6,
+    0.039_231_658_295_587_19,
+    -0.019_176_887_119_062_26,
+];
+
+/// atan(n0 / d0) - atan(n1 / d1) for d0, d1 > 0 (the difference lies in (-pi, pi)): one
+/// arctangent of num / den = (n0 d1 - n1 d0) / (d0 d1 + n0 n1), shifted by pi where den is
+/// negative. The argument is reduced to |r| <= tan(pi / 8) by atan(t) = pi/2 + atan(-1/t) or
+/// pi/4 + atan((t - 1) / (t + 1)), written in |num| and |den| so that one division is left;
+/// +-pi/2 where den = 0. Relative error about 1e-16.
+#[inline(always)]
+fn atan_difference<const FUSED: bool>(n0: f64, d0: f64, n1: f64, d1: f64) -> f64 {
+    let num = n0 * d1 - n1 * d0;
+    let den = d0 * d1 + n0 * n1;
+    let shift = if den < 0.0 { PI.copysign(num) } else { 0.0 };
+    let (a, b) = (num.abs(), den.abs());
+    // t = a / b against tan(pi/8) and tan(3 pi/8), without dividing.
+    let (top, bottom, offset) = if a > TAN_3PI_8 * b {
+        (-b, a, FRAC_PI_2)
+    } else if a > TAN_PI_8 * b {
+        (a - b, a + b, FRAC_PI_4)
+    } else {
+        (a, b, 0.0)
+    };
+    let sign = if (num < 0.0) != (den < 0.0) {
+        -1.0
+    } else {
+        1.0
+    };
+    sign * atan_reduced::<FUSED>(top / bottom, offset) + shift
+}
+
+/// offset + atan(r) for |r| <= tan(pi / 8) (the polynomial of [`ATAN_COEFFICIENTS`]; the
+/// reduction that brings an argument there is [`atan_difference`]'s).
+#[inline(always)]
+fn atan_reduced<const FUSED: bool>(r: f64, offset: f64) -> f64 {
+    let s = r * r;
+    let mut p = ATAN_COEFFICIENTS[10];
+    for &c in ATAN_COEFFICIENTS[..10].iter().rev() {
+        p = madd::<FUSED>(p, s, c);
+    }
+    offset + (r + r * (s * p))
+}
+
+/// The natural logarithm of a positive normal number, branch-free and in operations AVX2
+/// has for four lanes: x = 2^e m with m in [sqrt(1/2), sqrt(2)) from the bits, ln m =
+/// 2 atanh(f), f = (m - 1) / (m + 1), |f| < 0.172, by its series to f^23 (the next term is
+/// below 1e-17 of ln m). Relative error about 1e-16 away from x = 1, absolute about 1e-17
+/// near it.
+#[inline(always)]
+pub(super) fn ln<const FUSED: bool>(x: f64) -> f64 {
+    const SQRT_HALF: u64 = 0x3fe6_a09e_667f_3bcd;
+    const EXPONENT_MASK: u64 = 0xfff0_0000_0000_0000;
+    // The exponent for a mantissa in [sqrt(1/2), sqrt(2)), offset by 1024 to stay positive.
+    let shifted = x.to_bits() + (1024 << 52) - SQRT_HALF;
+    // (shifted >> 52) as a double by the 2^52 trick (no 64-bit integer conversion in AVX2).
+    let exponent = f64::from_bits((shifted >> 52) | 0x4330_0000_0000_0000)
+        - (4_503_599_627_370_496.0 + 1024.0);
+    let m = f64::from_bits(x.to_bits() - (shifted & EXPONENT_MASK) + (1024 << 52));
+    let f = (m - 1.0) / (m + 1.0);
+    let s = f * f;
+    let mut p = 1.0 / 23.0;
+    for k in (0..11).rev() {
+        p = madd::<FUSED>(p, s, 1.0 / (2 * k + 1) as f64);
+    }
+    madd::<FUSED>(exponent, std::f64::consts::LN_2, 2.0 * f * p)
+}
+
+/// a b + c, fused (one rounding) when `FUSED`: the AVX2 + FMA build's, the portable build
+/// keeps the two roundings (a fused multiply-add without the hardware is a slow library call).
+#[inline(always)]
+fn madd<const FUSED: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FUSED {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+/// One corner's share of a rectangle's potentials (see [`super::love`]): the rational
+/// derivatives, and the numerators and (positive) denominators of the arctangents' arguments.
+#[derive(Clone, Copy)]
+struct Corner {
+    psi_xx: f64,
+    psi_zz: f64,
+    psi_xy: f64,
+    psi_xz: f64,
+    psi_yz: f64,
+    /// psi_z's corner function is -atan(z_num / z_den), psi1_xx's atan(xx_num / xx_den).
+    z_num: f64,
+    z_den: f64,
+    xx_num: f64,
+    xx_den: f64,
+    /// psi1_xy's corner function is ln(`rho_plus_z`).
+    rho_plus_z: f64,
+}
+
+/// The corner functions at offsets (x, y) from a corner and depth z > 0 (scaled lengths),
+/// branch-free: t + rho for t < 0 as s2 / (rho - t), free of cancellation, and 1 / (rho (t + rho))
+/// as one division either way.
+#[inline(always)]
+fn corner(x: f64, y: f64, z: f64) -> Corner {
+    let (x2, y2, z2) = (x * x, y * y, z * z);
+    let rho = (x2 + y2 + z2).sqrt();
+    let (xz2, yz2) = (x2 + z2, y2 + z2);
+    // 1 / (rho (y + rho)) and 1 / (rho (x + rho)).
+    let (num_y, den_y) = if y >= 0.0 {
+        (1.0, y + rho)
+    } else {
+        (rho - y, xz2)
+    };
+    let (num_x, den_x) = if x >= 0.0 {
+        (1.0, x + rho)
+    } else {
+        (rho - x, yz2)
+    };
+    // One division for 1 / rho, 1 / (rho den_y), 1 / (rho den_x) and 1 / (rho xz2 yz2).
+    let (xz2_yz2, dens) = (xz2 * yz2, den_x * den_y);
+    let inverse = 1.0 / (rho * dens * xz2_yz2);
+    let over_rho = inverse * dens * xz2_yz2;
+    let over_y = num_y * (inverse * den_x * xz2_yz2);
+    let over_x = num_x * (inverse * den_y * xz2_yz2);
+    let xy = x * y;
+    let rho_plus_z = rho + z;
+    // rho - z = (x^2 + y^2) / (rho + z); psi1_xx's argument xy (rho - z) / (x^2 rho + z y^2),
+    // zero where xy is (its denominator vanishes only at x = y = 0).
+    let xx_den = rho_plus_z * (x2 * rho + z * y2);
+    let (xx_num, xx_den) = if xx_den > 0.0 {
+        (xy * (x2 + y2), xx_den)
+    } else {
+        (0.0, 1.0)
+    };
+    Corner {
+        psi_xx: x * over_y,
+        psi_zz: xy * (xz2 + yz2) * (inverse * dens),
+        psi_xy: over_rho,
+        psi_xz: z * over_y,
+        psi_yz: z * over_x,
+        z_num: xy,
+        z_den: z * rho,
+        xx_num,
+        xx_den,
+        rho_plus_z,
+    }
+}
+
+/// Stress at (x, y, z) (scaled by the half side across the line; z the depth, > 0) of a
+/// pressure 2 pi on the rectangle |x'| <= 1, |y'| <= b, in its frame, but for tau_xy's
+/// (1 - 2 nu) psi1_xy term, and the argument of that psi1_xy's logarithm.
+#[inline(always)]
+fn rectangle<const FUSED: bool>(x: f64, y: f64, z: f64, b: f64, nu: f64) -> ([f64; 6], f64) {
+    let c = [
+        corner(x + 1.0, y + b, z),
+        corner(x - 1.0, y + b, z),
+        corner(x + 1.0, y - b, z),
+        corner(x - 1.0, y - b, z),
+    ];
+    let sum = |f: fn(&Corner) -> f64| f(&c[0]) - f(&c[1]) - f(&c[2]) + f(&c[3]);
+    let atan = atan_difference::<FUSED>;
+    let psi_z = -(atan(c[0].z_num, c[0].z_den, c[1].z_num, c[1].z_den)
+        + atan(c[3].z_num, c[3].z_den, c[2].z_num, c[2].z_den));
+    let psi1_xx = atan(c[0].xx_num, c[0].xx_den, c[1].xx_num, c[1].xx_den)
+        + atan(c[3].xx_num, c[3].xx_den, c[2].xx_num, c[2].xx_den);
+    let (psi_xx, psi_zz) = (sum(|c| c.psi_xx), sum(|c| c.psi_zz));
+    let (psi_xy, psi_xz, psi_yz) = (sum(|c| c.psi_xy), sum(|c| c.psi_xz), sum(|c| c.psi_yz));
+    // Laplace's equation: psi_yy = -psi_xx - psi_zz, psi1_yy = -psi1_xx - psi_z.
+    let psi_yy = -psi_xx - psi_zz;
+    let psi1_yy = -psi1_xx - psi_z;
+    let m = 1.0 - 2.0 * nu;
+    let stress = [
+        2.0 * nu * psi_z - z * psi_xx - m * psi1_xx,
+        2.0 * nu * psi_z - z * psi_yy - m * psi1_yy,
+        psi_z - z * psi_zz,
+        -z * psi_xy,
+        -z * psi_xz,
+        -z * psi_yz,
+    ];
+    let log_argument = (c[0].rho_plus_z * c[3].rho_plus_z) / (c[1].rho_plus_z * c[2].rho_plus_z);
+    (stress, log_argument)
+}
+
+/// [`LANES`] source rectangles, lane by lane: centre, frame (across, along, outward normal),
+/// the inverse of the half side across the line, the aspect ratio (along / across), the
+/// pressure over 2 pi (Pa) and the rotation of the source's frame into the field's
+/// (row-major).
+#[derive(Debug, Clone, Copy)]
+struct Pass {
+    centre: [[f64; LANES]; 3],
+    across: [[f64; LANES]; 3],
+    along: [[f64; LANES]; 3],
+    normal: [[f64; LANES]; 3],
+    inverse_half_across: [f64; LANES],
+    aspect: [f64; LANES],
+    scale: [f64; LANES],
+    rotation: [[f64; LANES]; 9],
+}
+
+/// Source rectangles in passes of [`LANES`], the last padded with unloaded copies.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Batch {
+    passes: Vec<Pass>,
+}
+
+impl Batch {
+    /// The sources, padded.
+    pub(super) fn new(sources: &[Source]) -> Self {
+        let passes = sources
+            .chunks(LANES)
+            .map(|chunk| {
+                let mut p = Pass {
+                    centre: [[0.0; LANES]; 3],
+                    across: [[0.0; LANES]; 3],
+                    along: [[0.0; LANES]; 3],
+                    normal: [[0.0; LANES]; 3],
+                    inverse_half_across: [0.0; LANES],
+                    aspect: [0.0; LANES],
+                    scale: [0.0; LANES],
+                    rotation: [[0.0; LANES]; 9],
+                };
+                for l in 0..LANES {
+                    let (s, scale) = match chunk.get(l) {
+                        Some(s) => (s, s.pressure / (2.0 * PI)),
+                        None => (&chunk[0], 0.0),
+                    };
+                    for i in 0..3 {
+                        p.centre[i][l] = s.centre[i];
+                        p.across[i][l] = s.axis_nu[i];
+                        p.along[i][l] = s.axis_zeta[i];
+                        p.normal[i][l] = s.normal[i];
+                    }
+                    p.inverse_half_across[l] = 1.0 / s.half_nu;
+                    p.aspect[l] = s.half_zeta / s.half_nu;
+                    p.scale[l] = scale;
+                    for (i, r) in p.rotation.iter_mut().enumerate() {
+                        r[l] = s.rotation[(i / 3, i % 3)];
+                    }
+                }
+                p
+            })
+            .collect();
+        Self { passes }
+    }
+
+    /// Stress at `point` (m) from every source, in the field's frame (each source's tensor
+    /// rotated by its rotation), for Poisson's ratio `nu`. Pa.
+    pub(super) fn stress_at(&self, point: &Vector3<f64>, nu: f64) -> Stress {
+        if self.passes.is_empty() {
+            return [0.0; 6];
+        }
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            return unsafe { self.stress_at_avx2(point, nu) };
+        }
+        self.stress_at_lanes::<false>(point, nu)
+    }
+
+    /// [`Batch::stress_at`] compiled for AVX2 + FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn stress_at_avx2(&self, point: &Vector3<f64>, nu: f64) -> Stress {
+        self.stress_at_lanes::<true>(point, nu)
+    }
+
+    /// [`Batch::stress_at`], one pass at a time; `FUSED`: with fused multiply-adds.
+    #[inline(always)]
+    fn stress_at_lanes<const FUSED: bool>(&self, point: &Vector3<f64>, nu: f64) -> Stress {
+        let mut sum = [[0.0; LANES]; 6];
+        for pass in &self.passes {
+            pass.add_stress::<FUSED>(point, nu, &mut sum);
+        }
+        let mut out = [0.0; 6];
+        for (o, lanes) in out.iter_mut().zip(&sum) {
+            *o = lanes.iter().sum();
+        }
+        out
+    }
+}
+
+impl Pass {
+    /// The pass's stresses at `point` in the field's frame, added lane by lane to `sum`.
+    #[inline(always)]
+    fn add_stress<const FUSED: bool>(
+        &self,
+        point: &Vector3<f64>,
+        nu: f64,
+        sum: &mut [[f64; LANES]; 6],
+    ) {
+        // Component-major, so that each component's lanes are contiguous.
+        let mut local = [[0.0; LANES]; 6];
+        let mut log_argument = [0.0; LANES];
+        for l in 0..LANES {
+            let d = [
+                point[0] - self.centre[0][l],
+                point[1] - self.centre[1][l],
+                point[2] - self.centre[2][l],
+            ];
+            let dot = |a: &[[f64; LANES]; 3]| {
+                madd::<FUSED>(d[0], a[0][l], madd::<FUSED>(d[1], a[1][l], d[2] * a[2][l]))
+            };
+            let inverse = self.inverse_half_across[l];
+            let x = dot(&self.across) * inverse;
+            let y = dot(&self.along) * inverse;
+            let z = (-dot(&self.normal) * inverse).max(MIN_DEPTH);
+            let (stress, argument) = rectangle::<FUSED>(x, y, z, self.aspect[l], nu);
+            for (component, value) in local.iter_mut().zip(stress) {
+                component[l] = value;
+            }
+            log_argument[l] = argument;
+        }
+        // psi1_xy's part of tau_xy.
+        let m = 1.0 - 2.0 * nu;
+        for l in 0..LANES {
+            local[3][l] = madd::<FUSED>(-m, ln::<FUSED>(log_argument[l]), local[3][l]);
+        }
+        for l in 0..LANES {
+            let s = |k: usize| local[k][l];
+            let t = [[s(0), s(3), s(4)], [s(3), s(1), s(5)], [s(4), s(5), s(2)]];
+            let q = |i: usize, j: usize| self.rotation[3 * i + j][l];
+            // R S R^T, upper triangle.
+            let mut rs = [[0.0; 3]; 3];
+            for (i, row) in rs.iter_mut().enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = madd::<FUSED>(
+                        q(i, 0),
+                        t[0][j],
+                        madd::<FUSED>(q(i, 1), t[1][j], q(i, 2) * t[2][j]),
+                    );
+                }
+            }
+            let e = |i: usize, j: usize| {
+                madd::<FUSED>(
+                    rs[i][0],
+                    q(j, 0),
+                    madd::<FUSED>(rs[i][1], q(j, 1), rs[i][2] * q(j, 2)),
+                )
+            };
+            let rotated = [e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)];
+            for (k, v) in rotated.into_iter().enumerate() {
+                sum[k][l] = madd::<FUSED>(self.scale[l], v, sum[k][l]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::love;
+    use super::*;
+    use crate::contact::ContactCell;
+    use nalgebra::Matrix3;
+
+    /// A tensor given in frame `from` (columns) rotated into frame `to`: R S R^T, R = to^T from.
+    fn rotate(s: &Stress, rotation: &Matrix3<f64>) -> Stress {
+        let m = Matrix3::new(s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2]);
+        let r = rotation * m * rotation.transpose();
+        [
+            r[(0, 0)],
+            r[(1, 1)],
+            r[(2, 2)],
+            r[(0, 1)],
+            r[(0, 2)],
+            r[(1, 2)],
+        ]
+    }
+
+    /// A cell of a curved surface: centre on the sphere of radius `radius` (m) about the
+    /// origin's -z side, frame turned by `turn` about the normal, half sides (m).
+    fn cell(angle: (f64, f64), radius: f64, turn: f64, half: (f64, f64)) -> ContactCell {
+        let normal = Vector3::new(angle.0.sin(), angle.1.sin(), 1.0).normalize();
+        let seed = Vector3::new(turn.cos(), turn.sin(), 0.0);
+        let axis_nu = (seed - normal * seed.dot(&normal)).normalize();
+        ContactCell {
+            centre: normal * radius - Vector3::new(0.0, 0.0, radius),
+            normal,
+            axis_nu,
+            axis_zeta: normal.cross(&axis_nu),
+            half_nu: half.0,
+            half_zeta: half.1,
+        }
+    }
+
+    #[test]
+    fn a_batch_sums_loves_rectangles_rotated_into_the_field_frame() {
+        // Sources on a curved surface, each in its own tangent plane, pressures of both signs
+        // of size; field points below, beside and far away: the batch against the reference
+        // closed form one rectangle at a time (love::rectangle_stress), rotated by nalgebra.
+        let radius = 0.02;
+        let cells: Vec<ContactCell> = (0..11)
+            .map(|k| {
+                let k = k as f64;
+                cell(
+                    (0.004 * (k - 5.0), 0.003 * (k % 3.0)),
+                    radius,
+                    0.2 * k,
+                    (1e-4 * (1.0 + 0.1 * k), 3e-4 * (1.0 + 0.05 * k)),
+                )
+            })
+            .collect();
+        let field = cells[4];
+        let to =
+            Matrix3::from_columns(&[field.axis_nu, field.axis_zeta, -field.normal]).transpose();
+        let sources: Vec<Source> = cells
+            .iter()
+            .enumerate()
+            .map(|(k, c)| Source {
+                rotation: to * Matrix3::from_columns(&[c.axis_nu, c.axis_zeta, -c.normal]),
+                ..Source::of(c, 1e8 * (1.0 + k as f64))
+            })
+            .collect();
+        let batch = Batch::new(&sources);
+        let nu = 0.35;
+        for (depth, beside) in [
+            (1e-5, 0.0),
+            (1e-4, 0.0),
+            (3e-4, 2e-4),
+            (5e-3, 0.0),
+            (1e-4, 3e-3),
+        ] {
+            let point = field.centre - field.normal * depth + field.axis_nu * beside;
+            let mut reference = [0.0; 6];
+            for s in &sources {
+                let d = point - s.centre;
+                let local = love::rectangle_stress(
+                    d.dot(&s.axis_nu),
+                    d.dot(&s.axis_zeta),
+                    (-d.dot(&s.normal)).max(1e-6 * s.half_nu),
+                    s.half_nu,
+                    s.half_zeta,
+                    nu,
+                    s.pressure,
+                );
+                for (r, v) in reference.iter_mut().zip(rotate(&local, &s.rotation)) {
+                    *r += v;
+                }
+            }
+            let ours = batch.stress_at(&point, nu);
+            let size = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            // The portable build of the same passes, without fused multiply-adds.
+            let portable = batch.stress_at_lanes::<false>(&point, nu);
+            for (a, b) in ours.iter().zip(&portable) {
+                assert!((a - b).abs() < 1e-13 * size, "{ours:?} vs {portable:?}");
+            }
+            for (a, b) in ours.iter().zip(&reference) {
+                assert!(
+                    (a - b).abs() < 1e-12 * size,
+                    "depth {depth}: {ours:?} vs {reference:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_polynomial_arctangent_is_the_librarys_to_two_ulp() {
+        let mut worst: f64 = 0.0;
+        for k in -4000..=4000 {
+            for u in [
+                k as f64 * 1e-3,
+                (k as f64 * 1e-2).powi(3),
+                1.0 / (k as f64 * 1e-3),
+            ] {
+                let (ours, libm) = (atan_difference::<false>(u, 1.0, 0.0, 1.0), u.atan());
+                if libm != 0.0 {
+                    worst = worst.max(((ours - libm) / libm).abs());
+                }
+            }
+        }
+        assert!(worst < 2.0 * f64::EPSILON, "relative error {worst:e}");
+        assert_eq!(atan_difference::<false>(1.0, 0.0, 0.0, 1.0), FRAC_PI_2);
+        assert_eq!(atan_difference::<false>(-1.0, 0.0, 0.0, 1.0), -FRAC_PI_2);
+        assert_eq!(atan_difference::<false>(0.0, 1.0, 0.0, 1.0), 0.0);
+    }
+
+    #[test]
+    fn the_combined_arctangent_is_the_difference_of_two_in_every_quadrant() {
+        let values = [
+            -1e6, -3.0, -1.0, -0.4, -0.2, 0.0, 0.2, 0.45, 1.0, 2.5, 3.0, 1e6,
+        ];
+        for u in values {
+            for v in values {
+                for (d0, d1) in [(1.0, 1.0), (0.3, 7.0)] {
+                    let d = atan_difference::<false>(u * d0, d0, v * d1, d1);
+                    assert!((d - (u.atan() - v.atan())).abs() < 1e-15, "{u} {v}: {d}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_series_logarithm_is_the_librarys() {
+        for k in 1..20000 {
+            for x in [
+                k as f64 * 1e-3,
+                1.0 + (k as f64 - 1e4) * 1e-9,
+                (k as f64 * 1e-3).powi(9),
+            ] {
+                let (ours, libm) = (ln::<false>(x), x.ln());
+                assert!(
+                    (ours - libm).abs() <= 2.0 * f64::EPSILON * libm.abs().max(1e-1),
+                    "ln {x}: {ours} vs {libm}"
+                );
+            }
+        }
+    }
+}
