@@ -116,9 +116,9 @@ impl SubsurfaceSettings {
 fn deviator_invariants(s: &Stress) -> (f64, Option<(f64, f64)>) {
     let [xx, yy, zz, xy, xz, yz] = *s;
     let off = xy * xy + xz * xz + yz * yz;
-    let mean = (xx + yy + zz) / 3.0;
+    let mean = (xx + yy + zz) * (1.0 / 3.0);
     let (dx, dy, dz) = (xx - mean, yy - mean, zz - mean);
-    let q2 = (dx * dx + dy * dy + dz * dz + 2.0 * off) / 6.0;
+    let q2 = (dx * dx + dy * dy + dz * dz + 2.0 * off) * (1.0 / 6.0);
     if q2 <= 1e-30 * mean * mean || q2 == 0.0 {
         return (mean, None);
     }
@@ -141,12 +141,30 @@ pub fn principal_stresses(s: &Stress) -> [f64; 3] {
 }
 
 /// Principal shear stress tau_1 = (sigma_1 - sigma_3) / 2 of a tensor, Pa: from the
-/// invariants of [`deviator_invariants`], sigma_1 - sigma_3 = 2 sqrt(3) q sin(phi + pi / 3).
+/// invariants of [`deviator_invariants`], sigma_1 - sigma_3 = 2 sqrt(3) q sin(phi + pi / 3)
+/// = 2 sqrt(3) q cos(delta), delta = acos(cos 3 phi) / 3 - pi / 6 in [-pi/6, pi/6]; the
+/// arccosine as the argument of (cos 3 phi, sin 3 phi), the cosine by its Taylor series to
+/// delta^14 (the next term is below 2e-18).
 pub fn principal_shear(s: &Stress) -> f64 {
-    match deviator_invariants(s) {
-        (_, Some((q, r))) => 3f64.sqrt() * q * (r.acos() / 3.0 + PI / 3.0).sin(),
-        (_, None) => 0.0,
-    }
+    let (_, Some((q, r))) = deviator_invariants(s) else {
+        return 0.0;
+    };
+    let three_phi = lanes::argument::<false>(r, ((1.0 - r) * (1.0 + r)).sqrt());
+    let delta = three_phi * (1.0 / 3.0) - PI / 6.0;
+    // (-1)^k / (2k)!, k = 0..7.
+    const TAYLOR: [f64; 8] = [
+        1.0,
+        -0.5,
+        1.0 / 24.0,
+        -1.0 / 720.0,
+        1.0 / 40_320.0,
+        -1.0 / 3_628_800.0,
+        1.0 / 479_001_600.0,
+        -1.0 / 87_178_291_200.0,
+    ];
+    let d2 = delta * delta;
+    let cosine = TAYLOR.iter().rev().fold(0.0, |sum, c| sum * d2 + c);
+    3f64.sqrt() * q * cosine
 }
 
 /// The frame of a cell: columns across the line, along it, and into the body (-normal).
@@ -171,15 +189,14 @@ pub fn stress_below(
     nu: f64,
 ) -> Stress {
     let to = frame(at).transpose();
-    let sources: Vec<Source> = sources
-        .iter()
-        .filter(|&&j| pressure[j] != 0.0)
-        .map(|&j| Source {
-            rotation: to * frame(&cells[j]),
-            ..Source::of(&cells[j], pressure[j])
-        })
-        .collect();
-    field(at, &Batch::new(&sources), depth, nu)
+    let mut batch = Batch::default();
+    for &j in sources.iter().filter(|&&j| pressure[j] != 0.0) {
+        batch.push(
+            &Source::of(&cells[j], pressure[j]),
+            &(to * frame(&cells[j])),
+        );
+    }
+    field(at, &batch, depth, nu)
 }
 
 /// The equivalent pressure below one cell (MODEL §8.1): the criterion's largest value over
@@ -200,8 +217,6 @@ struct Source {
     half_nu: f64,
     half_zeta: f64,
     pressure: f64,
-    /// Rotation of its frame into the field row's (that row's first loaded cell's frame).
-    rotation: Matrix3<f64>,
 }
 
 impl Source {
@@ -214,7 +229,6 @@ impl Source {
             half_nu: c.half_nu,
             half_zeta: c.half_zeta,
             pressure,
-            rotation: Matrix3::identity(),
         }
     }
 }
@@ -350,60 +364,118 @@ impl Load<'_> {
     }
 
     /// The sources of row r's field, rotated into its frame, near and far: the loaded cells of
-    /// the rows of its surface whose lump lies within `near` (m, in the surface) of its own;
+    /// the rows of its surface whose lump lies within `reach` (m, in the surface) of its own;
     /// beyond, the rows' lumps, merged in blocks of consecutive rows up to half as long as their
-    /// distance from r in rows ([`merge`]; the rows of a surface are given in their order along
+    /// distance from r in rows ([`Block`]; the rows of a surface are given in their order along
     /// the line).
     fn sources_of(&self, r: usize, reach: f64) -> Sources {
         let Some(own) = &self.lumps[r] else {
             return Sources::default();
         };
         let to = source_frame(own).transpose();
-        let rotated = |mut s: Source| {
-            s.rotation = to * source_frame(&s);
-            s
-        };
         let same = &self.surfaces[self.surface[r]];
         let at = self.place[r];
-        let mut near = Vec::new();
-        // Far rows on each side, ordered outward from r: (distance in rows, lump).
-        let mut sides: [Vec<(usize, &Source)>; 2] = [Vec::new(), Vec::new()];
-        for (index, &o) in same.iter().enumerate() {
-            let Some(lump) = &self.lumps[o] else {
-                continue;
-            };
-            let gap = (lump.centre - own.centre).norm() - self.radius[o] - self.radius[r];
-            if gap > reach {
-                sides[usize::from(index > at)].push((index.abs_diff(at), lump));
-                continue;
-            }
+        // The row's lump and whether it lies beyond the reach (its gap to r's lump, the
+        // distance less both circumscribed radii, above `reach`), None for an unloaded row.
+        let lump_of = |o: usize| {
+            let lump = self.lumps[o].as_ref()?;
+            let limit = reach + self.radius[o] + self.radius[r];
+            let far = limit < 0.0 || (lump.centre - own.centre).norm_squared() > limit * limit;
+            Some((lump, far))
+        };
+        let far_lump = |o: usize| lump_of(o).and_then(|(lump, far)| far.then_some(lump));
+        let mut sources = Sources::default();
+        for &o in same
+            .iter()
+            .filter(|&&o| lump_of(o).is_some_and(|(_, far)| !far))
+        {
             for k in self.rows[o].clone().filter(|&k| self.pressure[k] > 0.0) {
-                near.push(rotated(Source::of(&self.cells[k], self.pressure[k])));
+                let cell = &self.cells[k];
+                sources
+                    .near
+                    .push(&Source::of(cell, self.pressure[k]), &(to * frame(cell)));
             }
         }
-        sides[0].reverse();
-        let mut far = Vec::new();
-        for side in &sides {
-            let mut block: Vec<&Source> = Vec::new();
-            let mut first = 0;
-            for &(distance, lump) in side {
-                if block.is_empty() {
-                    first = distance;
+        // The far rows on each side, outward from r.
+        let sides: [&mut dyn Iterator<Item = (usize, usize)>; 2] = [
+            &mut (0..at).rev().map(|index| (at - index, same[index])),
+            &mut (at + 1..same.len()).map(|index| (index - at, same[index])),
+        ];
+        for side in sides {
+            let mut block: Option<Block> = None;
+            for (distance, o) in side {
+                let Some(lump) = far_lump(o) else {
+                    continue;
+                };
+                let b = block.get_or_insert_with(|| Block::new(lump, distance));
+                b.add(lump);
+                if b.count >= (b.first / 2).max(1) {
+                    b.push_to(&mut sources.far, &to);
+                    block = None;
                 }
-                block.push(lump);
-                if block.len() >= (first / 2).max(1) {
-                    far.push(rotated(merge(&block)));
-                    block.clear();
-                }
             }
-            if !block.is_empty() {
-                far.push(rotated(merge(&block)));
+            if let Some(b) = block {
+                b.push_to(&mut sources.far, &to);
             }
         }
-        Sources {
-            near: Batch::new(&near),
-            far: Batch::new(&far),
+        sources
+    }
+}
+
+/// Lumps of consecutive rows as one rectangle: their force at its centroid over their area,
+/// as long as the rows together, in the frame of the first; `first` is the first row's
+/// distance from the field's row, in rows.
+struct Block<'a> {
+    lump: &'a Source,
+    first: usize,
+    count: usize,
+    force: f64,
+    area: f64,
+    moment: Vector3<f64>,
+    half_zeta: f64,
+}
+
+impl<'a> Block<'a> {
+    fn new(lump: &'a Source, first: usize) -> Self {
+        Self {
+            lump,
+            first,
+            count: 0,
+            force: 0.0,
+            area: 0.0,
+            moment: Vector3::zeros(),
+            half_zeta: 0.0,
         }
+    }
+
+    fn add(&mut self, s: &Source) {
+        let (a, f) = (
+            4.0 * s.half_nu * s.half_zeta,
+            s.pressure * 4.0 * s.half_nu * s.half_zeta,
+        );
+        self.force += f;
+        self.area += a;
+        self.moment += s.centre * f;
+        self.half_zeta += s.half_zeta;
+        self.count += 1;
+    }
+
+    /// The block's rectangle (the lump itself for one row) into `batch`, rotated by `to`
+    /// (the field frame's transpose).
+    fn push_to(&self, batch: &mut Batch, to: &Matrix3<f64>) {
+        let rotation = to * source_frame(self.lump);
+        if self.count == 1 {
+            batch.push(self.lump, &rotation);
+            return;
+        }
+        let merged = Source {
+            centre: self.moment / self.force,
+            half_nu: 0.25 * self.area / self.half_zeta,
+            half_zeta: self.half_zeta,
+            pressure: self.force / self.area,
+            ..self.lump.clone()
+        };
+        batch.push(&merged, &rotation);
     }
 }
 
@@ -413,32 +485,6 @@ impl Load<'_> {
 struct Sources {
     near: Batch,
     far: Batch,
-}
-
-/// Lumps of consecutive rows as one rectangle: their force at its centroid over their area,
-/// as long as the rows together, in the frame of the first.
-fn merge(block: &[&Source]) -> Source {
-    if let [one] = block {
-        return (*one).clone();
-    }
-    let (mut force, mut area, mut moment, mut half_zeta) = (0.0, 0.0, Vector3::zeros(), 0.0);
-    for s in block {
-        let (a, f) = (
-            4.0 * s.half_nu * s.half_zeta,
-            s.pressure * 4.0 * s.half_nu * s.half_zeta,
-        );
-        force += f;
-        area += a;
-        moment += s.centre * f;
-        half_zeta += s.half_zeta;
-    }
-    Source {
-        centre: moment / force,
-        half_nu: 0.25 * area / half_zeta,
-        half_zeta,
-        pressure: force / area,
-        ..block[0].clone()
-    }
 }
 
 /// Parabolic refinements of the depth search.
@@ -515,22 +561,33 @@ fn add(mut a: Stress, b: &Stress) -> Stress {
 
 /// The tensor at depth z from its values at `depths` (ascending, evenly spaced, at least 3):
 /// the cubic through the four depths around z (the parabola through three when there are
-/// three), componentwise.
+/// three), componentwise, its Lagrange weights in t = (z - first depth) / spacing.
 fn cubic_at(depths: &[f64], values: &[Stress], z: f64) -> Stress {
     let n = depths.len();
-    let order = n.min(4);
     let k = depths.partition_point(|&d| d <= z).clamp(1, n - 1);
-    let first = (k - 1).saturating_sub((order - 2) / 2).min(n - order);
-    let nodes = first..first + order;
+    let spacing = (depths[n - 1] - depths[0]) / (n - 1) as f64;
+    let (first, weights) = if n >= 4 {
+        let first = (k - 1).saturating_sub(1).min(n - 4);
+        let t = (z - depths[first]) / spacing;
+        let (a, b, c, d) = (t, t - 1.0, t - 2.0, t - 3.0);
+        (
+            first,
+            [
+                -b * c * d / 6.0,
+                a * c * d / 2.0,
+                -a * b * d / 2.0,
+                a * b * c / 6.0,
+            ],
+        )
+    } else {
+        let t = (z - depths[0]) / spacing;
+        let (a, b, c) = (t, t - 1.0, t - 2.0);
+        (0, [b * c / 2.0, -a * c, a * b / 2.0, 0.0])
+    };
     let mut out = [0.0; 6];
-    for i in nodes.clone() {
-        let weight: f64 = nodes
-            .clone()
-            .filter(|&j| j != i)
-            .map(|j| (z - depths[j]) / (depths[i] - depths[j]))
-            .product();
-        for (o, v) in out.iter_mut().zip(values[i]) {
-            *o += weight * v;
+    for (w, v) in weights.iter().zip(&values[first..]) {
+        for (o, x) in out.iter_mut().zip(v) {
+            *o += w * x;
         }
     }
     out
