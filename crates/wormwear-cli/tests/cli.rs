@@ -549,6 +549,54 @@ fn wear_into(file: &Path, dir: &Path, args: &[&str]) -> std::process::Output {
 }
 
 #[test]
+fn a_record_changed_after_it_was_written_is_refused_on_resume() {
+    // One digit of the first record's largest wear flipped (the JSON still valid, the line
+    // count unchanged): the resumed life would report it in summary.json and
+    // wear_steps.csv. Refused (exit 2) and named, the files left as they were; the sound
+    // records resume.
+    let dir = tempfile::tempdir().unwrap();
+    let design = example("gear-1x40-design.toml");
+    let life = ["-q", "--cycles", "10000", "--step-cycles", "10000"];
+    assert!(wear_into(&design, dir.path(), &life).status.success());
+    let path = dir.path().join("wear_records.jsonl");
+    let sound = std::fs::read_to_string(&path).unwrap();
+    let second = sound.lines().nth(1).unwrap();
+    let record: serde_json::Value = serde_json::from_str(second).unwrap();
+    let wear = record["max_wear_m"].as_f64().unwrap();
+    assert!(wear > 0.0);
+    let changed = serde_json::to_string(&(wear * 10.0)).unwrap();
+    let tampered = sound.replacen(
+        &format!("\"max_wear_m\":{}", serde_json::to_string(&wear).unwrap()),
+        &format!("\"max_wear_m\":{changed}"),
+        1,
+    );
+    assert_ne!(tampered, sound);
+    std::fs::write(&path, &tampered).unwrap();
+    let longer = [
+        "-q",
+        "--cycles",
+        "20000",
+        "--step-cycles",
+        "10000",
+        "--resume",
+    ];
+    let out = wear_into(&design, dir.path(), &longer);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("wear_records.jsonl"), "{err}");
+    assert!(err.contains("do not match the checksum"), "{err}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), tampered);
+    std::fs::write(&path, &sound).unwrap();
+    let out = wear_into(&design, dir.path(), &longer);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 3);
+}
+
+#[test]
 fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_difference() {
     // A checkpoint of the design case at 60 N m, 1500 rpm on a 40 x 60 flank grid; resumed
     // with 90 N m, 150 rpm and 30 x 60 (each named, exit 2, nothing written), then with a life

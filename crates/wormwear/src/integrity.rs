@@ -34,6 +34,27 @@ pub fn digest_text(text: &str) -> String {
     hash.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// A SHA-256 over text appended piece by piece (the records of a life as they are written).
+#[derive(Debug, Clone, Default)]
+pub struct RunningDigest(Sha256);
+
+impl RunningDigest {
+    /// Appends `text` to what the digest covers.
+    pub fn update(&mut self, text: &str) {
+        self.0.update(text.as_bytes());
+    }
+
+    /// The digest of everything appended so far, hex.
+    pub fn hex(&self) -> String {
+        self.0
+            .clone()
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    }
+}
+
 /// The JSON text of `value` (an object) with its checksum member added.
 pub fn seal<T: serde::Serialize>(value: &T) -> Result<String, IntegrityError> {
     let mut v = serde_json::to_value(value).map_err(|e| IntegrityError::Json(e.to_string()))?;
@@ -67,6 +88,17 @@ mod tests {
     struct Doc {
         step: usize,
         values: Vec<f64>,
+    }
+
+    #[test]
+    fn a_running_digest_is_the_digest_of_the_whole_text() {
+        let mut running = RunningDigest::default();
+        running.update("{\"step\":0}\n");
+        let first = running.hex();
+        running.update("{\"step\":1}\n");
+        assert_eq!(first, digest_text("{\"step\":0}\n"));
+        assert_eq!(running.hex(), digest_text("{\"step\":0}\n{\"step\":1}\n"));
+        assert_ne!(running.hex(), digest_text("{\"step\":0}\n{\"step\":2}\n"));
     }
 
     #[test]

@@ -41,6 +41,9 @@ struct CheckpointOut<'a> {
     damage: &'a [f64],
     found_phases: &'a [crate::wear::Phase],
     record_count: usize,
+    /// SHA-256 of the first `record_count` lines of [`RECORDS`] as written (each with its
+    /// newline): the records are sealed with the checkpoint.
+    records_sha256: String,
     /// The inputs the states were computed with ([`life_inputs`]).
     inputs: Option<&'a serde_json::Value>,
 }
@@ -67,6 +70,8 @@ struct CheckpointIn {
     found_phases: Vec<crate::wear::Phase>,
     #[serde(default)]
     record_count: Option<usize>,
+    #[serde(default)]
+    records_sha256: Option<String>,
     #[serde(default)]
     records: Option<Vec<crate::wear::StepRecord>>,
     #[serde(default)]
@@ -281,18 +286,18 @@ pub fn read_resume(
         (None, Some(count)) => {
             let rpath = dir.join(RECORDS);
             let lines = std::fs::read_to_string(&rpath).map_err(|e| bad(&rpath, e.to_string()))?;
-            let records: Vec<crate::wear::StepRecord> = lines
-                .lines()
-                .take(count)
-                .map(|l| serde_json::from_str(l).map_err(|e| bad(&rpath, e.to_string())))
-                .collect::<Result<_, _>>()?;
-            if records.len() < count {
+            let counted: Vec<&str> = lines.lines().take(count).collect();
+            if counted.len() < count {
                 return Err(bad(
                     &rpath,
-                    format!("{} records, the checkpoint needs {count}", records.len()),
+                    format!("{} records, the checkpoint needs {count}", counted.len()),
                 ));
             }
-            records
+            check_records(&counted, c.records_sha256.as_deref()).map_err(|m| bad(&rpath, m))?;
+            counted
+                .iter()
+                .map(|l| serde_json::from_str(l).map_err(|e| bad(&rpath, e.to_string())))
+                .collect::<Result<_, _>>()?
         }
         (None, None) => return Err(bad(&path, "no records and no record count".into())),
     };
@@ -314,6 +319,30 @@ pub fn read_resume(
         },
         c.inputs,
     )))
+}
+
+/// The records the checkpoint counts against its checksum of them: any change after they were
+/// written (a digit, a line) is refused, as is a checkpoint that does not seal its records.
+fn check_records(lines: &[&str], sealed: Option<&str>) -> Result<(), String> {
+    let Some(sealed) = sealed else {
+        return Err(format!(
+            "the checkpoint ({CHECKPOINT}) holds no checksum of the records (written by an \
+             earlier version?): run the life again without --resume"
+        ));
+    };
+    let mut digest = crate::integrity::RunningDigest::default();
+    for line in lines {
+        digest.update(line);
+        digest.update("\n");
+    }
+    if digest.hex() != sealed {
+        return Err(format!(
+            "the first {} records do not match the checksum in {CHECKPOINT}: the records were \
+             changed after they were written; run the life again without --resume",
+            lines.len()
+        ));
+    }
+    Ok(())
 }
 
 /// Why a checkpoint cannot be resumed (all input problems: exit code 2 from the CLI).
@@ -413,6 +442,8 @@ pub struct LifeWriter {
     dir: PathBuf,
     /// Records known to be on disk (None: none yet from this writer).
     records_written: Option<usize>,
+    /// SHA-256 of the records on disk, as written by this writer.
+    records_digest: crate::integrity::RunningDigest,
     /// The run's [`life_inputs`], stored in every checkpoint.
     inputs: Option<serde_json::Value>,
     /// When the tables were last written ([`LifeWriter::write_view`]), None: not yet.
@@ -425,6 +456,7 @@ impl LifeWriter {
         Self {
             dir: dir.to_path_buf(),
             records_written: None,
+            records_digest: Default::default(),
             inputs: None,
             tables_written: None,
         }
@@ -516,6 +548,7 @@ impl LifeWriter {
                     .map_err(io)?;
                 f.write_all(text.as_bytes()).map_err(io)?;
                 f.sync_data().map_err(io)?;
+                self.records_digest.update(&text);
             }
             _ => {
                 let mut text = String::new();
@@ -523,6 +556,8 @@ impl LifeWriter {
                     text.push_str(&line(r)?);
                 }
                 write_atomic(&rpath, text.as_bytes())?;
+                self.records_digest = Default::default();
+                self.records_digest.update(&text);
             }
         }
         self.records_written = Some(state.records.len());
@@ -538,6 +573,7 @@ impl LifeWriter {
             damage: &state.damage,
             found_phases: &state.found_phases,
             record_count: state.records.len(),
+            records_sha256: self.records_digest.hex(),
             inputs: self.inputs.as_ref(),
         };
         let text = crate::integrity::seal(&checkpoint).map_err(|e| OutputError::Encode {
