@@ -331,6 +331,22 @@ fn wear_and_rating_sections_are_checked() {
         &error_of(&with("life_cycles = 1e6\nendurance = { life_factor = -1 }")),
         &["wear.endurance.life_factor = -1"],
     );
+    // A degenerate pressure-life curve (a zero or vanishing exponent, factors at the ends of
+    // the doubles) would give infinite or NaN damage: refused, the field and range named.
+    for (key, value, range) in [
+        ("exponent", "0", "[0.02, 5]"),
+        ("exponent", "1e-300", "[0.02, 5]"),
+        ("life_factor", "1e-300", "[0.01, 100]"),
+        ("reference_pressure_mpa", "1e-300", "[1, 100000] MPa"),
+        ("reference_cycles", "1e-300", "[1, 1e15] cycles"),
+    ] {
+        assert_mentions(
+            &error_of(&with(&format!(
+                "life_cycles = 1e6\npitting = \"forecast\"\nendurance = {{ {key} = {value} }}"
+            ))),
+            &[&format!("wear.endurance.{key} = {value}"), range],
+        );
+    }
     // A valid forecast.
     let g = input::load_from_str(&with(
         "life_cycles = 1e6\npitting = \"forecast\"\npitting_onset_percent = 0.5\n\

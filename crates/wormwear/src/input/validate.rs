@@ -15,29 +15,52 @@ struct Checker {
     errors: Vec<FieldError>,
 }
 
+/// A number as a message shows it: plainly between 1e-4 and 1e7, in scientific notation
+/// outside (1e-300 is not 300 digits).
+struct Number(f64);
+
+impl fmt::Display for Number {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
 impl Checker {
+    /// Records a problem; a value that reads as a long number is shown as [`Number`] shows it.
     fn fail(&mut self, field: &str, value: impl fmt::Display, problem: impl Into<String>) {
+        let mut value = value.to_string();
+        if value.len() > 24 {
+            if let Ok(v) = value.parse::<f64>() {
+                value = Number(v).to_string();
+            }
+        }
         self.errors.push(FieldError {
             field: field.to_string(),
-            value: value.to_string(),
+            value,
             problem: problem.into(),
         });
     }
 
     /// Finite and inside [lo, hi] (inclusive). Returns the value when valid.
     fn range(&mut self, field: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Option<f64> {
+        let (lo_, hi_) = (Number(lo), Number(hi));
         if !v.is_finite() {
             self.fail(
                 field,
                 v,
-                format!("must be a finite number in [{lo}, {hi}] {unit}"),
+                format!("must be a finite number in [{lo_}, {hi_}] {unit}"),
             );
             None
         } else if v < lo || v > hi {
             self.fail(
                 field,
                 v,
-                format!("out of range: allowed [{lo}, {hi}] {unit}"),
+                format!("out of range: allowed [{lo_}, {hi_}] {unit}"),
             );
             None
         } else {
@@ -51,7 +74,7 @@ impl Checker {
             self.fail(
                 field,
                 v,
-                format!("must be a finite number > 0 and <= {hi} {unit}"),
+                format!("must be a finite number > 0 and <= {} {unit}", Number(hi)),
             );
             None
         } else {
@@ -1618,22 +1641,28 @@ fn endurance(ck: &mut Checker, e: Option<&EnduranceSpec>) -> Option<Endurance> {
     match e {
         None => Some(Endurance::DEFAULT),
         Some(e) => {
-            let p = ck.positive(
+            // Bounded so that every life on the curve, N = f N_ref (p / p_ref)^(-1/b) for
+            // pressures up to 10 GPa, is a finite positive number: b >= 0.02 keeps the power at
+            // most 50, and p_ref, N_ref and f keep the factors away from 0 and infinity.
+            let p = ck.range(
                 "wear.endurance.reference_pressure_mpa",
                 e.reference_pressure_mpa,
+                1.0,
                 1e5,
                 "MPa",
             );
-            let n = ck.positive(
+            let n = ck.range(
                 "wear.endurance.reference_cycles",
                 e.reference_cycles,
+                1.0,
                 1e15,
                 "cycles",
             );
-            let x = ck.range("wear.endurance.exponent", e.exponent, 0.0, 5.0, "");
-            let f = ck.positive(
+            let x = ck.range("wear.endurance.exponent", e.exponent, 0.02, 5.0, "");
+            let f = ck.range(
                 "wear.endurance.life_factor",
                 e.life_factor.unwrap_or(1.0),
+                0.01,
                 100.0,
                 "",
             );
