@@ -116,8 +116,9 @@ impl NativeGear {
     /// Reads and validates a gear file (TOML).
     #[staticmethod]
     fn load(py: Python<'_>, path: &str) -> PyResult<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| PyOSError::new_err(format!("cannot read {path}: {e}")))?;
+        let text =
+            wormwear::files::read_text(std::path::Path::new(path), wormwear::files::INPUT_LIMIT)
+                .map_err(|e| PyOSError::new_err(format!("cannot read {path}: {e}")))?;
         Self::from_text(py, &text, path)
     }
 

@@ -8,8 +8,8 @@ use wormwear::input::GearSet;
 /// Numeric table of a CSV file with a header row: the named columns, in that order, per data
 /// row. Errors name the file, the line and the column.
 pub fn read_table(path: &Path, columns: &[&str]) -> anyhow::Result<Vec<Vec<f64>>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = wormwear::files::read_text(path, wormwear::files::INPUT_LIMIT)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let mut lines = text
         .lines()
         .enumerate()

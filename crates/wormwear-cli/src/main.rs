@@ -417,7 +417,7 @@ fn analyse(
 ) -> Result<(wormwear::Results, Vec<PathBuf>), Failure> {
     let source = wormwear::Source {
         file: file.display().to_string(),
-        text: std::fs::read_to_string(file).unwrap_or_default(),
+        text: wormwear::files::read_text(file, wormwear::files::INPUT_LIMIT).unwrap_or_default(),
     };
     let life_cycles = request.life.as_ref().map_or(1.0, |p| p.life_cycles);
     let progress = life_progress(quiet || verbose || request.life.is_none());

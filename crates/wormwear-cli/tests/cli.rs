@@ -548,6 +548,76 @@ fn wear_into(file: &Path, dir: &Path, args: &[&str]) -> std::process::Output {
     into("wear", file, dir, args).output().unwrap()
 }
 
+/// Runs `command` to its end within `seconds`, killing it after: None if it did not end.
+fn output_within(command: &mut Command, seconds: u64) -> Option<std::process::Output> {
+    let mut child = command
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < seconds {
+        if child.try_wait().unwrap().is_some() {
+            return Some(child.wait_with_output().unwrap());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    None
+}
+
+#[cfg(unix)]
+#[test]
+fn a_device_or_a_fifo_given_as_a_file_is_refused_at_once() {
+    // /dev/zero as a gear file, a REXS file and a sweep's base, and a FIFO as a gear file:
+    // refused within seconds, naming the path and what it is (the previous build read
+    // /dev/zero until the memory ran out and blocked on the FIFO's open).
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("gear.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    let sweep = dir.path().join("sweep.toml");
+    std::fs::write(
+        &sweep,
+        "base = \"/dev/zero\"\nstages = [\"ltca\"]\n\n[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n",
+    )
+    .unwrap();
+    let mut cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
+        (vec!["check".into(), "/dev/zero".into()], "a device"),
+        (
+            vec![
+                "import".into(),
+                "/dev/zero".into(),
+                "-o".into(),
+                dir.path().join("i.toml").into(),
+            ],
+            "a device",
+        ),
+        (
+            vec![
+                "sweep".into(),
+                sweep.clone().into(),
+                "-o".into(),
+                dir.path().join("s").into(),
+            ],
+            "a device",
+        ),
+    ];
+    if made.is_ok_and(|s| s.success()) {
+        cases.push((vec!["check".into(), fifo.clone().into()], "a FIFO"));
+    }
+    for (args, what) in cases {
+        let out = output_within(bin().args(&args), 20)
+            .unwrap_or_else(|| panic!("{args:?} did not end within 20 s"));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}: {err}");
+        assert!(
+            err.contains("not a regular file") && err.contains(what),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 #[test]
 fn a_record_changed_after_it_was_written_is_refused_on_resume() {
     // One digit of the first record's largest wear flipped (the JSON still valid, the line

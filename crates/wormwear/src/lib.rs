@@ -21,6 +21,7 @@
 pub mod bending;
 pub mod calibration;
 pub mod contact;
+pub mod files;
 pub mod geometry;
 pub mod input;
 pub mod integrity;

@@ -135,6 +135,33 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
     let (again, warnings) = build_in(&g, &geo, Some(dir.path())).unwrap();
     assert_eq!(again.origin, Origin::Computed);
     assert!(warnings.is_empty(), "{warnings:?}");
+    // An entry that is a FIFO is not opened (that blocks until a writer comes): rebuilt with
+    // a warning, the FIFO replaced by the entry. The build runs in a thread so that a blocked
+    // open fails the test instead of hanging it.
+    #[cfg(unix)]
+    {
+        std::fs::remove_file(&file).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&file).status();
+        if made.is_ok_and(|s| s.success()) {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let (g2, geo2, cache) = (g.clone(), geo.clone(), dir.path().to_path_buf());
+            std::thread::spawn(move || {
+                let _ = tx.send(build_in(&g2, &geo2, Some(&cache)).map(|(b, w)| (b.origin, w)));
+            });
+            let (origin, warnings) = rx
+                .recv_timeout(std::time::Duration::from_secs(300))
+                .expect("the build blocked on a cache entry that is a FIFO")
+                .unwrap();
+            assert_eq!(origin, Origin::Computed);
+            assert!(
+                warnings.len() == 1
+                    && warnings[0].contains("a FIFO")
+                    && warnings[0].contains("rebuilt"),
+                "{warnings:?}"
+            );
+            assert!(std::fs::metadata(&file).unwrap().is_file());
+        }
+    }
     // LTCA with bending: reported "fe", in equilibrium, more compliant than without.
     let (rigid, bent) = compare(&g, &geo, &warm.model);
     assert_eq!(bent.bending_model, "fe");

@@ -599,3 +599,27 @@ fn damaged_files_never_panic() {
         }
     }
 }
+
+#[test]
+fn a_zip_member_larger_than_a_rexs_file_may_be_is_not_inflated() {
+    // 257 MiB of zeros deflate to a few hundred kB: the member is refused by its declared
+    // size, and by the bytes actually inflated when the declared size is wrong.
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .large_file(false);
+    zip.start_file("stage.rexs", options).unwrap();
+    let block = vec![0u8; 1 << 20];
+    for _ in 0..257 {
+        std::io::Write::write_all(&mut zip, &block).unwrap();
+    }
+    let bytes = zip.finish().unwrap().into_inner();
+    assert!(bytes.len() < 2 << 20, "{} bytes", bytes.len());
+    let err = rexs::parse_bytes(&bytes, "bomb.rexsz")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("stage.rexs") && err.contains("more than the 268435456 bytes"),
+        "{err}"
+    );
+}

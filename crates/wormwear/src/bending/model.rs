@@ -199,7 +199,7 @@ fn cache_path(dir: &Path, key: &str) -> PathBuf {
 /// The cached model for `key`: None when there is no entry or it is of another key; an error
 /// (the reason) when the entry cannot be trusted: unreadable, or its checksum fails.
 fn read_cache(path: &Path, key: &str) -> Result<Option<FeBending>, String> {
-    let text = match std::fs::read_to_string(path) {
+    let text = match crate::files::read_text(path, crate::files::OWN_FILE_LIMIT) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(e.to_string()),

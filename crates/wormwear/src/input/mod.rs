@@ -829,9 +829,11 @@ pub fn set_dotted(
 
 /// Reads, parses and validates a gear file.
 pub fn load(path: &Path) -> Result<GearSet, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
-        path: path.display().to_string(),
-        source,
+    let text = crate::files::read_text(path, crate::files::INPUT_LIMIT).map_err(|source| {
+        InputError::Io {
+            path: path.display().to_string(),
+            source,
+        }
     })?;
     load_from_str(&text)
 }

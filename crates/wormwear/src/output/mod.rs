@@ -172,7 +172,7 @@ pub fn update_summary(
     value: serde_json::Value,
 ) -> Result<(), OutputError> {
     let path = dir.join("summary.json");
-    let mut root = match std::fs::read_to_string(&path) {
+    let mut root = match crate::files::read_text(&path, crate::files::OWN_FILE_LIMIT) {
         Ok(text) => match serde_json::from_str::<serde_json::Value>(&text) {
             Ok(serde_json::Value::Object(m)) => m,
             _ => serde_json::Map::new(),

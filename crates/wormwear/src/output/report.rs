@@ -172,10 +172,11 @@ fn phase_timeline(phases: &[serde_json::Value], mode: Option<&serde_json::Value>
 }
 
 pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf, OutputError> {
-    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or(serde_json::Value::Null);
+    let summary: serde_json::Value =
+        crate::files::read_text(&dir.join("summary.json"), crate::files::OWN_FILE_LIMIT)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or(serde_json::Value::Null);
     let mut h = String::new();
     page_head(&mut h, title);
     contents(&mut h, &summary);
@@ -394,7 +395,7 @@ fn stage_section(
                 .and_then(|n| n.to_str())
                 .unwrap_or_default()
                 .to_string();
-            let Ok(svg) = std::fs::read_to_string(&path) else {
+            let Ok(svg) = crate::files::read_text(&path, crate::files::OWN_FILE_LIMIT) else {
                 continue;
             };
             let body = match svg.find("<svg") {

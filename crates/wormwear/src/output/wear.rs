@@ -270,7 +270,7 @@ pub fn read_resume(
         path: path.to_path_buf(),
         message,
     };
-    let text = match std::fs::read_to_string(&path) {
+    let text = match crate::files::read_text(&path, crate::files::OWN_FILE_LIMIT) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(source) => {
@@ -285,7 +285,8 @@ pub fn read_resume(
         (Some(records), _) => records,
         (None, Some(count)) => {
             let rpath = dir.join(RECORDS);
-            let lines = std::fs::read_to_string(&rpath).map_err(|e| bad(&rpath, e.to_string()))?;
+            let lines = crate::files::read_text(&rpath, crate::files::OWN_FILE_LIMIT)
+                .map_err(|e| bad(&rpath, e.to_string()))?;
             let counted: Vec<&str> = lines.lines().take(count).collect();
             if counted.len() < count {
                 return Err(bad(

@@ -155,10 +155,11 @@ impl Encoding {
 /// a JSON object or XML), so a misnamed file still reads.
 pub fn read(path: &Path) -> Result<Model, RexsError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| RexsError::Io {
-        path: name.clone(),
-        message: e.to_string(),
-    })?;
+    let bytes =
+        crate::files::read_bytes(path, crate::files::REXS_LIMIT).map_err(|e| RexsError::Io {
+            path: name.clone(),
+            message: e.to_string(),
+        })?;
     parse_bytes(&bytes, &name)
 }
 
@@ -214,9 +215,24 @@ fn read_zip(bytes: &[u8], name: &str) -> Result<Model, RexsError> {
         "{name}:{}",
         file.name().map(|n| n.to_string()).unwrap_or_default()
     );
+    // Inflated no further than the limit of a REXS file (a small archive can hold gigabytes).
+    let limit = crate::files::REXS_LIMIT;
+    if file.size() > limit {
+        return Err(format(format!(
+            "zip member {inner}: {} bytes inflated, more than the {limit} bytes allowed",
+            file.size()
+        )));
+    }
     let mut content = Vec::new();
-    file.read_to_end(&mut content)
+    (&mut file)
+        .take(limit + 1)
+        .read_to_end(&mut content)
         .map_err(|e| format(format!("zip member {inner}: {e}")))?;
+    if content.len() as u64 > limit {
+        return Err(format(format!(
+            "zip member {inner}: more than the {limit} bytes allowed when inflated"
+        )));
+    }
     parse_bytes(&content, &inner)
 }
 

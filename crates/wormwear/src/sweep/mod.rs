@@ -142,7 +142,7 @@ impl Sweep {
     /// Reads a sweep file and its base gear file (which must be valid).
     pub fn load(path: &Path) -> Result<Self, SweepError> {
         let read = |p: &Path| {
-            std::fs::read_to_string(p).map_err(|e| SweepError::Read {
+            crate::files::read_text(p, crate::files::INPUT_LIMIT).map_err(|e| SweepError::Read {
                 path: p.display().to_string(),
                 message: e.to_string(),
             })
@@ -613,7 +613,8 @@ fn finished_row(
     variant: &Variant,
     settings: &Settings,
 ) -> Option<Row> {
-    let text = std::fs::read_to_string(dir.join(VARIANT_FILE)).ok()?;
+    let text =
+        crate::files::read_text(&dir.join(VARIANT_FILE), crate::files::OWN_FILE_LIMIT).ok()?;
     let finished: Finished = crate::integrity::open(&text).ok()?;
     let document = variant_document(base, variant).ok()?;
     let expected = fingerprint(&input::document_text(&document).ok()?, settings);

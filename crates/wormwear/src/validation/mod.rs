@@ -192,7 +192,8 @@ fn key(job: &Job) -> String {
 
 /// A stored result of the same job (same key), if any.
 fn cached(dir: &Path, job: &Job) -> Option<JobResult> {
-    let text = std::fs::read_to_string(run_path(dir, &job.id)).ok()?;
+    let text =
+        crate::files::read_text(&run_path(dir, &job.id), crate::files::OWN_FILE_LIMIT).ok()?;
     // (A run that fails its checksum is run again.)
     let r: JobResult = crate::integrity::open(&text).ok()?;
     (r.key == key(job)).then_some(r)
