@@ -222,10 +222,28 @@ impl LifeOverrides {
             plan.step = StepControl::Cycles(c);
         }
         if let Some(d) = self.step_wear_um {
-            if !(d.is_finite() && d > 0.0 && d <= 1000.0) {
-                return Err(bad("step_wear_um", d, "a depth in (0, 1000] um"));
+            let min = crate::input::MIN_STEP_WEAR_UM;
+            if !(d.is_finite() && (min..=1000.0).contains(&d)) {
+                return Err(bad(
+                    "step_wear_um",
+                    d,
+                    &format!("a depth in [{min}, 1000] um"),
+                ));
             }
             plan.step = StepControl::MaxRemoval(d * 1e-6);
+        }
+        if let StepControl::Cycles(c) = plan.step {
+            if let Some(problem) = crate::input::fixed_steps_problem(plan.life_cycles, c) {
+                let field = if self.step_cycles.is_some() {
+                    "step_cycles"
+                } else {
+                    "cycles"
+                };
+                return Err(RunError::Request(format!(
+                    "{} = {c:e}: {problem}",
+                    names.of(field)
+                )));
+            }
         }
         if self.no_pitting {
             plan.phases.retain(|p| matches!(p, Phase::Wear { .. }));

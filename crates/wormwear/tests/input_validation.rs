@@ -265,6 +265,66 @@ fn wear_and_rating_sections_are_checked() {
     // A negative life.
     let text = set(&design(), "wear", "life_cycles", "life_cycles = -5");
     assert_mentions(&error_of(&text), &["wear.life_cycles = -5", "> 0"]);
+    // Plans that would never end or fill the disk: a vanishing adaptive step or sub-step, a
+    // life of 1e12 states, 100 000 phases, a million map states (the previous build accepted
+    // each and ran for hours or wrote ~6 files per state).
+    let text = set(&design(), "wear", "step_wear_um", "step_wear_um = 1e-300");
+    assert_mentions(
+        &error_of(&text),
+        &["wear.step_wear_um = 1e-300", "[0.05, 1000] um"],
+    );
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_wear_um = 4.0\nmax_substep_wear_um = 1e-300",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.max_substep_wear_um = 1e-300", "or 0: off"],
+    );
+    let text = set(
+        &set(&design(), "wear", "step_wear_um", "step_cycles = 1"),
+        "wear",
+        "life_cycles",
+        "life_cycles = 1e12",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "wear.step_cycles = 1",
+            "1.000e12 states",
+            "at least 1e7 cycles per step",
+        ],
+    );
+    let phases: Vec<String> = (1..=100_000)
+        .map(|k| format!("{{ kind = \"wear\", until_cycles = {k} }}"))
+        .collect();
+    let text = set(
+        &design(),
+        "wear",
+        "life_cycles",
+        &format!("life_cycles = 1e6\nphases = [{}]", phases.join(", ")),
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.phases = 100000 phases", "at most 100 phases"],
+    );
+    let maps: Vec<String> = (1..=1_000_000).map(|k| k.to_string()).collect();
+    let text = set(
+        &design(),
+        "wear",
+        "life_cycles",
+        &format!("life_cycles = 1e6\nmap_cycles = [{}]", maps.join(", ")),
+    );
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "wear.map_cycles = 1000000 entries",
+            "at most 200 map states",
+            "about 6000000",
+        ],
+    );
     // Phases out of order and an unknown phase kind.
     let text = set(
         &design(),

@@ -230,6 +230,16 @@ fn sweep_files_give_their_errors_with_the_field() {
         ),
         ("[[cases]]\nname = \"../x\"\n", "a folder name"),
         ("tuning = 1\n[grid]\na = [1]\n", "unknown field"),
+        // Life overrides out of range are refused when the sweep is read, not variant by
+        // variant when it runs.
+        (
+            "cycles = -5\n[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n",
+            "cycles = -5: must be a number of cycles",
+        ),
+        (
+            "cycles = 1e12\nstep_cycles = 1\n[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n",
+            "more than the 1e5 a run may take",
+        ),
     ];
     for (text, message) in cases {
         let err = Sweep::load(&write(text)).unwrap_err().to_string();

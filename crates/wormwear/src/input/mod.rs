@@ -345,6 +345,30 @@ pub enum LifeStop {
     BacklashLimit,
 }
 
+/// The most states a life with fixed steps may take (life cycles over step cycles): a plan
+/// beyond it would run for days; adaptive steps are bounded by [`MIN_STEP_WEAR_UM`].
+pub const MAX_LIFE_STATES: f64 = 1e5;
+/// The smallest adaptive step and sub-step removal, um (a life of a millimetre of wear in
+/// steps this small is 20 000 states).
+pub const MIN_STEP_WEAR_UM: f64 = 0.05;
+/// The most phases a schedule may list.
+pub const MAX_PHASES: usize = 100;
+/// The most map states a life may ask for (each writes about six files: maps and tables).
+pub const MAX_MAP_STATES: usize = 200;
+
+/// Why a fixed-step life is too long to run (None: it is not): the message after the value.
+pub fn fixed_steps_problem(life_cycles: f64, step_cycles: f64) -> Option<String> {
+    let states = life_cycles / step_cycles;
+    (states > MAX_LIFE_STATES).then(|| {
+        format!(
+            "a life of {life_cycles:e} cycles in steps of {step_cycles:e} is {states:.3e} states, \
+             more than the {MAX_LIFE_STATES:e} a run may take: give at least {:e} cycles per \
+             step, or adaptive steps (step_wear_um)",
+            life_cycles / MAX_LIFE_STATES
+        )
+    })
+}
+
 /// Life simulation plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct WearPlan {

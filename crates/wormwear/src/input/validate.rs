@@ -1551,13 +1551,21 @@ fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     if pitting == Some(Pitting::Off) {
         phases.retain(|p| matches!(p, Phase::Wear { .. }));
     }
-    let guard = ck.range(
-        "wear.max_substep_wear_um",
-        w.max_substep_wear_um.unwrap_or(5.0),
-        0.0,
-        1000.0,
-        "um",
-    );
+    let guard = match w.max_substep_wear_um.unwrap_or(5.0) {
+        0.0 => Some(0.0),
+        v => ck.range(
+            "wear.max_substep_wear_um",
+            v,
+            MIN_STEP_WEAR_UM,
+            1000.0,
+            "um (or 0: off)",
+        ),
+    };
+    if let (Some(life), Some(StepControl::Cycles(c))) = (life, step) {
+        if let Some(problem) = fixed_steps_problem(life, c) {
+            ck.fail("wear.step_cycles", Number(c), problem);
+        }
+    }
     let film_load = ck.choice(
         "wear.film_load",
         w.film_load.as_deref().unwrap_or("loaded-analysis"),
@@ -1630,7 +1638,7 @@ fn step_control(ck: &mut Checker, w: &WearSpec) -> Option<StepControl> {
             .positive("wear.step_cycles", c, 1e12, "cycles")
             .map(StepControl::Cycles),
         (Some(d), None) => ck
-            .positive("wear.step_wear_um", d, 1000.0, "um")
+            .range("wear.step_wear_um", d, MIN_STEP_WEAR_UM, 1000.0, "um")
             .map(|d| StepControl::MaxRemoval(d * 1e-6)),
         (None, None) => Some(StepControl::MaxRemoval(4e-6)),
     }
@@ -1681,6 +1689,14 @@ fn endurance(ck: &mut Checker, e: Option<&EnduranceSpec>) -> Option<Endurance> {
 
 /// The phase schedule, each phase checked; None when one is invalid (recorded).
 fn phases(ck: &mut Checker, specs: &[PhaseSpec]) -> Option<Vec<Phase>> {
+    if specs.len() > MAX_PHASES {
+        ck.fail(
+            "wear.phases",
+            format!("{} phases", specs.len()),
+            format!("a schedule may list at most {MAX_PHASES} phases"),
+        );
+        return None;
+    }
     let mut phases = Vec::new();
     let mut previous = 0.0;
     let mut ok = true;
@@ -1744,6 +1760,19 @@ fn phases(ck: &mut Checker, specs: &[PhaseSpec]) -> Option<Vec<Phase>> {
 fn map_cycles(ck: &mut Checker, list: Option<&Vec<f64>>) -> Option<Option<Vec<f64>>> {
     match list {
         None => Some(None),
+        Some(list) if list.len() > MAX_MAP_STATES => {
+            ck.fail(
+                "wear.map_cycles",
+                format!("{} entries", list.len()),
+                format!(
+                    "at most {MAX_MAP_STATES} map states (each writes about 6 files: {} would \
+                     write about {})",
+                    list.len(),
+                    6 * list.len()
+                ),
+            );
+            None
+        }
         Some(list) => {
             let mut ok = true;
             let mut previous = 0.0;

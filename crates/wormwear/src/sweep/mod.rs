@@ -198,6 +198,13 @@ impl Sweep {
             source,
         })?;
         let settings = Settings::new(stages, overrides, gear.wear.is_some())?;
+        // The life overrides checked on the base before any variant runs (a variant that
+        // changes the plan is checked again when it runs).
+        if settings.stages.contains(&Stage::Wear) {
+            overrides
+                .plan(&gear, OverrideNames::Python)
+                .map_err(|e| SweepError::Invalid(format!("the sweep's life: {e}")))?;
+        }
         if variants.is_empty() {
             return Err(SweepError::Invalid("the sweep has no variant".into()));
         }
