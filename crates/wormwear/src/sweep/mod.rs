@@ -493,11 +493,20 @@ pub fn toml_to_json(value: &toml::Value) -> serde_json::Value {
     serde_json::to_value(value).unwrap_or_else(|_| serde_json::Value::String(value.to_string()))
 }
 
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
+/// A CSV field, quoted when it holds a comma, a quote or a line break. A text (not a number)
+/// that starts like a spreadsheet formula (= + - @, a tab or a carriage return) is prefixed
+/// with an apostrophe, so a spreadsheet shows it instead of evaluating it.
 fn csv_field(text: &str) -> String {
+    let formula =
+        text.starts_with(['=', '+', '-', '@', '\t', '\r']) && text.parse::<f64>().is_err();
+    let text = if formula {
+        format!("'{text}")
+    } else {
+        text.to_string()
+    };
     match text.contains([',', '"', '\n', '\r']) {
         true => format!("\"{}\"", text.replace('"', "\"\"")),
-        false => text.to_string(),
+        false => text,
     }
 }
 
@@ -814,4 +823,21 @@ fn write_summary(sweep: &Sweep, rows: &[Row], dir: &Path) -> Result<(), SweepErr
 /// The path of a variant's folder in a sweep's output directory.
 pub fn variant_dir(dir: &Path, variant: &Variant) -> PathBuf {
     dir.join("variants").join(&variant.name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::csv_field;
+
+    #[test]
+    fn a_cell_that_reads_as_a_formula_is_shown_as_text() {
+        assert_eq!(csv_field("=1+1"), "'=1+1");
+        assert_eq!(csv_field("@SUM(A1)"), "'@SUM(A1)");
+        assert_eq!(csv_field("+cmd|' /C calc'!A0"), "'+cmd|' /C calc'!A0");
+        assert_eq!(csv_field("-2+3,x"), "\"'-2+3,x\"");
+        // Numbers stay numbers.
+        assert_eq!(csv_field("-5"), "-5");
+        assert_eq!(csv_field("+1.5e-3"), "+1.5e-3");
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+    }
 }
