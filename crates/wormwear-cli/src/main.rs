@@ -467,8 +467,10 @@ fn analyse(
     for w in &results.warnings {
         eprintln!("warning: {w}");
     }
-    if let (Some(rating), false) = (&results.rating, quiet) {
-        for w in &rating.warnings {
+    if let Some(rating) = &results.rating {
+        // The formulas' range notes unless quiet; an overload always.
+        let shown = |w: &&String| !quiet || w.starts_with(wormwear::rating::OVERLOAD_TAG);
+        for w in rating.warnings.iter().filter(shown) {
             eprintln!("warning: rating: {w}");
         }
     }

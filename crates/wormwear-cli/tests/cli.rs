@@ -619,6 +619,69 @@ fn a_device_or_a_fifo_given_as_a_file_is_refused_at_once() {
 }
 
 #[test]
+fn an_implausible_load_is_refused_and_an_overload_warned() {
+    // The 1/40 design case (60 N m) at 1e4 N m: refused before any analysis, naming the torque
+    // and the largest one allowed (the previous build ran it and turned the wheel by 0.74 rad
+    // with no warning). At 10 times the torque: computed, with the overload and the
+    // transmission-error warnings on stderr and in summary.json.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
+    let with_torque = |torque: &str| {
+        let path = dir.path().join(format!("t{torque}.toml"));
+        std::fs::write(
+            &path,
+            text.replace(
+                "worm_torque_nm = 60.0",
+                &format!("worm_torque_nm = {torque}"),
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let out = into("ltca", &with_torque("1e4"), &dir.path().join("a"), &["-q"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("conditions.worm_torque_nm = 10000")
+            && err.contains("times the wheel's pitting limit")
+            && err.contains("give at most about"),
+        "{err}"
+    );
+    assert!(!dir.path().join("a").join("summary.json").exists());
+    let out = into(
+        "ltca",
+        &with_torque("600.0"),
+        &dir.path().join("b"),
+        &["-q"],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("overload: the nominal mean Hertz stress"),
+        "{err}"
+    );
+    assert!(err.contains("of a wheel pitch"), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("b").join("summary.json")).unwrap())
+            .unwrap();
+    let joined = |section: &str| summary[section]["warnings"].to_string();
+    assert!(
+        joined("rating").contains("overload"),
+        "{}",
+        joined("rating")
+    );
+    assert!(
+        joined("ltca").contains("of a wheel pitch"),
+        "{}",
+        joined("ltca")
+    );
+}
+
+#[test]
 fn a_record_changed_after_it_was_written_is_refused_on_resume() {
     // One digit of the first record's largest wear flipped (the JSON still valid, the line
     // count unchanged): the resumed life would report it in summary.json and

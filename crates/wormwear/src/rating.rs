@@ -31,6 +31,8 @@ pub struct Rating {
     /// Mean Hertz stress parameter p_m* and stress sigma_Hm.
     pub p_m_star: f64,
     pub sigma_hm_mpa: f64,
+    /// The wheel material's pitting limit sigma_Hlim, N/mm^2.
+    pub pitting_limit_mpa: f64,
     /// Pitting safety S_H = sigma_HG / sigma_Hm.
     pub pitting_safety: f64,
     /// Wheel cycles to first pitting (A_p10 = 2 %), to the end of the growth phase, and the
@@ -118,6 +120,48 @@ pub fn p_m_star(
                 + 44.9814 * lead
         }
     }
+}
+
+/// The nominal mean Hertz stress over the wheel's pitting limit above which a loaded analysis
+/// warns that the load is beyond what the bronze carries (the wheel yields and runs in within
+/// hours; the elastic bending and transmission error are outside the model's range).
+pub const OVERLOAD_WARNING: f64 = 1.5;
+/// The same ratio above which a loaded analysis is refused: the elastic model's deflections,
+/// transmission error and lives are no longer the gear's (a 160-fold torque on the 1/40 gear
+/// turned the wheel by 0.74 rad).
+pub const OVERLOAD_REFUSAL: f64 = 5.0;
+
+/// How the overload warning of [`Rating::warnings`] begins (the CLI shows it even when quiet).
+pub const OVERLOAD_TAG: &str = "overload:";
+
+/// The input field of the gear's torque.
+fn torque_field(gear: &GearSet) -> (&'static str, f64) {
+    match gear.conditions.torque {
+        Torque::Worm(t) => ("conditions.worm_torque_nm", t),
+        Torque::Wheel(t) => ("conditions.wheel_torque_nm", t),
+    }
+}
+
+/// Why the gear's load is beyond a loaded analysis (None: it is not): the nominal mean Hertz
+/// stress sigma_Hm (MODEL §9) above [`OVERLOAD_REFUSAL`] times the wheel's pitting limit. The
+/// message names the torque field, its value and the largest torque the bound allows.
+pub fn overload(gear: &GearSet) -> Option<String> {
+    let r = rate(gear);
+    let limit = gear.wheel_material.pitting_limit * 1e-6;
+    let ratio = r.sigma_hm_mpa / limit;
+    if !(ratio > OVERLOAD_REFUSAL) {
+        return None;
+    }
+    let (field, torque) = torque_field(gear);
+    // sigma_Hm grows with the square root of the wheel torque.
+    let allowed = torque * (OVERLOAD_REFUSAL / ratio).powi(2);
+    Some(format!(
+        "{field} = {torque}: the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL §9) \
+         would be {:.0} N/mm^2, {ratio:.1} times the wheel's pitting limit ({limit:.0} N/mm^2); \
+         a loaded analysis holds to {OVERLOAD_REFUSAL} times (the elastic contact, bending and \
+         transmission error are not the gear's beyond): give at most about {allowed:.3e} N m",
+        r.sigma_hm_mpa
+    ))
 }
 
 /// Ratings for the gear's operating case with the file's factors. The wheel torque follows
@@ -213,6 +257,7 @@ pub fn rate(gear: &GearSet) -> Rating {
         output_power_w: p2,
         p_m_star: pm,
         sigma_hm_mpa: sigma_hm,
+        pitting_limit_mpa: sigma_lim,
         pitting_safety: sigma_hg / sigma_hm,
         n_li_cycles: n_li,
         n_lii_cycles: n_lii,
@@ -233,6 +278,17 @@ impl Rating {
     fn within_ranges(mut self) -> Self {
         let w = &mut self.warnings;
         let sigma_hm = self.sigma_hm_mpa;
+        let ratio = sigma_hm / self.pitting_limit_mpa;
+        if ratio > OVERLOAD_WARNING {
+            w.push(format!(
+                "{OVERLOAD_TAG} the nominal mean Hertz stress sigma_Hm {sigma_hm:.0} N/mm^2 is \
+                 {ratio:.1} times the wheel's pitting limit ({:.0} N/mm^2): beyond \
+                 {OVERLOAD_WARNING} times the bronze yields and runs in within hours, and the \
+                 elastic bending and transmission error are outside the model's range (refused \
+                 above {OVERLOAD_REFUSAL} times)",
+                self.pitting_limit_mpa
+            ));
+        }
         if self.pitting_safety < 1.0 {
             w.push(format!(
                 "pitting safety S_H = {:.2} below 1 (ISO/TR 14521 sigma_Hm {sigma_hm:.0} N/mm^2)",

@@ -124,6 +124,11 @@ impl Request {
         if self.stages.is_empty() {
             return Err(RunError::Request("no stage asked for".into()));
         }
+        if self.needs_bending() {
+            if let Some(problem) = crate::rating::overload(gear) {
+                return Err(RunError::Request(problem));
+            }
+        }
         let positions = gear.analysis.positions;
         if self.map_position >= positions {
             return Err(RunError::Request(format!(

@@ -511,6 +511,7 @@ fn over_the_cycle(
         stats.yielded_area_fraction,
         settings.flow_pressure,
     ));
+    warnings.extend(transmission_error_warning(&positions, teeth));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -535,6 +536,28 @@ fn over_the_cycle(
         power_balance,
         warnings,
     }
+}
+
+/// The share of a wheel pitch beyond which the loaded transmission error is implausible.
+pub const TE_PITCH_SHARE_WARNING: f64 = 0.1;
+
+/// A warning when the loaded transmission error at some position exceeds
+/// [`TE_PITCH_SHARE_WARNING`] of the wheel's angular pitch: deflections that large are outside
+/// the small-deflection (linear) model, whatever the solver says.
+fn transmission_error_warning(positions: &[PositionResult], teeth: u32) -> Option<String> {
+    let pitch = 2.0 * PI / teeth as f64;
+    let largest = positions
+        .iter()
+        .map(|p| p.transmission_error.abs())
+        .fold(0.0, f64::max);
+    (largest > TE_PITCH_SHARE_WARNING * pitch).then(|| {
+        format!(
+            "the loaded transmission error reaches {largest:.3e} rad, {:.0} % of a wheel pitch \
+             ({pitch:.4} rad): deflections this large are outside the linear model (check the \
+             torque, the bending model's supports and the materials)",
+            100.0 * largest / pitch
+        )
+    })
 }
 
 /// A warning when some of the flank reaches the flow pressure (MODEL §5.7): what share, and
