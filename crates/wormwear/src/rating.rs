@@ -149,7 +149,8 @@ pub fn overload(gear: &GearSet) -> Option<String> {
     let r = rate(gear);
     let limit = gear.wheel_material.pitting_limit * 1e-6;
     let ratio = r.sigma_hm_mpa / limit;
-    if !(ratio > OVERLOAD_REFUSAL) {
+    // (A NaN ratio, from a p_m* outside its formula, is no refusal.)
+    if ratio.is_nan() || ratio <= OVERLOAD_REFUSAL {
         return None;
     }
     let (field, torque) = torque_field(gear);
