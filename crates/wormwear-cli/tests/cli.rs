@@ -650,6 +650,17 @@ fn an_implausible_load_is_refused_and_an_overload_warned() {
         "{err}"
     );
     assert!(!dir.path().join("a").join("summary.json").exists());
+    // A vanishing torque: refused too (the previous build: "the ConjugateGradient solver did
+    // not converge").
+    let out = into("ltca", &with_torque("1e-9"), &dir.path().join("c"), &["-q"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("conditions.worm_torque_nm = 1e-9") && err.contains("give at least about"),
+        "{err}"
+    );
     let out = into(
         "ltca",
         &with_torque("600.0"),

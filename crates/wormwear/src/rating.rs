@@ -142,18 +142,33 @@ fn torque_field(gear: &GearSet) -> (&'static str, f64) {
     }
 }
 
-/// Why the gear's load is beyond a loaded analysis (None: it is not): the nominal mean Hertz
-/// stress sigma_Hm (MODEL §9) above [`OVERLOAD_REFUSAL`] times the wheel's pitting limit. The
-/// message names the torque field, its value and the largest torque the bound allows.
-pub fn overload(gear: &GearSet) -> Option<String> {
+/// The smallest nominal mean Hertz stress a loaded analysis takes, N/mm^2: below it the
+/// contact is narrower than the local mesh resolves and the solver's tolerances exceed the
+/// load (a 1e-9 N m torque on the 1/40 gear ended in a non-converged solver).
+pub const UNDERLOAD_REFUSAL_MPA: f64 = 1.0;
+
+/// Why the gear's load is outside what a loaded analysis can take (None: it is not): the
+/// nominal mean Hertz stress sigma_Hm (MODEL §9) above [`OVERLOAD_REFUSAL`] times the wheel's
+/// pitting limit, or below [`UNDERLOAD_REFUSAL_MPA`]. The message names the torque field, its
+/// value and the torque the bound allows (sigma_Hm grows with the square root of the torque).
+pub fn implausible_load(gear: &GearSet) -> Option<String> {
     let r = rate(gear);
     let limit = gear.wheel_material.pitting_limit * 1e-6;
     let ratio = r.sigma_hm_mpa / limit;
+    let (field, torque) = torque_field(gear);
+    if r.sigma_hm_mpa < UNDERLOAD_REFUSAL_MPA {
+        let needed = torque * (UNDERLOAD_REFUSAL_MPA / r.sigma_hm_mpa).powi(2);
+        return Some(format!(
+            "{field} = {torque:e}: the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL \
+             §9) would be {:.3e} N/mm^2, below the {UNDERLOAD_REFUSAL_MPA} N/mm^2 a loaded \
+             analysis resolves: give at least about {needed:.3e} N m",
+            r.sigma_hm_mpa
+        ));
+    }
     // (A NaN ratio, from a p_m* outside its formula, is no refusal.)
     if ratio.is_nan() || ratio <= OVERLOAD_REFUSAL {
         return None;
     }
-    let (field, torque) = torque_field(gear);
     // sigma_Hm grows with the square root of the wheel torque.
     let allowed = torque * (OVERLOAD_REFUSAL / ratio).powi(2);
     Some(format!(

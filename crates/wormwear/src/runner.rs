@@ -125,7 +125,7 @@ impl Request {
             return Err(RunError::Request("no stage asked for".into()));
         }
         if self.needs_bending() {
-            if let Some(problem) = crate::rating::overload(gear) {
+            if let Some(problem) = crate::rating::implausible_load(gear) {
                 return Err(RunError::Request(problem));
             }
         }

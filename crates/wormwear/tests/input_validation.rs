@@ -737,6 +737,39 @@ fn ten_thousand_sections_are_refused_at_once() {
 }
 
 #[test]
+fn errors_name_the_input_that_causes_them() {
+    // A throat radius far below the wheel's reference radius: named itself (the previous
+    // build blamed the face width, "must be < 0.000 mm").
+    let text = design().replace("throat_radius_mm = 103.94", "throat_radius_mm = 3.0");
+    let message = error_of(&text);
+    assert_mentions(
+        &message,
+        &["wheel.throat_radius_mm = 3", "must be >= 89.101 mm"],
+    );
+    assert!(!message.contains("face_width"), "{message}");
+    // A dotted key 20 000 levels deep: the parser's recursion limit, with the line (the
+    // previous build: "recursion limit" alone).
+    let deep = vec!["a"; 20_000].join(".");
+    let text = format!("{}\n{deep} = 1\n", design());
+    let line = text.lines().count();
+    assert_mentions(
+        &error_of(&text),
+        &[
+            &format!("line {line} nests 20000 levels deep"),
+            "dotted keys",
+        ],
+    );
+    // A vanishing face width: the bounds derived from it in scientific notation, not 300
+    // digits.
+    let text = design().replace("face_width_mm = 45.0", "face_width_mm = 1e-300");
+    let message = error_of(&text);
+    assert!(
+        message.len() < 2000 && message.contains("e-301"),
+        "{message}"
+    );
+}
+
+#[test]
 fn geometry_failures_name_the_inputs_to_change() {
     // Files that validate but cannot be generated (issue 16): an involute worm whose base
     // radius lies above its root (5 deg), a 4-start worm and hob on the 1/40 blank.

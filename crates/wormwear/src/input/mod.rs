@@ -739,15 +739,16 @@ fn syntax_error(e: &toml::de::Error, text: &str) -> InputError {
     // thousands of keys): name the most deeply nested line.
     InputError::Syntax(match (e.span(), deepest_line(text)) {
         (None, Some((line, depth))) if depth > 8 => format!(
-            "{message}: line {line} nests {depth} levels deep (tables, arrays or inline \
-             tables); a gear file needs at most 3"
+            "{message}: line {line} nests {depth} levels deep (table headers, dotted \
+             keys, arrays or inline tables); a gear file needs at most 3"
         ),
         _ => message,
     })
 }
 
 /// The line (1-based) of the deepest nesting of a TOML text and its depth: keys of a table
-/// header, or brackets and braces of a value (quoted text and comments skipped).
+/// header or of a dotted key, or brackets and braces of a value (quoted text and comments
+/// skipped).
 fn deepest_line(text: &str) -> Option<(usize, usize)> {
     let mut best: Option<(usize, usize)> = None;
     let mut depth = 0usize;
@@ -761,12 +762,19 @@ fn deepest_line(text: &str) -> Option<(usize, usize)> {
                 .map_or(1, |h| h.matches('.').count() + 1);
         } else {
             let mut quote: Option<char> = None;
+            // The dotted parts of a key (a line outside a value, up to its '=').
+            let mut key_parts = (depth == 0).then_some(1usize);
             for c in line.chars() {
                 match (quote, c) {
                     (Some(q), c) if c == q => quote = None,
                     (Some(_), _) => {}
                     (None, '"' | '\'') => quote = Some(c),
                     (None, '#') => break,
+                    (None, '.') if key_parts.is_some() => {
+                        key_parts = key_parts.map(|k| k + 1);
+                        deepest = deepest.max(key_parts.unwrap_or(0));
+                    }
+                    (None, '=') if key_parts.is_some() => key_parts = None,
                     (None, '[' | '{') => {
                         depth += 1;
                         deepest = deepest.max(depth);

@@ -663,7 +663,9 @@ impl Mesh<'_> {
     fn check(&self, ck: &mut Checker, warnings: &mut Vec<String>) {
         self.radial_clearances(ck, warnings);
         self.profile_shift(ck, warnings);
-        self.face_width(ck);
+        if self.throat_in_range(ck) {
+            self.face_width(ck);
+        }
         let lead_diff = self.hob.lead_angle() - self.worm.lead_angle();
         if (lead_diff - self.cutting.inclination).abs() > 1.0 * DEG {
             warnings.push(format!(
@@ -745,13 +747,41 @@ impl Mesh<'_> {
         } else if x2.abs() > 1.0 {
             warnings.push(format!("large wheel profile shift x2 = {x2:.3}"));
         }
-        if ra < r2 {
+        if ra < r2 && ra >= self.lowest_throat() {
             warnings.push(format!(
                 "wheel throat radius {:.3} mm is below the reference radius {:.3} mm",
                 ra / MM,
                 r2 / MM
             ));
         }
+    }
+
+    /// The lowest throat radius a wheel blank may have: two axial modules below the wheel's
+    /// reference radius z2 m_x / 2 (a wheel tip below that cuts away the teeth).
+    fn lowest_throat(&self) -> f64 {
+        let wm = self.worm;
+        let r2 = self.blank.teeth as f64 * wm.axial_pitch / (2.0 * PI);
+        r2 - 2.0 * wm.axial_module()
+    }
+
+    /// Whether the throat radius is at least [`Self::lowest_throat`]; else an error on it
+    /// (and the face width, which the throat decides, is not checked).
+    fn throat_in_range(&self, ck: &mut Checker) -> bool {
+        let (ra, lowest) = (self.blank.throat_radius, self.lowest_throat());
+        if ra >= lowest {
+            return true;
+        }
+        ck.fail(
+            "wheel.throat_radius_mm",
+            ra / MM,
+            format!(
+                "must be >= {:.3} mm: the wheel's tip (throat) radius is more than two axial \
+                 modules below its reference radius z2 m_x / 2 = {:.3} mm",
+                lowest / MM,
+                (lowest + 2.0 * self.worm.axial_module()) / MM
+            ),
+        );
+        false
     }
 
     /// The face width the worm can reach (at |z| = b/2 the blank top must be inside the worm
