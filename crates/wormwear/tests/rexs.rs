@@ -601,6 +601,25 @@ fn damaged_files_never_panic() {
 }
 
 #[test]
+fn a_zip_with_two_rexs_files_names_them_instead_of_importing_one() {
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default();
+    let text = std::fs::read(zi_example()).unwrap();
+    for name in ["first.rexs", "second.rexs"] {
+        zip.start_file(name, options).unwrap();
+        std::io::Write::write_all(&mut zip, &text).unwrap();
+    }
+    let bytes = zip.finish().unwrap().into_inner();
+    let err = rexs::parse_bytes(&bytes, "two.rexsz")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("2 REXS files") && err.contains("first.rexs, second.rexs"),
+        "{err}"
+    );
+}
+
+#[test]
 fn a_zip_member_larger_than_a_rexs_file_may_be_is_not_inflated() {
     // 257 MiB of zeros deflate to a few hundred kB: the member is refused by its declared
     // size, and by the bytes actually inflated when the declared size is wrong.

@@ -194,19 +194,29 @@ fn read_zip(bytes: &[u8], name: &str) -> Result<Model, RexsError> {
     };
     let mut archive = zip::ZipArchive::new(std::io::Cursor::new(bytes))
         .map_err(|e| format(format!("unreadable zip archive ({e})")))?;
-    let member = (0..archive.len()).find(|&i| {
-        archive
-            .name_for_index(i)
-            .and_then(|n| n.ok())
-            .is_some_and(|n| {
-                let n = n.to_ascii_lowercase();
-                n.ends_with(".rexs") || n.ends_with(".rexsj")
-            })
-    });
-    let Some(i) = member else {
-        return Err(format(
-            "the zip archive holds no .rexs or .rexsj file".into(),
-        ));
+    let members: Vec<(usize, String)> = (0..archive.len())
+        .filter_map(|i| {
+            let n = archive.name_for_index(i)?.ok()?.to_string();
+            let lower = n.to_ascii_lowercase();
+            (lower.ends_with(".rexs") || lower.ends_with(".rexsj")).then_some((i, n))
+        })
+        .collect();
+    let i = match members.as_slice() {
+        [] => {
+            return Err(format(
+                "the zip archive holds no .rexs or .rexsj file".into(),
+            ))
+        }
+        [(i, _)] => *i,
+        several => {
+            let names: Vec<&str> = several.iter().map(|(_, n)| n.as_str()).collect();
+            return Err(format(format!(
+                "the zip archive holds {} REXS files ({}): unzip it and import the one you \
+                 want",
+                names.len(),
+                names.join(", ")
+            )));
+        }
     };
     let mut file = archive
         .by_index(i)
