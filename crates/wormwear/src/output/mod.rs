@@ -388,7 +388,8 @@ impl Csv {
     }
 
     /// Appends a row of numbers (must match the header length); whole numbers (indices,
-    /// counts) are written as integers, the rest with 11 significant digits.
+    /// counts) are written as integers, the rest with 11 significant digits, and no value
+    /// (NaN or infinite; null in summary.json) as `NaN`.
     pub fn row(&mut self, values: &[f64]) {
         debug_assert_eq!(values.len(), self.columns);
         self.numbers.extend_from_slice(values);
@@ -399,7 +400,7 @@ impl Csv {
             if v.fract() == 0.0 && v.abs() < 1e15 {
                 let _ = write!(self.text, "{}", *v as i64);
             } else {
-                let _ = write!(self.text, "{v:.10e}");
+                push_number(&mut self.text, *v);
             }
         }
         self.text.push('\n');
@@ -409,7 +410,8 @@ impl Csv {
     pub fn labelled_row(&mut self, label: &str, values: &[f64]) {
         self.text.push_str(label);
         for v in values {
-            let _ = write!(self.text, ",{v:.10e}");
+            self.text.push(',');
+            push_number(&mut self.text, *v);
         }
         self.text.push('\n');
     }
@@ -420,9 +422,30 @@ impl Csv {
     }
 }
 
+/// A CSV number with 11 significant digits; no value (NaN or infinite) as `NaN`.
+fn push_number(text: &mut String, v: f64) {
+    if v.is_finite() {
+        let _ = write!(text, "{v:.10e}");
+    } else {
+        text.push_str(NO_VALUE);
+    }
+}
+
+/// How the CSV tables write no value (a quantity outside its formula's range, an unloaded
+/// cell): `NaN`, where summary.json writes null.
+pub const NO_VALUE: &str = "NaN";
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn no_value_is_nan_in_a_table_whether_nan_or_infinite() {
+        let mut csv = Csv::new(&["a", "b", "c"]);
+        csv.row(&[f64::NAN, f64::INFINITY, -f64::INFINITY]);
+        csv.labelled_row("x", &[f64::INFINITY, 1.5]);
+        assert_eq!(csv.text(), "a,b,c\nNaN,NaN,NaN\nx,NaN,1.5000000000e0\n");
+    }
 
     #[test]
     fn a_table_keeps_its_numbers_exactly_and_writes_them_rounded() {

@@ -462,7 +462,8 @@ impl Row {
 
     /// The result columns' values as CSV fields ([`RESULT_COLUMNS`]).
     fn result_fields(&self) -> Vec<String> {
-        let number = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
+        let number =
+            |x: Option<f64>| x.map_or(crate::output::NO_VALUE.to_string(), |v| format!("{v:e}"));
         let mut fields: Vec<String> = [
             self.max_pressure_pa,
             self.contact_area_fraction,
