@@ -180,7 +180,7 @@ def test_a_sweep_gives_the_same_rows_locally_through_the_cli_and_on_dask(cli, fa
         f'base = "{fast_gear_file}"\nstages = ["ltca", "wear"]\ncycles = 20000\nstep_cycles = 10000\n'
         "[grid]\n" + "".join(f'"{k}" = {json.dumps(v)}\n' for k, v in GRID.items())
     )
-    cli("-q", "sweep", sweep_file, "-o", tmp_path / "cli")
+    cli("-q", "sweep", sweep_file, "-o", tmp_path / "cli", "--base-anywhere")
     csv = pd.read_csv(tmp_path / "cli" / "sweep.csv")
     assert len(csv) == 6
     for column in RESULT_COLUMNS:
@@ -207,7 +207,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(cli, fast_gear_file, tmp_
     )
     out = tmp_path / "out"
     process = subprocess.Popen(
-        [str(cli_path()), "-q", "sweep", str(sweep_file), "-o", str(out)],
+        [str(cli_path()), "-q", "sweep", str(sweep_file), "-o", str(out), "--base-anywhere"],
         stderr=subprocess.PIPE,
     )
     deadline = time.time() + 120

@@ -172,6 +172,10 @@ enum Command {
         /// Output directory (created if needed).
         #[arg(short, long)]
         output: PathBuf,
+        /// Allow the sweep's `base` outside the sweep file's directory (by default a sweep
+        /// file may only read a gear file in its own folder or below).
+        #[arg(long)]
+        base_anywhere: bool,
     },
     /// Take a worm stage from a REXS file (.rexs XML, .rexsj JSON, .rexsz zip; REXS 1.x) and
     /// write it as a commented gear file, then validate it as `check` does.
@@ -322,7 +326,11 @@ fn main() -> ExitCode {
             examples,
             quick,
         } => validate(output, examples, *quick, cli.quiet),
-        Command::Sweep { file, output } => sweep(file, output, cli.quiet),
+        Command::Sweep {
+            file,
+            output,
+            base_anywhere,
+        } => sweep(file, output, *base_anywhere, cli.quiet),
         Command::Import {
             file,
             output,
@@ -795,9 +803,13 @@ fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(),
 
 /// Runs a sweep file's variants into `dir`: a line per finished variant on stderr, the rows'
 /// table and page at the end. Fails only when no variant succeeds.
-fn sweep(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
-    use wormwear::sweep::SweepError;
-    let study = wormwear::sweep::Sweep::load(file).map_err(|e| match e {
+fn sweep(file: &Path, dir: &Path, base_anywhere: bool, quiet: bool) -> Result<(), Failure> {
+    use wormwear::sweep::{BaseAccess, SweepError};
+    let access = match base_anywhere {
+        true => BaseAccess::Anywhere,
+        false => BaseAccess::Confined,
+    };
+    let study = wormwear::sweep::Sweep::load_with(file, access).map_err(|e| match e {
         SweepError::Output(_) => Failure::Run(e.into()),
         _ => Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display()))),
     })?;

@@ -599,6 +599,7 @@ fn a_device_or_a_fifo_given_as_a_file_is_refused_at_once() {
                 sweep.clone().into(),
                 "-o".into(),
                 dir.path().join("s").into(),
+                "--base-anywhere".into(),
             ],
             "a device",
         ),
@@ -1308,13 +1309,15 @@ fn the_library_runner_and_writers_give_the_cli_files_byte_for_byte() {
 fn sweep_runs_a_grid_writes_its_table_and_page_and_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("sweep.toml");
+    std::fs::copy(
+        example("gear-1x40-design.toml"),
+        dir.path().join("gear.toml"),
+    )
+    .unwrap();
     std::fs::write(
         &file,
-        format!(
-            "base = {:?}\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque_nm\" = [30.0, 60.0, 90.0]\n\
-             \"lubricant.composite_roughness_um\" = [0.5, 1.0]\n",
-            example("gear-1x40-design.toml").display().to_string()
-        ),
+        "base = \"gear.toml\"\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque_nm\" = [30.0, 60.0, 90.0]\n\
+         \"lubricant.composite_roughness_um\" = [0.5, 1.0]\n",
     )
     .unwrap();
     let out_dir = dir.path().join("out");
@@ -1365,6 +1368,37 @@ fn sweep_runs_a_grid_writes_its_table_and_page_and_resumes() {
     let bad = sweep();
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("missing.toml"));
+    // A base outside the sweep file's directory (here a file that is no gear file, whose first
+    // line the parse error would show): refused without reading it, unless allowed.
+    let outside = tempfile::tempdir().unwrap();
+    let secret = outside.path().join("secret.txt");
+    std::fs::write(&secret, "password = hunter2 and more\n").unwrap();
+    std::fs::write(
+        &file,
+        format!(
+            "base = {:?}\n[grid]\na = [1]\n",
+            secret.display().to_string()
+        ),
+    )
+    .unwrap();
+    let bad = sweep();
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("outside the sweep file's directory") && err.contains("--base-anywhere"),
+        "{err}"
+    );
+    assert!(!err.contains("hunter2"), "{err}");
+    let allowed = bin()
+        .arg("sweep")
+        .arg(&file)
+        .arg("-o")
+        .arg(&out_dir)
+        .arg("--base-anywhere")
+        .output()
+        .unwrap();
+    assert_eq!(allowed.status.code(), Some(2));
+    assert!(!String::from_utf8_lossy(&allowed.stderr).contains("outside the sweep"));
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use wormwear::input;
 use wormwear::runner::LifeOverrides;
 use wormwear::sweep::{
-    distinct_bending_models, grid_variants, run, Row, Sweep, Variant, VARIANT_FILE,
+    distinct_bending_models, grid_variants, run, BaseAccess, Row, Sweep, Variant, VARIANT_FILE,
 };
 
 /// The design example, fast: no bending, 6 positions, a coarser flank grid.
@@ -242,13 +242,20 @@ fn sweep_files_give_their_errors_with_the_field() {
         ),
     ];
     for (text, message) in cases {
-        let err = Sweep::load(&write(text)).unwrap_err().to_string();
+        let err = Sweep::load_with(&write(text), BaseAccess::Anywhere)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(message), "{text}: {err}");
     }
     // A list of cases, with names.
-    let sweep = Sweep::load(&write(
+    // The base lies outside the sweep file's folder: refused by default, read when allowed.
+    let err = Sweep::load(&write("[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("outside the sweep file's directory"), "{err}");
+    let sweep = Sweep::load_with(&write(
         "[[cases]]\nname = \"light\"\nconditions.worm_torque_nm = 20.0\n[[cases]]\n\"conditions.worm_speed_rpm\" = 750.0\n",
-    ))
+    ), BaseAccess::Anywhere)
     .unwrap();
     assert_eq!(
         sweep.variants,

@@ -138,9 +138,25 @@ pub struct Sweep {
     pub settings: Settings,
 }
 
+/// Where a sweep file's `base` may lie.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaseAccess {
+    /// In the sweep file's directory or below it (the default: a sweep file from elsewhere
+    /// cannot read, nor echo in an error, a file outside its folder).
+    Confined,
+    /// Anywhere (the CLI's `--base-anywhere`).
+    Anywhere,
+}
+
 impl Sweep {
-    /// Reads a sweep file and its base gear file (which must be valid).
+    /// Reads a sweep file and its base gear file (which must be valid and, by default, lie in
+    /// the sweep file's directory or below it).
     pub fn load(path: &Path) -> Result<Self, SweepError> {
+        Self::load_with(path, BaseAccess::Confined)
+    }
+
+    /// [`Sweep::load`] with the base allowed where `access` says.
+    pub fn load_with(path: &Path, access: BaseAccess) -> Result<Self, SweepError> {
         let read = |p: &Path| {
             crate::files::read_text(p, crate::files::INPUT_LIMIT).map_err(|e| SweepError::Read {
                 path: p.display().to_string(),
@@ -149,7 +165,11 @@ impl Sweep {
         };
         let file: SweepFile = toml::from_str(&read(path)?)
             .map_err(|e| SweepError::Invalid(format!("{}: {e}", path.display())))?;
-        let base_path = path.parent().unwrap_or(Path::new(".")).join(&file.base);
+        let folder = path.parent().unwrap_or(Path::new("."));
+        let base_path = folder.join(&file.base);
+        if access == BaseAccess::Confined {
+            confined(folder, &base_path, &file.base)?;
+        }
         let base_file = base_path.display().to_string();
         let base =
             input::parse_document(&read(&base_path)?).map_err(|source| SweepError::Base {
@@ -487,6 +507,26 @@ impl Row {
         ));
         fields
     }
+}
+
+/// That the base (`base_path`, written `written` in the sweep file) lies in `folder` or below
+/// it, symbolic links resolved; else an error that reads nothing of it.
+fn confined(folder: &Path, base_path: &Path, written: &str) -> Result<(), SweepError> {
+    let resolve = |p: &Path| {
+        std::fs::canonicalize(p).map_err(|e| SweepError::Read {
+            path: p.display().to_string(),
+            message: e.to_string(),
+        })
+    };
+    let (folder, base) = (resolve(folder)?, resolve(base_path)?);
+    if base.starts_with(&folder) {
+        return Ok(());
+    }
+    Err(SweepError::Invalid(format!(
+        "base = {written:?}: outside the sweep file's directory {}; copy the gear file next to \
+         the sweep file, or allow a base elsewhere (wormwear sweep --base-anywhere)",
+        folder.display()
+    )))
 }
 
 /// A TOML value as JSON (dates as their text).
