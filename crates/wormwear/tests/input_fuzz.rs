@@ -79,6 +79,9 @@ enum Mutation {
     Remove,
     AddUnknownKey,
     Nest(usize),
+    /// A long list in place of the value: increasing numbers, or phase-like tables (the
+    /// probe's 10^6 map cycles and 100 000 phases).
+    LongList(usize, bool),
 }
 
 fn hostile_value() -> impl Strategy<Value = Value> {
@@ -113,6 +116,8 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         2 => Just(Mutation::Remove),
         1 => Just(Mutation::AddUnknownKey),
         1 => (2usize..5000).prop_map(Mutation::Nest),
+        1 => (prop_oneof![Just(300usize), Just(100_000usize)], any::<bool>())
+            .prop_map(|(n, tables)| Mutation::LongList(n, tables)),
     ]
 }
 
@@ -153,6 +158,23 @@ fn apply(doc: &mut Value, path: &[Step], mutation: &Mutation) -> String {
                 return "zz_unknown_key".into();
             }
         }
+        Mutation::LongList(n, tables) => {
+            let items = (1..=*n).map(|k| match tables {
+                false => Value::Float(k as f64),
+                true => {
+                    let mut t = toml::Table::new();
+                    t.insert("kind".into(), Value::String("wear".into()));
+                    t.insert("until_cycles".into(), Value::Float(k as f64));
+                    Value::Table(t)
+                }
+            });
+            *at_mut(doc, path) = Value::Array(items.collect());
+            // Phase-like tables anywhere but in `phases` are refused for the key they replace
+            // or for their own first key (either may be named).
+            if *tables && key != "phases" {
+                return format!("{key}|kind");
+            }
+        }
         Mutation::Nest(depth) => {
             let target = at_mut(doc, path);
             let mut v = target.clone();
@@ -173,7 +195,7 @@ fn names_a_field(error: &InputError, key: &str) -> bool {
         InputError::Invalid(fields) => {
             !fields.is_empty() && fields.iter().all(|f| !f.field.is_empty())
         }
-        InputError::Syntax(message) => message.contains(key),
+        InputError::Syntax(message) => key.split('|').any(|k| message.contains(k)),
         InputError::Io { .. } => false,
     }
 }
@@ -263,6 +285,7 @@ fn deep_nesting_names_its_line() {
     let line = base.lines().count() + 2;
     for tail in [
         format!("\n[{}]\n", vec!["a"; 5000].join(".")),
+        format!("\n{} = 1\n", vec!["a"; 20_000].join(".")),
         format!("\nx = {}{}\n", "[".repeat(5000), "]".repeat(5000)),
     ] {
         let e = input::load_from_str(&format!("{base}{tail}")).unwrap_err();
