@@ -123,12 +123,17 @@ fn atan_reduced<const FUSED: bool>(r: f64, offset: f64) -> f64 {
 pub(super) fn ln<const FUSED: bool>(x: f64) -> f64 {
     const SQRT_HALF: u64 = 0x3fe6_a09e_667f_3bcd;
     const EXPONENT_MASK: u64 = 0xfff0_0000_0000_0000;
-    // The exponent for a mantissa in [sqrt(1/2), sqrt(2)), offset by 1024 to stay positive.
-    let shifted = x.to_bits() + (1024 << 52) - SQRT_HALF;
+    // The exponent for a mantissa in [sqrt(1/2), sqrt(2)), offset by 1024 to stay positive
+    // (bit arithmetic modulo 2^64, as the exponent field is).
+    let bits = x.to_bits();
+    let shifted = bits.wrapping_add(1024 << 52).wrapping_sub(SQRT_HALF);
     // (shifted >> 52) as a double by the 2^52 trick (no 64-bit integer conversion in AVX2).
     let exponent = f64::from_bits((shifted >> 52) | 0x4330_0000_0000_0000)
         - (4_503_599_627_370_496.0 + 1024.0);
-    let m = f64::from_bits(x.to_bits() - (shifted & EXPONENT_MASK) + (1024 << 52));
+    let m = f64::from_bits(
+        bits.wrapping_sub(shifted & EXPONENT_MASK)
+            .wrapping_add(1024 << 52),
+    );
     let f = (m - 1.0) / (m + 1.0);
     let (c, m) = (&ATANH_COEFFICIENTS, madd::<FUSED>);
     let s = f * f;
