@@ -738,6 +738,12 @@ fn ten_thousand_sections_are_refused_at_once() {
 
 #[test]
 fn errors_name_the_input_that_causes_them() {
+    // A vanishing speed (1e-300 rpm ended a life in a solver message): refused with its range.
+    let text = design().replace("worm_speed_rpm = 1500.0", "worm_speed_rpm = 1e-300");
+    assert_mentions(
+        &error_of(&text),
+        &["conditions.worm_speed_rpm = 1e-300", "[0.001, 20000] rpm"],
+    );
     // A throat radius far below the wheel's reference radius: named itself (the previous
     // build blamed the face width, "must be < 0.000 mm").
     let text = design().replace("throat_radius_mm = 103.94", "throat_radius_mm = 3.0");

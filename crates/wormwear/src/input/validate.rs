@@ -1887,9 +1887,12 @@ fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
             None
         }
     };
-    let speed = ck.positive(
+    // Below 1e-3 rpm the film and sliding-speed formulas underflow (1e-300 rpm ended a life
+    // in "the reachable cells carry only ... of the load").
+    let speed = ck.range(
         "conditions.worm_speed_rpm",
         c.worm_speed_rpm,
+        1e-3,
         20_000.0,
         "rpm",
     );

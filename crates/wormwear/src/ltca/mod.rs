@@ -511,7 +511,7 @@ fn over_the_cycle(
         stats.yielded_area_fraction,
         settings.flow_pressure,
     ));
-    warnings.extend(transmission_error_warning(&positions, teeth));
+    warnings.extend(deflection_warning(&positions, tca, teeth));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -538,23 +538,26 @@ fn over_the_cycle(
     }
 }
 
-/// The share of a wheel pitch beyond which the loaded transmission error is implausible.
-pub const TE_PITCH_SHARE_WARNING: f64 = 0.1;
+/// The share of a wheel pitch beyond which the load's rotation of the wheel is implausible.
+pub const DEFLECTION_PITCH_SHARE_WARNING: f64 = 0.1;
 
-/// A warning when the loaded transmission error at some position exceeds
-/// [`TE_PITCH_SHARE_WARNING`] of the wheel's angular pitch: deflections that large are outside
-/// the small-deflection (linear) model, whatever the solver says.
-fn transmission_error_warning(positions: &[PositionResult], teeth: u32) -> Option<String> {
+/// A warning when the load turns the wheel (the loaded transmission error less the unloaded
+/// kinematic error: contact approach and bending) by more than
+/// [`DEFLECTION_PITCH_SHARE_WARNING`] of its angular pitch at some position: deflections that
+/// large are outside the small-deflection (linear) model, whatever the solver says. (A large
+/// kinematic error, from a misalignment, is geometry and not warned here.)
+fn deflection_warning(positions: &[PositionResult], tca: &Tca, teeth: u32) -> Option<String> {
     let pitch = 2.0 * PI / teeth as f64;
     let largest = positions
         .iter()
-        .map(|p| p.transmission_error.abs())
+        .map(|p| (tca.positions[p.position].kinematic_error - p.transmission_error).abs())
         .fold(0.0, f64::max);
-    (largest > TE_PITCH_SHARE_WARNING * pitch).then(|| {
+    (largest > DEFLECTION_PITCH_SHARE_WARNING * pitch).then(|| {
         format!(
-            "the loaded transmission error reaches {largest:.3e} rad, {:.0} % of a wheel pitch \
-             ({pitch:.4} rad): deflections this large are outside the linear model (check the \
-             torque, the bending model's supports and the materials)",
+            "the load turns the wheel by {largest:.3e} rad (loaded less unloaded transmission \
+             error), {:.0} % of a wheel pitch ({pitch:.4} rad): deflections this large are \
+             outside the linear model (check the torque, the bending model's supports and the \
+             materials)",
             100.0 * largest / pitch
         )
     })
