@@ -416,12 +416,12 @@ fn wear_input_errors_exit_2_and_name_the_problem() {
         (
             "gear-1x40-design.toml",
             &["--step-wear-um", "1e-9"],
-            "up to 3.814e12 loaded analyses",
+            "must be a depth in [0.05, 1000] um",
         ),
         (
             "gear-1x40-design.toml",
             &["--cycles", "1e12", "--step-cycles", "1"],
-            "up to 1.000e12 loaded analyses",
+            "is 1.000e12 states, more than the 1e5 a run may take",
         ),
         ("gear-1x40-design.toml", &["--cycles=-5"], "--cycles = -5"),
         (
