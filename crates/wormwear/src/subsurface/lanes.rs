@@ -366,8 +366,9 @@ impl Batch {
     #[inline(always)]
     fn stress_at_lanes<const FUSED: bool>(&self, point: &Vector3<f64>, nu: f64) -> Stress {
         let mut sum = [[0.0; LANES]; 6];
+        let points = [[point[0]; LANES], [point[1]; LANES], [point[2]; LANES]];
         for pass in &self.passes {
-            pass.add_stress::<FUSED>(point, nu, &mut sum);
+            pass.add_stress::<FUSED>(&points, nu, &mut sum);
         }
         let mut out = [0.0; 6];
         for (o, lanes) in out.iter_mut().zip(&sum) {
@@ -375,14 +376,109 @@ impl Batch {
         }
         out
     }
+
+    /// The stress at each of `points` (m) from every source, as [`Batch::stress_at`] point
+    /// by point (Pa), with the last pass's loaded lanes of all the points packed together
+    /// instead of each point's padding lanes left idle.
+    pub(super) fn stress_at_points(&self, points: &[Vector3<f64>], nu: f64) -> Vec<Stress> {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            return unsafe { self.stress_at_points_avx2(points, nu) };
+        }
+        self.stress_at_points_lanes::<false>(points, nu)
+    }
+
+    /// [`Batch::stress_at_points`] compiled for AVX2 + FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn stress_at_points_avx2(&self, points: &[Vector3<f64>], nu: f64) -> Vec<Stress> {
+        self.stress_at_points_lanes::<true>(points, nu)
+    }
+
+    /// [`Batch::stress_at_points`]: the full passes point by point, then the remainder's
+    /// (point, source) pairs four to a pass.
+    #[inline(always)]
+    fn stress_at_points_lanes<const FUSED: bool>(
+        &self,
+        points: &[Vector3<f64>],
+        nu: f64,
+    ) -> Vec<Stress> {
+        let remainder = self.len % LANES;
+        let full = if remainder == 0 {
+            &self.passes[..]
+        } else {
+            &self.passes[..self.passes.len() - 1]
+        };
+        // Plain loops, no closures: a closure is not compiled with the caller's target
+        // features, and its fused multiply-adds would become library calls.
+        let mut out: Vec<Stress> = vec![[0.0; 6]; points.len()];
+        for (o, point) in out.iter_mut().zip(points) {
+            let mut sum = [[0.0; LANES]; 6];
+            let lanes = [[point[0]; LANES], [point[1]; LANES], [point[2]; LANES]];
+            for pass in full {
+                pass.add_stress::<FUSED>(&lanes, nu, &mut sum);
+            }
+            for (value, component) in o.iter_mut().zip(&sum) {
+                *value = component.iter().sum();
+            }
+        }
+        let Some(last) = self.passes.last().filter(|_| remainder > 0) else {
+            return out;
+        };
+        let mut pairs = Vec::with_capacity(points.len() * remainder);
+        for p in 0..points.len() {
+            for j in 0..remainder {
+                pairs.push((p, j));
+            }
+        }
+        for chunk in pairs.chunks(LANES) {
+            let mut packed = *last;
+            let mut lanes = [[0.0; LANES]; 3];
+            for l in 0..LANES {
+                // Lanes past the pairs repeat the first pair, unloaded.
+                let (p, j) = chunk.get(l).copied().unwrap_or(chunk[0]);
+                packed.copy_lane(l, last, j, l < chunk.len());
+                for (axis, value) in lanes.iter_mut().zip(points[p].iter()) {
+                    axis[l] = *value;
+                }
+            }
+            let mut sum = [[0.0; LANES]; 6];
+            packed.add_stress::<FUSED>(&lanes, nu, &mut sum);
+            for (l, &(p, _)) in chunk.iter().enumerate() {
+                for (o, component) in out[p].iter_mut().zip(&sum) {
+                    *o += component[l];
+                }
+            }
+        }
+        out
+    }
 }
 
 impl Pass {
-    /// The pass's stresses at `point` in the field's frame, added lane by lane to `sum`.
+    /// Lane `to` becomes lane `from` of `source`, loaded or not.
+    #[inline(always)]
+    fn copy_lane(&mut self, to: usize, source: &Pass, from: usize, loaded: bool) {
+        for i in 0..3 {
+            self.centre[i][to] = source.centre[i][from];
+            self.across[i][to] = source.across[i][from];
+            self.along[i][to] = source.along[i][from];
+            self.normal[i][to] = source.normal[i][from];
+        }
+        self.inverse_half_across[to] = source.inverse_half_across[from];
+        self.aspect[to] = source.aspect[from];
+        self.scale[to] = if loaded { source.scale[from] } else { 0.0 };
+        for (r, s) in self.rotation.iter_mut().zip(&source.rotation) {
+            r[to] = s[from];
+        }
+    }
+
+    /// The pass's stresses at `points` (one per lane, m) in the field's frame, added lane by
+    /// lane to `sum`.
     #[inline(always)]
     fn add_stress<const FUSED: bool>(
         &self,
-        point: &Vector3<f64>,
+        points: &[[f64; LANES]; 3],
         nu: f64,
         sum: &mut [[f64; LANES]; 6],
     ) {
@@ -391,9 +487,9 @@ impl Pass {
         let mut log_argument = [0.0; LANES];
         for l in 0..LANES {
             let d = [
-                point[0] - self.centre[0][l],
-                point[1] - self.centre[1][l],
-                point[2] - self.centre[2][l],
+                points[0][l] - self.centre[0][l],
+                points[1][l] - self.centre[1][l],
+                points[2][l] - self.centre[2][l],
             ];
             let dot = |a: &[[f64; LANES]; 3]| {
                 madd::<FUSED>(d[0], a[0][l], madd::<FUSED>(d[1], a[1][l], d[2] * a[2][l]))
@@ -537,6 +633,18 @@ mod tests {
             }
             let ours = batch.stress_at(&point, nu);
             let size = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            // Several points at once, the remainder's lanes packed: the same stresses.
+            let others = [
+                point,
+                point - field.normal * 1e-4,
+                point + field.axis_zeta * 2e-4,
+            ];
+            for (one, many) in others.iter().zip(batch.stress_at_points(&others, nu)) {
+                let single = batch.stress_at(one, nu);
+                for (a, b) in single.iter().zip(&many) {
+                    assert!((a - b).abs() < 1e-13 * size, "{single:?} vs {many:?}");
+                }
+            }
             // The portable build of the same passes, without fused multiply-adds.
             let portable = batch.stress_at_lanes::<false>(&point, nu);
             for (a, b) in ours.iter().zip(&portable) {

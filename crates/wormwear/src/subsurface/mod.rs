@@ -509,8 +509,18 @@ fn cell_equivalent(
     };
     let mut points = [(0.0, 0.0); MAX_DEPTHS];
     let mut count = depths.len().min(MAX_DEPTHS - REFINEMENTS);
-    for (p, (&z, s)) in points.iter_mut().zip(depths.iter().zip(far)).take(count) {
-        *p = (z, value(z, *s));
+    // The grid's depths in one call (the sources' last, partly loaded pass shared by them).
+    let grid: Vec<Vector3<f64>> = depths[..count]
+        .iter()
+        .map(|&z| at.centre - at.normal * z)
+        .collect();
+    let near_grid = near.stress_at_points(&grid, settings.poisson);
+    for (p, ((&z, s), n)) in points
+        .iter_mut()
+        .zip(depths.iter().zip(far).zip(&near_grid))
+        .take(count)
+    {
+        *p = (z, settings.criterion.read(&add(*n, s)));
     }
     for _ in 0..REFINEMENTS {
         let evaluated = &points[..count];
