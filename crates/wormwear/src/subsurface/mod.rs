@@ -355,10 +355,11 @@ impl Load<'_> {
             .iter()
             .map(|&z| field(&below, &sources.far, z, settings.poisson))
             .collect();
-        for (o, k) in out.iter_mut().zip(range.clone()) {
-            if self.pressure[k] > 0.0 {
-                *o = cell_equivalent(&self.cells[k], &sources.near, &far_field, &depths, settings);
-            }
+        let loaded: Vec<usize> = range.clone().filter(|&k| self.pressure[k] > 0.0).collect();
+        let cells: Vec<&ContactCell> = loaded.iter().map(|&k| &self.cells[k]).collect();
+        let found = row_search(&cells, &sources.near, &far_field, &depths, settings);
+        for (k, e) in loaded.into_iter().zip(found) {
+            out[k - range.start] = e;
         }
         out
     }
@@ -490,72 +491,116 @@ struct Sources {
 /// Parabolic refinements of the depth search.
 const REFINEMENTS: usize = 3;
 
-/// The equivalent pressure below cell `at`: the criterion on the depth grid of the stress
-/// of the `near` sources plus the far rows' field `far` (at `depths`), its maximum refined
-/// [`REFINEMENTS`] times by the parabola through the best depth so far and its nearest
-/// evaluated neighbours (successive parabolic interpolation), the near sources' field exact at
-/// each new depth, the far one interpolated ([`cubic_at`]).
-fn cell_equivalent(
-    at: &ContactCell,
-    near: &Batch,
-    far: &[Stress],
-    depths: &[f64],
-    settings: &SubsurfaceSettings,
-) -> Equivalent {
-    let value = |z: f64, far: Stress| {
-        settings
-            .criterion
-            .read(&add(field(at, near, z, settings.poisson), &far))
-    };
-    let mut points = [(0.0, 0.0); MAX_DEPTHS];
-    let mut count = depths.len().min(MAX_DEPTHS - REFINEMENTS);
-    // The grid's depths in one call (the sources' last, partly loaded pass shared by them).
-    let grid: Vec<Vector3<f64>> = depths[..count]
-        .iter()
-        .map(|&z| at.centre - at.normal * z)
-        .collect();
-    let near_grid = near.stress_at_points(&grid, settings.poisson);
-    for (p, ((&z, s), n)) in points
-        .iter_mut()
-        .zip(depths.iter().zip(far).zip(&near_grid))
-        .take(count)
-    {
-        *p = (z, settings.criterion.read(&add(*n, s)));
-    }
-    for _ in 0..REFINEMENTS {
-        let evaluated = &points[..count];
-        let best = (0..count)
+/// The depths evaluated below one cell, ascending, with the criterion's value at each.
+#[derive(Clone, Copy)]
+struct DepthSearch {
+    points: [(f64, f64); MAX_DEPTHS],
+    count: usize,
+    done: bool,
+}
+
+impl DepthSearch {
+    /// The next depth to evaluate: the vertex of the parabola through the best depth so far and
+    /// its nearest evaluated neighbours (successive parabolic interpolation); None when the
+    /// best is at an end of the grid or the vertex falls on a depth already evaluated (no
+    /// threshold on the step: a discrete choice would turn round-off in the pressures into a
+    /// different depth).
+    fn next_depth(&self) -> Option<f64> {
+        let evaluated = &self.points[..self.count];
+        let best = (0..self.count)
             .max_by(|&a, &b| evaluated[a].1.total_cmp(&evaluated[b].1))
             .unwrap_or(0);
-        if best == 0 || best + 1 == count {
-            break;
+        if best == 0 || best + 1 == self.count {
+            return None;
         }
         let ((z0, l), (z1, c), (z2, r)) =
             (evaluated[best - 1], evaluated[best], evaluated[best + 1]);
-        // Vertex of the parabola through three points.
         let (d0, d2) = (z1 - z0, z1 - z2);
         let num = d0 * d0 * (c - r) - d2 * d2 * (c - l);
         let den = d0 * (c - r) - d2 * (c - l);
         if den == 0.0 {
-            break;
+            return None;
         }
         let z = (z1 - 0.5 * num / den).clamp(z0, z2);
-        // No threshold on the step (a discrete choice would turn round-off in the pressures
-        // into a different depth): only a vertex on a point already there ends the search.
-        if evaluated.iter().any(|p| p.0 == z) {
+        (!evaluated.iter().any(|p| p.0 == z)).then_some(z)
+    }
+
+    /// Adds the value at depth z in its place.
+    fn insert(&mut self, z: f64, value: f64) {
+        let at = self.points[..self.count].partition_point(|p| p.0 < z);
+        self.points.copy_within(at..self.count, at + 1);
+        self.points[at] = (z, value);
+        self.count += 1;
+    }
+
+    /// The largest value and its depth.
+    fn best(&self) -> Equivalent {
+        let (depth, pressure) = self.points[..self.count]
+            .iter()
+            .copied()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or_default();
+        Equivalent { pressure, depth }
+    }
+}
+
+/// The equivalent pressure below each of a row's loaded `cells`: the criterion on the depth
+/// grid of the stress of the `near` sources plus the far rows' field `far` (at `depths`), its
+/// maximum refined [`REFINEMENTS`] times ([`DepthSearch::next_depth`]), the near sources'
+/// field exact at each new depth, the far one interpolated ([`cubic_at`]). The cells advance
+/// together, so each evaluation round is one call for all of them (the sources' last, partly
+/// loaded pass shared by their points).
+fn row_search(
+    cells: &[&ContactCell],
+    near: &Batch,
+    far: &[Stress],
+    depths: &[f64],
+    settings: &SubsurfaceSettings,
+) -> Vec<Equivalent> {
+    let read = |near: &Stress, far: &Stress| settings.criterion.read(&add(*near, far));
+    let grid = depths.len().min(MAX_DEPTHS - REFINEMENTS);
+    let below = |cell: &ContactCell, z: f64| cell.centre - cell.normal * z;
+    let points: Vec<Vector3<f64>> = cells
+        .iter()
+        .flat_map(|c| depths[..grid].iter().map(move |&z| below(c, z)))
+        .collect();
+    let near_grid = near.stress_at_points(&points, settings.poisson);
+    let mut searches: Vec<DepthSearch> = near_grid
+        .chunks(grid.max(1))
+        .map(|stresses| {
+            let mut s = DepthSearch {
+                points: [(0.0, 0.0); MAX_DEPTHS],
+                count: grid,
+                done: false,
+            };
+            for (p, ((&z, f), n)) in s
+                .points
+                .iter_mut()
+                .zip(depths.iter().zip(far).zip(stresses))
+            {
+                *p = (z, read(n, f));
+            }
+            s
+        })
+        .collect();
+    for _ in 0..REFINEMENTS {
+        let mut next = Vec::new();
+        for (k, s) in searches.iter_mut().enumerate().filter(|(_, s)| !s.done) {
+            match s.next_depth() {
+                Some(z) => next.push((k, z)),
+                None => s.done = true,
+            }
+        }
+        if next.is_empty() {
             break;
         }
-        let at = evaluated.partition_point(|p| p.0 < z);
-        points.copy_within(at..count, at + 1);
-        points[at] = (z, value(z, cubic_at(depths, far, z)));
-        count += 1;
+        let points: Vec<Vector3<f64>> = next.iter().map(|&(k, z)| below(cells[k], z)).collect();
+        let stresses = near.stress_at_points(&points, settings.poisson);
+        for (&(k, z), n) in next.iter().zip(&stresses) {
+            searches[k].insert(z, read(n, &cubic_at(depths, far, z)));
+        }
     }
-    let (depth, pressure) = points[..count]
-        .iter()
-        .copied()
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap_or_default();
-    Equivalent { pressure, depth }
+    searches.iter().map(DepthSearch::best).collect()
 }
 
 /// The most depths a search evaluates (grid and refinements).
