@@ -842,7 +842,16 @@ fn sweep(file: &Path, dir: &Path, base_anywhere: bool, quiet: bool) -> Result<()
         );
     }
     if failed == rows.len() {
-        return Err(Failure::Run(anyhow::anyhow!("sweep: every variant failed")));
+        let first = rows.first().map_or(String::new(), |r| {
+            format!(
+                "; the first, {}: {}",
+                r.variant,
+                r.error.as_deref().unwrap_or("no message")
+            )
+        });
+        return Err(Failure::Run(anyhow::anyhow!(
+            "sweep: every variant failed{first}"
+        )));
     }
     if !quiet {
         println!(

@@ -197,10 +197,25 @@ impl LifeOverrides {
         self.cycles.is_some()
     }
 
+    /// The names (Python keywords) of the overrides that are given.
+    pub fn given(&self) -> Vec<&'static str> {
+        let given = [
+            ("cycles", self.cycles.is_some()),
+            ("step_cycles", self.step_cycles.is_some()),
+            ("step_wear_um", self.step_wear_um.is_some()),
+            ("no_pitting", self.no_pitting),
+        ];
+        given.into_iter().filter(|g| g.1).map(|g| g.0).collect()
+    }
+
     /// The gear's life plan with these overrides; an error names the override and its range.
     pub fn plan(&self, gear: &GearSet, names: OverrideNames) -> Result<WearPlan, RunError> {
         let bad = |field: &str, value: f64, range: &str| {
-            RunError::Request(format!("{} = {value}: must be {range}", names.of(field)))
+            RunError::Request(format!(
+                "{} = {}: must be {range}",
+                names.of(field),
+                crate::input::Number(value)
+            ))
         };
         let mut plan = match (&gear.wear, self.cycles) {
             (Some(p), _) => p.clone(),
@@ -213,16 +228,16 @@ impl LifeOverrides {
                 )))
             }
         };
-        let cycles = |c: f64| c.is_finite() && c > 0.0 && c <= 1e12;
+        let cycles = |c: f64| c.is_finite() && (1.0..=1e12).contains(&c);
         if let Some(c) = self.cycles {
             if !cycles(c) {
-                return Err(bad("cycles", c, "a number of cycles in (0, 1e12]"));
+                return Err(bad("cycles", c, "a number of cycles in [1, 1e12]"));
             }
             plan.life_cycles = c;
         }
         if let Some(c) = self.step_cycles {
             if !cycles(c) {
-                return Err(bad("step_cycles", c, "a number of cycles in (0, 1e12]"));
+                return Err(bad("step_cycles", c, "a number of cycles in [1, 1e12]"));
             }
             plan.step = StepControl::Cycles(c);
         }

@@ -240,6 +240,12 @@ fn sweep_files_give_their_errors_with_the_field() {
             "cycles = 1e12\nstep_cycles = 1\n[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n",
             "more than the 1e5 a run may take",
         ),
+        // A life override where the stages run no life is refused, not ignored (the probe
+        // of issue 38 found cycles = -5 accepted beside stages = ["ltca"]).
+        (
+            "stages = [\"ltca\"]\ncycles = -5\n[grid]\n\"conditions.worm_torque_nm\" = [60.0]\n",
+            "cycles is a life override, but the stages (ltca) have no life",
+        ),
     ];
     for (text, message) in cases {
         let err = Sweep::load_with(&write(text), BaseAccess::Anywhere)
@@ -253,6 +259,16 @@ fn sweep_files_give_their_errors_with_the_field() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("outside the sweep file's directory"), "{err}");
+    // A base that cannot be read is named as the sweep file wrote it.
+    for base in ["missing.toml", "."] {
+        let path = dir.path().join("b.toml");
+        std::fs::write(&path, format!("base = {base:?}\n[grid]\na = [1]\n")).unwrap();
+        let err = Sweep::load(&path).unwrap_err().to_string();
+        assert!(
+            err.starts_with(&format!("base = {base:?}: cannot read")),
+            "{err}"
+        );
+    }
     let sweep = Sweep::load_with(&write(
         "[[cases]]\nname = \"light\"\nconditions.worm_torque_nm = 20.0\n[[cases]]\n\"conditions.worm_speed_rpm\" = 750.0\n",
     ), BaseAccess::Anywhere)

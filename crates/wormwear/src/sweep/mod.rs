@@ -115,6 +115,14 @@ impl Settings {
                 "stages = []: name at least one stage".into(),
             ));
         }
+        if let (false, Some(name)) = (stages.contains(&Stage::Wear), overrides.given().first()) {
+            let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
+            return Err(SweepError::Invalid(format!(
+                "{name} is a life override, but the stages ({}) have no life: add \"wear\" to \
+                 the stages or remove {name}",
+                names.join(", ")
+            )));
+        }
         Ok(Self { stages, overrides })
     }
 }
@@ -167,15 +175,24 @@ impl Sweep {
             .map_err(|e| SweepError::Invalid(format!("{}: {e}", path.display())))?;
         let folder = path.parent().unwrap_or(Path::new("."));
         let base_path = folder.join(&file.base);
+        // A base that cannot be read is named as the sweep file wrote it.
+        let named = |e: SweepError| match e {
+            SweepError::Read { path, message } => SweepError::Invalid(format!(
+                "base = {:?}: cannot read {path}: {message}",
+                file.base
+            )),
+            e => e,
+        };
         if access == BaseAccess::Confined {
-            confined(folder, &base_path, &file.base)?;
+            confined(folder, &base_path, &file.base).map_err(named)?;
         }
         let base_file = base_path.display().to_string();
-        let base =
-            input::parse_document(&read(&base_path)?).map_err(|source| SweepError::Base {
+        let base = input::parse_document(&read(&base_path).map_err(named)?).map_err(|source| {
+            SweepError::Base {
                 path: base_file.clone(),
                 source,
-            })?;
+            }
+        })?;
         let overrides = LifeOverrides {
             cycles: file.cycles,
             step_cycles: file.step_cycles,
@@ -538,8 +555,17 @@ pub fn toml_to_json(value: &toml::Value) -> serde_json::Value {
 /// that starts like a spreadsheet formula (= + - @, a tab or a carriage return) is prefixed
 /// with an apostrophe, so a spreadsheet shows it instead of evaluating it.
 fn csv_field(text: &str) -> String {
-    let formula =
-        text.starts_with(['=', '+', '-', '@', '\t', '\r']) && text.parse::<f64>().is_err();
+    csv_cell(text, text.parse::<f64>().is_ok())
+}
+
+/// A CSV field of a text value (a TOML string: "+1" is a name, not a number), prefixed with an
+/// apostrophe whenever it starts like a formula.
+fn csv_text(text: &str) -> String {
+    csv_cell(text, false)
+}
+
+fn csv_cell(text: &str, number: bool) -> String {
+    let formula = text.starts_with(['=', '+', '-', '@', '\t', '\r']) && !number;
     let text = if formula {
         format!("'{text}")
     } else {
@@ -829,10 +855,10 @@ pub fn write_csv(path: &Path, parameters: &[String], rows: &[&Row]) -> Result<()
         for p in parameters {
             text.push(',');
             let value = row.parameters.get(p).map_or(String::new(), |v| match v {
-                serde_json::Value::String(s) => s.clone(),
-                other => other.to_string(),
+                serde_json::Value::String(s) => csv_text(s),
+                other => csv_field(&other.to_string()),
             });
-            text.push_str(&csv_field(&value));
+            text.push_str(&value);
         }
         text.push_str(if row.ok { ",1" } else { ",0" });
         for field in row.result_fields() {
@@ -868,7 +894,7 @@ pub fn variant_dir(dir: &Path, variant: &Variant) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
-    use super::csv_field;
+    use super::{csv_field, csv_text};
 
     #[test]
     fn a_cell_that_reads_as_a_formula_is_shown_as_text() {
@@ -880,5 +906,9 @@ mod tests {
         assert_eq!(csv_field("-5"), "-5");
         assert_eq!(csv_field("+1.5e-3"), "+1.5e-3");
         assert_eq!(csv_field("a,b"), "\"a,b\"");
+        // A text value is text even when it reads as a number (a material named "+1").
+        assert_eq!(csv_text("+1"), "'+1");
+        assert_eq!(csv_text("-5"), "'-5");
+        assert_eq!(csv_text("bronze"), "bronze");
     }
 }
