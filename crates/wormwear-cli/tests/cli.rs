@@ -411,8 +411,15 @@ fn run_writes_every_stage_and_the_life() {
 #[test]
 fn wear_input_errors_exit_2_and_name_the_problem() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[&str], &str); 6] = [
+    let cases: [(&str, &[&str], &str); 7] = [
         ("gear-k-2x25.toml", &[], "[wear]"),
+        // A life of less than one wheel revolution is degenerate (the probe of issue 38 ran
+        // one of 1e-300 cycles to exit 0).
+        (
+            "gear-1x40-design.toml",
+            &["--cycles", "1e-300"],
+            "--cycles = 1e-300: must be a number of cycles in [1, 1e12]",
+        ),
         (
             "gear-1x40-design.toml",
             &["--step-wear-um", "1e-9"],
@@ -1300,6 +1307,33 @@ fn the_library_runner_and_writers_give_the_cli_files_byte_for_byte() {
             );
         }
     }
+}
+
+/// A sweep whose every variant fails says why in its message (the first variant's error), not
+/// only in sweep.csv (issue 38's probe: "every variant failed" named nothing).
+#[test]
+fn a_sweep_whose_variants_all_fail_names_the_first_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        example("gear-1x40-design.toml"),
+        dir.path().join("gear.toml"),
+    )
+    .unwrap();
+    let file = dir.path().join("sweep.toml");
+    std::fs::write(
+        &file,
+        "base = \"gear.toml\"\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque\" = [1.0]\n",
+    )
+    .unwrap();
+    let out = into("sweep", &file, &dir.path().join("out"), &["-q"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("every variant failed; the first, v1:") && err.contains("worm_torque"),
+        "{err}"
+    );
 }
 
 /// `wormwear sweep` of a 3 x 2 grid of torque x roughness on the design example: six rows in

@@ -13,6 +13,7 @@ use std::fmt;
 use std::path::Path;
 
 pub use schema::GearFile;
+pub use validate::Number;
 
 /// Profile type of a worm or hob thread (ISO 10828 designations; MODEL §2.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

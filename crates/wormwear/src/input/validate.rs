@@ -17,7 +17,7 @@ struct Checker {
 
 /// A number as a message shows it: plainly between 1e-4 and 1e7, in scientific notation
 /// outside (1e-300 is not 300 digits).
-struct Number(f64);
+pub struct Number(pub f64);
 
 impl fmt::Display for Number {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -1556,7 +1556,7 @@ fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
 }
 
 fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
-    let life = ck.positive("wear.life_cycles", w.life_cycles, 1e12, "cycles");
+    let life = ck.range("wear.life_cycles", w.life_cycles, 1.0, 1e12, "cycles");
     let step = step_control(ck, w);
     let endurance = endurance(ck, w.endurance.as_ref());
     let mut phases = phases(ck, &w.phases)?;
@@ -1665,7 +1665,7 @@ fn step_control(ck: &mut Checker, w: &WearSpec) -> Option<StepControl> {
             None
         }
         (None, Some(c)) => ck
-            .positive("wear.step_cycles", c, 1e12, "cycles")
+            .range("wear.step_cycles", c, 1.0, 1e12, "cycles")
             .map(StepControl::Cycles),
         (Some(d), None) => ck
             .range("wear.step_wear_um", d, MIN_STEP_WEAR_UM, 1000.0, "um")
