@@ -35,7 +35,7 @@ pub fn import(file: &Path, output: &Path, stage: Option<u64>, quiet: bool) -> Re
             }
             Ok(())
         }
-        Err(e) => Err(Failure::Input(anyhow::Error::new(e).context(format!(
+        Err(e) => Err(Failure::Input(anyhow::Error::new(imported.with_sources(e)).context(format!(
             "{stage_line} was written to {}, but it does not validate; edit it and run `wormwear check`",
             output.display()
         )))),

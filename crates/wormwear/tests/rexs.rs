@@ -382,6 +382,56 @@ fn bad_files_give_errors_naming_the_component_the_attribute_and_the_need() {
         )
     });
     assert!(e.contains("the load is needed"), "{e}");
+    // A negative quantity is refused naming itself (the probe of issue 38: it read as not
+    // given, and the message blamed the 40 degC viscosity).
+    let e = error_of(|t| {
+        t.replace(
+            "<attribute id=\"viscosity_at_100_degree_celsius\" unit=\"mm^2 / s\">",
+            "<attribute id=\"viscosity_at_100_degree_celsius\" unit=\"mm^2 / s\">-",
+        )
+    });
+    assert!(
+        e.contains("viscosity_at_100_degree_celsius") && e.contains("must be a positive number"),
+        "{e}"
+    );
+    // A missing 100 degC viscosity is named as the one missing.
+    let e = error_of(|t| {
+        t.replace(
+            "<attribute id=\"viscosity_at_100_degree_celsius\" unit=\"mm^2 / s\">37.0</attribute>",
+            "",
+        )
+    });
+    assert!(
+        e.contains("attribute viscosity_at_100_degree_celsius: missing"),
+        "{e}"
+    );
+}
+
+/// A stage that imports but does not validate: each field's problem names the REXS attribute
+/// it came from, and a mistyped 1e300 is not written with 300 digits (issue 38's probe).
+#[test]
+fn validation_errors_of_an_import_name_the_rexs_attribute() {
+    let text = std::fs::read_to_string(zi_example()).unwrap().replace(
+        "<attribute id=\"center_distance\" unit=\"mm\">100.0",
+        "<attribute id=\"center_distance\" unit=\"mm\">1e300",
+    );
+    let model = rexs::parse_bytes(text.as_bytes(), "big.rexs").unwrap();
+    let imp = import::import(&model, None, "big.rexs").unwrap();
+    let err = imp
+        .with_sources(input::load_from_str(&imp.text).unwrap_err())
+        .to_string();
+    assert!(
+        err.contains("operating.centre_distance_mm = 1e300")
+            && err.contains("(from REXS: worm_stage.center_distance)"),
+        "{err}"
+    );
+    for line in imp
+        .text
+        .lines()
+        .chain(imp.warnings.iter().map(|w| w.as_str()))
+    {
+        assert!(!line.contains("0000000000000000"), "a long number: {line}");
+    }
 }
 
 /// Two gears are the same when their validated data agree to round-off (relative 1e-11;

@@ -70,6 +70,77 @@ pub struct Imported {
     pub warnings: Vec<String>,
 }
 
+/// A number in a comment or a warning: four decimals between 1e-4 and 1e7, scientific
+/// notation outside (a mistyped 1e300 is not shown with 300 digits).
+struct Shown(f64);
+
+impl std::fmt::Display for Shown {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        match a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
+            true => write!(f, "{:.4}", self.0),
+            false => write!(f, "{:e}", self.0),
+        }
+    }
+}
+
+impl Imported {
+    /// Where the gear file's field `field` (dotted, e.g. `cutting.centre_distance_mm`) came
+    /// from: the comment the import wrote beside it (the REXS attribute, or "default ...").
+    pub fn source_of(&self, field: &str) -> Option<&str> {
+        let field = field.split('[').next().unwrap_or(field); // an element: its list's source
+        let mut table = String::new();
+        for line in self.text.lines() {
+            let line = line.trim();
+            if let Some(name) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
+                table = name.trim().to_string();
+            } else if let Some((key, rest)) = line.split_once('=') {
+                let dotted = match table.is_empty() {
+                    true => key.trim().to_string(),
+                    false => format!("{table}.{}", key.trim()),
+                };
+                if dotted == field {
+                    return rest.split_once("    # ").map(|(_, comment)| comment.trim());
+                }
+            }
+        }
+        None
+    }
+
+    /// A validation error of the written gear file with each field's REXS source added to
+    /// its problem, so that the message names the attribute to correct in the REXS file.
+    pub fn with_sources(&self, error: crate::input::InputError) -> crate::input::InputError {
+        match error {
+            crate::input::InputError::Invalid(fields) => crate::input::InputError::Invalid(
+                fields
+                    .into_iter()
+                    .map(|mut e| {
+                        let mut sources = Vec::new();
+                        if let Some(source) = self.source_of(&e.field) {
+                            sources.push(format!("from REXS: {source}"));
+                        }
+                        // The other fields a relation names (`must be <= a.b - c.d`).
+                        let words = e
+                            .problem
+                            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.'));
+                        for word in words.filter(|w| w.contains('.') && *w != e.field) {
+                            let word = word.trim_end_matches('.');
+                            if let Some(source) = self.source_of(word) {
+                                sources.push(format!("{word} from REXS: {source}"));
+                            }
+                        }
+                        if !sources.is_empty() {
+                            e.problem = format!("{} ({})", e.problem, sources.join("; "));
+                        }
+                        e
+                    })
+                    .collect(),
+            ),
+            other => other,
+        }
+    }
+}
+
 /// Makes the gear file of the worm stage `stage` (a component id; None: the model's only worm
 /// stage). `source` names the REXS file in the header comment.
 pub fn import(model: &Model, stage: Option<u64>, source: &str) -> Result<Imported, RexsError> {
@@ -389,8 +460,23 @@ impl<'m> Reader<'m> {
     }
 
     /// A number > 0, or None when absent or 0 (REXS writers put 0 for "not set").
+    /// A quantity that must be positive: 0 reads as not given (exporters write 0 for an
+    /// empty field); a negative or non-finite value is an error naming the attribute (it was
+    /// read as not given, so a default or another attribute's message stood in for it).
     fn positive(&self, c: &Component, id: &str, q: Quantity) -> Result<Option<f64>, RexsError> {
-        Ok(self.number(c, id, q)?.filter(|v| *v > 0.0))
+        match self.number(c, id, q)? {
+            Some(v) if v > 0.0 && v.is_finite() => Ok(Some(v)),
+            Some(0.0) => Ok(None),
+            Some(v) => Err(RexsError::attribute(
+                c,
+                id,
+                format!(
+                    "{}: must be a positive number (0 reads as not given)",
+                    crate::input::Number(v)
+                ),
+            )),
+            None => Ok(None),
+        }
     }
 
     fn integer(&self, c: &Component, id: &str) -> Result<Option<i64>, RexsError> {
@@ -579,15 +665,16 @@ fn worm_thread(reader: &Reader, parts: &Parts, out: &mut GearText) -> Result<Wor
         &sources.thickness,
     );
     out.note(&format!(
-        "lead angle atan(z1 m_x / d_m1) = {:.4} deg; tip relief: wormwear's default",
-        worm.lead_angle_deg
+        "lead angle atan(z1 m_x / d_m1) = {} deg; tip relief: wormwear's default",
+        Shown(worm.lead_angle_deg)
     ));
     if let Some(g) = sources.lead_angle {
         if (g.abs() - worm.lead_angle_deg).abs() > 0.01 {
             out.warn(format!(
-                "worm_gear.lead_angle_worm_gear = {g} deg does not match atan(z1 m_x / d_m1) = \
-                 {:.4} deg; the module and the diameter are used",
-                worm.lead_angle_deg
+                "worm_gear.lead_angle_worm_gear = {} deg does not match atan(z1 m_x / d_m1) = \
+                 {} deg; the module and the diameter are used",
+                Shown(g),
+                Shown(worm.lead_angle_deg)
             ));
         }
     }
@@ -1043,7 +1130,9 @@ fn wheel_blank(
         }
     }
     out.note(&format!(
-        "d_2 = z2 m_x = {d2:.4} mm; profile shift x2 = (a - d_m1/2 - d_2/2) / m_x = {x2:.4}"
+        "d_2 = z2 m_x = {} mm; profile shift x2 = (a - d_m1/2 - d_2/2) / m_x = {}",
+        Shown(d2),
+        Shown(x2)
     ));
     wheel_checks(reader, parts, worm, a, d2, tip.0, out)?;
     Ok(Wheel {
@@ -1120,21 +1209,24 @@ fn wheel_checks(
     if let Some(d) = reader.positive(c, "reference_diameter_worm_gear", Quantity::Length)? {
         if (d - d2).abs() > 1e-3 {
             out.warn(format!(
-                "worm_wheel.reference_diameter_worm_gear = {d} mm differs from z2 m_x = {d2:.4} mm"
+                "worm_wheel.reference_diameter_worm_gear = {} mm differs from z2 m_x = {} mm",
+                Shown(d),
+                Shown(d2)
             ));
         }
     }
     if let Some(rk) = reader.positive(c, "throat_radius_worm_wheel", Quantity::Length)? {
         if (rk - (a - tip)).abs() > 0.01 {
             out.warn(format!(
-                "worm_wheel.throat_radius_worm_wheel = {rk} mm: wormwear's blank has the gorge radius a - r_a2 = {:.4} mm",
-                a - tip
+                "worm_wheel.throat_radius_worm_wheel = {} mm: wormwear's blank has the gorge radius a - r_a2 = {} mm",
+                Shown(rk),
+                Shown(a - tip)
             ));
         }
     } else {
         out.note(&format!(
-            "gorge radius of the blank: a - r_a2 = {:.4} mm (REXS throat radius absent or 0)",
-            a - tip
+            "gorge radius of the blank: a - r_a2 = {} mm (REXS throat radius absent or 0)",
+            Shown(a - tip)
         ));
     }
     let wheel_form = c
@@ -1203,8 +1295,11 @@ fn operating(
     out.field_text("worm_rotation", rotation.0, Some(&rotation.1));
     let ratio = wheel.teeth as f64 / worm.starts as f64;
     out.note(&format!(
-        "ratio z2/z1 = {ratio:.4}; lead angle {:.4} deg; wheel reference radius {:.4} mm; face width {} mm",
-        worm.lead_angle_deg, wheel.reference_radius, wheel.face_width
+        "ratio z2/z1 = {}; lead angle {} deg; wheel reference radius {} mm; face width {} mm",
+        Shown(ratio),
+        Shown(worm.lead_angle_deg),
+        Shown(wheel.reference_radius),
+        Shown(wheel.face_width)
     ));
     Ok(())
 }
@@ -1427,7 +1522,7 @@ fn wheel_material(
         out.warn(format!(
             "the wheel material \"{name}\" (E = {} GPa) is not a bronze: exports often carry a \
              placeholder here; the wear model and its defaults are for bronze wheels",
-            e_mpa * 1e-3
+            crate::input::Number(e_mpa * 1e-3)
         ));
     }
     Ok(())
@@ -1541,7 +1636,8 @@ fn viscosity(
         }
         (None, Some(w)) => {
             let note = format!(
-                "nu({t} degC) by Ubbelohde-Walther (ASTM D341) through nu40, nu100 {density_note}"
+                "nu({t} degC) by Ubbelohde-Walther (ASTM D341) through lubricant.\
+                 viscosity_at_40_degree_celsius and viscosity_at_100_degree_celsius {density_note}"
             );
             out.field("viscosity_pa_s", w(t) * 1e-6 * density(t), &note);
             w(t) * 1e-6 * density(t)
@@ -1549,11 +1645,11 @@ fn viscosity(
         (None, None) => {
             let need = "missing: the lubricant's viscosities at 40 and 100 degC (or \
                         worm_stage.operating_viscosity) are needed";
-            return Err(RexsError::attribute(
-                l,
-                "viscosity_at_40_degree_celsius",
-                need,
-            ));
+            let missing = match nu40 {
+                None => "viscosity_at_40_degree_celsius",
+                Some(_) => "viscosity_at_100_degree_celsius",
+            };
+            return Err(RexsError::attribute(l, missing, need));
         }
     };
     match walther {
@@ -1945,7 +2041,7 @@ fn write_bearings(
     out.line(
         key,
         format!("[{}, {}]", float(points[0]), float(points[1])),
-        Some(&format!("concept bearings, {what}")),
+        Some(&format!("concept bearings' support_vector, {what}")),
     );
 }
 
