@@ -49,7 +49,8 @@ pub struct SectorMeshSettings {
 /// as rigid; its motion on the shaft is added by [`super::wheel_shaft`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WebSettings {
-    /// Thickness along the wheel axis, m (rounded to the layers of the mesh).
+    /// Thickness along the wheel axis, m (rounded to the layers of the mesh; at least the
+    /// layer or two nearest the median plane, however thin).
     pub thickness: f64,
     /// Hub radius, m.
     pub hub_radius: f64,
@@ -120,12 +121,22 @@ pub fn sector_mesh(
     let mut inner = Vec::new();
     let mut sides = Vec::new();
     // Layers in the web: those whose middle lies within half its thickness of the median plane
-    // (the web's faces snap to layer boundaries).
+    // (the web's faces snap to layer boundaries), and at least the layer(s) nearest that plane:
+    // a web thinner than a layer is modelled one layer thick (it snapped to none, and the
+    // rim, joined to the hub by nothing, made the stiffness matrix singular).
     let web = settings
         .web
         .filter(|w| w.hub_radius < r_in && w.thickness > 0.0);
+    let middle = |j0: usize, j1: usize| (0.5 * (l.z[j0] + l.z[j1])).abs();
+    let nearest = layers
+        .windows(2)
+        .map(|p| middle(p[0], p[1]))
+        .fold(f64::INFINITY, f64::min);
     let in_web = |j0: usize, j1: usize| {
-        web.is_some_and(|w| (0.5 * (l.z[j0] + l.z[j1])).abs() < 0.5 * w.thickness)
+        web.is_some_and(|w| {
+            let m = middle(j0, j1);
+            m < 0.5 * w.thickness || m <= nearest * (1.0 + 1e-9)
+        })
     };
     let mut left_flank = vec![Vec::new(); 3];
     let mut right_flank = vec![Vec::new(); 3];
