@@ -262,9 +262,14 @@ fn wear_and_rating_sections_are_checked() {
         &error_of(&text),
         &["wear.step_cycles", "either wear.step_wear_um", "not both"],
     );
-    // A negative life.
+    // A negative life, and one of less than a wheel revolution (1e-300 ran to exit 0).
     let text = set(&design(), "wear", "life_cycles", "life_cycles = -5");
-    assert_mentions(&error_of(&text), &["wear.life_cycles = -5", "> 0"]);
+    assert_mentions(&error_of(&text), &["wear.life_cycles = -5", "[1, 1e12]"]);
+    let text = set(&design(), "wear", "life_cycles", "life_cycles = 1e-300");
+    assert_mentions(
+        &error_of(&text),
+        &["wear.life_cycles = 1e-300", "[1, 1e12]"],
+    );
     // Plans that would never end or fill the disk: a vanishing adaptive step or sub-step, a
     // life of 1e12 states, 100 000 phases, a million map states (the previous build accepted
     // each and ran for hours or wrote ~6 files per state).
@@ -806,5 +811,54 @@ fn geometry_failures_name_the_inputs_to_change() {
             Err(e) => e.to_string(),
         };
         assert_mentions(&message, parts);
+    }
+}
+
+/// A problem that a change of one field causes in another names the field changed (issue 38's
+/// probe: 10 starts were reported as a thickness above the pitch, a 4.5 mm face width as section
+/// offsets out of range, without naming starts or the face width).
+#[test]
+fn relations_name_the_fields_they_depend_on() {
+    let cases = [
+        ("worm", "starts", "starts = 10", "worm.starts"),
+        ("worm", "starts", "starts = 2", "worm.starts"),
+        ("hob", "lead_mm", "lead_mm = 16.551", "worm.lead_mm"),
+        (
+            "worm",
+            "axial_thickness_mm",
+            "axial_thickness_mm = 0.7775",
+            "worm.axial_thickness_mm",
+        ),
+        (
+            "cutting",
+            "centre_distance_mm",
+            "centre_distance_mm = 1250.0",
+            "cutting.centre_distance_mm",
+        ),
+        ("wheel", "teeth", "teeth = 400", "wheel.teeth"),
+        (
+            "wheel",
+            "face_width_mm",
+            "face_width_mm = 4.5",
+            "wheel.face_width_mm",
+        ),
+        (
+            "wheel",
+            "outer_radius_mm",
+            "outer_radius_mm = 1100.0",
+            "wheel.outer_radius_mm",
+        ),
+    ];
+    for (table, key, line, field) in cases {
+        let message = error_of(&set(&design(), table, key, line));
+        // Named in a problem of another field (its own line is not the point).
+        let others: Vec<&str> = message
+            .lines()
+            .filter(|l| !l.trim_start().starts_with(&format!("- {table}.{key}")))
+            .collect();
+        assert!(
+            others.iter().any(|l| l.contains(field)),
+            "{line}: no other problem names {field}:\n{message}"
+        );
     }
 }

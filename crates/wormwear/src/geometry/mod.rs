@@ -75,14 +75,16 @@ impl Geometry {
             centre_distance: gear.nominal_centre_distance,
         };
         let hobbing = Hobbing::new(&hob, gear.cutting, gear.wheel.teeth);
-        let wheel_hint = |e: GeometryError| match e {
+        let wheel_hint = |e: GeometryError| {
+            match e {
             GeometryError::Wheel(m) => GeometryError::Wheel(format!(
                 "{m}; the inputs that shape it: [hob] starts, lead_mm, tip_radius_mm and \
-                 pressure angle, [cutting] centre_distance_mm, [wheel] teeth, outer_radius_mm \
-                 and face_width_mm (the blank must lie inside the region the hob envelops: a \
+                 pressure angle, [cutting] centre_distance_mm, offset_mm and inclination_deg, \
+                 [wheel] teeth, outer_radius_mm and face_width_mm (the blank must lie inside the region the hob envelops: a \
                  smaller outer radius or face width, or a hob matching the wheel's teeth)"
             )),
             other => other,
+        }
         };
         let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)
             .map_err(wheel_hint)?;

@@ -592,7 +592,7 @@ fn section_offsets(ck: &mut Checker, a: &AnalysisSpec, face_width: Option<f64>) 
                     z,
                     -0.5 * b / MM,
                     0.5 * b / MM,
-                    "mm (inside the face width)",
+                    "mm (inside wheel.face_width_mm)",
                 )
                 .map(|z| z * MM)
             })
@@ -613,8 +613,8 @@ fn hob_matches_worm(ck: &mut Checker, wm: &ThreadDef, hb: &ThreadDef) {
                 hb.lead() / MM
             ),
             format!(
-                "the hob must have the worm's axial pitch: axial module {:.6} mm \
-                 (relative difference allowed 1e-6)",
+                "the hob must have the worm's axial pitch (worm.lead_mm / worm.starts, or worm.\
+                 axial_module_mm): axial module {:.6} mm (relative difference allowed 1e-6)",
                 wm.axial_module() / MM
             ),
         );
@@ -714,8 +714,9 @@ impl Mesh<'_> {
                 "hob.tip_radius_mm",
                 hb.tip_radius / MM,
                 format!(
-                    "must be >= worm.tip_radius_mm + (cutting - operating centre distance) \
-                     = {:.4} mm (the worm tip would hit the wheel root)",
+                    "must be >= worm.tip_radius_mm + cutting.centre_distance_mm - \
+                     operating.centre_distance_mm = {:.4} mm (the worm tip would hit the wheel \
+                     root)",
                     (wm.tip_radius + a0 - an) / MM
                 ),
             );
@@ -738,8 +739,8 @@ impl Mesh<'_> {
                 an / MM,
                 format!(
                     "inconsistent with worm.reference_radius_mm + wheel reference radius \
-                     (z2 m_x / 2 = {:.4} mm): the implied profile shift x2 = {:.3} is outside \
-                     [-1.5, 1.5]",
+                     (wheel.teeth x axial module / 2 = {:.4} mm): the implied profile shift x2 = \
+                     {:.3} is outside [-1.5, 1.5]",
                     r2 / MM,
                     x2
                 ),
@@ -802,7 +803,8 @@ impl Mesh<'_> {
                 b / MM,
                 format!(
                     "larger than the worm can reach: must be < {:.3} mm (twice the half-width \
-                     at which the blank top leaves the worm tip cylinder)",
+                     at which the blank top, wheel.outer_radius_mm, leaves the worm tip \
+                     cylinder, worm.tip_radius_mm)",
                     2.0 * reach / MM
                 ),
             );
@@ -1178,7 +1180,11 @@ fn thread_space(
         ck.fail(
             &field("axial_thickness_mm"),
             s / MM,
-            format!("must be less than the axial pitch {:.4} mm", p_x / MM),
+            format!(
+                "must be less than the axial pitch {:.4} mm ({name}.lead_mm / {name}.starts, or \
+                 pi {name}.axial_module_mm)",
+                p_x / MM
+            ),
         );
         return None;
     }
@@ -1189,8 +1195,9 @@ fn thread_space(
             &field("tip_radius_mm"),
             ra / MM,
             format!(
-                "the thread is pointed below its tip: with this thickness and pressure angle the \
-                 tip radius must be < {:.4} mm",
+                "the thread is pointed below its tip: with this thickness and pressure angle \
+                 ({name}.axial_thickness_mm, {name}.pressure_angle_deg) the tip radius must be < \
+                 {:.4} mm",
                 (r1 + 0.5 * s / alpha_x.tan()) / MM
             ),
         );
@@ -1201,7 +1208,9 @@ fn thread_space(
             &field("root_radius_mm"),
             rf / MM,
             format!(
-                "the thread space closes above the root: the root radius must be > {:.4} mm",
+                "the thread space closes above the root: with this pitch, thickness and \
+                 pressure angle ({name}.lead_mm / {name}.starts, {name}.axial_thickness_mm, \
+                 {name}.pressure_angle_deg) the root radius must be > {:.4} mm",
                 (r1 - 0.5 * (p_x - s) / alpha_x.tan()) / MM
             ),
         );
