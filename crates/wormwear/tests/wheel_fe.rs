@@ -504,3 +504,39 @@ fn a_web_thinner_than_a_layer_is_the_layer_nearest_the_median_plane() {
     eprintln!("tooth tip compliance: web 18 mm {c18:.4e}, web of one layer {c1:.4e} m/N");
     assert!(c1.is_finite() && c1 > c18, "{c1:e} vs {c18:e}");
 }
+
+/// A wheel shaft that the load alone twists by more than a tooth pitch (2 mm radius under the
+/// design case's 2400 N m: tens of radians) is refused at once, naming the shaft (issue 38's
+/// probe: the solver's fallback ran for more than ten minutes); the 20 mm shaft is not.
+#[test]
+fn a_shaft_twisted_beyond_a_pitch_is_refused_naming_it() {
+    use wormwear::bending::wheel_model::WheelBending;
+    use wormwear::bending::wheel_shaft::WheelShaft;
+    use wormwear::ltca::{self, LtcaError, LtcaSettings};
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 2;
+    let geo = Geometry::build(&g).unwrap();
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let shaft = |radius: f64| WheelShaft {
+        radius,
+        hub_half_width: 0.5 * g.wheel.face_width,
+        bearings: [-0.06, 0.06],
+        youngs_modulus: 210e9,
+        poisson_ratio: 0.3,
+    };
+    let s = LtcaSettings::from_gear(&g);
+    let thin = WheelBending::build(&g, &geo, &settings(2), Some(&shaft(0.002)), 3, 3).unwrap();
+    let start = std::time::Instant::now();
+    match ltca::analyse_with(&g, &geo, &tca, &s, Some(&thin)) {
+        Err(LtcaError::ShaftTorsion(m)) => {
+            assert!(
+                m.contains("wheel.shaft_radius_mm") && m.contains("tooth pitch"),
+                "{m}"
+            )
+        }
+        other => panic!("not refused: {:?}", other.map(|l| l.max_pressure)),
+    }
+    assert!(start.elapsed().as_secs() < 5);
+    let stout = WheelBending::build(&g, &geo, &settings(2), Some(&shaft(0.02)), 3, 3).unwrap();
+    assert!(ltca::analyse_with(&g, &geo, &tca, &s, Some(&stout)).is_ok());
+}

@@ -304,6 +304,30 @@ pub enum LtcaError {
     NoContact(usize),
     #[error("position {0}: contact forces do not produce a worm torque in the driving sense")]
     TorqueSign(usize),
+    /// The wheel shaft twists by more than a tooth pitch under the load (see
+    /// [`shaft_torsion_problem`]).
+    #[error("{0}")]
+    ShaftTorsion(String),
+}
+
+/// A wheel shaft so compliant in torsion that the load alone turns the wheel by more than
+/// one tooth pitch: a mesh whose teeth would pass one another under a static load is not a
+/// gear the loaded analysis describes (and its solver, with the rigid rotation dwarfing the
+/// contact compliances, can take hours). `compliance`: the shaft's torsion at the wheel,
+/// rad per N m; `wheel_torque`, N m. The message names the inputs that set it.
+pub fn shaft_torsion_problem(compliance: f64, wheel_torque: f64, teeth: u32) -> Option<String> {
+    let pitch = 2.0 * std::f64::consts::PI / teeth as f64;
+    let rotation = compliance * wheel_torque.abs();
+    (rotation > pitch).then(|| {
+        format!(
+            "the wheel shaft twists by {} rad under the wheel torque {} N m, more than a tooth \
+             pitch ({} rad): a thicker shaft (wheel.shaft_radius_mm), closer bearings \
+             (wheel.bearing_positions_mm) or a lower torque (conditions) is needed",
+            crate::input::Number(rotation),
+            crate::input::Number(wheel_torque.abs()),
+            crate::input::Number(pitch)
+        )
+    })
 }
 
 /// Runs the loaded analysis with the gear's settings, without bending.
@@ -431,6 +455,15 @@ pub fn analyse_changed(
         Torque::Worm(t) => (Some(t), t * gear.ratio()),
         Torque::Wheel(t) => (None, t),
     };
+    if let Some(problem) = bending.and_then(|b| {
+        shaft_torsion_problem(
+            b.rigid_rotation_compliance(),
+            wheel_torque_guess,
+            gear.wheel.teeth,
+        )
+    }) {
+        return Err(LtcaError::ShaftTorsion(problem));
+    }
     let band0 = initial_band(gear, tca, wf, settings, &pair, wheel_torque_guess);
     let rows_per_row = change
         .plastic_set
