@@ -654,6 +654,7 @@ fn an_implausible_load_is_refused_and_an_overload_warned() {
     assert!(
         err.contains("conditions.worm_torque_nm = 10000")
             && err.contains("times the wheel's pitting limit")
+            && err.contains("materials.wheel.pitting_limit_mpa = 520")
             && err.contains("give at most about"),
         "{err}"
     );

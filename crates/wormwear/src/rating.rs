@@ -173,9 +173,10 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
     let allowed = torque * (OVERLOAD_REFUSAL / ratio).powi(2);
     Some(format!(
         "{field} = {torque}: the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL §9) \
-         would be {:.0} N/mm^2, {ratio:.1} times the wheel's pitting limit ({limit:.0} N/mm^2); \
-         a loaded analysis holds to {OVERLOAD_REFUSAL} times (the elastic contact, bending and \
-         transmission error are not the gear's beyond): give at most about {allowed:.3e} N m",
+         would be {:.0} N/mm^2, {ratio:.1} times the wheel's pitting limit \
+         (materials.wheel.pitting_limit_mpa = {limit:.0} N/mm^2); a loaded analysis holds to \
+         {OVERLOAD_REFUSAL} times (the elastic contact, bending and transmission error are not \
+         the gear's beyond): give at most about {allowed:.3e} N m, or check the pitting limit",
         r.sigma_hm_mpa
     ))
 }
