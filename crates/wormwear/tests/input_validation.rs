@@ -849,6 +849,20 @@ fn relations_name_the_fields_they_depend_on() {
             "wheel.outer_radius_mm",
         ),
     ];
+    // A relief length's bound names what sets it (a face width of 1e-300 mm gave "allowed
+    // [0.01, 2.5e-301] mm" and nothing else).
+    let text = set(
+        &design(),
+        "wheel",
+        "face_width_mm",
+        "face_width_mm = 2.0\nedge_relief_length_mm = 1.0",
+    );
+    let message = error_of(&text);
+    let relief = message
+        .lines()
+        .find(|l| l.contains("wheel.edge_relief_length_mm"))
+        .unwrap_or_else(|| panic!("{message}"));
+    assert!(relief.contains("a quarter of wheel.face_width_mm"), "{relief}");
     for (table, key, line, field) in cases {
         let message = error_of(&set(&design(), table, key, line));
         // Named in a problem of another field (its own line is not the point).

@@ -369,7 +369,7 @@ fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
             w.edge_relief_um,
             "wheel.edge_relief_length_mm",
             w.edge_relief_length_mm,
-            0.25 * b,
+            (0.25 * b, "a quarter of wheel.face_width_mm"),
         )
     });
     if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
@@ -1086,7 +1086,10 @@ fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<ThreadDef> {
         t.tip_relief_um,
         &field("tip_relief_length_mm"),
         t.tip_relief_length_mm,
-        0.5 * (ra - rf),
+        (
+            0.5 * (ra - rf),
+            &format!("half the thread depth, {name}.tip_radius_mm - {name}.root_radius_mm"),
+        ),
     );
     match relief {
         Some(r) => def.tip_relief = r,
@@ -1919,14 +1922,17 @@ fn edge_relief(
     amount: Option<f64>,
     length_field: &str,
     length: Option<f64>,
-    max_length: f64,
+    (max_length, max_is): (f64, &str),
 ) -> Option<EdgeRelief> {
     let a = match amount {
         Some(v) => ck.range(amount_field, v, 0.0, 500.0, "um")? * 1e-6,
         None => EdgeRelief::SHARP.amount,
     };
     let l = match length {
-        Some(v) => ck.range(length_field, v, 0.01, max_length / MM, "mm")? * MM,
+        Some(v) => {
+            let unit = format!("mm (the longest: {max_is})");
+            ck.range(length_field, v, 0.01, max_length / MM, &unit)? * MM
+        }
         None => EdgeRelief::SHARP.length.min(max_length),
     };
     Some(EdgeRelief {
