@@ -69,10 +69,11 @@ impl CellLoad {
 
     /// Damage after `cycles` cycles from `d0`: the exact solution of dD/dN = r - D w / h.
     pub fn damage_after(&self, d0: f64, cycles: f64) -> f64 {
-        if self.wear_rate <= 0.0 {
+        let steady = self.steady_damage();
+        // No wear, or so little that the steady damage overflows: the damage only grows.
+        if self.wear_rate <= 0.0 || !steady.is_finite() {
             return d0 + self.damage_rate * cycles;
         }
-        let steady = self.steady_damage();
         // D* + (D0 - D*) e^{-x}, written with expm1 so that a short step keeps its digits.
         let x = cycles * self.wear_rate / self.layer;
         d0 - (d0 - steady) * (-(-x).exp_m1())
@@ -94,14 +95,73 @@ impl CellLoad {
         if steady <= 1.0 {
             return None;
         }
-        // e^{-N w/h} = (D* - 1) / (D* - D0)
-        Some(-(self.layer / self.wear_rate) * ((steady - 1.0) / (steady - d0)).ln())
+        // e^{-N w/h} = (D* - 1) / (D* - D0) = 1 - eps. Where eps is small (a steady damage far
+        // above 1: little wear) that ratio rounds towards 1 and its logarithm to 0 (a wear
+        // coefficient of 1e-300 gave 0 cycles to pit, and a forecast stepped 0 cycles for
+        // ever): there N = (1 - D0) / r  D* / (D* - D0)  (-ln(1 - eps) / eps), whose last
+        // factor tends to 1 (the life without wear).
+        let eps = (1.0 - d0) / (steady - d0);
+        if eps >= 1e-3 {
+            return Some(-(self.layer / self.wear_rate) * ((steady - 1.0) / (steady - d0)).ln());
+        }
+        let growth = match steady.is_finite() {
+            true => steady / (steady - d0),
+            false => 1.0,
+        };
+        let log_ratio = match eps > 0.0 {
+            true => -(-eps).ln_1p() / eps,
+            false => 1.0,
+        };
+        Some((1.0 - d0) / self.damage_rate * growth * log_ratio)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_vanishing_wear_rate_gives_the_life_without_wear() {
+        // Wear rates down to the smallest subnormal: the cycles to pit tend to (1 - D0) / r,
+        // never 0 (the rounded logarithm gave 0, and a forecast stalled at 0 cycles), and the
+        // damage after them reaches 1; a moderate rate keeps the exact solution.
+        let r = 1.0 / 2e6;
+        for wear_rate in [1e-12, 1e-20, 1e-200, 1e-300, 5e-324] {
+            let c = CellLoad {
+                damage_rate: r,
+                wear_rate,
+                layer: 2e-4,
+            };
+            for d0 in [0.0, 0.5, 0.999] {
+                let n = c.cycles_to_pit(d0).unwrap();
+                let without = (1.0 - d0) / r;
+                // (1e-12 m per cycle over a 0.2 mm layer adds 0.5-1 % to the life: physics.)
+                let close = if wear_rate < 1e-15 { 1e-6 } else { 2e-2 };
+                assert!(
+                    n >= without && n / without - 1.0 < close,
+                    "{wear_rate} {d0}: {n}"
+                );
+                assert!(
+                    (c.damage_after(d0, n) - 1.0).abs() < 1e-9,
+                    "{wear_rate} {d0}"
+                );
+            }
+        }
+        let c = CellLoad {
+            damage_rate: r,
+            wear_rate: 1e-11,
+            layer: 2e-4,
+        };
+        let n = c.cycles_to_pit(0.2).unwrap();
+        assert!((c.damage_after(0.2, n) - 1.0).abs() < 1e-12);
+        // Past eps = 1e-3 the same through the series form.
+        let c = CellLoad {
+            wear_rate: 1e-13,
+            ..c
+        };
+        let n = c.cycles_to_pit(0.2).unwrap();
+        assert!((c.damage_after(0.2, n) - 1.0).abs() < 1e-12);
+    }
 
     const CURVE: Endurance = Endurance::DEFAULT;
 

@@ -248,3 +248,22 @@ fn k_and_the_life_factor_are_recovered_from_a_forecast_backlash_curve() {
     assert!(fit.relative_rms < 1e-4, "{}", fit.relative_rms);
     assert!(runs < 80, "{runs} lives");
 }
+
+/// A forecast on a bronze that barely wears (wear coefficient 1e-300) reaches its life: the
+/// cycles to pit of a node are those without wear, not 0 (the rounded logarithm gave 0, and
+/// the forecast stepped 0 cycles for ever; issue 38's probe), and its first pitting phase
+/// starts where the damage without wear reaches the onset.
+#[test]
+fn a_forecast_without_wear_advances_to_its_life() {
+    let mut g = coarse();
+    g.wheel_material.wear_coefficient = 1e-300;
+    let bench = Bench::new(&g);
+    let plan = forecast_plan();
+    let start = std::time::Instant::now();
+    let life = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
+    let r = &life.records;
+    assert_eq!(r.last().unwrap().cycles, 200_000.0);
+    assert!(r.len() < 20, "{} states", r.len());
+    assert!(r.windows(2).all(|w| w[1].cycles >= w[0].cycles));
+    assert!(start.elapsed().as_secs() < 300);
+}

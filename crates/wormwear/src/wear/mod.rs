@@ -871,6 +871,7 @@ pub fn simulate(
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    let mut stalled = 0;
     loop {
         let (l, band) = life_loop.analyse(&state)?;
         let cw = per_cycle(gear, geo, tca, &l, life.film_load);
@@ -906,11 +907,29 @@ pub fn simulate(
         state.band_factor = band;
         state.warm = Some(l.warm_start());
         state.run_in(&l);
+        let before = state.cycles;
         (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
         state.step += 1;
+        // A life that stops advancing would run for ever: a defect, reported as such.
+        stalled = if state.cycles > before {
+            0
+        } else {
+            stalled + 1
+        };
+        if stalled >= MAX_STALLED_STEPS {
+            return Err(WearError::Plan(format!(
+                "the life did not advance beyond {} cycles in {MAX_STALLED_STEPS} steps (step \
+                 {}): stopped rather than run for ever; please report it with the gear file",
+                state.cycles, state.step
+            )));
+        }
     }
     Ok(state)
 }
+
+/// Consecutive steps that may leave the cycles where they were (a pitting phase's cut pits
+/// take none) before a life is stopped as stalled.
+const MAX_STALLED_STEPS: usize = 50;
 
 /// Most loaded analyses a life plan may need (a case B life needs ~2 700).
 pub const MAX_ANALYSES: f64 = 200_000.0;
