@@ -1447,7 +1447,9 @@ fn check_capacity(problem: &Problem, cap: &[f64]) -> Result<(), SolverError> {
         .sum();
     if capacity <= problem.load {
         return Err(SolverError::Invalid(format!(
-            "the flow pressure lets the reachable cells carry only {capacity:e} of the load {:e}",
+            "the flow pressure lets the reachable cells carry only {capacity:e} of the load {:e}: \
+             raise the flow pressure (analysis.flow_pressure_mpa, by default the wheel's \
+             materials.wheel.hardness_gpa) or lower the torque (conditions)",
             problem.load
         )));
     }
@@ -1770,6 +1772,15 @@ mod tests {
         }
         assert!(sol.residuals.complementarity < 1e-8, "{:?}", sol.residuals);
         assert!(sol.residuals.min_gap > -1e-8, "{:?}", sol.residuals);
+        // A bound under which the cells cannot carry the load: refused, naming the inputs
+        // that set it (issue 38's probe: a 0.1 GPa hardness named none).
+        let mut weak = pb.clone();
+        weak.upper = Some(vec![0.5 * load / cells.len() as f64; cells.len()]);
+        let e = solve(&weak, &settings, None).unwrap_err().to_string();
+        assert!(
+            e.contains("analysis.flow_pressure_mpa") && e.contains("materials.wheel.hardness_gpa"),
+            "{e}"
+        );
         // The fallback itself: the capped cells held, PK given one iteration (it cannot
         // finish), the active set on the free cells gives the same loads.
         let fixed: Vec<bool> = sol.q.iter().map(|&q| q >= cap).collect();
