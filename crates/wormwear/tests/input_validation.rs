@@ -862,7 +862,10 @@ fn relations_name_the_fields_they_depend_on() {
         .lines()
         .find(|l| l.contains("wheel.edge_relief_length_mm"))
         .unwrap_or_else(|| panic!("{message}"));
-    assert!(relief.contains("a quarter of wheel.face_width_mm"), "{relief}");
+    assert!(
+        relief.contains("a quarter of wheel.face_width_mm"),
+        "{relief}"
+    );
     for (table, key, line, field) in cases {
         let message = error_of(&set(&design(), table, key, line));
         // Named in a problem of another field (its own line is not the point).
