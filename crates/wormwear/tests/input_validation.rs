@@ -848,6 +848,13 @@ fn relations_name_the_fields_they_depend_on() {
             "outer_radius_mm = 1100.0",
             "wheel.outer_radius_mm",
         ),
+        ("worm", "lead_mm", "lead_mm = 155.51", "worm.lead_mm"),
+        (
+            "wheel",
+            "face_width_mm",
+            "face_width_mm = 5.0",
+            "wheel.face_width_mm",
+        ),
     ];
     // A relief length's bound names what sets it (a face width of 1e-300 mm gave "allowed
     // [0.01, 2.5e-301] mm" and nothing else).

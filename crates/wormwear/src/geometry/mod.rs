@@ -56,14 +56,16 @@ impl Geometry {
         cells_face: usize,
     ) -> Result<Self, GeometryError> {
         let thread_hint = |member: &'static str| {
-            move |e: GeometryError| match e {
+            move |e: GeometryError| {
+                match e {
                 GeometryError::Profile(m) => GeometryError::Profile(format!(
-                    "{member}: {m}; the inputs that shape it: [{member}] profile, \
-                     pressure_angle_deg with pressure_angle_plane, root_radius_mm and \
-                     tip_radius_mm (an involute worm's base radius must lie below its root; a \
+                    "{member}: {m}; the inputs that shape it: [{member}] profile, starts, \
+                     lead_mm or axial_module_mm, pressure_angle_deg with pressure_angle_plane, \
+                     root_radius_mm and tip_radius_mm (an involute worm's base radius must lie below its root; a \
                      K or C worm's grinding wheel, or profile radius, must reach the root)"
                 )),
                 other => other,
+            }
             }
         };
         let worm = ThreadSurface::new(&gear.worm).map_err(thread_hint("worm"))?;

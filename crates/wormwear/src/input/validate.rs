@@ -864,8 +864,8 @@ fn check_wheel_body(gear: &GearSet) -> Result<(), InputError> {
             "wheel.web_thickness_mm",
             b.web_thickness,
             format!(
-                "must be <= the face width {:.4} mm",
-                gear.wheel.face_width / MM
+                "must be <= the face width (wheel.face_width_mm) {} mm",
+                Number(gear.wheel.face_width / MM)
             ),
         );
     }
@@ -1229,7 +1229,9 @@ fn lead_angle(ck: &mut Checker, name: &str, starts: i64, p_x: f64, r1: f64) -> O
             &format!("{name}.reference_radius_mm"),
             r1 / MM,
             format!(
-                "lead angle {:.2} deg exceeds 45 deg: the reference radius must be >= {:.4} mm",
+                "lead angle {:.2} deg exceeds 45 deg: with this lead ({name}.starts and \
+                 {name}.axial_module_mm or {name}.lead_mm) the reference radius must be >= \
+                 {:.4} mm",
                 lead_angle / DEG,
                 starts as f64 * p_x / (2.0 * PI) / MM
             ),
