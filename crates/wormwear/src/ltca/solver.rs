@@ -1200,26 +1200,7 @@ fn active_set_within(
     let n = problem.len();
     let e = &problem.separation;
     let load = problem.load;
-    // Feasible start: the given loads on open cells, else the cell of smallest separation.
-    let mut q: Vec<f64> = (0..n)
-        .map(|i| {
-            if e[i].is_finite() {
-                start.get(i).copied().unwrap_or(0.0).max(0.0)
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let total: f64 = q.iter().sum();
-    if total > 0.0 {
-        q.iter_mut().for_each(|v| *v *= load / total);
-    } else {
-        let first = (0..n)
-            .filter(|&i| e[i].is_finite())
-            .min_by(|&a, &b| e[a].total_cmp(&e[b]))
-            .ok_or(SolverError::Empty)?;
-        q[first] = load;
-    }
+    let mut q = feasible_start(problem, start)?;
     let mut set: Vec<usize> = (0..n).filter(|&i| q[i] > 0.0).collect();
     let mut y = vec![0.0; n];
     let mut approach = 0.0;
@@ -1249,27 +1230,7 @@ fn active_set_within(
                 approach = alpha;
                 break;
             }
-            let mut t: f64 = 1.0;
-            for (&i, &v) in set.iter().zip(&z) {
-                if v <= 0.0 {
-                    t = t.min(q[i] / (q[i] - v));
-                }
-            }
-            for (&i, &v) in set.iter().zip(&z) {
-                q[i] += t * (v - q[i]);
-            }
-            let qmax = q.iter().copied().fold(0.0, f64::max);
-            set.retain(|&i| q[i] > 1e-14 * qmax);
-            let mut inside = vec![false; n];
-            set.iter().for_each(|&i| inside[i] = true);
-            for (qi, keep) in q.iter_mut().zip(&inside) {
-                if !keep {
-                    *qi = 0.0;
-                }
-            }
-            if set.is_empty() {
-                return Err(SolverError::Invalid("active set emptied".into()));
-            }
+            step_back(&mut q, &mut set, &z)?;
         }
         // Gaps; the cells that penetrate most join the set.
         problem.apply(&q, &mut y);
@@ -1305,6 +1266,60 @@ fn active_set_within(
         residual: residuals.complementarity.max(-residuals.min_gap),
         tolerance: settings.tolerance,
     })
+}
+
+/// The active-set method's feasible start: the given loads on open cells scaled to the
+/// load, else the whole load on the cell of smallest separation.
+fn feasible_start(problem: &Problem, start: &[f64]) -> Result<Vec<f64>, SolverError> {
+    let (n, e, load) = (problem.len(), &problem.separation, problem.load);
+    let mut q: Vec<f64> = (0..n)
+        .map(|i| {
+            if e[i].is_finite() {
+                start.get(i).copied().unwrap_or(0.0).max(0.0)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let total: f64 = q.iter().sum();
+    if total > 0.0 {
+        q.iter_mut().for_each(|v| *v *= load / total);
+    } else {
+        let first = (0..n)
+            .filter(|&i| e[i].is_finite())
+            .min_by(|&a, &b| e[a].total_cmp(&e[b]))
+            .ok_or(SolverError::Empty)?;
+        q[first] = load;
+    }
+    Ok(q)
+}
+
+/// The ratio test of the active-set method: from loads `q` towards the set's equality
+/// solution `z` as far as every load stays non-negative; the cells whose load reaches zero
+/// leave the set (and their loads are zeroed).
+fn step_back(q: &mut [f64], set: &mut Vec<usize>, z: &[f64]) -> Result<(), SolverError> {
+    let mut t: f64 = 1.0;
+    for (&i, &v) in set.iter().zip(z) {
+        if v <= 0.0 {
+            t = t.min(q[i] / (q[i] - v));
+        }
+    }
+    for (&i, &v) in set.iter().zip(z) {
+        q[i] += t * (v - q[i]);
+    }
+    let qmax = q.iter().copied().fold(0.0, f64::max);
+    set.retain(|&i| q[i] > 1e-14 * qmax);
+    let mut inside = vec![false; q.len()];
+    set.iter().for_each(|&i| inside[i] = true);
+    for (qi, keep) in q.iter_mut().zip(&inside) {
+        if !keep {
+            *qi = 0.0;
+        }
+    }
+    if set.is_empty() {
+        return Err(SolverError::Invalid("active set emptied".into()));
+    }
+    Ok(())
 }
 
 /// The most floating-point work the active-set fallback may spend on one problem (the sum of

@@ -910,21 +910,28 @@ pub fn simulate(
         let before = state.cycles;
         (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
         state.step += 1;
-        // A life that stops advancing would run for ever: a defect, reported as such.
-        stalled = if state.cycles > before {
-            0
-        } else {
-            stalled + 1
-        };
-        if stalled >= MAX_STALLED_STEPS {
-            return Err(WearError::Plan(format!(
-                "the life did not advance beyond {} cycles in {MAX_STALLED_STEPS} steps (step \
-                 {}): stopped rather than run for ever; please report it with the gear file",
-                state.cycles, state.step
-            )));
-        }
+        stalled = stalled_steps(stalled, before, &state)?;
     }
     Ok(state)
+}
+
+/// The count of consecutive steps that left the cycles where they were, with the one that
+/// brought `state` from `before` cycles: a life that stops advancing would run for ever, a
+/// defect reported as such after [`MAX_STALLED_STEPS`].
+fn stalled_steps(stalled: usize, before: f64, state: &WearState) -> Result<usize, WearError> {
+    let stalled = if state.cycles > before {
+        0
+    } else {
+        stalled + 1
+    };
+    if stalled >= MAX_STALLED_STEPS {
+        return Err(WearError::Plan(format!(
+            "the life did not advance beyond {} cycles in {MAX_STALLED_STEPS} steps (step {}): \
+             stopped rather than run for ever; please report it with the gear file",
+            state.cycles, state.step
+        )));
+    }
+    Ok(stalled)
 }
 
 /// Consecutive steps that may leave the cycles where they were (a pitting phase's cut pits
