@@ -702,6 +702,31 @@ fn an_implausible_load_is_refused_and_an_overload_warned() {
 }
 
 #[test]
+fn an_fe_mesh_too_fine_for_the_machine_is_refused_naming_the_refinement() {
+    // The 1/40 design case at bending.mesh_refinement = 3: 1.6e6 unknowns in the wheel model.
+    // The previous build assembled it and grew past 20 GB before its factorisation; now it is
+    // refused within seconds, as an input error naming the field and what to change.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
+    let path = dir.path().join("fine.toml");
+    let fine = text.replace("model = \"fe\"", "model = \"fe\"\nmesh_refinement = 3");
+    assert_ne!(fine, text);
+    std::fs::write(&path, fine).unwrap();
+    let mut command = into("ltca", &path, &dir.path().join("out"), &["-q"]);
+    command.env("WORMWEAR_CACHE_DIR", dir.path().join("cache"));
+    let out = output_within(&mut command, 60).expect("refused within 60 s");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("bending.mesh_refinement = 3")
+            && err.contains("unknowns")
+            && err.contains("use a lower bending.mesh_refinement"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").join("summary.json").exists());
+}
+
+#[test]
 fn a_record_changed_after_it_was_written_is_refused_on_resume() {
     // One digit of the first record's largest wear flipped (the JSON still valid, the line
     // count unchanged): the resumed life would report it in summary.json and

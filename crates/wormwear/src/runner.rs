@@ -413,6 +413,7 @@ impl RunError {
             self,
             RunError::Request(_)
                 | RunError::Geometry(_)
+                | RunError::Bending(crate::bending::model::BendingError::TooLarge { .. })
                 | RunError::Wear(WearError::Checkpoint(_) | WearError::Plan(_))
         )
     }

@@ -113,7 +113,64 @@ pub enum FeError {
     Jacobian(usize),
     #[error("sparse factorisation failed: {0} (is the model restrained against rigid motion?)")]
     Factorisation(String),
+    /// The model is larger than [`MAX_FACTOR_NONZEROS`] allows: refused before the element
+    /// stiffnesses and the numeric factorisation are computed.
+    #[error("{}", too_large(*unknowns, *nonzeros))]
+    TooLarge {
+        unknowns: usize,
+        /// Nonzeros of the factor from the symbolic analysis; None when refused on the
+        /// unknowns alone ([`MAX_UNKNOWNS`]).
+        nonzeros: Option<usize>,
+    },
 }
+
+/// The size limits of one solve (the unknowns, the factor's nonzeros).
+#[derive(Debug, Clone, Copy)]
+struct SizeLimits {
+    unknowns: usize,
+    factor_nonzeros: usize,
+}
+
+impl SizeLimits {
+    /// The limits of the bending models: [`MAX_UNKNOWNS`], [`MAX_FACTOR_NONZEROS`].
+    const MODEL: Self = Self {
+        unknowns: MAX_UNKNOWNS,
+        factor_nonzeros: MAX_FACTOR_NONZEROS,
+    };
+}
+
+/// The text of [`FeError::TooLarge`].
+fn too_large(unknowns: usize, nonzeros: Option<usize>) -> String {
+    let limit = format!(
+        "{:.2e} nonzeros ({:.1} GB), the most one model may use",
+        MAX_FACTOR_NONZEROS as f64,
+        MAX_FACTOR_NONZEROS as f64 * 8e-9
+    );
+    match nonzeros {
+        Some(n) => format!(
+            "the model has {unknowns} unknowns and its Cholesky factor would hold {:.2e} \
+             nonzeros ({:.1} GB), above {limit}",
+            n as f64,
+            n as f64 * 8e-9
+        ),
+        None => format!(
+            "the model has {unknowns} unknowns (more than {MAX_UNKNOWNS}): its Cholesky factor \
+             would hold far more than {limit}"
+        ),
+    }
+}
+
+/// The most nonzeros a model's Cholesky factor may hold: 3.75e8 (3 GB of values). Both FE
+/// models are built side by side, so two factors of this size and their element matrices
+/// fit in 8 GB. Refinement 1 of the reference gears needs 0.3e8 (wheel) and 1.2e8 (worm);
+/// refinement 2 about 1e9 each (8 GB each, and minutes of factorisation), which is refused.
+pub const MAX_FACTOR_NONZEROS: usize = 375_000_000;
+
+/// The most unknowns a model may have before its pattern is even built: a 20-node hexahedral
+/// mesh of 10^6 unknowns has a factor of several 10^9 nonzeros (4.6e5 unknowns already give
+/// 1e9), far above [`MAX_FACTOR_NONZEROS`]; this check costs nothing and keeps the refusal of
+/// such meshes from taking gigabytes for their pattern.
+pub const MAX_UNKNOWNS: usize = 1_000_000;
 
 /// Element stiffness (60 x 60, row-major) of element `e`.
 pub fn element_stiffness(mesh: &Mesh, e: usize, material: &Elastic) -> Result<Vec<f64>, FeError> {
@@ -305,6 +362,11 @@ impl LowerPattern {
         Self { col_ptr, row_idx }
     }
 
+    /// The pattern as faer's symbolic matrix (n x n, lower triangle).
+    fn symbolic(&self, n: usize) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+        faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx)
+    }
+
     #[inline]
     fn position(&self, row: usize, col: usize) -> usize {
         let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
@@ -353,20 +415,56 @@ fn assemble(
     springs: &[Spring],
     loads: &[Vec<Load>],
 ) -> System {
-    let ndof = 3 * mesh.nodes.len();
-    let mut prescribed = vec![None; ndof];
-    for &(n, d, v) in fixed {
-        prescribed[3 * n + d] = Some(v);
-    }
-    let mut map = vec![usize::MAX; ndof];
-    let mut free = 0;
-    for (i, p) in prescribed.iter().enumerate() {
-        if p.is_none() {
-            map[i] = free;
-            free += 1;
+    let dofs = Dofs::new(mesh, fixed);
+    let pattern = LowerPattern::new(mesh, springs, &dofs.map, dofs.free);
+    fill(mesh, elements, springs, loads, dofs, pattern)
+}
+
+/// The DOF bookkeeping of one run: the prescribed value of every global DOF and its free index.
+struct Dofs {
+    prescribed: Vec<Option<f64>>,
+    /// Free-DOF index of every global DOF (usize::MAX where prescribed).
+    map: Vec<usize>,
+    free: usize,
+}
+
+impl Dofs {
+    fn new(mesh: &Mesh, fixed: &[Fixed]) -> Self {
+        let ndof = 3 * mesh.nodes.len();
+        let mut prescribed = vec![None; ndof];
+        for &(n, d, v) in fixed {
+            prescribed[3 * n + d] = Some(v);
+        }
+        let mut map = vec![usize::MAX; ndof];
+        let mut free = 0;
+        for (i, p) in prescribed.iter().enumerate() {
+            if p.is_none() {
+                map[i] = free;
+                free += 1;
+            }
+        }
+        Self {
+            prescribed,
+            map,
+            free,
         }
     }
-    let pattern = LowerPattern::new(mesh, springs, &map, free);
+}
+
+/// The stiffness values on `pattern` and the right-hand sides (see [`assemble`]).
+fn fill(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+    dofs: Dofs,
+    pattern: LowerPattern,
+) -> System {
+    let Dofs {
+        prescribed,
+        map,
+        free,
+    } = dofs;
     let mut values = vec![0.0; pattern.row_idx.len()];
     let ncase = loads.len();
     let mut rhs = Mat::<f64>::zeros(free, ncase);
@@ -444,39 +542,60 @@ fn assemble(
 /// nodes vanishing as they do for prescribed DOFs), so their difference is L^-T [0; y_B]: one
 /// factorisation and two triangular solves instead of two factorisations and four. The
 /// prescribed displacements are the same in both runs, so the difference is zero there.
+///
+/// The size is checked before anything large is computed: the unknowns against
+/// [`MAX_UNKNOWNS`], then the factor's nonzeros from the symbolic analysis against
+/// [`MAX_FACTOR_NONZEROS`] ([`FeError::TooLarge`]); only then the element stiffnesses.
 fn solve_free_minus_blocked(
     mesh: &Mesh,
-    elements: &[Vec<f64>],
+    material: &Elastic,
     fixed: &[Fixed],
     springs: &[Spring],
     blocked: &[usize],
     loads: &[Vec<Load>],
+    limits: SizeLimits,
 ) -> Result<Solution, FeError> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
     };
-    let system = assemble(mesh, elements, fixed, springs, loads);
-    let free = system.rhs.nrows();
+    let dofs = Dofs::new(mesh, fixed);
+    let free = dofs.free;
+    if free > limits.unknowns {
+        return Err(FeError::TooLarge {
+            unknowns: free,
+            nonzeros: None,
+        });
+    }
+    let pattern = LowerPattern::new(mesh, springs, &dofs.map, free);
     let mut is_blocked = vec![false; free];
     for &n in blocked {
         for d in 0..3 {
             let g = 3 * n + d;
-            if system.map[g] != usize::MAX {
-                is_blocked[system.map[g]] = true;
+            if dofs.map[g] != usize::MAX {
+                is_blocked[dofs.map[g]] = true;
             }
         }
     }
-    let (forward, inverse, unblocked) = order_blocked_last(&system.matrix, &is_blocked)?;
+    let (forward, inverse, unblocked) = order_blocked_last(pattern.symbolic(free), &is_blocked)?;
     let failed = |e: &dyn std::fmt::Debug| FeError::Factorisation(format!("{e:?}"));
     let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
     let symbolic = factorize_symbolic_cholesky(
-        system.matrix.symbolic(),
+        pattern.symbolic(free),
         Side::Lower,
         SymmetricOrdering::Custom(perm),
         CholeskySymbolicParams::default(),
     )
     .map_err(|e| failed(&e))?;
+    if symbolic.len_val() > limits.factor_nonzeros {
+        return Err(FeError::TooLarge {
+            unknowns: free,
+            nonzeros: Some(symbolic.len_val()),
+        });
+    }
+    let elements = element_stiffnesses(mesh, material)?;
+    let system = fill(mesh, &elements, springs, loads, dofs, pattern);
+    drop(elements);
     let par = faer::get_global_parallelism();
     let cases = loads.len();
     let mut values = vec![0.0; symbolic.len_val()];
@@ -521,7 +640,7 @@ fn solve_free_minus_blocked(
 /// then them in their own order. Returns (forward: new -> old, inverse: old -> new, the number
 /// of unknowns before the last ones).
 fn order_blocked_last(
-    matrix: &SparseColMat<usize, f64>,
+    matrix: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
     last: &[bool],
 ) -> Result<(Vec<usize>, Vec<usize>, usize), FeError> {
     use faer::dyn_stack::{MemBuffer, MemStack};
@@ -532,7 +651,7 @@ fn order_blocked_last(
     for (k, &i) in kept.iter().enumerate() {
         local[i] = k;
     }
-    let (col_ptr, row_idx) = (matrix.symbolic().col_ptr(), matrix.symbolic().row_idx());
+    let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
     let mut ptr = Vec::with_capacity(kept.len() + 1);
     let mut rows = Vec::new();
     ptr.push(0);
@@ -601,6 +720,7 @@ fn lower_solve(
 }
 
 /// Displacements of every load case in the free-DOF numbering of one run.
+#[derive(Debug)]
 struct Solution {
     /// free DOFs x cases, m.
     x: Mat<f64>,
@@ -811,9 +931,75 @@ pub fn free_minus_blocked(
         .iter()
         .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
         .collect();
-    let elements = element_stiffnesses(mesh, material)?;
-    let difference = solve_free_minus_blocked(mesh, &elements, fixed, springs, blocked, &cases)?;
+    let difference = solve_free_minus_blocked(
+        mesh,
+        material,
+        fixed,
+        springs,
+        blocked,
+        &cases,
+        SizeLimits::MODEL,
+    )?;
     Ok((0..cases.len())
         .map(|c| observed.iter().map(|&n| difference.at(c, n)).collect())
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STEEL: Elastic = Elastic {
+        youngs_modulus: 210e9,
+        poisson_ratio: 0.3,
+    };
+
+    /// A clamped cantilever box: its fixed DOFs and one tip load case.
+    fn cantilever(n: usize) -> (Mesh, Vec<Fixed>, Vec<Vec<Load>>) {
+        let (mesh, lattice) = box_mesh((0.04, 0.01, 0.01), (4 * n, n, n), |p| p);
+        let fixed = lattice
+            .iter()
+            .enumerate()
+            .filter(|(_, ijk)| ijk[0] == 0)
+            .flat_map(|(k, _)| (0..3).map(move |d| (k, d, 0.0)))
+            .collect();
+        let tip = lattice.iter().position(|ijk| ijk[0] == 8 * n).unwrap();
+        (mesh, fixed, vec![vec![(tip, 1, -1.0)]])
+    }
+
+    #[test]
+    fn a_model_whose_factor_exceeds_the_limit_is_refused_before_it_is_built() {
+        let (mesh, fixed, loads) = cantilever(2);
+        let unlimited = SizeLimits {
+            unknowns: usize::MAX,
+            factor_nonzeros: usize::MAX,
+        };
+        let solve =
+            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], &loads, limits);
+        assert!(solve(unlimited).is_ok());
+        // The factor holds more nonzeros than the lower triangle of the matrix.
+        let dofs = Dofs::new(&mesh, &fixed);
+        let nnz_lower = LowerPattern::new(&mesh, &[], &dofs.map, dofs.free)
+            .row_idx
+            .len();
+        match solve(SizeLimits {
+            factor_nonzeros: nnz_lower,
+            ..unlimited
+        }) {
+            Err(FeError::TooLarge {
+                nonzeros: Some(n), ..
+            }) => assert!(n > nnz_lower),
+            other => panic!("expected TooLarge with the factor's size, got {other:?}"),
+        }
+        match solve(SizeLimits {
+            unknowns: dofs.free - 1,
+            ..unlimited
+        }) {
+            Err(FeError::TooLarge {
+                unknowns,
+                nonzeros: None,
+            }) => assert_eq!(unknowns, dofs.free),
+            other => panic!("expected TooLarge on the unknowns, got {other:?}"),
+        }
+    }
 }

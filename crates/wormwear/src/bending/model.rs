@@ -31,6 +31,37 @@ pub enum BendingError {
     Wheel(#[source] FeError),
     #[error("worm finite-element model")]
     Worm(#[source] FeError),
+    /// A model above the FE size limits ([`FeError::TooLarge`]), refused before it is built.
+    #[error(
+        "bending.mesh_refinement = {refinement}: the {member} finite-element model is too \
+         large: {cause}; {}",
+        if *refinement > 1 {
+            "use a lower bending.mesh_refinement (1 is the default)"
+        } else {
+            "use bending.model = \"none\" (contact only), or fewer fit points \
+             (bending.height_points, width_points, worm_width_points set the mesh's layers)"
+        }
+    )]
+    TooLarge {
+        member: &'static str,
+        refinement: usize,
+        cause: FeError,
+    },
+}
+
+impl BendingError {
+    /// The error of `member`'s FE model built at `refinement`.
+    fn of(member: &'static str, refinement: usize, source: FeError) -> Self {
+        match (&source, member) {
+            (FeError::TooLarge { .. }, _) => Self::TooLarge {
+                member,
+                refinement,
+                cause: source,
+            },
+            (_, "wheel") => Self::Wheel(source),
+            _ => Self::Worm(source),
+        }
+    }
 }
 
 /// Where the model came from.
@@ -146,9 +177,10 @@ pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<FeBending, BendingError
             )
         },
     );
+    let refinement = b.mesh_refinement;
     Ok(FeBending {
-        wheel: wheel.map_err(BendingError::Wheel)?,
-        worm: worm.map_err(BendingError::Worm)?,
+        wheel: wheel.map_err(|e| BendingError::of("wheel", refinement, e))?,
+        worm: worm.map_err(|e| BendingError::of("worm", refinement, e))?,
     })
 }
 
