@@ -727,6 +727,48 @@ fn an_fe_mesh_too_fine_for_the_machine_is_refused_naming_the_refinement() {
 }
 
 #[test]
+fn a_contact_mesh_too_fine_for_the_dense_solver_is_refused_naming_its_fields() {
+    // The 1/40 design case with 110 cells across the contact line: about 13 000 cells a
+    // position. The previous build solved it for more than 600 s (FE bending); now the first
+    // position is refused before its influence blocks, as an input error naming the fields.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
+    let path = dir.path().join("fine.toml");
+    // (Refused whatever the bending model: without it the test needs no FE build.)
+    let text = text.replace("model = \"fe\"", "model = \"none\"");
+    let fine = text.replace("positions = 20", "positions = 20\ncontact_columns = 110");
+    assert_ne!(fine, text);
+    std::fs::write(&path, fine).unwrap();
+    let out = output_within(
+        &mut into("ltca", &path, &dir.path().join("out"), &["-q"]),
+        60,
+    )
+    .expect("refused within 60 s");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("more than the 8192")
+            && err.contains("analysis.contact_columns (now 110")
+            && err.contains("analysis.contact_slice_step")
+            && err.contains("analysis.flank_cells_face"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").join("summary.json").exists());
+    // The convergence studies' finest mesh across the line still runs (without bending, to
+    // keep the test short).
+    let fine41 = text.replace("positions = 20", "positions = 4\ncontact_columns = 41");
+    std::fs::write(&path, fine41).unwrap();
+    let out = into("ltca", &path, &dir.path().join("out41"), &["-q"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
 fn a_record_changed_after_it_was_written_is_refused_on_resume() {
     // One digit of the first record's largest wear flipped (the JSON still valid, the line
     // count unchanged): the resumed life would report it in summary.json and

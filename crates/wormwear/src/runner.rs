@@ -414,6 +414,11 @@ impl RunError {
             RunError::Request(_)
                 | RunError::Geometry(_)
                 | RunError::Bending(crate::bending::model::BendingError::TooLarge { .. })
+                | RunError::Ltca(crate::ltca::LtcaError::TooManyCells { .. })
+                | RunError::Wear(WearError::Ltca {
+                    source: crate::ltca::LtcaError::TooManyCells { .. },
+                    ..
+                })
                 | RunError::Wear(WearError::Checkpoint(_) | WearError::Plan(_))
         )
     }

@@ -308,7 +308,31 @@ pub enum LtcaError {
     /// [`shaft_torsion_problem`]).
     #[error("{0}")]
     ShaftTorsion(String),
+    /// A position's contact problem above [`MAX_CONTACT_CELLS`], refused before its influence
+    /// blocks are built.
+    #[error(
+        "position {position}: the contact problem has {cells} cells, more than the \
+         {MAX_CONTACT_CELLS} the dense contact solver takes (its work grows about as the cube \
+         of the cells: {MAX_CONTACT_CELLS} cells take about 9 s a position with FE bending on \
+         2 cores); use fewer analysis.contact_columns (now {columns}, the cells across the \
+         line), a larger analysis.contact_slice_step (now {slice_step}) or fewer \
+         analysis.flank_cells_face (the slices along the line)"
+    )]
+    TooManyCells {
+        position: usize,
+        cells: usize,
+        columns: usize,
+        slice_step: usize,
+    },
 }
+
+/// The most contact cells one position's problem may hold (MODEL §5.3): the influence blocks
+/// are dense and the solver's iterations grow with the cells, so its work grows about as their
+/// cube (the design case with FE bending, 2 cores: 2 700 cells 0.11 s a position, 5 400 cells
+/// 1.2 s, 8 200 cells 8.6 s, 10 700 cells 11 s, 13 400 cells more than 30 s). 8 192 is half
+/// again the finest mesh of the convergence studies (contact_columns = 41: about 5 100 cells
+/// on the reference gears). The matrix-free operator of issue 36 is what would lift it.
+pub const MAX_CONTACT_CELLS: usize = 8192;
 
 /// A wheel shaft so compliant in torsion that the load alone turns the wheel by more than
 /// one tooth pitch: a mesh whose teeth would pass one another under a static load is not a
@@ -1329,6 +1353,14 @@ fn solve_position(
         let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, worn);
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
+        }
+        if cells.len() > MAX_CONTACT_CELLS {
+            return Err(LtcaError::TooManyCells {
+                position: n,
+                cells: cells.len(),
+                columns: settings.columns,
+                slice_step: settings.slice_step,
+            });
         }
         // The previous analysis' loads on the same cells (the first mesh only: a widened band
         // puts other points under the same indices).
