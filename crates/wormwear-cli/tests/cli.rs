@@ -701,29 +701,44 @@ fn an_implausible_load_is_refused_and_an_overload_warned() {
     );
 }
 
+/// Writes the design case with each (from, to) replacement made (each must match) into `dir`,
+/// runs `ltca` on it and returns its exit code and stderr; no summary.json may be left.
+fn design_ltca(dir: &Path, edits: &[(&str, &str)]) -> (Option<i32>, String) {
+    let mut text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, to);
+    }
+    let path = dir.join("edited.toml");
+    std::fs::write(&path, text).unwrap();
+    let out_dir = dir.join("out");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let mut command = into("ltca", &path, &out_dir, &["-q"]);
+    command.env("WORMWEAR_CACHE_DIR", dir.join("cache"));
+    let out = output_within(&mut command, 60).expect("ended within 60 s");
+    let summary = out_dir.join("summary.json").exists();
+    assert_eq!(summary, out.status.success());
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 #[test]
 fn an_fe_mesh_too_fine_for_the_machine_is_refused_naming_the_refinement() {
     // The 1/40 design case at bending.mesh_refinement = 3: 1.6e6 unknowns in the wheel model.
     // The previous build assembled it and grew past 20 GB before its factorisation; now it is
     // refused within seconds, as an input error naming the field and what to change.
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
-    let path = dir.path().join("fine.toml");
-    let fine = text.replace("model = \"fe\"", "model = \"fe\"\nmesh_refinement = 3");
-    assert_ne!(fine, text);
-    std::fs::write(&path, fine).unwrap();
-    let mut command = into("ltca", &path, &dir.path().join("out"), &["-q"]);
-    command.env("WORMWEAR_CACHE_DIR", dir.path().join("cache"));
-    let out = output_within(&mut command, 60).expect("refused within 60 s");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let edit = ("model = \"fe\"", "model = \"fe\"\nmesh_refinement = 3");
+    let (code, err) = design_ltca(dir.path(), &[edit]);
+    assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("bending.mesh_refinement = 3")
             && err.contains("unknowns")
             && err.contains("use a lower bending.mesh_refinement"),
         "{err}"
     );
-    assert!(!dir.path().join("out").join("summary.json").exists());
 }
 
 #[test]
@@ -731,21 +746,15 @@ fn a_contact_mesh_too_fine_for_the_dense_solver_is_refused_naming_its_fields() {
     // The 1/40 design case with 110 cells across the contact line: about 13 000 cells a
     // position. The previous build solved it for more than 600 s (FE bending); now the first
     // position is refused before its influence blocks, as an input error naming the fields.
-    let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
-    let path = dir.path().join("fine.toml");
     // (Refused whatever the bending model: without it the test needs no FE build.)
-    let text = text.replace("model = \"fe\"", "model = \"none\"");
-    let fine = text.replace("positions = 20", "positions = 20\ncontact_columns = 110");
-    assert_ne!(fine, text);
-    std::fs::write(&path, fine).unwrap();
-    let out = output_within(
-        &mut into("ltca", &path, &dir.path().join("out"), &["-q"]),
-        60,
-    )
-    .expect("refused within 60 s");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    let no_bending = ("model = \"fe\"", "model = \"none\"");
+    let columns = |n: &str| format!("positions = 4\ncontact_columns = {n}");
+    let (code, err) = design_ltca(
+        dir.path(),
+        &[no_bending, ("positions = 20", &columns("110"))],
+    );
+    assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("more than the 8192")
             && err.contains("analysis.contact_columns (now 110")
@@ -753,19 +762,12 @@ fn a_contact_mesh_too_fine_for_the_dense_solver_is_refused_naming_its_fields() {
             && err.contains("analysis.flank_cells_face"),
         "{err}"
     );
-    assert!(!dir.path().join("out").join("summary.json").exists());
-    // The convergence studies' finest mesh across the line still runs (without bending, to
-    // keep the test short).
-    let fine41 = text.replace("positions = 20", "positions = 4\ncontact_columns = 41");
-    std::fs::write(&path, fine41).unwrap();
-    let out = into("ltca", &path, &dir.path().join("out41"), &["-q"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    // The convergence studies' finest mesh across the line still runs.
+    let (code, err) = design_ltca(
+        dir.path(),
+        &[no_bending, ("positions = 20", &columns("41"))],
     );
+    assert_eq!(code, Some(0), "{err}");
 }
 
 #[test]
