@@ -167,7 +167,7 @@ fn zk_stage_takes_its_disc_and_standard_defaults_and_warns_of_a_steel_wheel() {
     // Defaults said in comments; every attribute used or listed.
     assert!(imp
         .text
-        .contains("default: worm tip + bottom clearance 0.2 m_x"));
+        .contains("default worm tip + bottom clearance 0.2 m_x"));
     assert!(imp.text.contains("REXS attributes not used by this import"));
 }
 
@@ -432,6 +432,27 @@ fn validation_errors_of_an_import_name_the_rexs_attribute() {
     {
         assert!(!line.contains("0000000000000000"), "a long number: {line}");
     }
+}
+
+#[test]
+fn a_zero_wheel_tip_diameter_reads_as_not_given_and_its_default_names_the_attribute() {
+    // The JSON ZA 1/40 stage with the wheel's tip diameter 0: the default d_a2 is used, which
+    // the file's hob root cuts by 37 nm. The previous build's refusal named the default rule
+    // and not the attribute that was 0 (probe: "unclear").
+    let text = std::fs::read_to_string(data("za-1x40-left.rexsj")).unwrap();
+    let given = "\"floating_point\": 207.88";
+    assert!(text.contains(given));
+    let text = text.replace(given, "\"floating_point\": 0");
+    let model = rexs::parse_bytes(text.as_bytes(), "zero.rexsj").unwrap();
+    let imp = import::import(&model, None, "zero.rexsj").unwrap();
+    let err = imp
+        .with_sources(input::load_from_str(&imp.text).unwrap_err())
+        .to_string();
+    assert!(
+        err.contains("hob.root_radius_mm")
+            && err.contains("worm_wheel.tip_diameter_worm_gear not given (absent or 0)"),
+        "{err}"
+    );
 }
 
 /// Two gears are the same when their validated data agree to round-off (relative 1e-11;

@@ -688,7 +688,7 @@ impl Mesh<'_> {
                 "wheel.throat_radius_mm",
                 self.throat_radius_mm,
                 format!(
-                    "must be < operating.centre_distance_mm - worm.root_radius_mm = {:.4} mm \
+                    "must be < operating.centre_distance_mm - worm.root_radius_mm = {:.6} mm \
                      (the wheel tip would hit the worm root)",
                     (an - wm.root_radius) / MM
                 ),
@@ -702,7 +702,7 @@ impl Mesh<'_> {
                 "hob.root_radius_mm",
                 hb.root_radius / MM,
                 format!(
-                    "must be <= cutting.centre_distance_mm - wheel.throat_radius_mm = {:.4} mm \
+                    "must be <= cutting.centre_distance_mm - wheel.throat_radius_mm = {:.6} mm \
                      (the hob root would cut the wheel tip)",
                     (a0 - ra) / MM
                 ),
@@ -715,7 +715,7 @@ impl Mesh<'_> {
                 hb.tip_radius / MM,
                 format!(
                     "must be >= worm.tip_radius_mm + cutting.centre_distance_mm - \
-                     operating.centre_distance_mm = {:.4} mm (the worm tip would hit the wheel \
+                     operating.centre_distance_mm = {:.6} mm (the worm tip would hit the wheel \
                      root)",
                     (wm.tip_radius + a0 - an) / MM
                 ),

@@ -1044,7 +1044,9 @@ fn hob_radii(
         ),
         (None, None) => (
             worm.tip_radius + clearance,
-            "default: worm tip + bottom clearance 0.2 m_x (DIN 3975)".to_string(),
+            "worm_wheel_hob_tool.tip_diameter_worm_gear and worm_wheel.root_diameter_worm_gear \
+             not given (absent or 0): default worm tip + bottom clearance 0.2 m_x (DIN 3975)"
+                .to_string(),
         ),
     };
     let custom_root = match hob {
@@ -1171,7 +1173,9 @@ fn wheel_radii(
         Some(d) => (0.5 * d, "worm_wheel.tip_diameter_worm_gear / 2".to_string()),
         None => (
             0.5 * d2 + (1.0 + x2) * m,
-            "default: d_a2 = d_2 + 2 (1 + x2) m_x (DIN 3975, h_a* = 1)".to_string(),
+            "worm_wheel.tip_diameter_worm_gear not given (absent or 0): default d_a2 = d_2 + \
+             2 (1 + x2) m_x (DIN 3975, h_a* = 1)"
+                .to_string(),
         ),
     };
     let outer = match reader.positive(c, "outer_diameter_worm_wheel", Quantity::Length)? {
@@ -1181,7 +1185,9 @@ fn wheel_radii(
         ),
         None => (
             tip.0 + 0.5 * m,
-            "default: d_e2 = d_a2 + m_x (DIN 3975 guidance)".to_string(),
+            "worm_wheel.outer_diameter_worm_wheel not given (absent or 0): default d_e2 = \
+             d_a2 + m_x (DIN 3975 guidance)"
+                .to_string(),
         ),
     };
     Ok((tip, outer))
