@@ -473,6 +473,15 @@ pub enum Rotation {
     Negative,
 }
 
+/// Which contact solver the loaded analysis uses (`analysis.solver`, MODEL §5.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum SolverKind {
+    /// Polonsky-Keer conjugate gradient with active set.
+    ConjugateGradient,
+    /// The published fixed point on the approach (MODEL §5.4).
+    FixedPoint,
+}
+
 /// Analysis settings (grid sizes, positions...).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Analysis {
@@ -499,7 +508,7 @@ pub struct Analysis {
     pub pressure_patch_across: f64,
     pub pressure_patch_along: f64,
     /// LTCA solver.
-    pub solver: crate::ltca::solver::SolverKind,
+    pub solver: SolverKind,
     /// Direction of the pressure on a contact cell (MODEL §5.2's n_i).
     pub pressure_direction: PressureDirection,
 }

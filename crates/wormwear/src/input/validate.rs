@@ -537,7 +537,7 @@ fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Analysis> {
             ("wheel-flank", PressureDirection::WheelFlank),
         ],
     );
-    use crate::ltca::solver::SolverKind;
+    use super::SolverKind;
     let solver = ck.choice(
         "analysis.solver",
         &a.solver,

@@ -378,14 +378,9 @@ pub struct Problem {
     pub upper: Option<Vec<f64>>,
 }
 
-/// Which solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum SolverKind {
-    /// Polonsky-Keer conjugate gradient with active set.
-    ConjugateGradient,
-    /// The published fixed point on the approach (MODEL §5.4).
-    FixedPoint,
-}
+/// Which solver: an input setting (`analysis.solver`), defined with the inputs so that the
+/// input module does not depend on the solver's.
+pub use crate::input::SolverKind;
 
 /// Convergence settings.
 #[derive(Debug, Clone, Copy)]
