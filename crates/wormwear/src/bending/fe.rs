@@ -172,7 +172,8 @@ pub const MAX_FACTOR_NONZEROS: usize = 375_000_000;
 /// such meshes from taking gigabytes for their pattern.
 pub const MAX_UNKNOWNS: usize = 1_000_000;
 
-/// Element stiffness (60 x 60, row-major) of element `e`.
+/// Element stiffness (60 x 60, row-major) of element `e`: K = sum over the 3 x 3 x 3 Gauss
+/// points of B^T D B w det J.
 pub fn element_stiffness(mesh: &Mesh, e: usize, material: &Elastic) -> Result<Vec<f64>, FeError> {
     let g = [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()];
     let w = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
@@ -183,84 +184,106 @@ pub fn element_stiffness(mesh: &Mesh, e: usize, material: &Elastic) -> Result<Ve
         for (ib, &gb) in g.iter().enumerate() {
             for (ic, &gc) in g.iter().enumerate() {
                 let (_, dn) = shape([ga, gb, gc]);
-                // Jacobian J_ij = d x_j / d xi_i.
-                let mut jac = [[0.0; 3]; 3];
-                for (nd, xn) in dn.iter().zip(&x) {
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            jac[i][j] += nd[i] * xn[j];
-                        }
-                    }
-                }
-                let det = jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1])
-                    - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
-                    + jac[0][2] * (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]);
-                if det <= 0.0 {
-                    return Err(FeError::Jacobian(e));
-                }
-                let inv = [
-                    [
-                        (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1]) / det,
-                        (jac[0][2] * jac[2][1] - jac[0][1] * jac[2][2]) / det,
-                        (jac[0][1] * jac[1][2] - jac[0][2] * jac[1][1]) / det,
-                    ],
-                    [
-                        (jac[1][2] * jac[2][0] - jac[1][0] * jac[2][2]) / det,
-                        (jac[0][0] * jac[2][2] - jac[0][2] * jac[2][0]) / det,
-                        (jac[0][2] * jac[1][0] - jac[0][0] * jac[1][2]) / det,
-                    ],
-                    [
-                        (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]) / det,
-                        (jac[0][1] * jac[2][0] - jac[0][0] * jac[2][1]) / det,
-                        (jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0]) / det,
-                    ],
-                ];
-                // Physical derivatives dN/dx_j = sum_i inv[j][i] dN/dxi_i.
-                let mut b = [[0.0; 60]; 6];
-                for (n, nd) in dn.iter().enumerate() {
-                    let dx = [
-                        inv[0][0] * nd[0] + inv[0][1] * nd[1] + inv[0][2] * nd[2],
-                        inv[1][0] * nd[0] + inv[1][1] * nd[1] + inv[1][2] * nd[2],
-                        inv[2][0] * nd[0] + inv[2][1] * nd[1] + inv[2][2] * nd[2],
-                    ];
-                    let c0 = 3 * n;
-                    b[0][c0] = dx[0];
-                    b[1][c0 + 1] = dx[1];
-                    b[2][c0 + 2] = dx[2];
-                    b[3][c0 + 1] = dx[2];
-                    b[3][c0 + 2] = dx[1];
-                    b[4][c0] = dx[2];
-                    b[4][c0 + 2] = dx[0];
-                    b[5][c0] = dx[1];
-                    b[5][c0 + 1] = dx[0];
-                }
-                let weight = w[ia] * w[ib] * w[ic] * det;
-                // K += B^T D B weight.
-                let mut db = [[0.0; 60]; 6];
-                for i in 0..6 {
-                    for j in 0..6 {
-                        if d[i][j] != 0.0 {
-                            for col in 0..60 {
-                                db[i][col] += d[i][j] * b[j][col];
-                            }
-                        }
-                    }
-                }
-                for r in 0..60 {
-                    for i in 0..6 {
-                        let bri = b[i][r];
-                        if bri != 0.0 {
-                            let row = &mut k[r * 60..(r + 1) * 60];
-                            for (col, v) in row.iter_mut().enumerate() {
-                                *v += bri * db[i][col] * weight;
-                            }
-                        }
-                    }
-                }
+                let jac = jacobian(&dn, &x);
+                let (inv, det) = inverse(&jac).ok_or(FeError::Jacobian(e))?;
+                let b = strain_displacement(&dn, &inv);
+                add_btdb(&mut k, &b, &d, w[ia] * w[ib] * w[ic] * det);
             }
         }
     }
     Ok(k)
+}
+
+/// Jacobian J_ij = d x_j / d xi_i of the map from natural to physical coordinates.
+fn jacobian(dn: &[[f64; 3]; 20], x: &[[f64; 3]]) -> [[f64; 3]; 3] {
+    let mut jac = [[0.0; 3]; 3];
+    for (nd, xn) in dn.iter().zip(x) {
+        for i in 0..3 {
+            for j in 0..3 {
+                jac[i][j] += nd[i] * xn[j];
+            }
+        }
+    }
+    jac
+}
+
+/// The inverse of a Jacobian and its determinant; None when the determinant is not positive
+/// (an inverted or degenerate element).
+fn inverse(jac: &[[f64; 3]; 3]) -> Option<([[f64; 3]; 3], f64)> {
+    let det = jac[0][0] * (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1])
+        - jac[0][1] * (jac[1][0] * jac[2][2] - jac[1][2] * jac[2][0])
+        + jac[0][2] * (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]);
+    if det <= 0.0 {
+        return None;
+    }
+    let inv = [
+        [
+            (jac[1][1] * jac[2][2] - jac[1][2] * jac[2][1]) / det,
+            (jac[0][2] * jac[2][1] - jac[0][1] * jac[2][2]) / det,
+            (jac[0][1] * jac[1][2] - jac[0][2] * jac[1][1]) / det,
+        ],
+        [
+            (jac[1][2] * jac[2][0] - jac[1][0] * jac[2][2]) / det,
+            (jac[0][0] * jac[2][2] - jac[0][2] * jac[2][0]) / det,
+            (jac[0][2] * jac[1][0] - jac[0][0] * jac[1][2]) / det,
+        ],
+        [
+            (jac[1][0] * jac[2][1] - jac[1][1] * jac[2][0]) / det,
+            (jac[0][1] * jac[2][0] - jac[0][0] * jac[2][1]) / det,
+            (jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0]) / det,
+        ],
+    ];
+    Some((inv, det))
+}
+
+/// Strain-displacement matrix B (6 x 60, Voigt order xx, yy, zz, yz, xz, xy) from the natural
+/// derivatives of the shape functions and the inverse Jacobian: dN/dx_j = sum_i inv[j][i]
+/// dN/dxi_i.
+fn strain_displacement(dn: &[[f64; 3]; 20], inv: &[[f64; 3]; 3]) -> [[f64; 60]; 6] {
+    let mut b = [[0.0; 60]; 6];
+    for (n, nd) in dn.iter().enumerate() {
+        let dx = [
+            inv[0][0] * nd[0] + inv[0][1] * nd[1] + inv[0][2] * nd[2],
+            inv[1][0] * nd[0] + inv[1][1] * nd[1] + inv[1][2] * nd[2],
+            inv[2][0] * nd[0] + inv[2][1] * nd[1] + inv[2][2] * nd[2],
+        ];
+        let c0 = 3 * n;
+        b[0][c0] = dx[0];
+        b[1][c0 + 1] = dx[1];
+        b[2][c0 + 2] = dx[2];
+        b[3][c0 + 1] = dx[2];
+        b[3][c0 + 2] = dx[1];
+        b[4][c0] = dx[2];
+        b[4][c0 + 2] = dx[0];
+        b[5][c0] = dx[1];
+        b[5][c0 + 1] = dx[0];
+    }
+    b
+}
+
+/// K += B^T D B weight (K row-major 60 x 60).
+fn add_btdb(k: &mut [f64], b: &[[f64; 60]; 6], d: &[[f64; 6]; 6], weight: f64) {
+    let mut db = [[0.0; 60]; 6];
+    for i in 0..6 {
+        for j in 0..6 {
+            if d[i][j] != 0.0 {
+                for col in 0..60 {
+                    db[i][col] += d[i][j] * b[j][col];
+                }
+            }
+        }
+    }
+    for r in 0..60 {
+        for i in 0..6 {
+            let bri = b[i][r];
+            if bri != 0.0 {
+                let row = &mut k[r * 60..(r + 1) * 60];
+                for (col, v) in row.iter_mut().enumerate() {
+                    *v += bri * db[i][col] * weight;
+                }
+            }
+        }
+    }
 }
 
 /// Prescribed displacement of one degree of freedom (node, direction 0..3, value m).
@@ -555,85 +578,128 @@ fn solve_free_minus_blocked(
     loads: &[Vec<Load>],
     limits: SizeLimits,
 ) -> Result<Solution, FeError> {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
-    };
     let dofs = Dofs::new(mesh, fixed);
-    let free = dofs.free;
-    if free > limits.unknowns {
+    if dofs.free > limits.unknowns {
         return Err(FeError::TooLarge {
-            unknowns: free,
+            unknowns: dofs.free,
             nonzeros: None,
         });
     }
-    let pattern = LowerPattern::new(mesh, springs, &dofs.map, free);
-    let mut is_blocked = vec![false; free];
-    for &n in blocked {
-        for d in 0..3 {
-            let g = 3 * n + d;
-            if dofs.map[g] != usize::MAX {
-                is_blocked[dofs.map[g]] = true;
-            }
-        }
-    }
-    let (forward, inverse, unblocked) = order_blocked_last(pattern.symbolic(free), &is_blocked)?;
-    let failed = |e: &dyn std::fmt::Debug| FeError::Factorisation(format!("{e:?}"));
-    let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
-    let symbolic = factorize_symbolic_cholesky(
-        pattern.symbolic(free),
-        Side::Lower,
-        SymmetricOrdering::Custom(perm),
-        CholeskySymbolicParams::default(),
-    )
-    .map_err(|e| failed(&e))?;
-    if symbolic.len_val() > limits.factor_nonzeros {
-        return Err(FeError::TooLarge {
-            unknowns: free,
-            nonzeros: Some(symbolic.len_val()),
-        });
-    }
+    let pattern = LowerPattern::new(mesh, springs, &dofs.map, dofs.free);
+    let factor = BlockedLast::analyse(&pattern, &dofs, blocked, limits)?;
     let elements = element_stiffnesses(mesh, material)?;
     let system = fill(mesh, &elements, springs, loads, dofs, pattern);
     drop(elements);
-    let par = faer::get_global_parallelism();
-    let cases = loads.len();
-    let mut values = vec![0.0; symbolic.len_val()];
-    let mut mem = MemBuffer::new(
-        symbolic
-            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(cases, par)),
-    );
-    symbolic
-        .factorize_numeric_llt(
-            &mut values,
-            system.matrix.as_ref(),
-            Side::Lower,
-            faer::linalg::cholesky::llt::factor::LltRegularization::default(),
-            par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .map_err(|e| failed(&e))?;
-    drop(system.matrix);
-    let mut y = Mat::<f64>::from_fn(free, cases, |i, c| system.rhs[(forward[i], c)]);
-    drop(system.rhs);
-    lower_solve(&symbolic, &values, y.as_mut(), false, par, &mut mem);
-    for c in 0..cases {
-        for i in 0..unblocked {
-            y[(i, c)] = 0.0;
-        }
-    }
-    lower_solve(&symbolic, &values, y.as_mut(), true, par, &mut mem);
+    let x = factor.difference(system.matrix, system.rhs)?;
     let mut prescribed = system.prescribed;
     for p in prescribed.iter_mut().flatten() {
         *p = 0.0;
     }
     Ok(Solution {
-        x: Mat::<f64>::from_fn(free, cases, |i, c| y[(inverse[i], c)]),
+        x,
         map: system.map,
         prescribed,
     })
+}
+
+/// The symbolic Cholesky factor of a run's free-free stiffness with the blocked DOFs ordered
+/// last ([`order_blocked_last`]), see [`solve_free_minus_blocked`].
+struct BlockedLast {
+    /// New -> old and old -> new free-DOF order.
+    forward: Vec<usize>,
+    inverse: Vec<usize>,
+    /// The unknowns before the blocked ones.
+    unblocked: usize,
+    symbolic: faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+}
+
+impl BlockedLast {
+    /// Orders and analyses `pattern`; refuses a factor above `limits.factor_nonzeros`.
+    fn analyse(
+        pattern: &LowerPattern,
+        dofs: &Dofs,
+        blocked: &[usize],
+        limits: SizeLimits,
+    ) -> Result<Self, FeError> {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let free = dofs.free;
+        let mut is_blocked = vec![false; free];
+        for &n in blocked {
+            for d in 0..3 {
+                let g = 3 * n + d;
+                if dofs.map[g] != usize::MAX {
+                    is_blocked[dofs.map[g]] = true;
+                }
+            }
+        }
+        let (forward, inverse, unblocked) =
+            order_blocked_last(pattern.symbolic(free), &is_blocked)?;
+        let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(free),
+            Side::Lower,
+            SymmetricOrdering::Custom(perm),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+        if symbolic.len_val() > limits.factor_nonzeros {
+            return Err(FeError::TooLarge {
+                unknowns: free,
+                nonzeros: Some(symbolic.len_val()),
+            });
+        }
+        Ok(Self {
+            forward,
+            inverse,
+            unblocked,
+            symbolic,
+        })
+    }
+
+    /// Factorises `matrix` and returns the free run minus the blocked run of every case of
+    /// `rhs` (free-DOF numbering): L^-T [0; y_B] with y = L^-1 f.
+    fn difference(
+        &self,
+        matrix: SparseColMat<usize, f64>,
+        rhs: Mat<f64>,
+    ) -> Result<Mat<f64>, FeError> {
+        use faer::dyn_stack::{MemBuffer, MemStack};
+        let symbolic = &self.symbolic;
+        let (free, cases) = (rhs.nrows(), rhs.ncols());
+        let par = faer::get_global_parallelism();
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut mem = MemBuffer::new(
+            symbolic
+                .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+                .or(symbolic.solve_in_place_scratch::<f64>(cases, par)),
+        );
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                matrix.as_ref(),
+                Side::Lower,
+                faer::linalg::cholesky::llt::factor::LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+        drop(matrix);
+        let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(self.forward[i], c)]);
+        drop(rhs);
+        lower_solve(symbolic, &values, y.as_mut(), false, par, &mut mem);
+        for c in 0..cases {
+            for i in 0..self.unblocked {
+                y[(i, c)] = 0.0;
+            }
+        }
+        lower_solve(symbolic, &values, y.as_mut(), true, par, &mut mem);
+        Ok(Mat::<f64>::from_fn(free, cases, |i, c| {
+            y[(self.inverse[i], c)]
+        }))
+    }
 }
 
 /// Fill-reducing order with the `last` unknowns at the end: AMD on the matrix without them,
