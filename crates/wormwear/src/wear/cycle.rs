@@ -1,0 +1,253 @@
+//! Wear of one mesh cycle (MODEL §7.2): the loaded band's passage over every node of the reference
+//! tooth, the time integral of the pressure by quadrature, the film and the local wear coefficient
+//! from [`crate::lubrication`], Archard's removal. Why the band is moved continuously: see the
+//! module doc of [`super`].
+
+use crate::geometry::{FlankField, Geometry, WheelFlank};
+use crate::input::{FilmLoad, GearSet};
+use crate::kinematics::{GapEvaluator, Tca};
+use crate::ltca::passage::Passage;
+use crate::ltca::Ltca;
+use crate::lubrication::{self, LineContact};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Wear of one mesh cycle (one passage of the contact over every point of the reference
+/// tooth) on the loaded wheel flank's nodes.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CycleWear {
+    /// Depth worn normal to the flank per cycle, m.
+    pub depth: FlankField,
+    /// Film ratio lambda at the passage (the smallest if swept more than once; NaN where the
+    /// loaded line never passes).
+    pub lambda: FlankField,
+    /// Film thickness h_min Phi_T at the passage, m (NaN where not swept).
+    pub film: FlankField,
+    /// Line load at the passage, N/m (the largest if swept more than once; 0 where not
+    /// swept).
+    pub line_load: FlankField,
+    /// Relative radius of curvature across the line at that passage, m (0 where not swept).
+    pub contact_radius: FlankField,
+    /// Half-width of the loaded band when it passes (the largest), m (0 where not swept).
+    pub half_width: FlankField,
+    /// Hertz half-width of the line contact at that passage, a = sqrt(4 w R / (pi E*)) with
+    /// its line load w and relative radius R (MODEL §12 g), m (0 where not swept).
+    pub hertz_half_width: FlankField,
+}
+
+/// Rolling velocities of every node of the loaded flank (u1, u2; m/s); where the TCA has
+/// none (nodes at the border of the region the worm flank reaches, whose surface gradient is
+/// undefined), the nearest node of the same column that has them.
+fn rolling_velocities(wf: &WheelFlank, tca: &Tca) -> Vec<(f64, f64)> {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    (0..=nj)
+        .flat_map(|j| {
+            let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
+            let valid: Vec<usize> = column
+                .iter()
+                .copied()
+                .filter(|&k| tca.node_contact[k].u2.is_finite())
+                .collect();
+            column
+                .iter()
+                .map(|&k| {
+                    let src = valid
+                        .iter()
+                        .copied()
+                        .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
+                        .unwrap_or(k);
+                    let c = &tca.node_contact[src];
+                    (c.u1, c.u2)
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// What the wear of one cycle reads at every passage of the band over a node ([`per_cycle`]):
+/// the gear, the flank, the TCA's sliding, the rolling velocities, the time between positions
+/// (rad of wheel rotation) and the wheel speed (rad/s), E' (Pa), the dry wear coefficient,
+/// the hardness (Pa) and the film load's reading.
+struct PassageWear<'a> {
+    gear: &'a GearSet,
+    wf: &'a WheelFlank,
+    tca: &'a Tca,
+    rolling: Vec<(f64, f64)>,
+    dt: f64,
+    wheel_speed: f64,
+    e_prime: f64,
+    k_dry: f64,
+    hardness: f64,
+    film_load: FilmLoad,
+}
+
+impl PassageWear<'_> {
+    /// Per node of column j, from the band's instants on it: depth per cycle, lambda, film,
+    /// line load, band half-width, and the relative radius at the passage of the largest line
+    /// load (MODEL §7.2, §6).
+    fn column(&self, j: usize, samples: &mut [crate::ltca::passage::Sample]) -> Vec<[f64; 6]> {
+        let ni = self.wf.cells_height;
+        let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
+        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+        for pair in samples.windows(2) {
+            // Consecutive instants of the same engagement only.
+            let Some(passage) = Passage::between(&pair[0], &pair[1], self.dt) else {
+                continue;
+            };
+            for (i, o) in out.iter_mut().enumerate() {
+                self.node(j * (ni + 1) + i, &passage, o);
+            }
+        }
+        out
+    }
+
+    /// Adds one passage over node k to its entry `o` ([`Self::column`]).
+    fn node(&self, k: usize, passage: &Passage, o: &mut [f64; 6]) {
+        let (a, b) = (passage.a, passage.b);
+        let duration = (b.time - a.time) / self.wheel_speed;
+        let (lo, hi, steps) = (passage.lo, passage.hi, passage.steps);
+        let w = 0.5 * (a.line_load + b.line_load);
+        let fill = |x: f64, y: f64| {
+            if !x.is_finite() {
+                y
+            } else if !y.is_finite() {
+                x
+            } else {
+                0.5 * (x + y)
+            }
+        };
+        let node = &self.wf.nodes[k];
+        if node.r < lo || node.r > hi {
+            return;
+        }
+        let nc = &self.tca.node_contact[k];
+        let (u1, u2) = self.rolling[k];
+        let mut integral = 0.0;
+        for m in 0..steps {
+            integral += passage.pressure(node.r, (m as f64 + 0.5) / steps as f64);
+        }
+        integral *= duration / steps as f64;
+        if integral <= 0.0 {
+            return;
+        }
+        // The film of the line contact with the local line load (MODEL §6, §12 h), or, as a
+        // refinement, with at least the Hertz load of the band's peak pressure
+        // (w = 2 pi R p0^2 / E').
+        let radius = fill(a.radius, b.radius);
+        let peak = a.pressure.max(b.pressure);
+        let film_line_load = match self.film_load {
+            FilmLoad::LoadedAnalysis => w,
+            FilmLoad::HertzPeakFloor => w.max(2.0 * PI * radius * peak * peak / self.e_prime),
+        };
+        let contact = LineContact {
+            radius,
+            u1,
+            u2,
+            line_load: film_line_load,
+            pressure: peak,
+        };
+        let fl = lubrication::film(&self.gear.lubricant, self.e_prime, &contact);
+        let kw = lubrication::wear_coefficient(self.k_dry, fl.lambda);
+        o[0] += kw / self.hardness * nc.sliding_speed * integral;
+        if o[1].is_nan() || fl.lambda < o[1] {
+            o[1] = fl.lambda;
+            o[2] = fl.h_min * fl.thermal_factor;
+        }
+        if w > o[3] {
+            o[3] = w;
+            o[5] = radius;
+        }
+        o[4] = o[4].max(a.half_width.max(b.half_width));
+    }
+}
+
+/// Wear of one mesh cycle from the loaded analysis (MODEL §7.1-7.2), on the loaded flank.
+///
+/// Between two consecutive instants a, b of the reference tooth on a node column, the loaded
+/// band is taken to translate from its centroid c_a to c_b while its shape blends from p_a to
+/// p_b; the time integral of the pressure at every node follows by quadrature over the
+/// interval (sub-steps of at most a tenth of the band width). The passage is thus resolved
+/// whatever the number of positions (no aliasing), and the band follows the worn geometry
+/// (the profiles are the loaded analysis on it). Depth = (k(lambda)/H) |vg| integral(p dt),
+/// |vg| of the node at its contact moment, lambda from the interpolated line load (floored at
+/// the Hertz load of the peak pressure with [`FilmLoad::HertzPeakFloor`]).
+pub fn per_cycle(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    ltca: &Ltca,
+    film_load: FilmLoad,
+) -> CycleWear {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let ni = wf.cells_height;
+    let tau = 2.0 * PI / geo.teeth as f64;
+    let np = tca.positions.len();
+    let dt = tau / np as f64;
+    // Wheel speed, rad/s: converts wheel rotation into time.
+    let wheel_speed = gear.conditions.worm_speed / gear.ratio();
+    let mut columns = crate::ltca::passage::band_samples(wf, tca, &ltca.positions, tau);
+    let e_prime = lubrication::reduced_modulus(
+        gear.worm_material.youngs_modulus,
+        gear.worm_material.poisson_ratio,
+        gear.wheel_material.youngs_modulus,
+        gear.wheel_material.poisson_ratio,
+    );
+    // E* of the Hertz half-width: 1/E* = (1-v1^2)/E1 + (1-v2^2)/E2 = 2/E'.
+    let e_star = 0.5 * e_prime;
+    let k_dry = gear.wheel_material.wear_coefficient;
+    let hardness = gear.wheel_material.hardness;
+    let mut depth = FlankField::zeros(wf);
+    let mut lambda = FlankField::zeros(wf);
+    let mut film = FlankField::zeros(wf);
+    let mut line_load = FlankField::zeros(wf);
+    let mut half_width = FlankField::zeros(wf);
+    let mut hertz_half_width = FlankField::zeros(wf);
+    let mut contact_radius = FlankField::zeros(wf);
+    lambda.values.fill(f64::NAN);
+    film.values.fill(f64::NAN);
+    let context = PassageWear {
+        gear,
+        wf,
+        tca,
+        rolling: rolling_velocities(wf, tca),
+        dt,
+        wheel_speed,
+        e_prime,
+        k_dry,
+        hardness,
+        film_load,
+    };
+    // Node columns are independent (each writes its own nodes): in parallel, then gathered.
+    let per_column: Vec<Vec<[f64; 6]>> = columns
+        .par_iter_mut()
+        .enumerate()
+        .map(|(j, samples)| context.column(j, samples))
+        .collect();
+    for (j, out) in per_column.iter().enumerate() {
+        for (i, o) in out.iter().enumerate() {
+            let k = j * (ni + 1) + i;
+            depth.values[k] = o[0];
+            lambda.values[k] = o[1];
+            film.values[k] = o[2];
+            line_load.values[k] = o[3];
+            half_width.values[k] = o[4];
+            contact_radius.values[k] = o[5];
+            hertz_half_width.values[k] = crate::contact::hertz_half_width(o[3], o[5], e_star);
+        }
+    }
+    CycleWear {
+        depth,
+        lambda,
+        film,
+        line_load,
+        half_width,
+        contact_radius,
+        hertz_half_width,
+    }
+}
+
+/// Lever |(P x n)_z| of node k of a flank (rotation invariant about the wheel axis), m.
+pub(super) fn node_lever(wf: &WheelFlank, k: usize) -> f64 {
+    let n = &wf.nodes[k];
+    GapEvaluator::lever(&n.position(), &n.normal_vec())
+}

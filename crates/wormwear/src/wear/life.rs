@@ -1,0 +1,615 @@
+//! The life loop (MODEL §7.1, §7.5): wear steps with the geometry updated, the step control, the
+//! phases of the schedule, pitting between steps, the maps' states, and the checks that a plan can
+//! end and that a life does not stall.
+
+use super::{
+    cut_pits, forecast, per_cycle, pit_depths, pitted_fraction, Backlash, CycleWear, Phase,
+    Pitting, PositionState, StepControl, StepRecord, WearError, WearLimits, WearPlan, WearState,
+};
+use crate::geometry::{FlankField, Geometry, WheelFlank};
+use crate::input::GearSet;
+use crate::kinematics::Tca;
+use crate::ltca::{stats, Ltca};
+
+/// What the life loop hands out after each completed state: the state (to checkpoint), the
+/// loaded analysis and the per-cycle wear on that geometry.
+pub struct StepView<'a> {
+    pub state: &'a WearState,
+    pub ltca: &'a Ltca,
+    pub cycle: &'a CycleWear,
+    /// The last state of the run (the life is reached).
+    pub last: bool,
+    /// A state whose maps are written (`map_cycles`, or 0, 1, 2, 4, ... by default).
+    pub map: bool,
+}
+
+/// Runs the life (MODEL §7.3-7.7, §8) from `state` (unworn, or a checkpoint): at each state
+/// the loaded analysis on the worn geometry, the wear of one cycle, a record; then, in a wear
+/// phase, a step of C_k cycles (fixed, or removing at most the given depth; never across a
+/// phase end or a map cycle) with the geometry frozen; at the start of a pitting phase the
+/// pits are cut (every node whose loaded-pattern pressure exceeds the phase's limit loses
+/// 0.78 a, a the local Hertz half-width there, MODEL §12 g), then the phase passes without
+/// wear. Until the life is reached, or a wear limit is ([`WearLimits`]: the pointed tip, or the
+/// backlash limit if the plan stops there; the state's `stopped` says which). `on_state` is
+/// called after every record (checkpoint, files); an error from it stops the run.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    settings: &crate::ltca::LtcaSettings,
+    bending: Option<&dyn crate::ltca::BendingModel>,
+    life: &WearPlan,
+    mut state: WearState,
+    on_state: &mut dyn FnMut(&StepView) -> Result<(), WearError>,
+) -> Result<WearState, WearError> {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    if state.removal.values.len() != wf.nodes.len() || state.removal.cells_height != wf.cells_height
+    {
+        return Err(WearError::Checkpoint(format!(
+            "{} x {} cells, the gear has {} x {}",
+            state.removal.cells_height, state.removal.cells_face, wf.cells_height, wf.cells_face
+        )));
+    }
+    if state.pitted.len() != wf.nodes.len() {
+        state.pitted = vec![false; wf.nodes.len()];
+    }
+    if state.damage.len() != wf.nodes.len() {
+        state.damage = vec![0.0; wf.nodes.len()];
+    }
+    if !state.plastic_set.fits(wf) {
+        state.plastic_set = FlankField::zeros(wf);
+    }
+    check_plan_can_end(gear, life)?;
+    let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
+    let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
+    let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    let mut stalled = 0;
+    loop {
+        let (l, band) = life_loop.analyse(&state)?;
+        let cw = per_cycle(gear, geo, tca, &l, life.film_load);
+        let loads = forecast::NodeLoads::new(
+            wf,
+            &l,
+            &cw,
+            &life.endurance,
+            life.pit_depth,
+            life.pitting_stress,
+        );
+        life_loop.start_forecast_phase(&mut state, &loads);
+        let phase = life_loop.phase_at(&state, state.cycles);
+        let record = life_loop.record(&state, &l, &cw, phase, step_cycles, substeps);
+        // A resumed run recomputes the state it stopped at: keep one record per step.
+        state.records.retain(|r| r.step < state.step);
+        state.stopped = life_loop.limits.passed(&record);
+        state.records.push(record);
+        let left = life.life_cycles - state.cycles;
+        let last = left <= 1e-9 * life.life_cycles.max(1.0) || state.stopped.is_some();
+        on_state(&StepView {
+            state: &state,
+            ltca: &l,
+            cycle: &cw,
+            last,
+            map: life_loop.is_map_state(&state),
+        })?;
+        if last {
+            break;
+        }
+        // What the next analysis starts from (after the checkpoint, which keeps what this
+        // state's analysis used).
+        state.band_factor = band;
+        state.warm = Some(l.warm_start());
+        state.run_in(&l);
+        let before = state.cycles;
+        (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
+        state.step += 1;
+        stalled = stalled_steps(stalled, before, &state)?;
+    }
+    Ok(state)
+}
+
+/// The count of consecutive steps that left the cycles where they were, with the one that
+/// brought `state` from `before` cycles: a life that stops advancing would run for ever, a
+/// defect reported as such after [`MAX_STALLED_STEPS`].
+fn stalled_steps(stalled: usize, before: f64, state: &WearState) -> Result<usize, WearError> {
+    let stalled = if state.cycles > before {
+        0
+    } else {
+        stalled + 1
+    };
+    if stalled >= MAX_STALLED_STEPS {
+        return Err(WearError::Plan(format!(
+            "the life did not advance beyond {} cycles in {MAX_STALLED_STEPS} steps (step {}): \
+             stopped rather than run for ever; please report it with the gear file",
+            state.cycles, state.step
+        )));
+    }
+    Ok(stalled)
+}
+
+/// Consecutive steps that may leave the cycles where they were (a pitting phase's cut pits
+/// take none) before a life is stopped as stalled.
+const MAX_STALLED_STEPS: usize = 50;
+
+/// Most loaded analyses a life plan may need (a case B life needs ~2 700).
+pub const MAX_ANALYSES: f64 = 200_000.0;
+
+/// Refuses a plan whose step count has no practical bound: fixed steps of `life / step`
+/// states, or adaptive steps and sub-steps so small that wearing down to the standard's
+/// pointed-tip limit (MODEL §9 (a)), which no life passes, would take more than
+/// [`MAX_ANALYSES`] loaded analyses.
+pub fn check_plan_can_end(gear: &GearSet, life: &WearPlan) -> Result<(), WearError> {
+    let limit = crate::rating::rate(gear).wear_limit_pointed_tip_m;
+    let (what, count) = match life.step {
+        StepControl::Cycles(c) => (
+            format!(
+                "fixed steps of {c:e} cycles over {:e} cycles",
+                life.life_cycles
+            ),
+            life.life_cycles / c,
+        ),
+        StepControl::MaxRemoval(d) => (
+            format!(
+                "adaptive steps of {:e} um up to the pointed-tip wear limit of {:.3} mm",
+                d * 1e6,
+                limit * 1e3
+            ),
+            limit / d,
+        ),
+    };
+    let guard = life.max_substep_removal;
+    let (what, count) = if guard > 0.0 && limit / guard > count {
+        (
+            format!(
+                "sub-steps of at most {:e} um (max_substep_wear_um) up to the pointed-tip wear \
+                 limit of {:.3} mm",
+                guard * 1e6,
+                limit * 1e3
+            ),
+            limit / guard,
+        )
+    } else {
+        (what, count)
+    };
+    if count > MAX_ANALYSES {
+        return Err(WearError::Plan(format!(
+            "up to {count:.3e} loaded analyses could be needed ({what}), more than \
+             {MAX_ANALYSES:e}: use larger steps or a shorter life"
+        )));
+    }
+    Ok(())
+}
+
+/// What the life loop of [`simulate`] works with, and its named steps.
+struct LifeLoop<'a> {
+    gear: &'a GearSet,
+    geo: &'a Geometry,
+    tca: &'a Tca,
+    settings: &'a crate::ltca::LtcaSettings,
+    bending: Option<&'a dyn crate::ltca::BendingModel>,
+    life: &'a WearPlan,
+    wf: &'a WheelFlank,
+    backlash: Backlash,
+    /// Backlash per position of the unworn flank, rad.
+    initial_backlash: Vec<f64>,
+    active_area: f64,
+    /// Sliding speed at the reference diameter (the standard's v_gm) and sigma_Hlim, for
+    /// Rank's N_LI from the model's mean pressure.
+    sliding_speed: f64,
+    pitting_limit: f64,
+    limits: WearLimits,
+}
+
+impl<'a> LifeLoop<'a> {
+    fn new(
+        gear: &'a GearSet,
+        geo: &'a Geometry,
+        tca: &'a Tca,
+        settings: &'a crate::ltca::LtcaSettings,
+        bending: Option<&'a dyn crate::ltca::BendingModel>,
+        life: &'a WearPlan,
+    ) -> Self {
+        let wf = geo.wheel_flank(tca.loaded_flank);
+        let backlash = Backlash::new(gear, geo, tca);
+        let initial_backlash = backlash.per_position(&FlankField::zeros(wf));
+        Self {
+            gear,
+            geo,
+            tca,
+            settings,
+            bending,
+            life,
+            wf,
+            backlash,
+            initial_backlash,
+            active_area: wf.active_area(),
+            sliding_speed: crate::rating::rate(gear).sliding_speed_m_s,
+            pitting_limit: gear.wheel_material.pitting_limit,
+            limits: WearLimits::new(gear, geo, tca, life),
+        }
+    }
+
+    /// The schedule of this life: the plan's, or the one its forecast has found so far.
+    fn schedule<'s>(&'s self, state: &'s WearState) -> &'s [Phase] {
+        match self.life.pitting {
+            Pitting::Forecast => &state.found_phases,
+            _ => &self.life.phases,
+        }
+    }
+
+    /// Whether the pits come from the damage (`wear::forecast`).
+    fn pits_from_damage(&self) -> bool {
+        matches!(self.life.pitting, Pitting::Damage | Pitting::Forecast)
+    }
+
+    /// A forecast starts a pitting phase at a state of a wear phase (after its first state)
+    /// where loaded nodes whose damage has reached 1 make up the onset share of the flank
+    /// (default 2 %; 0: the first such node; `wear::forecast`). The phase lasts the life on
+    /// the pressure–life curve of its least loaded pit.
+    fn start_forecast_phase(&self, state: &mut WearState, loads: &forecast::NodeLoads) {
+        if self.life.pitting != Pitting::Forecast {
+            return;
+        }
+        let cycles = state.cycles;
+        if let Some((_, Phase::Pitting { .. }, _)) = self.phase_at(state, cycles) {
+            return;
+        }
+        let wear_start = state.found_phases.last().map_or(0.0, phase_end);
+        let Some(pressure) = loads.median_due_pressure(&state.damage) else {
+            return;
+        };
+        let onset = self.life.pitting_onset_share;
+        if cycles > wear_start && loads.due_share(&state.damage) >= onset {
+            state.found_phases.push(Phase::Wear { until: cycles });
+            state.found_phases.push(Phase::Pitting {
+                until: cycles + self.life.endurance.life(pressure),
+                pressure_limit: None,
+                margin: 0.0,
+            });
+        }
+    }
+
+    /// The step from a state (`left`: cycles to the life's end): in a pitting phase, its pits
+    /// or its passing without wear ([`Self::pitting_step`]); in a wear phase, a wear step,
+    /// which with pits from the damage ends where the nodes due make up the onset share. The damage advances
+    /// over a wear step and holds in a pitting phase (`wear::forecast`). Returns the step's cycles
+    /// and sub-steps.
+    fn step(
+        &self,
+        state: &mut WearState,
+        l: &Ltca,
+        cw: CycleWear,
+        loads: &forecast::NodeLoads,
+        phase: Option<(usize, Phase, f64)>,
+        left: f64,
+    ) -> Result<(f64, usize), WearError> {
+        let end = match phase {
+            Some((k, Phase::Pitting { .. }, end)) => {
+                let advanced = self.pitting_step(state, l, &cw, loads, k, end);
+                return Ok((advanced, 1));
+            }
+            Some((_, Phase::Wear { .. }, end)) => end,
+            None => self.life.life_cycles,
+        };
+        let mut left = left
+            .min(end - state.cycles)
+            .min(self.next_map_cycles(state.cycles) - state.cycles);
+        if self.pits_from_damage() {
+            // Steps end where the nodes due to pit make up the onset share: a forecast starts
+            // its phases there, and a schedule with pits from the damage resolves the same
+            // states (the phases a forecast found repeat it).
+            let onset = self.life.pitting_onset_share;
+            if let Some(n) = loads.cycles_to_onset(&state.damage, onset) {
+                left = left.min(n);
+            }
+        }
+        let rate = cw.depth.max();
+        let step_cycles = match self.life.step {
+            StepControl::Cycles(c) => c.min(left),
+            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
+            StepControl::MaxRemoval(_) => left,
+        };
+        let target = state.cycles + step_cycles;
+        let substeps = self.wear_step(state, cw, step_cycles)?;
+        // The sub-steps' sum lands on the step's end, and a step to a phase's end on that
+        // end, exactly: a schedule's phases then start at the cycles they were found at.
+        state.cycles = if (end - target).abs() <= 1e-9 * end {
+            end
+        } else {
+            target
+        };
+        loads.advance(&mut state.damage, step_cycles, true);
+        Ok((step_cycles, substeps))
+    }
+
+    /// Phase at some cycles: (index, phase, end); None after the schedule (wear).
+    fn phase_at(&self, state: &WearState, cycles: f64) -> Option<(usize, Phase, f64)> {
+        let mut start = 0.0;
+        for (k, p) in self.schedule(state).iter().enumerate() {
+            let end = phase_end(p);
+            if cycles < end * (1.0 - 1e-12) && cycles >= start * (1.0 - 1e-12) {
+                return Some((k, *p, end));
+            }
+            start = end;
+        }
+        None
+    }
+
+    /// The first map cycle beyond `cycles` (infinite: none).
+    fn next_map_cycles(&self, cycles: f64) -> f64 {
+        self.life
+            .map_cycles
+            .iter()
+            .flatten()
+            .copied()
+            .find(|&c| c > cycles * (1.0 + 1e-12) + 1e-9)
+            .unwrap_or(f64::INFINITY)
+    }
+
+    /// Whether the maps of this state are written: at the map cycles, or by default at the
+    /// states 0, 1, 2, 4, 8, ...
+    fn is_map_state(&self, state: &WearState) -> bool {
+        match &self.life.map_cycles {
+            None => state.step == 0 || state.step.is_power_of_two(),
+            Some(list) => list
+                .iter()
+                .any(|&c| (c - state.cycles).abs() <= 1e-9 * c.max(1.0)),
+        }
+    }
+
+    /// Loaded analysis on the worn geometry. The worn contact widens: the band of the local
+    /// meshes starts as wide as the last analysis needed (no repeated widenings), carried in
+    /// the state for an exact resume. An unworn flank is analysed as the LTCA stage does.
+    fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
+        let mut local = *self.settings;
+        local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
+        let changed = |f: &FlankField| f.values.iter().any(|&h| h != 0.0);
+        let change = crate::ltca::FlankChange {
+            removal: Some(&state.removal).filter(|f| changed(f)),
+            plastic_set: Some(&state.plastic_set).filter(|f| changed(f)),
+        };
+        let l = crate::ltca::analyse_changed(
+            self.gear,
+            self.geo,
+            self.tca,
+            &local,
+            self.bending,
+            change,
+            state.warm.as_ref(),
+        )
+        .map_err(|source| WearError::Ltca {
+            step: state.step,
+            cycles: state.cycles,
+            source,
+        })?;
+        let widenings = l
+            .positions
+            .iter()
+            .map(|p| p.band_widenings)
+            .max()
+            .unwrap_or(0);
+        let band = (widenings > 0)
+            .then(|| (local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0))
+            .or(state.band_factor);
+        Ok((l, band))
+    }
+
+    /// The rigid lag the flank change `change` adds at each position (rad, MODEL §12 j) and
+    /// each position's TE, TE relative to that lag, tooth loads and largest pressure.
+    fn position_states(&self, l: &Ltca, change: &FlankField) -> (Vec<f64>, Vec<PositionState>) {
+        let per_position = self.backlash.per_position(change);
+        let lag: Vec<f64> = per_position
+            .iter()
+            .zip(&self.initial_backlash)
+            .map(|(b, b0)| b - b0)
+            .collect();
+        let positions: Vec<PositionState> = l
+            .positions
+            .iter()
+            .map(|p| PositionState {
+                te_rad: p.transmission_error,
+                te_relative_rad: p.transmission_error + lag[p.position],
+                tooth_load_n: p.tooth_load.clone(),
+                max_pressure_pa: p.max_pressure,
+            })
+            .collect();
+        (lag, positions)
+    }
+
+    /// The record of a state (MODEL §7.7, §12 j, §12 k).
+    fn record(
+        &self,
+        state: &WearState,
+        l: &Ltca,
+        cw: &CycleWear,
+        phase: Option<(usize, Phase, f64)>,
+        step_cycles: f64,
+        substeps: usize,
+    ) -> StepRecord {
+        let wf = self.wf;
+        let change = state.flank_change();
+        let (lag, positions) = self.position_states(l, &change);
+        let b = self.backlash.stats(&change);
+        let initial = self.initial_backlash.iter().sum::<f64>()
+            / self.initial_backlash.len().max(1) as f64
+            * self.backlash.reference_radius;
+        let (te_mean, te_p2p) = l.te_stats();
+        let (te_rel_mean, te_rel_p2p) = stats(positions.iter().map(|p| p.te_relative_rad));
+        let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
+        let volume = state.removal.integral(wf);
+        let worst_node = argmax(&state.removal.values).map(|k| &wf.nodes[k]);
+        let worst_cell = argmax(&l.pattern).map(|k| &wf.cells[k]);
+        let previous = state
+            .records
+            .iter()
+            .rev()
+            .find(|r| r.step < state.step)
+            .map_or(0, |r| r.loaded_analyses);
+        StepRecord {
+            step: state.step,
+            cycles: state.cycles,
+            step_cycles,
+            substeps,
+            phase: match phase {
+                Some((_, Phase::Pitting { .. }, _)) => "pitting".into(),
+                _ => "wear".into(),
+            },
+            pitted_area_fraction: pitted_fraction(wf, &state.pitted),
+            max_wear_m: state.removal.max(),
+            max_wear_r_m: worst_node.map_or(f64::NAN, |n| n.r),
+            max_wear_z_m: worst_node.map_or(f64::NAN, |n| n.z),
+            wear_patch_max_m: state.removal.patch_mean_max(
+                wf,
+                self.settings.patch_across,
+                self.settings.patch_along,
+            ),
+            mean_wear_m: volume / self.active_area,
+            worn_volume_m3: volume,
+            backlash_m: b.linear_mean_m,
+            backlash_increase_m: b.linear_mean_m - initial,
+            backlash_min_rad: b.min_rad,
+            backlash_max_rad: b.max_rad,
+            max_pressure_pa: l.max_pressure,
+            max_pressure_r_m: worst_cell.map_or(f64::NAN, |c| c.r),
+            max_pressure_z_m: worst_cell.map_or(f64::NAN, |c| c.z),
+            mean_pressure_pa: l.mean_pressure,
+            contact_area_fraction: l.s0,
+            s1: l.s1,
+            s2: l.s2,
+            te_mean_rad: te_mean,
+            te_p2p_rad: te_p2p,
+            mesh_stiffness_mean_nm_per_rad: l.stiffness_mean(),
+            max_wear_per_cycle_m: cw.depth.max(),
+            lambda_min: lambdas.clone().fold(f64::INFINITY, f64::min),
+            lambda_max: lambdas.fold(0.0, f64::max),
+            pressure_patch_max_pa: l.pressure_patch_max,
+            rigid_lag_rad: lag.iter().sum::<f64>() / lag.len().max(1) as f64,
+            te_mean_relative_rad: te_rel_mean,
+            te_p2p_relative_rad: te_rel_p2p,
+            n_li_model_cycles: crate::rating::rank_first_pitting_cycles(
+                self.sliding_speed,
+                l.mean_pressure * 1e-6,
+                self.pitting_limit * 1e-6,
+            ),
+            loaded_analyses: previous + substeps.max(1),
+            thinnest_tooth_m: self.limits.thinnest(&state.removal).0,
+            worn_through_loaded: self
+                .limits
+                .worn_through_loaded(&state.removal, &l.pattern, wf)
+                .is_some(),
+            power_balance: l.power_balance,
+            max_damage: state.damage.iter().copied().fold(0.0, f64::max),
+            max_plastic_set_m: state.plastic_set_after(l).max(),
+            max_plastic_indentation_m: l.plastic_indentation.max(),
+            yielded_area_fraction: l.yielded_area_fraction,
+            equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            positions,
+        }
+    }
+
+    /// A state in pitting phase k (ending at `end`): at its start the pits are cut (same
+    /// cycles; the next record shows the new pressures): above the phase's limit (published
+    /// coupling) or where the damage has reached 1 ([`forecast`]; the cut nodes start
+    /// again undamaged). Then the phase passes without wear up to its end (or the life's, if
+    /// first). Returns the cycles advanced.
+    fn pitting_step(
+        &self,
+        state: &mut WearState,
+        l: &Ltca,
+        cw: &CycleWear,
+        loads: &forecast::NodeLoads,
+        k: usize,
+        end: f64,
+    ) -> f64 {
+        let Phase::Pitting {
+            pressure_limit,
+            margin,
+            ..
+        } = self.schedule(state)[k]
+        else {
+            return 0.0;
+        };
+        if !state.pitted_phases.contains(&k) && self.pits_from_damage() {
+            loads.cut_due(&mut state.damage, &mut state.removal, &mut state.pitted);
+            state.pitted_phases.push(k);
+            return 0.0;
+        }
+        if !state.pitted_phases.contains(&k) {
+            let duration = end - state.cycles;
+            let limit = pressure_limit
+                .unwrap_or_else(|| self.life.endurance.pressure(duration) * (1.0 + margin));
+            let depth = pit_depths(cw, self.life.pit_depth);
+            for k in cut_pits(
+                self.wf,
+                &l.pattern,
+                limit,
+                &depth,
+                &mut state.removal,
+                &mut state.pitted,
+            ) {
+                state.damage[k] = 0.0;
+            }
+            state.pitted_phases.push(k);
+            return 0.0;
+        }
+        let end = end.min(self.life.life_cycles);
+        let advanced = end - state.cycles;
+        state.cycles = end;
+        advanced
+    }
+
+    /// Advances the state by `step_cycles` of wear at the rates of `rate_map`, in equal
+    /// sub-steps with the pressures recomputed when the stability guard asks for them
+    /// (MODEL §7.3). Returns the number of sub-steps.
+    fn wear_step(
+        &self,
+        state: &mut WearState,
+        mut rate_map: CycleWear,
+        step_cycles: f64,
+    ) -> Result<usize, WearError> {
+        let mut remaining = step_cycles;
+        let mut substeps = 0;
+        loop {
+            let rate = rate_map.depth.max();
+            let cap = self.life.max_substep_removal;
+            let dc = if cap > 0.0 && rate * remaining > cap * (1.0 + 1e-9) {
+                // Equal sub-steps over what is left of the step.
+                let n = (rate * remaining / cap).ceil();
+                remaining / n
+            } else {
+                remaining
+            };
+            for (h, dh) in state.removal.values.iter_mut().zip(&rate_map.depth.values) {
+                *h += dc * dh;
+            }
+            state.cycles += dc;
+            remaining -= dc;
+            substeps += 1;
+            if remaining <= 1e-9 * step_cycles {
+                return Ok(substeps);
+            }
+            let (l, band) = self.analyse(state)?;
+            state.band_factor = band;
+            state.warm = Some(l.warm_start());
+            state.run_in(&l);
+            rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
+        }
+    }
+}
+
+/// The cycles a phase lasts until.
+fn phase_end(p: &Phase) -> f64 {
+    match *p {
+        Phase::Wear { until } | Phase::Pitting { until, .. } => until,
+    }
+}
+
+/// Index of the largest value (None when empty or all NaN).
+fn argmax(values: &[f64]) -> Option<usize> {
+    values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(k, _)| k)
+}

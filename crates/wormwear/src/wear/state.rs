@@ -1,0 +1,387 @@
+//! The state of a life after a completed step (MODEL §7.3): the flank's removal and plastic set,
+//! the pits and the records of every state, what a checkpoint holds; the warnings an engineer must
+//! see at its end; pits cut into the flank (MODEL §8).
+
+use super::{cycles_label, forecast, CycleWear, Phase};
+use crate::geometry::{FlankField, WheelFlank};
+use crate::input::PitDepth;
+use crate::ltca::Ltca;
+
+/// State of a life run after a completed step: what a checkpoint holds.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WearState {
+    /// Completed wear steps.
+    pub step: usize,
+    /// Wheel cycles run.
+    pub cycles: f64,
+    /// Depth worn off the loaded flank so far, normal to it, m.
+    pub removal: FlankField,
+    /// Plastic set of the loaded flank so far (running-in, MODEL §5.7): the permanent
+    /// indentation where the contact reached the flow pressure, normal to the flank, m
+    /// (empty: none yet).
+    #[serde(default)]
+    pub plastic_set: FlankField,
+    /// Records of the states so far (the initial one and one per completed step).
+    pub records: Vec<StepRecord>,
+    /// Pitting phases (indices in the schedule) whose pits have been cut.
+    #[serde(default)]
+    pub pitted_phases: Vec<usize>,
+    /// Pitted nodes of the loaded flank (empty: none).
+    #[serde(default)]
+    pub pitted: Vec<bool>,
+    /// Band factor of the local contact meshes for this state's loaded analysis, reached by
+    /// the widenings so far (None: the settings' own).
+    #[serde(default)]
+    pub band_factor: Option<f64>,
+    /// Loads the solver of this state's loaded analysis starts from (the previous analysis';
+    /// None: a cold start). Kept with the state so a resumed run repeats the analysis exactly.
+    #[serde(default)]
+    pub warm: Option<crate::ltca::WarmStart>,
+    /// Why the life ended before its cycles: the wear limit passed
+    /// ([`super::WearLimits::passed`]).
+    #[serde(default)]
+    pub stopped: Option<String>,
+    /// Fatigue damage of every node of the loaded flank ([`forecast`]; empty: none yet).
+    #[serde(default)]
+    pub damage: Vec<f64>,
+    /// The schedule a pitting forecast has found so far (empty without a forecast).
+    #[serde(default)]
+    pub found_phases: Vec<Phase>,
+}
+
+impl WearState {
+    /// Unworn start.
+    pub fn new(wf: &WheelFlank) -> Self {
+        Self {
+            step: 0,
+            cycles: 0.0,
+            removal: FlankField::zeros(wf),
+            plastic_set: FlankField::zeros(wf),
+            records: Vec::new(),
+            pitted_phases: Vec::new(),
+            pitted: Vec::new(),
+            band_factor: None,
+            warm: None,
+            stopped: None,
+            damage: vec![0.0; wf.nodes.len()],
+            found_phases: Vec::new(),
+        }
+    }
+
+    /// The loaded flank's change so far on the grid's nodes, normal to it, m: the wear and the
+    /// plastic set (MODEL §7.5, §5.7), what the backlash sees.
+    pub fn flank_change(&self) -> FlankField {
+        let mut change = self.removal.clone();
+        let set = self.plastic_set.with_rows(change.cells_height);
+        for (h, s) in change.values.iter_mut().zip(&set.values) {
+            *h += s;
+        }
+        change
+    }
+
+    /// The plastic set once the loaded analysis `l` of this state's flank has run in
+    /// (MODEL §5.7): the set plus the analysis' plastic indentation, m, on the rows of the
+    /// indentation (finer than the grid's, [`crate::ltca::Ltca::plastic_indentation`]).
+    pub fn plastic_set_after(&self, l: &Ltca) -> FlankField {
+        let add = &l.plastic_indentation;
+        let mut set = self.plastic_set.with_rows(add.cells_height);
+        if set.values.len() != add.values.len() {
+            return add.clone();
+        }
+        for (s, d) in set.values.iter_mut().zip(&add.values) {
+            *s += d;
+        }
+        set
+    }
+
+    /// [`Self::plastic_set_after`] on the grid's nodes, m.
+    pub fn plastic_set_nodes_after(&self, l: &Ltca) -> FlankField {
+        self.plastic_set_after(l)
+            .with_rows(self.removal.cells_height)
+    }
+
+    /// Running-in (MODEL §5.7): the plastic indentation of a loaded analysis on this state's
+    /// flank becomes part of its plastic set.
+    pub fn run_in(&mut self, l: &Ltca) {
+        self.plastic_set = self.plastic_set_after(l);
+    }
+}
+
+/// The gear's state at some cycles: wear so far and the loaded analysis on that geometry
+/// (units in the names; MODEL §7.7).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepRecord {
+    /// Completed steps (0: the unworn gear).
+    pub step: usize,
+    pub cycles: f64,
+    /// Cycles of the step that led here (0 for the start).
+    pub step_cycles: f64,
+    /// Sub-steps that step was split into by the stability guard (1: not split).
+    pub substeps: usize,
+    /// Phase of the schedule at these cycles: "wear" or "pitting".
+    pub phase: String,
+    /// Share of the active flank area pitted so far (pits cut at the starts of pitting
+    /// phases).
+    pub pitted_area_fraction: f64,
+    /// Largest depth worn, m, and where on the flank (node radius and face position), m.
+    pub max_wear_m: f64,
+    #[serde(default)]
+    pub max_wear_r_m: f64,
+    #[serde(default)]
+    pub max_wear_z_m: f64,
+    /// Largest mean wear depth over a patch of the pressure patch's size (`[analysis]
+    /// pressure_patch_*`, default 0.5 mm along the profile by 1 mm along the face), m: the
+    /// peak wear that converges with the mesh (`max_wear_m`, one node, follows a band
+    /// narrower than a grid row at the worm-tip trace; [`FlankField::patch_mean_max`]).
+    #[serde(default)]
+    pub wear_patch_max_m: f64,
+    /// Worn volume / active flank area (mean depth over the flank), m.
+    pub mean_wear_m: f64,
+    /// Worn volume of one tooth flank, m^3.
+    pub worn_volume_m3: f64,
+    /// Tangential backlash at r2, mean over positions, m; and its increase since the start.
+    pub backlash_m: f64,
+    pub backlash_increase_m: f64,
+    pub backlash_min_rad: f64,
+    pub backlash_max_rad: f64,
+    /// Largest pressure of the loaded pattern and the centre of its cell, m.
+    pub max_pressure_pa: f64,
+    #[serde(default)]
+    pub max_pressure_r_m: f64,
+    #[serde(default)]
+    pub max_pressure_z_m: f64,
+    pub mean_pressure_pa: f64,
+    pub contact_area_fraction: f64,
+    pub s1: f64,
+    pub s2: f64,
+    pub te_mean_rad: f64,
+    pub te_p2p_rad: f64,
+    pub mesh_stiffness_mean_nm_per_rad: f64,
+    /// Wear per cycle on this geometry (the rate of the next step), largest, m.
+    pub max_wear_per_cycle_m: f64,
+    /// Film ratio range over the swept nodes.
+    pub lambda_min: f64,
+    pub lambda_max: f64,
+    /// Largest mean pressure over a patch of stated size (`[analysis] pressure_patch_*`,
+    /// default 0.5 mm across the line by 1 mm along the face), Pa: unlike the maximum
+    /// (`max_pressure_pa`, one cell, grows with refinement at a sharp edge) it converges with
+    /// the mesh.
+    #[serde(default)]
+    pub pressure_patch_max_pa: f64,
+    /// Rigid lag that the wear adds, mean over positions: the growth of the loaded flank's
+    /// smallest angular gap (the worn flank's kinematic lag, part of the backlash), rad
+    /// (MODEL §12 j).
+    #[serde(default)]
+    pub rigid_lag_rad: f64,
+    /// Loaded TE relative to the rigid lag (TE + lag at each position): mean and
+    /// peak-to-peak, rad.
+    #[serde(default)]
+    pub te_mean_relative_rad: f64,
+    #[serde(default)]
+    pub te_p2p_relative_rad: f64,
+    /// Rank's cycles to first pitting N_LI with the model's mean pressure of the loaded
+    /// pattern in place of sigma_Hm (MODEL §12 k); None where the formula is out of range.
+    #[serde(default)]
+    pub n_li_model_cycles: Option<f64>,
+    /// Loaded analyses run so far (this state's included): a step split by the stability
+    /// guard costs one per sub-step (MODEL §7.3: the geometry is frozen within one).
+    #[serde(default)]
+    pub loaded_analyses: usize,
+    /// Thinnest wheel tooth left anywhere on the flank (the normal wear depth that would go
+    /// through it; negative: worn through), m ([`super::WearLimits::thinnest`]).
+    #[serde(default)]
+    pub thinnest_tooth_m: f64,
+    /// Whether a node of this state's loaded pattern is worn through
+    /// ([`super::WearLimits::worn_through_loaded`]).
+    #[serde(default)]
+    pub worn_through_loaded: bool,
+    /// Frictionless power balance of this state's loaded analysis (`Ltca::power_balance`).
+    #[serde(default)]
+    pub power_balance: f64,
+    /// Largest fatigue damage of the loaded flank's nodes (1: a node's life on the
+    /// pressure-life curve is spent; [`forecast`]).
+    #[serde(default)]
+    pub max_damage: f64,
+    /// Largest plastic set of the flank once this state's analysis has run in (MODEL §5.7),
+    /// m, and the largest indentation this state's analysis added, m.
+    #[serde(default)]
+    pub max_plastic_set_m: f64,
+    #[serde(default)]
+    pub max_plastic_indentation_m: f64,
+    /// Share of the active flank area where this state's contact reached the flow pressure.
+    #[serde(default)]
+    pub yielded_area_fraction: f64,
+    /// Largest equivalent pressure below the flank over the pattern (MODEL §8.1), Pa (0 in
+    /// records of earlier versions).
+    #[serde(default)]
+    pub equivalent_pressure_max_pa: f64,
+    /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
+    /// `wear_positions.csv`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub positions: Vec<PositionState>,
+}
+
+/// One position of a state's loaded analysis (MODEL §7.7: load sharing and TE over life).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PositionState {
+    /// Loaded transmission error, rad (negative = lag).
+    pub te_rad: f64,
+    /// TE + the rigid lag of the wear at this position, rad.
+    pub te_relative_rad: f64,
+    /// Normal force per studied tooth (TCA tooth order), N.
+    pub tooth_load_n: Vec<f64>,
+    pub max_pressure_pa: f64,
+}
+
+impl WearState {
+    /// What an engineer must see about this life at its last state (summary.json, stderr, the
+    /// top of report.html): why it stopped early, loaded analyses off the power balance,
+    /// contact on worn-through teeth, flank nodes whose fatigue damage has reached 1 (MODEL
+    /// §8.1), and pressures at the flow pressure (MODEL §5.7).
+    pub fn warnings(&self, wf: &WheelFlank) -> Vec<String> {
+        let mut w = Vec::new();
+        if let Some(why) = &self.stopped {
+            w.push(format!("wear limit: {why}"));
+        }
+        let balance = self
+            .records
+            .iter()
+            .find(|r| r.power_balance.abs() > crate::ltca::POWER_BALANCE_LIMIT);
+        if let Some(r) = balance {
+            w.push(format!(
+                "wear: from {} cycles the loaded analyses depart from the frictionless power \
+                 balance by {:+.1} % (more than {} %): the load sits at non-conjugate points (the \
+                 wheel's face edge under a misalignment) and the model's torques, TE and wear \
+                 there are unreliable (power_balance in wear_steps.csv)",
+                cycles_label(r.cycles),
+                100.0 * r.power_balance,
+                100.0 * crate::ltca::POWER_BALANCE_LIMIT
+            ));
+        }
+        if let Some(r) = self.records.iter().find(|r| r.worn_through_loaded) {
+            w.push(format!(
+                "wear: from {} cycles the loaded pattern reaches flank nodes whose tooth is worn \
+                 through (contact computed on material that is gone; see wear.limits)",
+                cycles_label(r.cycles)
+            ));
+        }
+        w.extend(self.damage_warning(wf));
+        if let Some(r) = self
+            .records
+            .last()
+            .filter(|r| r.yielded_area_fraction > 0.0)
+        {
+            w.push(format!(
+                "contact: at {} cycles {:.2} % of the active flank reaches the flow pressure (MODEL \
+                 §5.7): \
+                 the pressures there are the bronze's plastic limit, and the flank takes a \
+                 plastic set",
+                cycles_label(r.cycles),
+                100.0 * r.yielded_area_fraction
+            ));
+        }
+        w
+    }
+
+    /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
+    /// many, their share of the active flank, the largest damage.
+    fn damage_warning(&self, wf: &WheelFlank) -> Option<String> {
+        let due: Vec<usize> = (0..self.damage.len())
+            .filter(|&k| self.damage[k] >= forecast::REACHED)
+            .collect();
+        if due.is_empty() || self.damage.len() != wf.nodes.len() {
+            return None;
+        }
+        let mut pitted = vec![false; wf.nodes.len()];
+        for &k in &due {
+            pitted[k] = true;
+        }
+        let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
+        Some(format!(
+            "pitting: {} flank nodes (about {:.2} % of the active flank) have reached a fatigue \
+             damage of 1 at {} cycles (largest {:.3}): the model expects pits there (damage map; MODEL \
+             §8.1)",
+            due.len(),
+            100.0 * pitted_fraction(wf, &pitted),
+            cycles_label(self.cycles),
+            largest
+        ))
+    }
+}
+
+/// Depth of the pits at every node (MODEL §8, §12 g): 0.78 a, a the local Hertz half-width
+/// (published) or the loaded band's half-width (refinement), m.
+pub fn pit_depths(cw: &CycleWear, rule: PitDepth) -> FlankField {
+    let half_width = match rule {
+        PitDepth::Hertz => &cw.hertz_half_width,
+        PitDepth::LoadedBand => &cw.half_width,
+    };
+    FlankField {
+        values: half_width.values.iter().map(|a| 0.78 * a).collect(),
+        ..half_width.clone()
+    }
+}
+
+/// Share of the active flank area around pitted nodes (cells with a pitted corner).
+pub(super) fn pitted_fraction(wf: &WheelFlank, pitted: &[bool]) -> f64 {
+    let ni = wf.cells_height;
+    let mut area = 0.0;
+    for j in 0..wf.cells_face {
+        for i in 0..ni {
+            let corners = [
+                j * (ni + 1) + i,
+                j * (ni + 1) + i + 1,
+                (j + 1) * (ni + 1) + i,
+                (j + 1) * (ni + 1) + i + 1,
+            ];
+            if corners.iter().any(|&k| pitted[k]) {
+                area += wf.cell_area[j * ni + i];
+            }
+        }
+    }
+    area / wf.active_area()
+}
+
+/// Cuts the pits of a pitting phase (MODEL §8): every node whose loaded-pattern pressure (the
+/// largest of its cells) exceeds `limit` (Pa) and that the contact passes (depth > 0) loses
+/// `depth` more (m; [`pit_depths`]: 0.78 a, the depth of the largest shear stress under a
+/// line contact). Returns the nodes cut.
+pub fn cut_pits(
+    wf: &WheelFlank,
+    pattern: &[f64],
+    limit: f64,
+    depth: &FlankField,
+    removal: &mut FlankField,
+    pitted: &mut [bool],
+) -> Vec<usize> {
+    let mut cut = Vec::new();
+    for (k, pit) in pitted.iter_mut().enumerate() {
+        if node_pattern_pressure(wf, pattern, k) > limit && depth.values[k] > 0.0 {
+            removal.values[k] += depth.values[k];
+            *pit = true;
+            cut.push(k);
+        }
+    }
+    cut
+}
+
+/// The (up to four) cells of the flank grid around node k, as indices of a cell pattern.
+pub(super) fn node_cells(wf: &WheelFlank, k: usize) -> impl Iterator<Item = usize> {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let (i, j) = (k % (ni + 1), k / (ni + 1));
+    [
+        (i, j),
+        (i.wrapping_sub(1), j),
+        (i, j.wrapping_sub(1)),
+        (i.wrapping_sub(1), j.wrapping_sub(1)),
+    ]
+    .into_iter()
+    .filter(move |&(ci, cj)| ci < ni && cj < nj)
+    .map(move |(ci, cj)| cj * ni + ci)
+}
+
+/// Loaded-pattern pressure at node k of the flank grid: the largest of the (up to four)
+/// cells around it, Pa.
+pub(super) fn node_pattern_pressure(wf: &WheelFlank, pattern: &[f64], k: usize) -> f64 {
+    node_cells(wf, k).map(|c| pattern[c]).fold(0.0, f64::max)
+}
