@@ -1,0 +1,175 @@
+//! The affine torque step: the exact change of the solution with the load while the loaded set
+//! stays the same (the complementarity problem is then linear), with its block-Jacobi
+//! preconditioner.
+
+use super::{residuals_at_load, Problem, Solution, SolverSettings};
+
+/// Exact change of the solution with the load while the loaded set stays the same
+/// (the complementarity problem is then linear): with K_AA v = 1 on the loaded set A,
+/// q(W) = q0 + (W - W0) v / sum(v) and alpha(W) = alpha0 + (W - W0) / sum(v).
+/// Finds the load at which sum(weights . q) = target and returns that solution, or None when
+/// the loaded set would change (a load turning negative or a gap closing), or CG fails.
+pub fn affine_load_update(
+    problem: &Problem,
+    solution: &Solution,
+    weights: &[f64],
+    target: f64,
+    settings: &SolverSettings,
+) -> Option<(Solution, f64)> {
+    let n = problem.len();
+    // The free cells (loaded, below their cap) move with the load; capped cells stay.
+    let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
+    let active: Vec<bool> = solution
+        .q
+        .iter()
+        .enumerate()
+        .map(|(i, &q)| q > 0.0 && q < cap(i))
+        .collect();
+    // Conjugate gradient on the loaded set for K_AA v = 1, preconditioned by the exact
+    // Cholesky factors of the contact blocks restricted to the loaded set (exact in one step
+    // without bending; the bending term is low rank, so few more steps with it).
+    let preconditioner = BlockPreconditioner::new(problem, &active);
+    let mut v = vec![0.0; n];
+    let mut r: Vec<f64> = active.iter().map(|&a| if a { 1.0 } else { 0.0 }).collect();
+    let mut z = vec![0.0; n];
+    preconditioner.apply(&r, &mut z);
+    let mut p = z.clone();
+    let mut kp = vec![0.0; n];
+    let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+    let rr0: f64 = r.iter().map(|x| x * x).sum();
+    for _ in 0..settings.max_iterations.min(10 * n) {
+        problem.apply(&p, &mut kp);
+        for i in 0..n {
+            if !active[i] {
+                kp[i] = 0.0;
+            }
+        }
+        let pkp: f64 = p.iter().zip(&kp).map(|(a, b)| a * b).sum();
+        if pkp <= 0.0 {
+            return None;
+        }
+        let a = rz / pkp;
+        for i in 0..n {
+            v[i] += a * p[i];
+            r[i] -= a * kp[i];
+        }
+        let rr: f64 = r.iter().map(|x| x * x).sum();
+        if rr <= 1e-24 * rr0 {
+            break;
+        }
+        preconditioner.apply(&r, &mut z);
+        let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let beta = rz_new / rz;
+        rz = rz_new;
+        for i in 0..n {
+            p[i] = z[i] + beta * p[i];
+        }
+    }
+    let sum_v: f64 = v.iter().sum();
+    if sum_v <= 0.0 {
+        return None;
+    }
+    let t0: f64 = weights.iter().zip(&solution.q).map(|(w, q)| w * q).sum();
+    let slope: f64 = weights.iter().zip(&v).map(|(w, x)| w * x).sum::<f64>() / sum_v;
+    if slope == 0.0 || !slope.is_finite() {
+        return None;
+    }
+    let load = problem.load + (target - t0) / slope;
+    let dw = load - problem.load;
+    let q: Vec<f64> = solution
+        .q
+        .iter()
+        .zip(&v)
+        .map(|(q, x)| q + dw * x / sum_v)
+        .collect();
+    if q.iter()
+        .zip(&active)
+        .enumerate()
+        .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
+    {
+        return None;
+    }
+    let approach = solution.approach + dw / sum_v;
+    let mut u = vec![0.0; n];
+    problem.apply(&q, &mut u);
+    let gap: Vec<f64> = (0..n)
+        .map(|i| u[i] + problem.separation[i] - approach)
+        .collect();
+    let tol = settings.tolerance * approach.abs();
+    if (0..n).any(|i| {
+        !active[i]
+            && problem.separation[i].is_finite()
+            && if q[i] >= cap(i) {
+                gap[i] > tol
+            } else {
+                gap[i] < -tol
+            }
+    }) {
+        return None;
+    }
+    let residuals = residuals_at_load(
+        load,
+        &q,
+        &gap,
+        approach,
+        solution.residuals.iterations,
+        problem.upper.as_deref(),
+    );
+    Some((
+        Solution {
+            q,
+            approach,
+            gap,
+            residuals,
+        },
+        load,
+    ))
+}
+
+/// Block-Jacobi preconditioner: Cholesky factors of each contact block restricted to a set of
+/// unknowns (identity where a factorisation fails).
+pub(super) struct BlockPreconditioner {
+    parts: Vec<(Vec<usize>, Option<faer::linalg::solvers::Llt<f64>>)>,
+}
+
+impl BlockPreconditioner {
+    fn new(problem: &Problem, set: &[bool]) -> Self {
+        use rayon::prelude::*;
+        let parts = problem
+            .blocks
+            .par_iter()
+            .map(|b| {
+                let idx: Vec<usize> = (b.start..b.start + b.size).filter(|&i| set[i]).collect();
+                let rows: Vec<&[f64]> = idx.iter().map(|&i| b.row(i - b.start)).collect();
+                let m = faer::Mat::from_fn(idx.len(), idx.len(), |r, c| rows[r][idx[c] - b.start]);
+                let llt = (!idx.is_empty())
+                    .then(|| m.llt(faer::Side::Lower).ok())
+                    .flatten();
+                (idx, llt)
+            })
+            .collect();
+        Self { parts }
+    }
+
+    /// z = M^-1 r on the set (r outside the set is ignored, z there is 0).
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        use faer::linalg::solvers::Solve;
+        z.iter_mut().for_each(|v| *v = 0.0);
+        for (idx, llt) in &self.parts {
+            match llt {
+                Some(llt) => {
+                    let mut rhs = faer::Mat::from_fn(idx.len(), 1, |k, _| r[idx[k]]);
+                    llt.solve_in_place(&mut rhs);
+                    for (k, &i) in idx.iter().enumerate() {
+                        z[i] = rhs[(k, 0)];
+                    }
+                }
+                None => {
+                    for &i in idx {
+                        z[i] = r[i];
+                    }
+                }
+            }
+        }
+    }
+}
