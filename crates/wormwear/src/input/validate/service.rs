@@ -1,0 +1,238 @@
+//! The materials, the lubricant, the rating factors and the operating conditions (MODEL §6, §9,
+//! §11 defaults).
+
+use super::*;
+
+/// The worm's material when the file gives none (MODEL §11).
+pub(super) fn default_worm_material() -> Material {
+    Material {
+        name: "case-hardened steel (default)".into(),
+        youngs_modulus: 203e9,
+        poisson_ratio: 0.29,
+        hardness: 7.0e9,
+        wear_coefficient: 0.0,
+        density: 7850.0,
+        pitting_limit: f64::INFINITY,
+    }
+}
+
+/// The wheel's material when the file gives none (MODEL §11).
+pub(super) fn default_wheel_material() -> Material {
+    Material {
+        name: "chill-cast phosphor bronze CuSn12 (default)".into(),
+        youngs_modulus: 110e9,
+        poisson_ratio: 0.29,
+        hardness: 1.0e9,
+        wear_coefficient: 2.5e-8,
+        density: 8800.0,
+        pitting_limit: 425e6,
+    }
+}
+
+pub(super) fn material(
+    ck: &mut Checker,
+    name: &str,
+    m: Option<&MaterialSpec>,
+    default: Material,
+) -> Option<Material> {
+    let Some(m) = m else { return Some(default) };
+    let field = |f: &str| format!("{name}.{f}");
+    let e = ck.range(
+        &field("youngs_modulus_gpa"),
+        m.youngs_modulus_gpa,
+        1.0,
+        2000.0,
+        "GPa",
+    );
+    let nu = ck.range(&field("poisson_ratio"), m.poisson_ratio, 0.0, 0.499, "");
+    let h = match m.hardness_gpa {
+        Some(v) => ck
+            .range(&field("hardness_gpa"), v, 0.01, 100.0, "GPa")
+            .map(|v| v * 1e9),
+        None => Some(default.hardness),
+    };
+    let k = match m.wear_coefficient {
+        Some(v) => ck.range(&field("wear_coefficient"), v, 0.0, 1e-2, ""),
+        None => Some(default.wear_coefficient),
+    };
+    let rho = match m.density_kg_m3 {
+        Some(v) => ck.range(&field("density_kg_m3"), v, 100.0, 30_000.0, "kg/m^3"),
+        None => Some(default.density),
+    };
+    let lim = match m.pitting_limit_mpa {
+        Some(v) => ck
+            .range(&field("pitting_limit_mpa"), v, 10.0, 10_000.0, "MPa")
+            .map(|v| v * 1e6),
+        None => Some(default.pitting_limit),
+    };
+    Some(Material {
+        name: m.name.clone().unwrap_or_else(|| name.to_string()),
+        youngs_modulus: e? * 1e9,
+        poisson_ratio: nu?,
+        hardness: h?,
+        wear_coefficient: k?,
+        density: rho?,
+        pitting_limit: lim?,
+    })
+}
+
+pub(super) fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant> {
+    let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
+        Some(v) => ck.range(&format!("lubricant.{f}"), v, lo, hi, unit),
+        None => Some(d),
+    };
+    let eta = get(
+        "viscosity_pa_s",
+        l.viscosity_pa_s,
+        0.227,
+        1e-4,
+        100.0,
+        "Pa s",
+    );
+    let apv = get(
+        "pressure_viscosity_per_gpa",
+        l.pressure_viscosity_per_gpa,
+        9.5,
+        0.0,
+        100.0,
+        "1/GPa",
+    );
+    let beta = get(
+        "thermo_viscosity_k",
+        l.thermo_viscosity_k,
+        3200.0,
+        0.0,
+        100_000.0,
+        "K",
+    );
+    let kf = get(
+        "thermal_conductivity_w_m_k",
+        l.thermal_conductivity_w_m_k,
+        0.148,
+        0.01,
+        10.0,
+        "W/(m K)",
+    );
+    let t = get(
+        "temperature_c",
+        l.temperature_c,
+        333.0 - 273.15,
+        -50.0,
+        250.0,
+        "degC",
+    );
+    let rq = get(
+        "composite_roughness_um",
+        l.composite_roughness_um,
+        1.0,
+        0.001,
+        100.0,
+        "um",
+    );
+    Some(Lubricant {
+        name: l
+            .name
+            .clone()
+            .unwrap_or_else(|| "polyglycol (default)".into()),
+        viscosity: eta?,
+        pressure_viscosity: apv? * 1e-9,
+        thermo_viscosity: beta?,
+        thermal_conductivity: kf?,
+        temperature: t? + 273.15,
+        composite_roughness: rq? * 1e-6,
+    })
+}
+
+pub(super) fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
+    let mut factor = |name: &str, v: Option<f64>, d: f64, lo: f64, hi: f64| match v {
+        Some(v) => ck.range(&format!("rating.{name}"), v, lo, hi, ""),
+        None => Some(d),
+    };
+    let ys = factor(
+        "friction_size_factor",
+        r.friction_size_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yg = factor(
+        "friction_geometry_factor",
+        r.friction_geometry_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yw = factor(
+        "friction_material_factor",
+        r.friction_material_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let yr = factor(
+        "friction_roughness_factor",
+        r.friction_roughness_factor,
+        1.0,
+        0.1,
+        10.0,
+    );
+    let z = factor(
+        "pitting_life_factor",
+        r.pitting_life_factor,
+        1.0,
+        0.01,
+        100.0,
+    );
+    let ap = factor(
+        "pitted_area_max_percent",
+        r.pitted_area_max_percent,
+        8.0,
+        2.0 + 1e-9,
+        100.0,
+    );
+    Some(RatingFactors {
+        friction_factor: ys? * yg? * yw? * yr?,
+        pitting_life_factor: z?,
+        pitted_area_max_percent: ap?,
+    })
+}
+
+pub(super) fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
+    let torque = match (c.worm_torque_nm, c.wheel_torque_nm) {
+        (Some(t), None) => ck
+            .positive("conditions.worm_torque_nm", t, 1e6, "N m")
+            .map(Torque::Worm),
+        (None, Some(t)) => ck
+            .positive("conditions.wheel_torque_nm", t, 1e8, "N m")
+            .map(Torque::Wheel),
+        (Some(_), Some(_)) => {
+            ck.fail(
+                "conditions.wheel_torque_nm",
+                c.wheel_torque_nm.unwrap_or_default(),
+                "give either conditions.worm_torque_nm or conditions.wheel_torque_nm, not both",
+            );
+            None
+        }
+        (None, None) => {
+            ck.fail(
+                "conditions.worm_torque_nm",
+                "(missing)",
+                "give conditions.worm_torque_nm or conditions.wheel_torque_nm",
+            );
+            None
+        }
+    };
+    // Below 1e-3 rpm the film and sliding-speed formulas underflow (1e-300 rpm ended a life
+    // in "the reachable cells carry only ... of the load").
+    let speed = ck.range(
+        "conditions.worm_speed_rpm",
+        c.worm_speed_rpm,
+        1e-3,
+        20_000.0,
+        "rpm",
+    );
+    Some(Conditions {
+        torque: torque?,
+        worm_speed: speed? * 2.0 * PI / 60.0,
+    })
+}
