@@ -1,0 +1,373 @@
+//! What the positions give over the mesh cycle (MODEL §5.6, §5.7, §8.1): the swept contact
+//! pattern, the mesh-converged patch pressure, the equivalent (sub-surface) pressures, the plastic
+//! rows, and the warnings on deflection and the flow pressure.
+
+use super::*;
+
+/// The share of a wheel pitch beyond which the load's rotation of the wheel is implausible.
+pub const DEFLECTION_PITCH_SHARE_WARNING: f64 = 0.1;
+
+/// A warning when the load turns the wheel (the loaded transmission error less the unloaded
+/// kinematic error: contact approach and bending) by more than
+/// [`DEFLECTION_PITCH_SHARE_WARNING`] of its angular pitch at some position: deflections that
+/// large are outside the small-deflection (linear) model, whatever the solver says. (A large
+/// kinematic error, from a misalignment, is geometry and not warned here.)
+pub(super) fn deflection_warning(
+    positions: &[PositionResult],
+    tca: &Tca,
+    teeth: u32,
+) -> Option<String> {
+    let pitch = 2.0 * PI / teeth as f64;
+    let largest = positions
+        .iter()
+        .map(|p| (tca.positions[p.position].kinematic_error - p.transmission_error).abs())
+        .fold(0.0, f64::max);
+    (largest > DEFLECTION_PITCH_SHARE_WARNING * pitch).then(|| {
+        format!(
+            "the load turns the wheel by {largest:.3e} rad (loaded less unloaded transmission \
+             error), {:.0} % of a wheel pitch ({pitch:.4} rad): deflections this large are \
+             outside the linear model (check the torque, the bending model's supports and the \
+             materials)",
+            100.0 * largest / pitch
+        )
+    })
+}
+
+/// A warning when some of the flank reaches the flow pressure (MODEL §5.7): what share, and
+/// that its pressures are the plastic limit's.
+pub(super) fn flow_pressure_warning(
+    yielded_area_fraction: f64,
+    flow_pressure: f64,
+) -> Option<String> {
+    (yielded_area_fraction > 0.0).then(|| {
+        format!(
+            "{:.2} % of the active flank reaches the flow pressure {:.0} MPa (MODEL §5.7): the \
+             pressures there are the bronze's plastic limit, not an elastic solution, and the \
+             flank takes a plastic set",
+            100.0 * yielded_area_fraction,
+            flow_pressure * 1e-6
+        )
+    })
+}
+
+/// The loaded pattern's statistics (MODEL §5.6, §5.7): the mean pressure of the loaded cells
+/// (Pa), the loaded share of the active flank S0, the share above the mean S1 (of the active
+/// flank) and S2 (of the loaded area), and the share at the flow pressure `flow_pressure`.
+pub(super) struct PatternStats {
+    pub(super) mean_pressure: f64,
+    pub(super) s0: f64,
+    pub(super) s1: f64,
+    pub(super) s2: f64,
+    pub(super) yielded_area_fraction: f64,
+}
+
+impl PatternStats {
+    pub(super) fn of(wf: &WheelFlank, pattern: &[f64], flow_pressure: f64) -> Self {
+        let bound = flow_pressure * (1.0 - 1e-9);
+        let active_area = wf.active_area();
+        let yielded_area: f64 = (0..pattern.len())
+            .filter(|&k| pattern[k] >= bound)
+            .map(|k| wf.cell_area[k])
+            .sum();
+        let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
+        let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
+        let mean_pressure = if loaded.is_empty() {
+            0.0
+        } else {
+            loaded.iter().map(|&k| pattern[k]).sum::<f64>() / loaded.len() as f64
+        };
+        let above: f64 = loaded
+            .iter()
+            .filter(|&&k| pattern[k] > mean_pressure)
+            .map(|&k| wf.cell_area[k])
+            .sum();
+        Self {
+            mean_pressure,
+            s0: contact_area / active_area,
+            s1: above / active_area,
+            s2: if contact_area > 0.0 {
+                above / contact_area
+            } else {
+                0.0
+            },
+            yielded_area_fraction: yielded_area / active_area,
+        }
+    }
+}
+
+/// What the band's passage leaves on the global grid ([`swept_pattern`]).
+pub(super) struct Swept {
+    /// Largest pressure at each cell centre, Pa (MODEL §5.6).
+    pub(super) pattern: Vec<f64>,
+    /// Largest plastic interference at each node of the plastic set's rows, m (MODEL §5.7).
+    pub(super) plastic_indentation: FlankField,
+    /// Largest equivalent pressure at each cell centre (Pa) and the depth where it is reached
+    /// (m; MODEL §8.1).
+    pub(super) equivalent_pattern: Vec<f64>,
+    pub(super) equivalent_depth: Vec<f64>,
+}
+
+/// The loaded pattern (MODEL §5.6), the plastic indentation (MODEL §5.7) and the equivalent
+/// pressure (MODEL §8.1) of the band's passage over the global grid: the largest pressure over
+/// the whole mesh cycle at each cell centre (the positions' instants and the band's continuous
+/// passage between them, [`passage`], so the pattern neither has holes between positions nor
+/// moves with their number), the largest interference of the cells at the flow pressure at
+/// each node, and the largest equivalent pressure at each cell centre with its depth.
+pub(super) fn swept_pattern(
+    wf: &WheelFlank,
+    tca: &Tca,
+    positions: &[PositionResult],
+    teeth: u32,
+    rows_per_row: usize,
+) -> Swept {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let tau = 2.0 * PI / teeth as f64;
+    let dt = tau / tca.positions.len() as f64;
+    let columns = passage::band_samples(wf, tca, positions, tau);
+    let is_slice: Vec<bool> = columns.iter().map(|c| !c.is_empty()).collect();
+    let node_r = |j: usize, i: usize| wf.nodes[j * (ni + 1) + i].r;
+    type Column = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);
+    let swept: Vec<Column> = columns
+        .par_iter()
+        .enumerate()
+        .map(|(j, samples)| {
+            let mid: Vec<f64> = (0..ni)
+                .map(|i| 0.5 * (node_r(j, i) + node_r(j, i + 1)))
+                .collect();
+            // The plastic set's rows (MODEL §5.7): the grid's, rows_per_row times finer.
+            let rows = ni * rows_per_row;
+            let (low, high) = (node_r(j, 0), node_r(j, ni));
+            let fine: Vec<f64> = (0..=rows)
+                .map(|i| low + (high - low) * i as f64 / rows as f64)
+                .collect();
+            (
+                passage::swept_max(samples, &mid, dt, passage::Swept::Pressure),
+                passage::swept_max(samples, &fine, dt, passage::Swept::Plastic),
+                passage::swept_equivalent(samples, &mid, dt),
+            )
+        })
+        .collect();
+    // Cell-centre values on each node column (ni per column), then the cell between two.
+    let between = |values: &mut Vec<f64>| {
+        fill_between_slices(values, ni, &is_slice, wf);
+        (0..nj)
+            .flat_map(|j| (0..ni).map(move |i| (j, i)))
+            .map(|(j, i)| 0.5 * (values[j * ni + i] + values[(j + 1) * ni + i]))
+            .collect::<Vec<f64>>()
+    };
+    let mut mid: Vec<f64> = swept.iter().flat_map(|c| c.0.iter().copied()).collect();
+    let pattern = between(&mut mid);
+    let mut equivalent: Vec<f64> = swept.iter().flat_map(|c| c.2.iter().map(|e| e.0)).collect();
+    // The depth as the equivalent pressure's moments (a cell between a loaded and an
+    // unloaded column takes the loaded one's depth).
+    let mut moment: Vec<f64> = swept
+        .iter()
+        .flat_map(|c| c.2.iter().map(|e| e.0 * e.1))
+        .collect();
+    let equivalent_pattern = between(&mut equivalent);
+    let equivalent_depth = between(&mut moment)
+        .iter()
+        .zip(&equivalent_pattern)
+        .map(|(m, p)| if *p > 0.0 { m / p } else { 0.0 })
+        .collect();
+    let mut plastic_indentation = FlankField::zeros_refined(wf, rows_per_row);
+    plastic_indentation.values = swept.iter().flat_map(|c| c.1.iter().copied()).collect();
+    fill_between_slices(
+        &mut plastic_indentation.values,
+        ni * rows_per_row + 1,
+        &is_slice,
+        wf,
+    );
+    Swept {
+        pattern,
+        plastic_indentation,
+        equivalent_pattern,
+        equivalent_depth,
+    }
+}
+
+/// The equivalent pressure of the local cells of one position (MODEL §8.1): the rows across
+/// the line are its slices, the surfaces its teeth.
+pub fn position_equivalents(p: &PositionResult, settings: &SubsurfaceSettings) -> Vec<Equivalent> {
+    let mut rows = Vec::new();
+    let mut start = 0;
+    for k in 1..=p.cells.len() {
+        let (a, b) = (&p.cells[start], p.cells.get(k));
+        if b.is_none_or(|b| b.tooth_index != a.tooth_index || b.slice != a.slice) {
+            rows.push(start..k);
+            start = k;
+        }
+    }
+    // The rows of a tooth in their order along the line (node columns).
+    rows.sort_by_key(|r| (p.cells[r.start].tooth_index, p.cells[r.start].slice));
+    let surface: Vec<usize> = rows.iter().map(|r| p.cells[r.start].tooth_index).collect();
+    let cells: Vec<ContactCell> = p.cells.iter().map(|c| c.cell).collect();
+    crate::subsurface::equivalent_pressures(&cells, &p.pressure, &rows, &surface, settings)
+}
+
+/// Where the equivalent pressure peaks and the principal shear stress on the section below
+/// it (MODEL §8.1): the position, the tooth, the face position z (m) and the section across
+/// the line below that cell's row (60 x 40 points down to 2 loaded half-widths). `near`
+/// (flank radius and face position of the reference tooth, m): the peak among the cells over
+/// that point (within their half extents), over the whole flank when none is loaded there.
+/// None when no cell is loaded.
+pub fn equivalent_section(
+    l: &Ltca,
+    near: Option<(f64, f64)>,
+) -> Option<(usize, i32, f64, crate::subsurface::Section)> {
+    let over = |c: &LocalCell, (r, z): (f64, f64)| {
+        (c.z - z).abs() <= c.half_dz && (c.r - r).abs() <= c.cell.half_nu.max(c.cell.half_zeta)
+    };
+    let loaded = |p: &&PositionResult, k: &usize| p.equivalent[*k].pressure > 0.0;
+    let cells = || {
+        l.positions
+            .iter()
+            .flat_map(|p| (0..p.equivalent.len()).map(move |k| (p, k)))
+            .filter(|(p, k)| loaded(p, k))
+    };
+    let mut candidates: Vec<(&PositionResult, usize)> = near
+        .map(|at| cells().filter(|(p, k)| over(&p.cells[*k], at)).collect())
+        .unwrap_or_default();
+    if candidates.is_empty() {
+        candidates = cells().collect();
+    }
+    let (p, k) = candidates.into_iter().max_by(|a, b| {
+        a.0.equivalent[a.1]
+            .pressure
+            .total_cmp(&b.0.equivalent[b.1].pressure)
+    })?;
+    let peak = &p.cells[k];
+    let same_row = |c: &LocalCell| c.tooth_index == peak.tooth_index && c.slice == peak.slice;
+    let start = (0..=k)
+        .rev()
+        .take_while(|&i| same_row(&p.cells[i]))
+        .last()?;
+    let end = (k..p.cells.len())
+        .take_while(|&i| same_row(&p.cells[i]))
+        .last()?
+        + 1;
+    let sources: Vec<usize> = (0..p.cells.len())
+        .filter(|&i| p.cells[i].tooth_index == peak.tooth_index)
+        .collect();
+    let cells: Vec<ContactCell> = p.cells.iter().map(|c| c.cell).collect();
+    let section = crate::subsurface::section(
+        &cells,
+        &p.pressure,
+        start..end,
+        &sources,
+        (60, 40, 2.0),
+        l.subsurface.poisson,
+    );
+    Some((p.position, peak.tooth, peak.z, section))
+}
+
+/// Node columns that are no slice take the linear interpolation along the face width of the
+/// nearest slice columns on each side (the nearest one's values at the grid's ends); `values`
+/// holds `rows` values per node column, column after column.
+pub(super) fn fill_between_slices(
+    values: &mut [f64],
+    rows: usize,
+    is_slice: &[bool],
+    wf: &WheelFlank,
+) {
+    let slices: Vec<usize> = (0..is_slice.len()).filter(|&j| is_slice[j]).collect();
+    if slices.is_empty() || slices.len() == is_slice.len() {
+        return;
+    }
+    for j in (0..is_slice.len()).filter(|&j| !is_slice[j]) {
+        let after = slices.partition_point(|&s| s < j);
+        let (a, b) = match (after.checked_sub(1).map(|x| slices[x]), slices.get(after)) {
+            (Some(a), Some(&b)) => (a, b),
+            (Some(a), None) => (a, a),
+            (None, Some(&b)) => (b, b),
+            (None, None) => continue,
+        };
+        let t = if a == b {
+            0.0
+        } else {
+            (wf.z[j] - wf.z[a]) / (wf.z[b] - wf.z[a])
+        };
+        for i in 0..rows {
+            let (va, vb) = (values[a * rows + i], values[b * rows + i]);
+            values[j * rows + i] = va + (vb - va) * t;
+        }
+    }
+}
+
+/// Rows of the plastic set for each row of the flank's grid (MODEL §5.7): enough for four
+/// rows across a local cell of the band `band` (m), so that the set a running-in leaves is
+/// read back by the next state's cells as they left it (sampled on the grid's own rows, a
+/// yielded band narrower than a row was missed and indented again at every state, and the set
+/// grew with the cells across the line). 1 for the purely elastic contact.
+pub(super) fn plastic_rows_per_row(wf: &WheelFlank, settings: &LtcaSettings, band: f64) -> usize {
+    if !settings.flow_pressure.is_finite() {
+        return 1;
+    }
+    let row = (0..=wf.cells_face)
+        .map(|j| (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64)
+        .fold(0.0, f64::max);
+    let cell = 2.0 * band / settings.columns.max(1) as f64;
+    (4.0 * row / cell).ceil().clamp(1.0, 64.0) as usize
+}
+
+/// Largest mean pressure over a patch `across` wide across the contact line and `along` long
+/// along the face width (m), over every tooth at every position, Pa: the pressure of a "cell
+/// of stated size". At a sharp edge the local cells' own maximum grows as the mesh is refined
+/// (an integrable singularity); this mean converges. Cells are placed in (distance across the
+/// line from the band's first column, z) with their widths 2 half_nu and 2 half_dz; pressure is
+/// zero outside the cells. The largest mean has a window end on a cell boundary in each
+/// direction, which is where the candidates are taken.
+pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64) -> f64 {
+    positions
+        .par_iter()
+        .map(|p| {
+            // (across lo, across hi, z lo, z hi, pressure) of the loaded cells, per tooth.
+            let mut teeth: std::collections::BTreeMap<usize, Vec<[f64; 5]>> = Default::default();
+            for (c, &pr) in p.cells.iter().zip(&p.pressure) {
+                if pr <= 0.0 {
+                    continue;
+                }
+                let w = 2.0 * c.cell.half_nu;
+                teeth.entry(c.tooth_index).or_default().push([
+                    c.column as f64 * w,
+                    (c.column + 1) as f64 * w,
+                    c.z - c.half_dz,
+                    c.z + c.half_dz,
+                    pr,
+                ]);
+            }
+            teeth
+                .values()
+                .map(|cells| patch_mean_max(cells, across, along))
+                .fold(0.0, f64::max)
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
+/// [`max_patch_pressure`] over one tooth's loaded cells.
+pub(super) fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64 {
+    // Cells sorted by their z extent's start: a window's cells are found by bisection.
+    let mut cells = cells.to_vec();
+    cells.sort_by(|a, b| a[2].total_cmp(&b[2]));
+    let longest = cells.iter().map(|c| c[3] - c[2]).fold(0.0, f64::max);
+    let mut best: f64 = 0.0;
+    for c in &cells {
+        for x0 in [c[0], c[1] - across] {
+            for z0 in [c[2], c[3] - along] {
+                let (x1, z1) = (x0 + across, z0 + along);
+                let first = cells.partition_point(|d| d[2] < z0 - longest);
+                let force: f64 = cells[first..]
+                    .iter()
+                    .take_while(|d| d[2] < z1)
+                    .map(|d| {
+                        let ox = (d[1].min(x1) - d[0].max(x0)).max(0.0);
+                        let oz = (d[3].min(z1) - d[2].max(z0)).max(0.0);
+                        d[4] * ox * oz
+                    })
+                    .sum();
+                best = best.max(force / (across * along));
+            }
+        }
+    }
+    best
+}

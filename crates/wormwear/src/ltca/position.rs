@@ -1,0 +1,293 @@
+//! The loaded contact at one position (MODEL §5.2-5.4): the influence blocks and the bending
+//! term, the solve, the band widened while the contact reaches its edge, and the outer update of
+//! the wheel torque that closes the worm-torque equilibrium.
+
+use super::*;
+
+/// The positions' mean worm and wheel torques (N m), the frictionless power balance
+/// wheel torque / (ratio x worm torque) - 1 and its warnings, which name the face position
+/// (m) of the pattern's peak.
+pub(super) fn torque_balance(
+    positions: &[PositionResult],
+    ratio: f64,
+    wf: &WheelFlank,
+    pattern: &[f64],
+) -> (f64, f64, f64, Vec<String>) {
+    let ni = wf.cells_height;
+    let wheel_torque =
+        positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
+    let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
+    let power_balance = wheel_torque / (ratio * worm_torque) - 1.0;
+    let peak = (0..pattern.len())
+        .max_by(|&a, &b| pattern[a].total_cmp(&pattern[b]))
+        .map_or(0.0, |k| 0.5 * (wf.z[k / ni] + wf.z[k / ni + 1]));
+    let warnings = power_balance_warnings(power_balance, wheel_torque, ratio, worm_torque, peak);
+    (worm_torque, wheel_torque, power_balance, warnings)
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn solve_position(
+    geo: &Geometry,
+    tca: &Tca,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    pair: &ElasticPair,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    n: usize,
+    band0: f64,
+    worm_torque: Option<f64>,
+    wheel_torque_guess: f64,
+    worn: Option<Worn>,
+    seed: Option<&WarmStart>,
+) -> Result<PositionResult, LtcaError> {
+    let mut band = band0;
+    let mut widenings = 0;
+    loop {
+        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, worn);
+        if cells.is_empty() {
+            return Err(LtcaError::NoContact(n));
+        }
+        if cells.len() > MAX_CONTACT_CELLS {
+            return Err(LtcaError::TooManyCells {
+                position: n,
+                cells: cells.len(),
+                columns: settings.columns,
+                slice_step: settings.slice_step,
+            });
+        }
+        // The previous analysis' loads on the same cells (the first mesh only: a widened band
+        // puts other points under the same indices).
+        let mut warm: Option<Vec<f64>> = seed
+            .filter(|_| widenings == 0)
+            .and_then(|s| s.for_cells(n, &cells));
+        // Blocks per tooth (cells are grouped by tooth in mesh order), assembled in parallel.
+        let mut ranges = Vec::new();
+        let mut start = 0;
+        while start < cells.len() {
+            let t = cells[start].tooth_index;
+            let mut end = start;
+            while end < cells.len() && cells[end].tooth_index == t {
+                end += 1;
+            }
+            ranges.push((start, end - start));
+            start = end;
+        }
+        let blocks: Vec<Block> = ranges
+            .into_iter()
+            .map(|(start, size)| {
+                // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
+                // of a tooth differ only slightly (line-aligned areas vary by the line's
+                // obliquity), and the tangential term's small asymmetry on curved flanks is
+                // dropped. Entries are assembled as the solver reads them: the rows of the
+                // cells that carry load, and the screened solve's candidate block.
+                let group = &cells[start..start + size];
+                let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
+                let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
+                Block {
+                    start,
+                    size,
+                    matrix: BlockMatrix::Lazy(Box::new(InfluenceRows::new(
+                        pair, &contact, &levers,
+                    ))),
+                }
+            })
+            .collect();
+        let low_rank = bending.map(|b| {
+            let mut lr = b.coefficients(&cells);
+            for (i, c) in cells.iter().enumerate() {
+                lr.divide_row(i, c.lever);
+            }
+            lr
+        });
+        // Sign of the worm moments: all loaded cells push the worm the same way.
+        let sign = {
+            let s: f64 = cells.iter().map(|c| c.worm_lever.signum()).sum();
+            if s == 0.0 {
+                return Err(LtcaError::TorqueSign(n));
+            }
+            s.signum()
+        };
+        let upper = settings.flow_pressure.is_finite().then(|| {
+            cells
+                .iter()
+                .map(|c| settings.flow_pressure * c.cell.area() * c.lever)
+                .collect()
+        });
+        let mut problem = Problem {
+            upper,
+            blocks,
+            low_rank,
+            separation: cells.iter().map(|c| c.separation).collect(),
+            load: wheel_torque_guess,
+        };
+        let mut solution = None;
+        let weights: Vec<f64> = cells
+            .iter()
+            .map(|c| c.worm_lever * sign / c.lever)
+            .collect();
+        let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
+        // Outer update of the wheel torque until the worm torque balances (MODEL §5.2): with
+        // the fast solver, one exact affine step on the loaded set after the first solve; the
+        // fixed-point solver (and any change of the loaded set) iterates, by secants on the
+        // (wheel torque, worm torque) pairs: with cells at the flow pressure (MODEL §5.7) the
+        // worm torque is not proportional to the wheel torque and a plain rescaling can cycle.
+        let mut previous = None;
+        for it in 0..20 {
+            let sol =
+                solver::solve(&problem, &settings.solver, warm.as_deref()).map_err(|source| {
+                    LtcaError::Solver {
+                        position: n,
+                        source,
+                    }
+                })?;
+            let worm = worm_of(&sol.q);
+            let target = match worm_torque {
+                Some(t) => t,
+                None => {
+                    solution = Some((sol, worm));
+                    break;
+                }
+            };
+            let ratio = target / worm;
+            if (ratio - 1.0).abs() < 1e-9 {
+                solution = Some((sol, worm));
+                break;
+            }
+            if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
+                if let Some((updated, load)) =
+                    solver::affine_load_update(&problem, &sol, &weights, target, &settings.solver)
+                {
+                    problem.load = load;
+                    let worm = worm_of(&updated.q);
+                    let close = ((worm - target) / target).abs() < 1e-9;
+                    warm = Some(updated.q.clone());
+                    solution = Some((updated, worm));
+                    if close {
+                        break;
+                    }
+                    continue;
+                }
+            }
+            let next = next_wheel_torque(previous, (problem.load, worm), target);
+            previous = Some((problem.load, worm));
+            problem.load = next;
+            warm = Some(sol.q.clone());
+            solution = Some((sol, worm));
+        }
+        let (sol, worm) = solution.expect("at least one solve");
+        // Load at the band edge: widen and redo.
+        let nc = settings.columns;
+        let qmax = sol.q.iter().copied().fold(0.0, f64::max);
+        let at_edge = cells
+            .iter()
+            .zip(&sol.q)
+            .any(|(c, &q)| q > 1e-6 * qmax && (c.column == 0 || c.column == nc - 1));
+        if at_edge && widenings < 4 {
+            band *= 1.6;
+            widenings += 1;
+            continue;
+        }
+        let (forces, pressure, plastic_depth) =
+            cell_loads(&cells, &sol.q, &sol.gap, settings.flow_pressure);
+        let mut tooth_load = vec![0.0; tca.teeth.len()];
+        for (c, f) in cells.iter().zip(&forces) {
+            tooth_load[c.tooth_index] += f;
+        }
+        let total_force: f64 = forces.iter().sum();
+        let lever_b = barycentre_lever(&ev.placement, &cells, &forces, total_force);
+        let approach = sol.approach;
+        let target = worm_torque.unwrap_or(worm);
+        return Ok(PositionResult {
+            position: n,
+            tooth_load,
+            wheel_torque: problem.load,
+            worm_torque: worm,
+            approach,
+            transmission_error: tca.positions[n].kinematic_error - approach,
+            stiffness_angular: problem.load / approach,
+            stiffness_linear: total_force / (approach * lever_b),
+            max_pressure: pressure.iter().copied().fold(0.0, f64::max),
+            residuals: sol.residuals,
+            torque_residual: (worm - target).abs() / target,
+            pressure,
+            plastic_depth,
+            equivalent: Vec::new(),
+            cells,
+            band_widenings: widenings,
+        });
+    }
+}
+
+/// Per local cell: the normal force (N), the pressure (Pa) and the plastic depth (m: the
+/// interference of a cell at the flow pressure, MODEL §5.7) from the solver's loads q (N m)
+/// and gaps (rad).
+pub(super) fn cell_loads(
+    cells: &[LocalCell],
+    q: &[f64],
+    gap: &[f64],
+    flow_pressure: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let forces: Vec<f64> = cells.iter().zip(q).map(|(c, q)| q / c.lever).collect();
+    let pressure: Vec<f64> = cells
+        .iter()
+        .zip(&forces)
+        // (The bound holds on q = p S lever; the division's round-off stays below it.)
+        .map(|(c, f)| (f / c.cell.area()).min(flow_pressure))
+        .collect();
+    let plastic_depth: Vec<f64> = cells
+        .iter()
+        .zip(&pressure)
+        .zip(gap)
+        .map(|((c, &p), &y)| {
+            let at_bound = p >= flow_pressure * (1.0 - 1e-12);
+            if at_bound && y < 0.0 {
+                -y * c.lever
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    (forces, pressure, plastic_depth)
+}
+
+/// Lever |(B x n)_z| (m) of the force barycentre B with the force-weighted mean normal n
+/// (MODEL §5.6), for the linear mesh stiffness.
+pub(super) fn barycentre_lever(
+    placement: &crate::input::Placement,
+    cells: &[LocalCell],
+    forces: &[f64],
+    total_force: f64,
+) -> f64 {
+    let mut b = Vector3::zeros();
+    let mut nsum = Vector3::zeros();
+    for (c, f) in cells.iter().zip(forces) {
+        b += c.cell.centre * *f;
+        nsum += c.cell.normal * *f;
+    }
+    let b_wheel = placement.worm_to_wheel(&(b / total_force));
+    let n_wheel = placement.vector_worm_to_wheel(&nsum.normalize());
+    GapEvaluator::lever(&b_wheel, &n_wheel)
+}
+
+/// The next wheel torque (N m) of the torque balance (MODEL §5.2) from the last two
+/// (wheel torque, worm torque) pairs: the secant through them where it rises (the worm torque
+/// grows with the wheel torque), else the rescaling by target / worm of the last one.
+pub(super) fn next_wheel_torque(
+    previous: Option<(f64, f64)>,
+    last: (f64, f64),
+    target: f64,
+) -> f64 {
+    let (load, worm) = last;
+    let rescaled = load * target / worm;
+    let Some((load0, worm0)) = previous else {
+        return rescaled;
+    };
+    let slope = (worm - worm0) / (load - load0);
+    let secant = load + (target - worm) / slope;
+    if slope.is_finite() && slope > 0.0 && secant > 0.0 {
+        secant
+    } else {
+        rescaled
+    }
+}
