@@ -1,0 +1,337 @@
+//! The tables of a life: `wear_steps.csv` (one row per state), `wear_positions.csv` (TE and load
+//! sharing per state and position), the node table of a map state, and the `wear` values of
+//! summary.json.
+
+use super::*;
+
+/// The tables and curves over the states so far: `wear_steps.csv`, `wear_positions.csv`, the
+/// `wear` section of summary.json and the curves over cycles.
+pub(super) fn write_tables(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    plan: &WearPlan,
+    view: &StepView,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let state = view.state;
+    let mut files = Vec::new();
+    // Steps table and summary.
+    let csv = steps_table(state);
+    let path = dir.join("wear_steps.csv");
+    csv.write(&path)?;
+    files.push(path);
+    let path = dir.join("wear_positions.csv");
+    position_table(tca, &state.records).write(&path)?;
+    files.push(path);
+    update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
+    // Curves over cycles.
+    let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
+        label: label.to_string(),
+        points: state
+            .records
+            .iter()
+            .map(|r| (r.cycles * 1e-6, f(r)))
+            .collect(),
+        color,
+        bold: true,
+    };
+    let charts: [(&str, &str, &str, Vec<Series>); 4] = [
+        (
+            "wear_backlash.svg",
+            "Backlash increase (tangential at r2, mean over positions)",
+            "backlash increase (um)",
+            backlash_series(&state.records),
+        ),
+        (
+            "wear_depth.svg",
+            "Wear depth",
+            "depth (um)",
+            vec![
+                curve(&|r| r.max_wear_m * UM, "max (one node, mesh-dependent)", 1),
+                curve(&|r| r.wear_patch_max_m * UM, "max over a patch", 2),
+                curve(&|r| r.mean_wear_m * UM, "mean over the flank", 0),
+            ],
+        ),
+        (
+            "wear_transmission_error.svg",
+            "Loaded transmission error over life",
+            "TE (urad, wheel)",
+            vec![
+                curve(&|r| r.te_mean_rad * UM, "mean", 0),
+                curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
+                curve(
+                    &|r| r.te_mean_relative_rad * UM,
+                    "mean relative to the wear's rigid lag",
+                    3,
+                ),
+                curve(
+                    &|r| r.te_p2p_relative_rad * UM,
+                    "peak-to-peak relative to the lag",
+                    4,
+                ),
+            ],
+        ),
+        (
+            "wear_pressure.svg",
+            "Contact pressure over life",
+            "pressure (MPa)",
+            vec![
+                curve(&|r| r.max_pressure_pa * MPA, "P_max (raw)", 1),
+                curve(
+                    &|r| r.pressure_patch_max_pa * MPA,
+                    "P_patch (largest mean over a patch)",
+                    2,
+                ),
+                curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
+            ],
+        ),
+    ];
+    for (name, title, y, series) in charts {
+        let path = dir.join(name);
+        line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// Per state and position: TE, TE relative to the wear's rigid lag, largest pressure and the
+/// normal force on each studied tooth (load sharing over life, MODEL §7.7).
+pub fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
+    let tooth_columns: Vec<String> = tca
+        .teeth
+        .iter()
+        .map(|k| format!("tooth{k}_load_n"))
+        .collect();
+    let mut header = vec![
+        "step",
+        "cycles",
+        "position",
+        "te_rad",
+        "te_relative_rad",
+        "max_pressure_pa",
+    ];
+    header.extend(tooth_columns.iter().map(String::as_str));
+    let mut csv = Csv::new(&header);
+    for r in records {
+        for (n, p) in r.positions.iter().enumerate() {
+            let mut row = vec![
+                r.step as f64,
+                r.cycles,
+                n as f64,
+                p.te_rad,
+                p.te_relative_rad,
+                p.max_pressure_pa,
+            ];
+            row.extend(
+                (0..tooth_columns.len()).map(|t| p.tooth_load_n.get(t).copied().unwrap_or(0.0)),
+            );
+            csv.row(&row);
+        }
+    }
+    csv
+}
+
+/// The table of states (`wear_steps.csv`): one row per record (units in the names).
+pub fn steps_table(state: &WearState) -> Csv {
+    let mut csv = Csv::new(&[
+        "step",
+        "cycles",
+        "step_cycles",
+        "max_wear_m",
+        "wear_patch_max_m",
+        "mean_wear_m",
+        "worn_volume_m3",
+        "backlash_m",
+        "backlash_increase_m",
+        "max_pressure_pa",
+        "mean_pressure_pa",
+        "contact_area_fraction",
+        "s1",
+        "s2",
+        "te_mean_rad",
+        "te_p2p_rad",
+        "mesh_stiffness_mean_nm_per_rad",
+        "max_wear_per_cycle_m",
+        "lambda_min",
+        "substeps",
+        "loaded_analyses",
+        "pressure_patch_max_pa",
+        "rigid_lag_rad",
+        "te_mean_relative_rad",
+        "te_p2p_relative_rad",
+        "n_li_model_cycles",
+        "pitted_area_fraction",
+        "thinnest_tooth_um",
+        "worn_through_loaded",
+        "power_balance",
+        "max_damage",
+        "max_plastic_set_m",
+        "max_plastic_indentation_m",
+        "yielded_area_fraction",
+        "equivalent_pressure_max_pa",
+    ]);
+    for r in &state.records {
+        csv.row(&[
+            r.step as f64,
+            r.cycles,
+            r.step_cycles,
+            r.max_wear_m,
+            r.wear_patch_max_m,
+            r.mean_wear_m,
+            r.worn_volume_m3,
+            r.backlash_m,
+            r.backlash_increase_m,
+            r.max_pressure_pa,
+            r.mean_pressure_pa,
+            r.contact_area_fraction,
+            r.s1,
+            r.s2,
+            r.te_mean_rad,
+            r.te_p2p_rad,
+            r.mesh_stiffness_mean_nm_per_rad,
+            r.max_wear_per_cycle_m,
+            r.lambda_min,
+            r.substeps as f64,
+            r.loaded_analyses as f64,
+            r.pressure_patch_max_pa,
+            r.rigid_lag_rad,
+            r.te_mean_relative_rad,
+            r.te_p2p_relative_rad,
+            r.n_li_model_cycles.unwrap_or(f64::NAN),
+            r.pitted_area_fraction,
+            r.thinnest_tooth_m * UM,
+            f64::from(u8::from(r.worn_through_loaded)),
+            r.power_balance,
+            r.max_damage,
+            r.max_plastic_set_m,
+            r.max_plastic_indentation_m,
+            r.yielded_area_fraction,
+            r.equivalent_pressure_max_pa,
+        ]);
+    }
+    csv
+}
+
+/// The `wear` section of summary.json after the state of `view`.
+pub fn summary_value(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    plan: &WearPlan,
+    view: &StepView,
+) -> Result<serde_json::Value, OutputError> {
+    let state = view.state;
+    let summary = WearSummary {
+        life_cycles: plan.life_cycles,
+        step_control: &plan.step,
+        bending_model: &view.ltca.bending_model,
+        film_load: plan.film_load,
+        pit_depth: plan.pit_depth,
+        states: state.records.len(),
+        loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
+        max_pressure_definition: MAX_PRESSURE_DEFINITION,
+        mesh_dependent: MESH_DEPENDENT,
+        limits: LimitsSummary::new(gear, geo, tca, plan, state),
+        pitting: plan.pitting,
+        phases: crate::wear::forecast::phase_spans(&state.records),
+        found_phases: &state.found_phases,
+        warnings: state.warnings(geo.wheel_flank(tca.loaded_flank)),
+        steps: state
+            .records
+            .iter()
+            .map(|r| crate::wear::StepRecord {
+                positions: Vec::new(),
+                ..r.clone()
+            })
+            .collect(),
+    };
+    serde_json::to_value(&summary).map_err(|e| OutputError::Encode {
+        what: "wear summary".into(),
+        message: e.to_string(),
+    })
+}
+
+/// The backlash increase over cycles (1e6, um): the whole curve, and its pitting phases drawn
+/// over it in orange (no wear: flat).
+pub(super) fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series> {
+    let points = |rs: &[crate::wear::StepRecord]| -> Vec<(f64, f64)> {
+        rs.iter()
+            .map(|r| (r.cycles * 1e-6, r.backlash_increase_m * UM))
+            .collect()
+    };
+    let spans = crate::wear::forecast::phase_spans(records);
+    let pitting: Vec<_> = spans.iter().filter(|s| s.kind == "pitting").collect();
+    let mut series = vec![Series {
+        label: if pitting.is_empty() {
+            String::new()
+        } else {
+            "wear".into()
+        },
+        points: points(records),
+        color: 0,
+        bold: true,
+    }];
+    for (k, s) in pitting.iter().enumerate() {
+        let inside: Vec<_> = records
+            .iter()
+            .filter(|r| r.cycles >= s.start_cycles && r.cycles <= s.end_cycles)
+            .cloned()
+            .collect();
+        series.push(Series {
+            label: if k == 0 {
+                "pitting phase".into()
+            } else {
+                String::new()
+            },
+            points: points(&inside),
+            color: 4,
+            bold: true,
+        });
+    }
+    series
+}
+
+/// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j
+/// across the face) its (r, z) mm, cumulative wear m, wear per cycle m, film ratio and film
+/// thickness m, damage, and the plastic set m once the state has run in
+/// ([`WearState::plastic_set_after`], read at the nodes).
+pub fn node_table(
+    wf: &crate::geometry::WheelFlank,
+    state: &WearState,
+    cycle: &crate::wear::CycleWear,
+    plastic_set: &FlankField,
+) -> Csv {
+    let plastic_set = plastic_set.with_rows(wf.cells_height);
+    let mut csv = Csv::new(&[
+        "i",
+        "j",
+        "r_mm",
+        "z_mm",
+        "wear_m",
+        "wear_per_cycle_m",
+        "lambda",
+        "film_m",
+        "damage",
+        "plastic_set_m",
+    ]);
+    for j in 0..=wf.cells_face {
+        for i in 0..=wf.cells_height {
+            let k = j * (wf.cells_height + 1) + i;
+            let n = wf.node(i, j);
+            csv.row(&[
+                i as f64,
+                j as f64,
+                n.r * 1e3,
+                n.z * 1e3,
+                state.removal.values[k],
+                cycle.depth.values[k],
+                cycle.lambda.values[k],
+                cycle.film.values[k],
+                state.damage.get(k).copied().unwrap_or(0.0),
+                plastic_set.values.get(k).copied().unwrap_or(0.0),
+            ]);
+        }
+    }
+    csv
+}
