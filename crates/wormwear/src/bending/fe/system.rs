@@ -1,0 +1,574 @@
+//! The sparse linear system of a run and its direct solution (faer Cholesky): the DOF bookkeeping,
+//! the stiffness assembled in place on the node graph's lower-triangle pattern, the prescribed
+//! displacements moved to the right-hand sides, and the free-minus-blocked solve from one
+//! factorisation with its size limits checked before anything large is built.
+
+use super::*;
+
+/// The size limits of one solve (the unknowns, the factor's nonzeros).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SizeLimits {
+    pub(super) unknowns: usize,
+    pub(super) factor_nonzeros: usize,
+}
+
+impl SizeLimits {
+    /// The limits of the bending models: [`MAX_UNKNOWNS`], [`MAX_FACTOR_NONZEROS`].
+    pub(super) const MODEL: Self = Self {
+        unknowns: MAX_UNKNOWNS,
+        factor_nonzeros: MAX_FACTOR_NONZEROS,
+    };
+}
+
+/// The text of [`FeError::TooLarge`].
+pub(super) fn too_large(unknowns: usize, nonzeros: Option<usize>) -> String {
+    let limit = format!(
+        "{:.2e} nonzeros ({:.1} GB), the most one model may use",
+        MAX_FACTOR_NONZEROS as f64,
+        MAX_FACTOR_NONZEROS as f64 * 8e-9
+    );
+    match nonzeros {
+        Some(n) => format!(
+            "the model has {unknowns} unknowns and its Cholesky factor would hold {:.2e} \
+             nonzeros ({:.1} GB), above {limit}",
+            n as f64,
+            n as f64 * 8e-9
+        ),
+        None => format!(
+            "the model has {unknowns} unknowns (more than {MAX_UNKNOWNS}): its Cholesky factor \
+             would hold far more than {limit}"
+        ),
+    }
+}
+
+/// Lower triangle of the free-free stiffness in compressed columns, assembled in place: the
+/// pattern comes from the node graph (nodes sharing an element or a spring), so no triplet list
+/// is built or sorted. Rows of each column are sorted; `position` finds an entry.
+pub(super) struct LowerPattern {
+    pub(super) col_ptr: Vec<usize>,
+    pub(super) row_idx: Vec<usize>,
+}
+
+impl LowerPattern {
+    pub(super) fn new(mesh: &Mesh, springs: &[Spring], map: &[usize], free: usize) -> Self {
+        let nn = mesh.nodes.len();
+        let mut adjacent: Vec<Vec<u32>> = vec![Vec::new(); nn];
+        for e in &mesh.elements {
+            for &a in e {
+                adjacent[a].extend(e.iter().map(|&b| b as u32));
+            }
+        }
+        for spring in springs {
+            for &(a, _) in &spring.terms {
+                adjacent[a].extend(spring.terms.iter().map(|&(b, _)| b as u32));
+            }
+        }
+        adjacent.par_iter_mut().for_each(|list| {
+            list.sort_unstable();
+            list.dedup();
+        });
+        let mut col_ptr = Vec::with_capacity(free + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for (n, list) in adjacent.iter().enumerate() {
+            for d in 0..3 {
+                let g = 3 * n + d;
+                if map[g] == usize::MAX {
+                    continue;
+                }
+                for &m in list {
+                    for dd in 0..3 {
+                        let gr = 3 * m as usize + dd;
+                        if gr >= g && map[gr] != usize::MAX {
+                            row_idx.push(map[gr]);
+                        }
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        Self { col_ptr, row_idx }
+    }
+
+    /// The pattern as faer's symbolic matrix (n x n, lower triangle).
+    pub(super) fn symbolic(&self, n: usize) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+        faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx)
+    }
+
+    #[inline]
+    pub(super) fn position(&self, row: usize, col: usize) -> usize {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let p = a + self.row_idx[a..b].partition_point(|&r| r < row);
+        debug_assert!(p < b && self.row_idx[p] == row, "entry outside the pattern");
+        p
+    }
+}
+
+/// Solves with element stiffnesses already computed (shared by runs on the same mesh).
+pub(super) fn solve_assembled(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    fixed: &[Fixed],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+) -> Result<Solution, FeError> {
+    let system = assemble(mesh, elements, fixed, springs, loads);
+    let llt = system
+        .matrix
+        .sp_cholesky(Side::Lower)
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    Ok(Solution {
+        x: llt.solve(&system.rhs),
+        map: system.map,
+        prescribed: system.prescribed,
+    })
+}
+
+/// The assembled linear system of one run: the free-free stiffness (lower triangle, free-DOF
+/// numbering), the right-hand sides of the load cases (N), and the DOF bookkeeping.
+pub(super) struct System {
+    pub(super) matrix: SparseColMat<usize, f64>,
+    pub(super) rhs: Mat<f64>,
+    /// Free-DOF index of every global DOF (usize::MAX where prescribed).
+    pub(super) map: Vec<usize>,
+    pub(super) prescribed: Vec<Option<f64>>,
+}
+
+/// Assembles the stiffness with the prescribed displacements eliminated (moved to the
+/// right-hand sides) and the springs added.
+pub(super) fn assemble(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    fixed: &[Fixed],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+) -> System {
+    let dofs = Dofs::new(mesh, fixed);
+    let pattern = LowerPattern::new(mesh, springs, &dofs.map, dofs.free);
+    fill(mesh, elements, springs, loads, dofs, pattern)
+}
+
+/// The DOF bookkeeping of one run: the prescribed value of every global DOF and its free index.
+pub(super) struct Dofs {
+    pub(super) prescribed: Vec<Option<f64>>,
+    /// Free-DOF index of every global DOF (usize::MAX where prescribed).
+    pub(super) map: Vec<usize>,
+    pub(super) free: usize,
+}
+
+impl Dofs {
+    pub(super) fn new(mesh: &Mesh, fixed: &[Fixed]) -> Self {
+        let ndof = 3 * mesh.nodes.len();
+        let mut prescribed = vec![None; ndof];
+        for &(n, d, v) in fixed {
+            prescribed[3 * n + d] = Some(v);
+        }
+        let mut map = vec![usize::MAX; ndof];
+        let mut free = 0;
+        for (i, p) in prescribed.iter().enumerate() {
+            if p.is_none() {
+                map[i] = free;
+                free += 1;
+            }
+        }
+        Self {
+            prescribed,
+            map,
+            free,
+        }
+    }
+}
+
+/// The stiffness values on `pattern` and the right-hand sides (see [`assemble`]).
+pub(super) fn fill(
+    mesh: &Mesh,
+    elements: &[Vec<f64>],
+    springs: &[Spring],
+    loads: &[Vec<Load>],
+    dofs: Dofs,
+    pattern: LowerPattern,
+) -> System {
+    let Dofs {
+        prescribed,
+        map,
+        free,
+    } = dofs;
+    let mut values = vec![0.0; pattern.row_idx.len()];
+    let ncase = loads.len();
+    let mut rhs = Mat::<f64>::zeros(free, ncase);
+    for (c, case) in loads.iter().enumerate() {
+        for &(n, d, v) in case {
+            let g = 3 * n + d;
+            if map[g] != usize::MAX {
+                rhs[(map[g], c)] += v;
+            }
+        }
+    }
+    // Stiffness entry (free row fr, global column gc): into the matrix (lower triangle) when
+    // the column is free, onto the right-hand sides when it is prescribed.
+    let mut scatter = |fr: usize, gc: usize, v: f64| match prescribed[gc] {
+        Some(u) => {
+            for case in 0..ncase {
+                rhs[(fr, case)] -= v * u;
+            }
+        }
+        None => {
+            let fc = map[gc];
+            if fc <= fr {
+                values[pattern.position(fr, fc)] += v;
+            }
+        }
+    };
+    for (e, k) in mesh.elements.iter().zip(elements) {
+        let dofs: Vec<usize> = e
+            .iter()
+            .flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2])
+            .collect();
+        for (r, &gr) in dofs.iter().enumerate() {
+            let fr = map[gr];
+            if fr == usize::MAX {
+                continue;
+            }
+            for (c, &gc) in dofs.iter().enumerate() {
+                scatter(fr, gc, k[r * 60 + c]);
+            }
+        }
+    }
+    for spring in springs {
+        let dofs: Vec<(usize, f64)> = spring
+            .terms
+            .iter()
+            .flat_map(|&(n, d)| (0..3).map(move |c| (3 * n + c, d[c])))
+            .filter(|&(_, w)| w != 0.0)
+            .collect();
+        for &(gr, wr) in &dofs {
+            let fr = map[gr];
+            if fr == usize::MAX {
+                continue;
+            }
+            for &(gc, wc) in &dofs {
+                scatter(fr, gc, spring.stiffness * wr * wc);
+            }
+        }
+    }
+    let symbolic =
+        SymbolicSparseColMat::new_checked(free, free, pattern.col_ptr, None, pattern.row_idx);
+    System {
+        matrix: SparseColMat::<usize, f64>::new(symbolic, values),
+        rhs,
+        map,
+        prescribed,
+    }
+}
+
+/// The free run (`fixed` only) minus the blocked run (also the `blocked` nodes held at zero)
+/// of the same mesh and loads, from ONE Cholesky factorisation (MODEL §5.5 step 2). The
+/// blocked DOFs B are ordered last (AMD order for the others, R), so with A = L L^T the leading
+/// block L_RR of L is the Cholesky factor of the blocked run's matrix A_RR. Forward
+/// substitution y = L^-1 f serves both runs (its R part does not see f_B); the free run is
+/// L^-T y and the blocked run L^-T [y_R; 0] (x_R = A_RR^-1 f_R, x_B = 0, its loads on blocked
+/// nodes vanishing as they do for prescribed DOFs), so their difference is L^-T [0; y_B]: one
+/// factorisation and two triangular solves instead of two factorisations and four. The
+/// prescribed displacements are the same in both runs, so the difference is zero there.
+///
+/// The size is checked before anything large is computed: the unknowns against
+/// [`MAX_UNKNOWNS`], then the factor's nonzeros from the symbolic analysis against
+/// [`MAX_FACTOR_NONZEROS`] ([`FeError::TooLarge`]); only then the element stiffnesses.
+pub(super) fn solve_free_minus_blocked(
+    mesh: &Mesh,
+    material: &Elastic,
+    fixed: &[Fixed],
+    springs: &[Spring],
+    blocked: &[usize],
+    loads: &[Vec<Load>],
+    limits: SizeLimits,
+) -> Result<Solution, FeError> {
+    let dofs = Dofs::new(mesh, fixed);
+    if dofs.free > limits.unknowns {
+        return Err(FeError::TooLarge {
+            unknowns: dofs.free,
+            nonzeros: None,
+        });
+    }
+    let pattern = LowerPattern::new(mesh, springs, &dofs.map, dofs.free);
+    let factor = BlockedLast::analyse(&pattern, &dofs, blocked, limits)?;
+    let elements = element_stiffnesses(mesh, material)?;
+    let system = fill(mesh, &elements, springs, loads, dofs, pattern);
+    drop(elements);
+    let x = factor.difference(system.matrix, system.rhs)?;
+    let mut prescribed = system.prescribed;
+    for p in prescribed.iter_mut().flatten() {
+        *p = 0.0;
+    }
+    Ok(Solution {
+        x,
+        map: system.map,
+        prescribed,
+    })
+}
+
+/// The symbolic Cholesky factor of a run's free-free stiffness with the blocked DOFs ordered
+/// last ([`order_blocked_last`]), see [`solve_free_minus_blocked`].
+pub(super) struct BlockedLast {
+    /// New -> old and old -> new free-DOF order.
+    pub(super) forward: Vec<usize>,
+    pub(super) inverse: Vec<usize>,
+    /// The unknowns before the blocked ones.
+    pub(super) unblocked: usize,
+    pub(super) symbolic: faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+}
+
+impl BlockedLast {
+    /// Orders and analyses `pattern`; refuses a factor above `limits.factor_nonzeros`.
+    pub(super) fn analyse(
+        pattern: &LowerPattern,
+        dofs: &Dofs,
+        blocked: &[usize],
+        limits: SizeLimits,
+    ) -> Result<Self, FeError> {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let free = dofs.free;
+        let mut is_blocked = vec![false; free];
+        for &n in blocked {
+            for d in 0..3 {
+                let g = 3 * n + d;
+                if dofs.map[g] != usize::MAX {
+                    is_blocked[dofs.map[g]] = true;
+                }
+            }
+        }
+        let (forward, inverse, unblocked) =
+            order_blocked_last(pattern.symbolic(free), &is_blocked)?;
+        let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(free),
+            Side::Lower,
+            SymmetricOrdering::Custom(perm),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+        if symbolic.len_val() > limits.factor_nonzeros {
+            return Err(FeError::TooLarge {
+                unknowns: free,
+                nonzeros: Some(symbolic.len_val()),
+            });
+        }
+        Ok(Self {
+            forward,
+            inverse,
+            unblocked,
+            symbolic,
+        })
+    }
+
+    /// Factorises `matrix` and returns the free run minus the blocked run of every case of
+    /// `rhs` (free-DOF numbering): L^-T [0; y_B] with y = L^-1 f.
+    pub(super) fn difference(
+        &self,
+        matrix: SparseColMat<usize, f64>,
+        rhs: Mat<f64>,
+    ) -> Result<Mat<f64>, FeError> {
+        use faer::dyn_stack::{MemBuffer, MemStack};
+        let symbolic = &self.symbolic;
+        let (free, cases) = (rhs.nrows(), rhs.ncols());
+        let par = faer::get_global_parallelism();
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut mem = MemBuffer::new(
+            symbolic
+                .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+                .or(symbolic.solve_in_place_scratch::<f64>(cases, par)),
+        );
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                matrix.as_ref(),
+                Side::Lower,
+                faer::linalg::cholesky::llt::factor::LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+        drop(matrix);
+        let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(self.forward[i], c)]);
+        drop(rhs);
+        lower_solve(symbolic, &values, y.as_mut(), false, par, &mut mem);
+        for c in 0..cases {
+            for i in 0..self.unblocked {
+                y[(i, c)] = 0.0;
+            }
+        }
+        lower_solve(symbolic, &values, y.as_mut(), true, par, &mut mem);
+        Ok(Mat::<f64>::from_fn(free, cases, |i, c| {
+            y[(self.inverse[i], c)]
+        }))
+    }
+}
+
+/// Fill-reducing order with the `last` unknowns at the end: AMD on the matrix without them,
+/// then them in their own order. Returns (forward: new -> old, inverse: old -> new, the number
+/// of unknowns before the last ones).
+pub(super) fn order_blocked_last(
+    matrix: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    last: &[bool],
+) -> Result<(Vec<usize>, Vec<usize>, usize), FeError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let n = last.len();
+    let mut local = vec![usize::MAX; n];
+    let kept: Vec<usize> = (0..n).filter(|&i| !last[i]).collect();
+    for (k, &i) in kept.iter().enumerate() {
+        local[i] = k;
+    }
+    let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
+    let mut ptr = Vec::with_capacity(kept.len() + 1);
+    let mut rows = Vec::new();
+    ptr.push(0);
+    for &c in &kept {
+        rows.extend(
+            row_idx[col_ptr[c]..col_ptr[c + 1]]
+                .iter()
+                .filter(|&&r| !last[r])
+                .map(|&r| local[r]),
+        );
+        ptr.push(rows.len());
+    }
+    let m = kept.len();
+    let nnz = rows.len();
+    let pattern = SymbolicSparseColMat::new_checked(m, m, ptr, None, rows);
+    let (mut fwd, mut inv) = (vec![0usize; m], vec![0usize; m]);
+    let mut mem = MemBuffer::new(amd::order_scratch::<usize>(m, nnz));
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        pattern.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let mut forward: Vec<usize> = fwd.iter().map(|&k| kept[k]).collect();
+    forward.extend((0..n).filter(|&i| last[i]));
+    let mut inverse = vec![0; n];
+    for (new, &old) in forward.iter().enumerate() {
+        inverse[old] = new;
+    }
+    Ok((forward, inverse, m))
+}
+
+/// In place, on the permuted unknowns: rhs <- L^-1 rhs, or L^-T rhs when `transpose`.
+pub(super) fn lower_solve(
+    symbolic: &faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+    values: &[f64],
+    rhs: faer::MatMut<'_, f64>,
+    transpose: bool,
+    par: faer::Par,
+    mem: &mut faer::dyn_stack::MemBuffer,
+) {
+    use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+    use faer::sparse::linalg::triangular_solve;
+    use faer::Conj;
+    let stack = faer::dyn_stack::MemStack::new(mem);
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let l = faer::sparse::SparseColMatRef::<'_, usize, f64>::new(s.factor(), values);
+            if transpose {
+                triangular_solve::solve_lower_triangular_transpose_in_place(l, Conj::No, rhs, par);
+            } else {
+                triangular_solve::solve_lower_triangular_in_place(l, Conj::No, rhs, par);
+            }
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let l = SupernodalLltRef::new(s, values);
+            if transpose {
+                l.l_transpose_solve_with_conj(Conj::No, rhs, par, stack);
+            } else {
+                l.l_solve_with_conj(Conj::No, rhs, par, stack);
+            }
+        }
+    }
+}
+
+/// Displacements of every load case in the free-DOF numbering of one run.
+#[derive(Debug)]
+pub(super) struct Solution {
+    /// free DOFs x cases, m.
+    pub(super) x: Mat<f64>,
+    pub(super) map: Vec<usize>,
+    pub(super) prescribed: Vec<Option<f64>>,
+}
+
+impl Solution {
+    /// Displacement of a node under case c, m.
+    pub(super) fn at(&self, c: usize, n: usize) -> [f64; 3] {
+        let mut u = [0.0; 3];
+        for (d, ud) in u.iter_mut().enumerate() {
+            let g = 3 * n + d;
+            *ud = match self.prescribed[g] {
+                Some(v) => v,
+                None => self.x[(self.map[g], c)],
+            };
+        }
+        u
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STEEL: Elastic = Elastic {
+        youngs_modulus: 210e9,
+        poisson_ratio: 0.3,
+    };
+
+    /// A clamped cantilever box: its fixed DOFs and one tip load case.
+    fn cantilever(n: usize) -> (Mesh, Vec<Fixed>, Vec<Vec<Load>>) {
+        let (mesh, lattice) = box_mesh((0.04, 0.01, 0.01), (4 * n, n, n), |p| p);
+        let fixed = lattice
+            .iter()
+            .enumerate()
+            .filter(|(_, ijk)| ijk[0] == 0)
+            .flat_map(|(k, _)| (0..3).map(move |d| (k, d, 0.0)))
+            .collect();
+        let tip = lattice.iter().position(|ijk| ijk[0] == 8 * n).unwrap();
+        (mesh, fixed, vec![vec![(tip, 1, -1.0)]])
+    }
+
+    #[test]
+    fn a_model_whose_factor_exceeds_the_limit_is_refused_before_it_is_built() {
+        let (mesh, fixed, loads) = cantilever(2);
+        let unlimited = SizeLimits {
+            unknowns: usize::MAX,
+            factor_nonzeros: usize::MAX,
+        };
+        let solve =
+            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], &loads, limits);
+        assert!(solve(unlimited).is_ok());
+        // The factor holds more nonzeros than the lower triangle of the matrix.
+        let dofs = Dofs::new(&mesh, &fixed);
+        let nnz_lower = LowerPattern::new(&mesh, &[], &dofs.map, dofs.free)
+            .row_idx
+            .len();
+        match solve(SizeLimits {
+            factor_nonzeros: nnz_lower,
+            ..unlimited
+        }) {
+            Err(FeError::TooLarge {
+                nonzeros: Some(n), ..
+            }) => assert!(n > nnz_lower),
+            other => panic!("expected TooLarge with the factor's size, got {other:?}"),
+        }
+        match solve(SizeLimits {
+            unknowns: dofs.free - 1,
+            ..unlimited
+        }) {
+            Err(FeError::TooLarge {
+                unknowns,
+                nonzeros: None,
+            }) => assert_eq!(unknowns, dofs.free),
+            other => panic!("expected TooLarge on the unknowns, got {other:?}"),
+        }
+    }
+}
