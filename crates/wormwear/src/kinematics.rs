@@ -475,7 +475,9 @@ fn slice_minimum(
     (r, gap, at_end)
 }
 
-/// Runs the unloaded analysis (MODEL §4).
+/// Runs the unloaded analysis (MODEL §4): the contact map (the worm's own envelope on the wheel
+/// flank), the gaps of every studied tooth at every position, the kinematic error, the no-load
+/// pattern and the contact lines.
 pub fn analyse_with(
     gear: &GearSet,
     geo: &Geometry,
@@ -485,153 +487,34 @@ pub fn analyse_with(
     let flank = ev.flank;
     let sigma = ev.sigma;
     let wf = geo.wheel_flank(flank);
-    let z2 = geo.teeth as f64;
-    let tau = 2.0 * PI / z2;
-    let np = settings.positions;
     let kk = settings.teeth_each_side as i32;
-    let teeth: Vec<i32> = (-kk..=kk).collect();
-    let nt = teeth.len();
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
-    let n_nodes = wf.nodes.len();
-    let n_cells = wf.cells.len();
-
-    // Contact map: the worm's own envelope on the wheel flank.
     let worm_cut = Hobbing::new(&geo.worm, gear.operating, geo.teeth);
     let theta1_dot = sigma * gear.conditions.worm_speed;
-    let envelopes: Vec<_> = wf
-        .nodes
-        .par_iter()
-        .map(|p| worm_cut.envelope(flank, p.r, p.z))
-        .collect();
-    let contact_theta2: Vec<f64> = envelopes
-        .iter()
-        .zip(&wf.nodes)
-        .map(|(e, p)| e.psi - p.theta)
-        .collect();
-    let reachable_mask: Vec<bool> = envelopes
-        .iter()
-        .map(|e| e.kind == PointKind::Flank)
-        .collect();
+    let map = ContactMap::new(&worm_cut, flank, wf);
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
     // Centre the studied extended positions [phase - K, phase + K + 1) (in pitches) on the
     // contact moment of the flank's central node.
-    let centre = contact_theta2[(nj / 2) * (ni + 1) + ni / 2];
+    let centre = map.contact_theta2[(nj / 2) * (ni + 1) + ni / 2];
+    let tau = 2.0 * PI / geo.teeth as f64;
     let phase = if centre.is_finite() {
         sigma * centre / tau - 0.5
     } else {
         0.0
     };
-    let node_contact: Vec<NodeContact> = (0..n_nodes)
-        .map(|k| {
-            let (i, j) = (k % (ni + 1), k / (ni + 1));
-            node_contact(
-                geo,
-                &ev,
-                wf,
-                &envelopes[k],
-                &contact_theta2,
-                &reachable_mask,
-                i,
-                j,
-                theta1_dot,
-            )
-        })
-        .collect();
-    // Gaps at nodes and cells, slice minima: one task per (position, tooth).
-    struct Block {
-        node_gaps: Vec<f64>,
-        cell_gaps: Vec<f64>,
-        slices: Vec<(f64, f64, bool)>,
-    }
-    let blocks: Vec<Block> = (0..np * nt)
-        .into_par_iter()
-        .map(|b| {
-            let (n, t) = (b / nt, b % nt);
-            let theta2 = sigma * (phase + n as f64 / np as f64) * tau;
-            let theta1 = theta2 * ev.ratio;
-            let offset = sigma * teeth[t] as f64 * tau;
-            let node_gaps: Vec<f64> = wf
-                .nodes
-                .iter()
-                .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
-                .collect();
-            let cell_gaps: Vec<f64> = wf
-                .cells
-                .iter()
-                .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
-                .collect();
-            let slices = (0..=nj)
-                .map(|j| slice_minimum(&ev, wf, j, &node_gaps, offset, theta2, theta1))
-                .collect();
-            Block {
-                node_gaps,
-                cell_gaps,
-                slices,
-            }
-        })
-        .collect();
-
-    // Kinematic error per position.
-    let mut positions = Vec::with_capacity(np);
-    for n in 0..np {
-        let theta2 = sigma * (phase + n as f64 / np as f64) * tau;
-        let min = (0..nt)
-            .flat_map(|t| blocks[n * nt + t].slices.iter().map(|s| s.1))
-            .chain((0..nt).flat_map(|t| blocks[n * nt + t].cell_gaps.iter().copied()))
-            .fold(f64::INFINITY, f64::min);
-        if !min.is_finite() {
-            return Err(KinematicsError::NoContact(n));
-        }
-        positions.push(Position {
-            theta2,
-            theta1: theta2 * ev.ratio,
-            kinematic_error: -min,
-            teeth_in_contact: 0,
-        });
-    }
-
-    // Levers (angular -> normal distance) per cell and node.
-    let cell_lever: Vec<f64> = wf
-        .cells
-        .iter()
-        .map(|c| GapEvaluator::lever(&c.position(), &c.normal_vec()))
-        .collect();
-
-    // No-load pattern and teeth in contact.
+    let study = Study {
+        ev: &ev,
+        wf,
+        sigma,
+        tau,
+        phase,
+        positions: settings.positions,
+        teeth: (-kk..=kk).collect(),
+    };
+    let node_contact = map.node_contacts(geo, &ev, wf, theta1_dot);
+    let blocks = study.gap_blocks();
+    let mut positions = study.kinematic_errors(&blocks)?;
     let j_mark = settings.marking_thickness;
-    let mut min_separation = vec![f64::INFINITY; n_cells];
-    let mut warnings = Vec::new();
-    // Extended positions n + k N_p cover [-K N_p, (K + 1) N_p); if the tooth at either end of
-    // that range is near contact, teeth beyond the studied ones may touch too.
-    let mut end_touch = f64::INFINITY;
-    for n in 0..np {
-        let ke = positions[n].kinematic_error;
-        let mut in_contact = 0;
-        for t in 0..nt {
-            let block = &blocks[n * nt + t];
-            let mut tooth_min = f64::INFINITY;
-            for c in 0..n_cells {
-                let sep = (block.cell_gaps[c] + ke) * cell_lever[c];
-                tooth_min = tooth_min.min(sep);
-                if sep < min_separation[c] {
-                    min_separation[c] = sep;
-                }
-            }
-            if tooth_min <= j_mark {
-                in_contact += 1;
-            }
-            if (t == 0 && n == 0) || (t == nt - 1 && n == np - 1) {
-                end_touch = end_touch.min(tooth_min);
-            }
-        }
-        positions[n].teeth_in_contact = in_contact;
-    }
-    if end_touch <= j_mark {
-        warnings.push(format!(
-            "the outermost studied tooth (k = +-{kk}) is within {:.2} um of contact at the end of \
-             the studied range: teeth beyond it may touch; increase analysis.teeth_each_side",
-            end_touch * 1e6
-        ));
-    }
+    let (min_separation, warnings) = study.no_load_pattern(&blocks, &mut positions, j_mark);
     let marked: Vec<bool> = min_separation.iter().map(|&s| s <= j_mark).collect();
     let pattern_area: f64 = wf
         .cell_area
@@ -640,82 +523,13 @@ pub fn analyse_with(
         .filter(|(_, &m)| m)
         .map(|(a, _)| a)
         .sum();
-    let active_area = wf.active_area();
-
-    let tip_trace: Vec<(f64, f64)> =
-        wf.z.par_iter()
-            .enumerate()
-            .map(|(j, &z)| {
-                let top = wf.node(ni, j).r;
-                match worm_cut.radial_limits(flank, z, top) {
-                    Ok((lo, _)) => (z, lo.max(wf.node(0, j).r)),
-                    Err(_) => (z, top),
-                }
-            })
-            .collect();
-
-    // Contact lines.
-    let mut contact_lines = Vec::with_capacity(np * nt * (nj + 1));
-    for n in 0..np {
-        let ke = positions[n].kinematic_error;
-        let (theta2, theta1) = (positions[n].theta2, positions[n].theta1);
-        for t in 0..nt {
-            let offset = sigma * teeth[t] as f64 * tau;
-            for (j, &(r, gap, at_end)) in blocks[n * nt + t].slices.iter().enumerate() {
-                if !gap.is_finite() {
-                    continue;
-                }
-                let z = wf.z[j];
-                let (theta, _) = wf.column_theta(j, r);
-                let p = wheel_point(r, theta + offset, z, theta2);
-                let q = ev.placement.wheel_to_worm(&p);
-                let rho = (q.y * q.y + q.z * q.z).sqrt();
-                let normal = ev.worm.outward_normal(flank, q.y, q.z);
-                let n_wheel = ev.placement.vector_worm_to_wheel(&normal);
-                let lever = GapEvaluator::lever(&p, &n_wheel);
-                let curvature_radius = if at_end {
-                    f64::NAN
-                } else {
-                    curvature_radius(&ev, wf, j, r, offset, theta2, theta1, lever, &node_contact)
-                };
-                contact_lines.push(SliceContact {
-                    position: n,
-                    tooth: teeth[t],
-                    slice: j,
-                    r,
-                    z,
-                    theta,
-                    angular_gap: gap,
-                    separation: (gap + ke) * lever,
-                    worm_radius: rho,
-                    at_end,
-                    curvature_radius,
-                });
-            }
-        }
-    }
-
-    let r1 = gear.worm.reference_radius;
-    let pitch = material_velocities(
-        &Vector3::new(0.0, r1, 0.0),
-        &geo.worm,
-        &Placement::aligned(gear.nominal_centre_distance),
-        theta1_dot,
-        ev.ratio,
-    );
-    let pitch_sliding_speed = Vector3::from(pitch.sliding).norm();
-
-    let mut node_gaps = Vec::with_capacity(np * nt * n_nodes);
-    let mut cell_gaps = Vec::with_capacity(np * nt * n_cells);
-    for b in &blocks {
-        node_gaps.extend_from_slice(&b.node_gaps);
-        cell_gaps.extend_from_slice(&b.cell_gaps);
-    }
+    let contact_lines = study.contact_lines(&blocks, &positions, &node_contact);
+    let (node_gaps, cell_gaps) = GapBlock::joined(&blocks);
     Ok(Tca {
         loaded_flank: flank,
         sigma,
         phase,
-        teeth,
+        teeth: study.teeth,
         positions,
         node_gaps,
         cell_gaps,
@@ -724,12 +538,311 @@ pub fn analyse_with(
         marked,
         marking_thickness: j_mark,
         pattern_area,
-        active_area,
-        tip_trace,
+        active_area: wf.active_area(),
+        tip_trace: tip_trace(&worm_cut, flank, wf),
         node_contact,
-        pitch_sliding_speed,
+        pitch_sliding_speed: pitch_sliding_speed(gear, geo, theta1_dot, ev.ratio),
         warnings,
     })
+}
+
+/// The sliding speed at the worm's reference radius on the line of centres, m/s.
+fn pitch_sliding_speed(gear: &GearSet, geo: &Geometry, theta1_dot: f64, ratio: f64) -> f64 {
+    let r1 = gear.worm.reference_radius;
+    let pitch = material_velocities(
+        &Vector3::new(0.0, r1, 0.0),
+        &geo.worm,
+        &Placement::aligned(gear.nominal_centre_distance),
+        theta1_dot,
+        ratio,
+    );
+    Vector3::from(pitch.sliding).norm()
+}
+
+/// The contact map: the worm's own envelope on the wheel flank (MODEL §4.5), per node: the
+/// envelope point, the wheel angle of its contact moment, and whether the worm's flank (not
+/// its tip or an edge) reaches it.
+struct ContactMap {
+    envelopes: Vec<crate::geometry::EnvelopePoint>,
+    contact_theta2: Vec<f64>,
+    reachable_mask: Vec<bool>,
+}
+
+impl ContactMap {
+    /// The contact of every flank node (MODEL §4.5-4.6), node-major as the flank.
+    fn node_contacts(
+        &self,
+        geo: &Geometry,
+        ev: &GapEvaluator,
+        wf: &WheelFlank,
+        theta1_dot: f64,
+    ) -> Vec<NodeContact> {
+        let ni = wf.cells_height;
+        (0..wf.nodes.len())
+            .map(|k| {
+                let (i, j) = (k % (ni + 1), k / (ni + 1));
+                node_contact(
+                    geo,
+                    ev,
+                    wf,
+                    &self.envelopes[k],
+                    &self.contact_theta2,
+                    &self.reachable_mask,
+                    i,
+                    j,
+                    theta1_dot,
+                )
+            })
+            .collect()
+    }
+
+    fn new(worm_cut: &Hobbing, flank: Flank, wf: &WheelFlank) -> Self {
+        let envelopes: Vec<_> = wf
+            .nodes
+            .par_iter()
+            .map(|p| worm_cut.envelope(flank, p.r, p.z))
+            .collect();
+        let contact_theta2: Vec<f64> = envelopes
+            .iter()
+            .zip(&wf.nodes)
+            .map(|(e, p)| e.psi - p.theta)
+            .collect();
+        let reachable_mask: Vec<bool> = envelopes
+            .iter()
+            .map(|e| e.kind == PointKind::Flank)
+            .collect();
+        Self {
+            envelopes,
+            contact_theta2,
+            reachable_mask,
+        }
+    }
+}
+
+/// The studied positions and teeth of an unloaded analysis, and what its steps share.
+struct Study<'a> {
+    ev: &'a GapEvaluator<'a>,
+    wf: &'a WheelFlank,
+    /// +1 or -1: the wheel's sense of rotation.
+    sigma: f64,
+    /// Angular pitch of the wheel, rad.
+    tau: f64,
+    /// Phase of the first position, in pitches.
+    phase: f64,
+    positions: usize,
+    /// Tooth indices studied, -K..=K.
+    teeth: Vec<i32>,
+}
+
+/// Gaps of one studied tooth at one position: at the nodes and cells (angular, rad) and each
+/// slice's minimum (r, gap, at the end of the flank).
+struct GapBlock {
+    node_gaps: Vec<f64>,
+    cell_gaps: Vec<f64>,
+    slices: Vec<(f64, f64, bool)>,
+}
+
+impl GapBlock {
+    /// The node and cell gaps of all blocks, in block order (position-major).
+    fn joined(blocks: &[GapBlock]) -> (Vec<f64>, Vec<f64>) {
+        let n_nodes = blocks.first().map_or(0, |b| b.node_gaps.len());
+        let n_cells = blocks.first().map_or(0, |b| b.cell_gaps.len());
+        let mut node_gaps = Vec::with_capacity(blocks.len() * n_nodes);
+        let mut cell_gaps = Vec::with_capacity(blocks.len() * n_cells);
+        for b in blocks {
+            node_gaps.extend_from_slice(&b.node_gaps);
+            cell_gaps.extend_from_slice(&b.cell_gaps);
+        }
+        (node_gaps, cell_gaps)
+    }
+}
+
+impl Study<'_> {
+    /// Wheel angle of position n, rad.
+    fn theta2(&self, n: usize) -> f64 {
+        self.sigma * (self.phase + n as f64 / self.positions as f64) * self.tau
+    }
+
+    /// Gaps at nodes and cells, slice minima: one task per (position, tooth), position-major.
+    fn gap_blocks(&self) -> Vec<GapBlock> {
+        let (ev, wf) = (self.ev, self.wf);
+        let nt = self.teeth.len();
+        let nj = wf.cells_face;
+        (0..self.positions * nt)
+            .into_par_iter()
+            .map(|b| {
+                let (n, t) = (b / nt, b % nt);
+                let theta2 = self.theta2(n);
+                let theta1 = theta2 * ev.ratio;
+                let offset = self.sigma * self.teeth[t] as f64 * self.tau;
+                let node_gaps: Vec<f64> = wf
+                    .nodes
+                    .iter()
+                    .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
+                    .collect();
+                let cell_gaps: Vec<f64> = wf
+                    .cells
+                    .iter()
+                    .map(|p| ev.angular(p.r, p.theta + offset, p.z, theta2, theta1))
+                    .collect();
+                let slices = (0..=nj)
+                    .map(|j| slice_minimum(ev, wf, j, &node_gaps, offset, theta2, theta1))
+                    .collect();
+                GapBlock {
+                    node_gaps,
+                    cell_gaps,
+                    slices,
+                }
+            })
+            .collect()
+    }
+
+    /// Kinematic error per position: minus the smallest gap over the studied teeth (MODEL §4.3).
+    fn kinematic_errors(&self, blocks: &[GapBlock]) -> Result<Vec<Position>, KinematicsError> {
+        let nt = self.teeth.len();
+        let mut positions = Vec::with_capacity(self.positions);
+        for n in 0..self.positions {
+            let theta2 = self.theta2(n);
+            let min = (0..nt)
+                .flat_map(|t| blocks[n * nt + t].slices.iter().map(|s| s.1))
+                .chain((0..nt).flat_map(|t| blocks[n * nt + t].cell_gaps.iter().copied()))
+                .fold(f64::INFINITY, f64::min);
+            if !min.is_finite() {
+                return Err(KinematicsError::NoContact(n));
+            }
+            positions.push(Position {
+                theta2,
+                theta1: theta2 * self.ev.ratio,
+                kinematic_error: -min,
+                teeth_in_contact: 0,
+            });
+        }
+        Ok(positions)
+    }
+
+    /// The no-load pattern (MODEL §4.4): the smallest normal separation of every cell over the
+    /// cycle, m, and the teeth within the marking thickness `j_mark` at each position (set on
+    /// `positions`); a warning when the outermost studied tooth is near contact.
+    fn no_load_pattern(
+        &self,
+        blocks: &[GapBlock],
+        positions: &mut [Position],
+        j_mark: f64,
+    ) -> (Vec<f64>, Vec<String>) {
+        let wf = self.wf;
+        let (np, nt) = (self.positions, self.teeth.len());
+        let n_cells = wf.cells.len();
+        // Levers (angular -> normal distance) per cell.
+        let cell_lever: Vec<f64> = wf
+            .cells
+            .iter()
+            .map(|c| GapEvaluator::lever(&c.position(), &c.normal_vec()))
+            .collect();
+        let mut min_separation = vec![f64::INFINITY; n_cells];
+        let mut warnings = Vec::new();
+        // Extended positions n + k N_p cover [-K N_p, (K + 1) N_p); if the tooth at either end
+        // of that range is near contact, teeth beyond the studied ones may touch too.
+        let mut end_touch = f64::INFINITY;
+        for n in 0..np {
+            let ke = positions[n].kinematic_error;
+            let mut in_contact = 0;
+            for t in 0..nt {
+                let block = &blocks[n * nt + t];
+                let mut tooth_min = f64::INFINITY;
+                for c in 0..n_cells {
+                    let sep = (block.cell_gaps[c] + ke) * cell_lever[c];
+                    tooth_min = tooth_min.min(sep);
+                    if sep < min_separation[c] {
+                        min_separation[c] = sep;
+                    }
+                }
+                if tooth_min <= j_mark {
+                    in_contact += 1;
+                }
+                if (t == 0 && n == 0) || (t == nt - 1 && n == np - 1) {
+                    end_touch = end_touch.min(tooth_min);
+                }
+            }
+            positions[n].teeth_in_contact = in_contact;
+        }
+        if end_touch <= j_mark {
+            let kk = self.teeth.last().copied().unwrap_or(0);
+            warnings.push(format!(
+                "the outermost studied tooth (k = +-{kk}) is within {:.2} um of contact at the end \
+                 of the studied range: teeth beyond it may touch; increase analysis.teeth_each_side",
+                end_touch * 1e6
+            ));
+        }
+        (min_separation, warnings)
+    }
+
+    /// The contact line of every studied tooth at every position: each slice's minimum gap with
+    /// its point, separation, worm radius, lever and relative curvature radius (MODEL §4.6).
+    fn contact_lines(
+        &self,
+        blocks: &[GapBlock],
+        positions: &[Position],
+        node_contact: &[NodeContact],
+    ) -> Vec<SliceContact> {
+        let (ev, wf) = (self.ev, self.wf);
+        let nt = self.teeth.len();
+        let mut contact_lines = Vec::with_capacity(self.positions * nt * (wf.cells_face + 1));
+        for (n, position) in positions.iter().enumerate() {
+            let ke = position.kinematic_error;
+            let (theta2, theta1) = (position.theta2, position.theta1);
+            for t in 0..nt {
+                let offset = self.sigma * self.teeth[t] as f64 * self.tau;
+                for (j, &(r, gap, at_end)) in blocks[n * nt + t].slices.iter().enumerate() {
+                    if !gap.is_finite() {
+                        continue;
+                    }
+                    let z = wf.z[j];
+                    let (theta, _) = wf.column_theta(j, r);
+                    let p = wheel_point(r, theta + offset, z, theta2);
+                    let q = ev.placement.wheel_to_worm(&p);
+                    let rho = (q.y * q.y + q.z * q.z).sqrt();
+                    let normal = ev.worm.outward_normal(ev.flank, q.y, q.z);
+                    let n_wheel = ev.placement.vector_worm_to_wheel(&normal);
+                    let lever = GapEvaluator::lever(&p, &n_wheel);
+                    let curvature_radius = if at_end {
+                        f64::NAN
+                    } else {
+                        curvature_radius(ev, wf, j, r, offset, theta2, theta1, lever, node_contact)
+                    };
+                    contact_lines.push(SliceContact {
+                        position: n,
+                        tooth: self.teeth[t],
+                        slice: j,
+                        r,
+                        z,
+                        theta,
+                        angular_gap: gap,
+                        separation: (gap + ke) * lever,
+                        worm_radius: rho,
+                        at_end,
+                        curvature_radius,
+                    });
+                }
+            }
+        }
+        contact_lines
+    }
+}
+
+/// The lowest radius the worm's tip reaches on each node column of the wheel flank, (z, r), m
+/// (the flank's root where the worm does not reach below it).
+fn tip_trace(worm_cut: &Hobbing, flank: Flank, wf: &WheelFlank) -> Vec<(f64, f64)> {
+    let ni = wf.cells_height;
+    wf.z.par_iter()
+        .enumerate()
+        .map(|(j, &z)| {
+            let top = wf.node(ni, j).r;
+            match worm_cut.radial_limits(flank, z, top) {
+                Ok((lo, _)) => (z, lo.max(wf.node(0, j).r)),
+                Err(_) => (z, top),
+            }
+        })
+        .collect()
 }
 
 /// Relative radius of curvature across the contact line on slice j at r: R = sin^2(beta) / g''
