@@ -146,6 +146,211 @@ pub fn worm_mesh(
     )
 }
 
+/// The worm's lattice mapped onto the thread: the node of lattice point (ri radial, si along
+/// the helical coordinate, li half-layer around the axis) and its position (thread frame, m).
+struct ThreadLattice<'a> {
+    thread: &'a ThreadSurface,
+    lattice: &'a WormLattice,
+    body: &'a WormBody,
+    /// Axial pitch, lead (m), hand (+-1) and lead / 2 pi.
+    p: f64,
+    lead: f64,
+    hand: f64,
+    h: f64,
+    n_layers: usize,
+    half_layers: usize,
+    /// The flank at smaller s first, of thread 0.
+    low_flank: Flank,
+    high_flank: Flank,
+    shaft: f64,
+    bore: f64,
+    /// Elements in the core, inside the shaft, along the thread height, per half space and
+    /// across the thread.
+    n_core: usize,
+    n_in: usize,
+    n_h: usize,
+    n_sp: usize,
+    n_ac: usize,
+    /// Radial indices of the shaft surface and of the root.
+    ri_shaft: usize,
+    ri_root: usize,
+    /// Half-steps per pitch.
+    m2: usize,
+    /// Axial positions of the two flanks at the root radius, m.
+    xl_f: f64,
+    xr_f: f64,
+    /// The seam: (ri, si, 2N) is (ri, si + shift, 0).
+    shift: i64,
+}
+
+impl<'a> ThreadLattice<'a> {
+    fn new(
+        thread: &'a ThreadSurface,
+        body: &'a WormBody,
+        settings: &WormMeshSettings,
+        lattice: &'a WormLattice,
+    ) -> Self {
+        let p = thread.axial_pitch();
+        let lead = thread.lead();
+        let hand = thread.hand_sign();
+        let n_layers = lattice.phi.len() - 1;
+        let xa = |flank: Flank, rho: f64| thread.axial_profile(flank, rho).0;
+        let (low_flank, high_flank) =
+            if xa(Flank::Left, body.root_radius) < xa(Flank::Right, body.root_radius) {
+                (Flank::Left, Flank::Right)
+            } else {
+                (Flank::Right, Flank::Left)
+            };
+        let shaft = body.shaft_radius.min(body.root_radius);
+        let n_core = if shaft < body.root_radius {
+            settings.core.max(1)
+        } else {
+            0
+        };
+        let (n_in, n_sp, n_ac) = (
+            settings.inner.max(1),
+            settings.space.max(1),
+            settings.across.max(1),
+        );
+        let ri_shaft = 2 * n_in;
+        let m2 = 2 * (2 * n_sp + n_ac);
+        Self {
+            thread,
+            lattice,
+            body,
+            p,
+            lead,
+            hand,
+            h: lead / (2.0 * PI),
+            n_layers,
+            half_layers: 2 * n_layers,
+            low_flank,
+            high_flank,
+            shaft,
+            bore: 0.25 * shaft,
+            n_core,
+            n_in,
+            n_h: lattice.height.len() - 1,
+            n_sp,
+            n_ac,
+            ri_shaft,
+            ri_root: ri_shaft + 2 * n_core,
+            m2,
+            xl_f: xa(low_flank, body.root_radius),
+            xr_f: xa(high_flank, body.root_radius),
+            shift: (hand * (lead / p).round()) as i64 * m2 as i64,
+        }
+    }
+
+    /// Axial position of a flank of thread 0 at radius rho, m.
+    fn xa(&self, flank: Flank, rho: f64) -> f64 {
+        self.thread.axial_profile(flank, rho).0
+    }
+
+    /// Radius of radial index ri: bore to shaft, shaft to root, root to tip on the lattice's
+    /// heights, m.
+    fn rho_of(&self, ri: usize) -> f64 {
+        let (body, shaft, bore) = (self.body, self.shaft, self.bore);
+        let (ri_shaft, ri_root) = (self.ri_shaft, self.ri_root);
+        if ri <= ri_shaft {
+            bore + (shaft - bore) * ri as f64 / ri_shaft as f64
+        } else if ri <= ri_root {
+            shaft
+                + (body.root_radius - shaft) * (ri - ri_shaft) as f64 / (ri_root - ri_shaft) as f64
+        } else {
+            let height = &self.lattice.height;
+            let t = (ri - ri_root) as f64 / 2.0;
+            let (i, f) = (t.floor() as usize, t.fract());
+            let frac = if i >= self.n_h {
+                1.0
+            } else {
+                height[i] + (height[i + 1] - height[i]) * f
+            };
+            body.root_radius + (body.tip_radius - body.root_radius) * frac
+        }
+    }
+
+    /// Helical coordinate s of lattice node (ri, si), m.
+    fn s_of(&self, ri: usize, si: i64) -> f64 {
+        let (p, m2) = (self.p, self.m2);
+        let (xl_f, xr_f) = (self.xl_f, self.xr_f);
+        let j = si.div_euclid(m2 as i64);
+        let loc = si.rem_euclid(m2 as i64) as usize;
+        let base = j as f64 * p;
+        let (a0, a1) = (2 * self.n_sp, 2 * self.n_sp + 2 * self.n_ac);
+        if loc < a0 {
+            base - 0.5 * p + (xl_f + 0.5 * p) * loc as f64 / a0 as f64
+        } else if loc <= a1 {
+            let rho = self.rho_of(ri);
+            let (xl, xr) = if ri > self.ri_root {
+                (self.xa(self.low_flank, rho), self.xa(self.high_flank, rho))
+            } else {
+                (xl_f, xr_f)
+            };
+            base + xl + (xr - xl) * (loc - a0) as f64 / (a1 - a0) as f64
+        } else {
+            base + xr_f + (0.5 * p - xr_f) * (loc - a1) as f64 / (m2 - a1) as f64
+        }
+    }
+
+    /// Angle of half-layer li about the axis, rad.
+    fn phi_of(&self, li: usize) -> f64 {
+        let phi = &self.lattice.phi;
+        let (i, odd) = (li / 2, li % 2 == 1);
+        if i >= self.n_layers {
+            PI
+        } else if odd {
+            0.5 * (phi[i] + phi[i + 1])
+        } else {
+            phi[i]
+        }
+    }
+
+    /// Position of lattice node (ri, si, li), thread frame, m.
+    fn position(&self, ri: usize, si: i64, li: usize) -> [f64; 3] {
+        let (rho, phi) = (self.rho_of(ri), self.phi_of(li));
+        [
+            self.s_of(ri, si) + self.hand * self.h * phi,
+            rho * phi.cos(),
+            rho * phi.sin(),
+        ]
+    }
+
+    /// The lattice point the seam glues (ri, si, li) to.
+    fn canonical(&self, ri: usize, si: i64, li: usize) -> (usize, i64, usize) {
+        if li == self.half_layers {
+            (ri, si + self.shift, 0)
+        } else {
+            (ri, si, li)
+        }
+    }
+}
+
+/// The mesh's nodes by lattice point, added when first used.
+#[derive(Default)]
+struct LatticeNodes {
+    points: Vec<[f64; 3]>,
+    index: HashMap<(usize, i64, usize), usize>,
+}
+
+impl LatticeNodes {
+    fn at(&mut self, lattice: &ThreadLattice, ri: usize, si: i64, li: usize) -> usize {
+        let key = lattice.canonical(ri, si, li);
+        let points = &mut self.points;
+        *self.index.entry(key).or_insert_with(|| {
+            points.push(lattice.position(key.0, key.1, key.2));
+            points.len() - 1
+        })
+    }
+
+    fn find(&self, lattice: &ThreadLattice, ri: usize, si: i64, li: usize) -> Option<usize> {
+        self.index.get(&lattice.canonical(ri, si, li)).copied()
+    }
+}
+
+/// The threads of the model: the central one and its two neighbours.
+const THREADS: [i64; 3] = [-1, 0, 1];
+
 /// Builds the worm mesh on the given lattice (layers and thread heights); `settings` gives
 /// the element counts across and in the core.
 pub fn worm_mesh_on(
@@ -155,198 +360,45 @@ pub fn worm_mesh_on(
     settings: &WormMeshSettings,
     lattice: &WormLattice,
 ) -> WormMesh {
-    let p = thread.axial_pitch();
-    let lead = thread.lead();
-    let hand = thread.hand_sign();
-    let h = lead / (2.0 * PI);
-    let n_layers = lattice.phi.len() - 1;
-    let half_layers = 2 * n_layers;
-    // Axial profiles of thread 0, the flank at smaller s first.
-    let xa = |flank: Flank, rho: f64| thread.axial_profile(flank, rho).0;
-    let (low_flank, high_flank) =
-        if xa(Flank::Left, body.root_radius) < xa(Flank::Right, body.root_radius) {
-            (Flank::Left, Flank::Right)
-        } else {
-            (Flank::Right, Flank::Left)
-        };
-    let shaft = body.shaft_radius.min(body.root_radius);
-    let bore = 0.25 * shaft;
-    let n_core = if shaft < body.root_radius {
-        settings.core.max(1)
-    } else {
-        0
-    };
-    let (n_in, n_h, n_sp, n_ac) = (
-        settings.inner.max(1),
-        lattice.height.len() - 1,
-        settings.space.max(1),
-        settings.across.max(1),
-    );
-    let ri_shaft = 2 * n_in;
-    let ri_root = ri_shaft + 2 * n_core;
-    let m2 = 2 * (2 * n_sp + n_ac); // half-steps per pitch
-    let rho_of = |ri: usize| -> f64 {
-        if ri <= ri_shaft {
-            bore + (shaft - bore) * ri as f64 / ri_shaft as f64
-        } else if ri <= ri_root {
-            shaft
-                + (body.root_radius - shaft) * (ri - ri_shaft) as f64 / (ri_root - ri_shaft) as f64
-        } else {
-            let t = (ri - ri_root) as f64 / 2.0;
-            let (i, f) = (t.floor() as usize, t.fract());
-            let frac = if i >= n_h {
-                1.0
-            } else {
-                lattice.height[i] + (lattice.height[i + 1] - lattice.height[i]) * f
-            };
-            body.root_radius + (body.tip_radius - body.root_radius) * frac
-        }
-    };
-    let (xl_f, xr_f) = (
-        xa(low_flank, body.root_radius),
-        xa(high_flank, body.root_radius),
-    );
-    // Helical coordinate s of lattice node (ri, si).
-    let s_of = |ri: usize, si: i64| -> f64 {
-        let j = si.div_euclid(m2 as i64);
-        let loc = si.rem_euclid(m2 as i64) as usize;
-        let base = j as f64 * p;
-        let (a0, a1) = (2 * n_sp, 2 * n_sp + 2 * n_ac);
-        if loc < a0 {
-            base - 0.5 * p + (xl_f + 0.5 * p) * loc as f64 / a0 as f64
-        } else if loc <= a1 {
-            let rho = rho_of(ri);
-            let (xl, xr) = if ri > ri_root {
-                (xa(low_flank, rho), xa(high_flank, rho))
-            } else {
-                (xl_f, xr_f)
-            };
-            base + xl + (xr - xl) * (loc - a0) as f64 / (a1 - a0) as f64
-        } else {
-            base + xr_f + (0.5 * p - xr_f) * (loc - a1) as f64 / (m2 - a1) as f64
-        }
-    };
-    let phi_of = |li: usize| {
-        let (i, odd) = (li / 2, li % 2 == 1);
-        if i >= n_layers {
-            PI
-        } else if odd {
-            0.5 * (lattice.phi[i] + lattice.phi[i + 1])
-        } else {
-            lattice.phi[i]
-        }
-    };
-    let position = |ri: usize, si: i64, li: usize| -> [f64; 3] {
-        let (rho, phi) = (rho_of(ri), phi_of(li));
-        [
-            s_of(ri, si) + hand * h * phi,
-            rho * phi.cos(),
-            rho * phi.sin(),
-        ]
-    };
-    // The seam: (ri, si, 2N) is (ri, si + hand z1 pitches, 0).
-    let shift = (hand * (lead / p).round()) as i64 * m2 as i64;
-    let canonical = |ri: usize, si: i64, li: usize| -> (usize, i64, usize) {
-        if li == half_layers {
-            (ri, si + shift, 0)
-        } else {
-            (ri, si, li)
-        }
-    };
-    let mut nodes: Vec<[f64; 3]> = Vec::new();
-    let mut index: HashMap<(usize, i64, usize), usize> = HashMap::new();
-    let mut node_at = |ri: usize, si: i64, li: usize| -> usize {
-        let key = canonical(ri, si, li);
-        *index.entry(key).or_insert_with(|| {
-            nodes.push(position(key.0, key.1, key.2));
-            nodes.len() - 1
-        })
-    };
+    let t = ThreadLattice::new(thread, body, settings, lattice);
+    let (p, lead, m2) = (t.p, t.lead, t.m2);
+    let mut nodes = LatticeNodes::default();
     // Pitches spanned: the bearings with 2 leads and a pitch of margin on the outside (the
     // drive ring, half a lead out, must lie where the seam is glued).
     let x_lo = body.bearings[0].min(body.bearings[1]) - 2.0 * lead - p;
     let x_hi = body.bearings[0].max(body.bearings[1]) + 2.0 * lead + p;
     let j_lo = (x_lo / p).floor() as i64;
     let j_hi = (x_hi / p).ceil() as i64;
-    let threads = [-1i64, 0, 1];
     let mut elements = Vec::new();
-    // Blocks of one pitch: (ri range start, elements radially, loc start, elements across).
-    let mut add_block =
-        |elements: &mut Vec<[usize; 20]>, ri0: usize, nr: usize, si0: i64, ns: usize| {
-            for l in 0..n_layers {
-                for ir in 0..nr {
-                    for is in 0..ns {
-                        let mut e = [0usize; 20];
-                        for (a, c) in NATURAL.iter().enumerate() {
-                            let si = si0 + (2 * is) as i64 + 1 + c[0] as i64;
-                            let ri = (ri0 as i64 + (2 * ir) as i64 + 1 + c[1] as i64) as usize;
-                            let li = (2 * l as i64 + 1 + c[2] as i64) as usize;
-                            e[a] = node_at(ri, si, li);
-                        }
-                        elements.push(e);
-                    }
-                }
-            }
-        };
     for j in j_lo..j_hi {
         let si0 = j * m2 as i64;
         let body_pitch = (j as f64 * p).abs() <= body.body_half_length;
-        add_block(&mut elements, 0, n_in, si0, m2 / 2);
-        if body_pitch && n_core > 0 {
-            add_block(&mut elements, ri_shaft, n_core, si0, m2 / 2);
+        add_block(&t, &mut nodes, &mut elements, (0, t.n_in), (si0, m2 / 2));
+        if body_pitch && t.n_core > 0 {
+            add_block(
+                &t,
+                &mut nodes,
+                &mut elements,
+                (t.ri_shaft, t.n_core),
+                (si0, m2 / 2),
+            );
         }
-        if threads.contains(&j) && body_pitch {
-            add_block(&mut elements, ri_root, n_h, si0 + 2 * n_sp as i64, n_ac);
+        if THREADS.contains(&j) && body_pitch {
+            let across = (si0 + 2 * t.n_sp as i64, t.n_ac);
+            add_block(&t, &mut nodes, &mut elements, (t.ri_root, t.n_h), across);
         }
     }
-    let mesh_nodes = nodes;
     for e in &mut elements {
-        let x: [[f64; 3]; 20] = std::array::from_fn(|a| mesh_nodes[e[a]]);
+        let x: [[f64; 3]; 20] = std::array::from_fn(|a| nodes.points[e[a]]);
         if centre_jacobian(&x) < 0.0 {
             *e = mirrored(*e);
         }
     }
-    // Bookkeeping from the lattice.
-    let find = |ri: usize, si: i64, li: usize| index.get(&canonical(ri, si, li)).copied();
-    let flank_nodes = |loc: usize| -> Vec<Vec<(usize, usize, usize)>> {
-        threads
-            .iter()
-            .map(|&j| {
-                let mut out = Vec::new();
-                for li in 0..half_layers {
-                    for hi in 0..=2 * n_h {
-                        if let Some(id) = find(ri_root + hi, j * m2 as i64 + loc as i64, li) {
-                            out.push((li, hi, id));
-                        }
-                    }
-                }
-                out
-            })
-            .collect()
-    };
-    let (loc_low, loc_high) = (2 * n_sp, 2 * n_sp + 2 * n_ac);
-    let (loc_loaded, loc_opposite) = if loaded == low_flank {
+    let (loc_low, loc_high) = (2 * t.n_sp, 2 * t.n_sp + 2 * t.n_ac);
+    let (loc_loaded, loc_opposite) = if loaded == t.low_flank {
         (loc_low, loc_high)
     } else {
         (loc_high, loc_low)
-    };
-    // Outer shaft surface nodes nearest to the plane x = x0, one per half-layer.
-    let ring = |x0: f64| -> Vec<usize> {
-        (0..half_layers)
-            .filter_map(|li| {
-                let phi = phi_of(li);
-                let s_target = x0 - hand * h * phi;
-                let j = (s_target / p).floor() as i64;
-                ((j - 1) * m2 as i64..(j + 2) * m2 as i64)
-                    .filter_map(|si| find(ri_shaft, si, li).map(|id| (si, id)))
-                    .min_by(|a, b| {
-                        let da = (s_of(ri_shaft, a.0) - s_target).abs();
-                        let db = (s_of(ri_shaft, b.0) - s_target).abs();
-                        da.total_cmp(&db)
-                    })
-                    .map(|(_, id)| id)
-            })
-            .collect()
     };
     let outward = if body.bearings[0] < body.bearings[1] {
         -1.0
@@ -354,15 +406,88 @@ pub fn worm_mesh_on(
         1.0
     };
     WormMesh {
-        loaded: flank_nodes(loc_loaded),
-        opposite: flank_nodes(loc_opposite),
-        bearing_rings: [ring(body.bearings[0]), ring(body.bearings[1])],
-        drive_ring: ring(body.bearings[0] + outward * 0.5 * lead),
+        loaded: flank_nodes(&t, &nodes, loc_loaded),
+        opposite: flank_nodes(&t, &nodes, loc_opposite),
+        bearing_rings: [
+            shaft_ring(&t, &nodes, body.bearings[0]),
+            shaft_ring(&t, &nodes, body.bearings[1]),
+        ],
+        drive_ring: shaft_ring(&t, &nodes, body.bearings[0] + outward * 0.5 * lead),
+        half_layers: t.half_layers,
+        height_steps: 2 * t.n_h,
         mesh: Mesh {
-            nodes: mesh_nodes,
+            nodes: nodes.points,
             elements,
         },
-        half_layers,
-        height_steps: 2 * n_h,
     }
+}
+
+/// The elements of one block of one pitch on every layer: radial indices from `ri0` with `nr`
+/// elements, helical from `si0` with `ns` elements.
+fn add_block(
+    t: &ThreadLattice,
+    nodes: &mut LatticeNodes,
+    elements: &mut Vec<[usize; 20]>,
+    (ri0, nr): (usize, usize),
+    (si0, ns): (i64, usize),
+) {
+    for l in 0..t.n_layers {
+        for ir in 0..nr {
+            for is in 0..ns {
+                let mut e = [0usize; 20];
+                for (a, c) in NATURAL.iter().enumerate() {
+                    let si = si0 + (2 * is) as i64 + 1 + c[0] as i64;
+                    let ri = (ri0 as i64 + (2 * ir) as i64 + 1 + c[1] as i64) as usize;
+                    let li = (2 * l as i64 + 1 + c[2] as i64) as usize;
+                    e[a] = nodes.at(t, ri, si, li);
+                }
+                elements.push(e);
+            }
+        }
+    }
+}
+
+/// Per thread, the flank nodes at helical offset `loc` in the pitch: (half-layer, height
+/// half-index from the root, node).
+fn flank_nodes(
+    t: &ThreadLattice,
+    nodes: &LatticeNodes,
+    loc: usize,
+) -> Vec<Vec<(usize, usize, usize)>> {
+    THREADS
+        .iter()
+        .map(|&j| {
+            let mut out = Vec::new();
+            for li in 0..t.half_layers {
+                for hi in 0..=2 * t.n_h {
+                    if let Some(id) =
+                        nodes.find(t, t.ri_root + hi, j * t.m2 as i64 + loc as i64, li)
+                    {
+                        out.push((li, hi, id));
+                    }
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// Outer shaft surface nodes nearest to the plane x = x0, one per half-layer.
+fn shaft_ring(t: &ThreadLattice, nodes: &LatticeNodes, x0: f64) -> Vec<usize> {
+    let (p, m2) = (t.p, t.m2 as i64);
+    (0..t.half_layers)
+        .filter_map(|li| {
+            let phi = t.phi_of(li);
+            let s_target = x0 - t.hand * t.h * phi;
+            let j = (s_target / p).floor() as i64;
+            ((j - 1) * m2..(j + 2) * m2)
+                .filter_map(|si| nodes.find(t, t.ri_shaft, si, li).map(|id| (si, id)))
+                .min_by(|a, b| {
+                    let da = (t.s_of(t.ri_shaft, a.0) - s_target).abs();
+                    let db = (t.s_of(t.ri_shaft, b.0) - s_target).abs();
+                    da.total_cmp(&db)
+                })
+                .map(|(_, id)| id)
+        })
+        .collect()
 }
