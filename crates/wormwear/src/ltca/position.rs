@@ -25,6 +25,9 @@ pub(super) fn torque_balance(
     (worm_torque, wheel_torque, power_balance, warnings)
 }
 
+/// The loaded contact at position n (MODEL §5.2-5.4): the local mesh in a band around the
+/// contact lines, the problem on it, the solve with the wheel torque updated until the worm
+/// torque balances, and the band widened (up to four times) while load reaches its edge.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_position(
     geo: &Geometry,
@@ -58,164 +61,214 @@ pub(super) fn solve_position(
         }
         // The previous analysis' loads on the same cells (the first mesh only: a widened band
         // puts other points under the same indices).
-        let mut warm: Option<Vec<f64>> = seed
+        let warm: Option<Vec<f64>> = seed
             .filter(|_| widenings == 0)
             .and_then(|s| s.for_cells(n, &cells));
-        // Blocks per tooth (cells are grouped by tooth in mesh order), assembled in parallel.
-        let mut ranges = Vec::new();
-        let mut start = 0;
-        while start < cells.len() {
-            let t = cells[start].tooth_index;
-            let mut end = start;
-            while end < cells.len() && cells[end].tooth_index == t {
-                end += 1;
-            }
-            ranges.push((start, end - start));
-            start = end;
-        }
-        let blocks: Vec<Block> = ranges
-            .into_iter()
-            .map(|(start, size)| {
-                // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
-                // of a tooth differ only slightly (line-aligned areas vary by the line's
-                // obliquity), and the tangential term's small asymmetry on curved flanks is
-                // dropped. Entries are assembled as the solver reads them: the rows of the
-                // cells that carry load, and the screened solve's candidate block.
-                let group = &cells[start..start + size];
-                let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
-                let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
-                Block {
-                    start,
-                    size,
-                    matrix: BlockMatrix::Lazy(Box::new(InfluenceRows::new(
-                        pair, &contact, &levers,
-                    ))),
-                }
-            })
-            .collect();
-        let low_rank = bending.map(|b| {
-            let mut lr = b.coefficients(&cells);
-            for (i, c) in cells.iter().enumerate() {
-                lr.divide_row(i, c.lever);
-            }
-            lr
-        });
-        // Sign of the worm moments: all loaded cells push the worm the same way.
-        let sign = {
-            let s: f64 = cells.iter().map(|c| c.worm_lever.signum()).sum();
-            if s == 0.0 {
-                return Err(LtcaError::TorqueSign(n));
-            }
-            s.signum()
-        };
-        let upper = settings.flow_pressure.is_finite().then(|| {
-            cells
-                .iter()
-                .map(|c| settings.flow_pressure * c.cell.area() * c.lever)
-                .collect()
-        });
-        let mut problem = Problem {
-            upper,
-            blocks,
-            low_rank,
-            separation: cells.iter().map(|c| c.separation).collect(),
-            load: wheel_torque_guess,
-        };
-        let mut solution = None;
-        let weights: Vec<f64> = cells
-            .iter()
-            .map(|c| c.worm_lever * sign / c.lever)
-            .collect();
-        let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
-        // Outer update of the wheel torque until the worm torque balances (MODEL §5.2): with
-        // the fast solver, one exact affine step on the loaded set after the first solve; the
-        // fixed-point solver (and any change of the loaded set) iterates, by secants on the
-        // (wheel torque, worm torque) pairs: with cells at the flow pressure (MODEL §5.7) the
-        // worm torque is not proportional to the wheel torque and a plain rescaling can cycle.
-        let mut previous = None;
-        for it in 0..20 {
-            let sol =
-                solver::solve(&problem, &settings.solver, warm.as_deref()).map_err(|source| {
-                    LtcaError::Solver {
-                        position: n,
-                        source,
-                    }
-                })?;
-            let worm = worm_of(&sol.q);
-            let target = match worm_torque {
-                Some(t) => t,
-                None => {
-                    solution = Some((sol, worm));
-                    break;
-                }
-            };
-            let ratio = target / worm;
-            if (ratio - 1.0).abs() < 1e-9 {
-                solution = Some((sol, worm));
-                break;
-            }
-            if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
-                if let Some((updated, load)) =
-                    solver::affine_load_update(&problem, &sol, &weights, target, &settings.solver)
-                {
-                    problem.load = load;
-                    let worm = worm_of(&updated.q);
-                    let close = ((worm - target) / target).abs() < 1e-9;
-                    warm = Some(updated.q.clone());
-                    solution = Some((updated, worm));
-                    if close {
-                        break;
-                    }
-                    continue;
-                }
-            }
-            let next = next_wheel_torque(previous, (problem.load, worm), target);
-            previous = Some((problem.load, worm));
-            problem.load = next;
-            warm = Some(sol.q.clone());
-            solution = Some((sol, worm));
-        }
-        let (sol, worm) = solution.expect("at least one solve");
-        // Load at the band edge: widen and redo.
-        let nc = settings.columns;
-        let qmax = sol.q.iter().copied().fold(0.0, f64::max);
-        let at_edge = cells
-            .iter()
-            .zip(&sol.q)
-            .any(|(c, &q)| q > 1e-6 * qmax && (c.column == 0 || c.column == nc - 1));
-        if at_edge && widenings < 4 {
+        let (mut problem, weights) =
+            contact_problem(&cells, pair, settings, bending, wheel_torque_guess)
+                .ok_or(LtcaError::TorqueSign(n))?;
+        let (sol, worm) =
+            balance_worm_torque(&mut problem, &weights, settings, worm_torque, warm, n)?;
+        if at_band_edge(&cells, &sol.q, settings.columns) && widenings < 4 {
             band *= 1.6;
             widenings += 1;
             continue;
         }
-        let (forces, pressure, plastic_depth) =
-            cell_loads(&cells, &sol.q, &sol.gap, settings.flow_pressure);
-        let mut tooth_load = vec![0.0; tca.teeth.len()];
-        for (c, f) in cells.iter().zip(&forces) {
-            tooth_load[c.tooth_index] += f;
-        }
-        let total_force: f64 = forces.iter().sum();
-        let lever_b = barycentre_lever(&ev.placement, &cells, &forces, total_force);
-        let approach = sol.approach;
+        let mut result = position_result(n, tca, ev, settings, cells, &sol, problem.load);
+        result.worm_torque = worm;
         let target = worm_torque.unwrap_or(worm);
-        return Ok(PositionResult {
-            position: n,
-            tooth_load,
-            wheel_torque: problem.load,
-            worm_torque: worm,
-            approach,
-            transmission_error: tca.positions[n].kinematic_error - approach,
-            stiffness_angular: problem.load / approach,
-            stiffness_linear: total_force / (approach * lever_b),
-            max_pressure: pressure.iter().copied().fold(0.0, f64::max),
-            residuals: sol.residuals,
-            torque_residual: (worm - target).abs() / target,
-            pressure,
-            plastic_depth,
-            equivalent: Vec::new(),
-            cells,
-            band_widenings: widenings,
-        });
+        result.torque_residual = (worm - target).abs() / target;
+        result.band_widenings = widenings;
+        return Ok(result);
+    }
+}
+
+/// The ranges (start, size) of the teeth's cells (cells are grouped by tooth in mesh order).
+fn tooth_ranges(cells: &[LocalCell]) -> Vec<(usize, usize)> {
+    let mut ranges = Vec::new();
+    let mut start = 0;
+    while start < cells.len() {
+        let t = cells[start].tooth_index;
+        let mut end = start;
+        while end < cells.len() && cells[end].tooth_index == t {
+            end += 1;
+        }
+        ranges.push((start, end - start));
+        start = end;
+    }
+    ranges
+}
+
+/// The complementarity problem on the cells (MODEL §5.2, §5.3): one contact block per tooth,
+/// the bending term, the flow-pressure bounds, the separations and the wheel torque `load`;
+/// with the weights that turn the unknowns into the worm torque. None when the cells' worm
+/// moments cancel (no driving sense).
+fn contact_problem(
+    cells: &[LocalCell],
+    pair: &ElasticPair,
+    settings: &LtcaSettings,
+    bending: Option<&dyn BendingModel>,
+    load: f64,
+) -> Option<(Problem, Vec<f64>)> {
+    let blocks: Vec<Block> = tooth_ranges(cells)
+        .into_iter()
+        .map(|(start, size)| {
+            // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
+            // of a tooth differ only slightly (line-aligned areas vary by the line's
+            // obliquity), and the tangential term's small asymmetry on curved flanks is
+            // dropped. Entries are assembled as the solver reads them: the rows of the
+            // cells that carry load, and the screened solve's candidate block.
+            let group = &cells[start..start + size];
+            let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
+            let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
+            Block {
+                start,
+                size,
+                matrix: BlockMatrix::Lazy(Box::new(InfluenceRows::new(pair, &contact, &levers))),
+            }
+        })
+        .collect();
+    let low_rank = bending.map(|b| {
+        let mut lr = b.coefficients(cells);
+        for (i, c) in cells.iter().enumerate() {
+            lr.divide_row(i, c.lever);
+        }
+        lr
+    });
+    // Sign of the worm moments: all loaded cells push the worm the same way.
+    let s: f64 = cells.iter().map(|c| c.worm_lever.signum()).sum();
+    if s == 0.0 {
+        return None;
+    }
+    let sign = s.signum();
+    let upper = settings.flow_pressure.is_finite().then(|| {
+        cells
+            .iter()
+            .map(|c| settings.flow_pressure * c.cell.area() * c.lever)
+            .collect()
+    });
+    let problem = Problem {
+        upper,
+        blocks,
+        low_rank,
+        separation: cells.iter().map(|c| c.separation).collect(),
+        load,
+    };
+    let weights = cells
+        .iter()
+        .map(|c| c.worm_lever * sign / c.lever)
+        .collect();
+    Some((problem, weights))
+}
+
+/// Outer update of the wheel torque (`problem.load`) until the worm torque balances
+/// `worm_torque` (MODEL §5.2; None: the wheel torque is given): with the fast solver, one exact
+/// affine step on the loaded set after the first solve; the fixed-point solver (and any change
+/// of the loaded set) iterates, by secants on the (wheel torque, worm torque) pairs: with
+/// cells at the flow pressure (MODEL §5.7) the worm torque is not proportional to the wheel
+/// torque and a plain rescaling can cycle. Returns the last solution and its worm torque.
+fn balance_worm_torque(
+    problem: &mut Problem,
+    weights: &[f64],
+    settings: &LtcaSettings,
+    worm_torque: Option<f64>,
+    mut warm: Option<Vec<f64>>,
+    n: usize,
+) -> Result<(solver::Solution, f64), LtcaError> {
+    let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
+    let mut solution = None;
+    let mut previous = None;
+    for it in 0..20 {
+        let sol = solver::solve(problem, &settings.solver, warm.as_deref()).map_err(|source| {
+            LtcaError::Solver {
+                position: n,
+                source,
+            }
+        })?;
+        let worm = worm_of(&sol.q);
+        let target = match worm_torque {
+            Some(t) => t,
+            None => {
+                solution = Some((sol, worm));
+                break;
+            }
+        };
+        let ratio = target / worm;
+        if (ratio - 1.0).abs() < 1e-9 {
+            solution = Some((sol, worm));
+            break;
+        }
+        if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
+            if let Some((updated, load)) =
+                solver::affine_load_update(problem, &sol, weights, target, &settings.solver)
+            {
+                problem.load = load;
+                let worm = worm_of(&updated.q);
+                let close = ((worm - target) / target).abs() < 1e-9;
+                warm = Some(updated.q.clone());
+                solution = Some((updated, worm));
+                if close {
+                    break;
+                }
+                continue;
+            }
+        }
+        let next = next_wheel_torque(previous, (problem.load, worm), target);
+        previous = Some((problem.load, worm));
+        problem.load = next;
+        warm = Some(sol.q.clone());
+        solution = Some((sol, worm));
+    }
+    Ok(solution.expect("at least one solve"))
+}
+
+/// Whether load reaches the first or last of the `columns` cells across the line.
+fn at_band_edge(cells: &[LocalCell], q: &[f64], columns: usize) -> bool {
+    let qmax = q.iter().copied().fold(0.0, f64::max);
+    cells
+        .iter()
+        .zip(q)
+        .any(|(c, &q)| q > 1e-6 * qmax && (c.column == 0 || c.column == columns - 1))
+}
+
+/// The position's result from the solution at wheel torque `wheel_torque` (N m): forces,
+/// pressures and plastic depths per cell, the load per tooth, TE and stiffness; the worm
+/// torque, its residual and the band widenings are the caller's.
+fn position_result(
+    n: usize,
+    tca: &Tca,
+    ev: &GapEvaluator,
+    settings: &LtcaSettings,
+    cells: Vec<LocalCell>,
+    sol: &solver::Solution,
+    wheel_torque: f64,
+) -> PositionResult {
+    let (forces, pressure, plastic_depth) =
+        cell_loads(&cells, &sol.q, &sol.gap, settings.flow_pressure);
+    let mut tooth_load = vec![0.0; tca.teeth.len()];
+    for (c, f) in cells.iter().zip(&forces) {
+        tooth_load[c.tooth_index] += f;
+    }
+    let total_force: f64 = forces.iter().sum();
+    let lever_b = barycentre_lever(&ev.placement, &cells, &forces, total_force);
+    let approach = sol.approach;
+    PositionResult {
+        position: n,
+        tooth_load,
+        wheel_torque,
+        worm_torque: f64::NAN,
+        approach,
+        transmission_error: tca.positions[n].kinematic_error - approach,
+        stiffness_angular: wheel_torque / approach,
+        stiffness_linear: total_force / (approach * lever_b),
+        max_pressure: pressure.iter().copied().fold(0.0, f64::max),
+        residuals: sol.residuals,
+        torque_residual: f64::NAN,
+        pressure,
+        plastic_depth,
+        equivalent: Vec::new(),
+        cells,
+        band_widenings: 0,
     }
 }
 
