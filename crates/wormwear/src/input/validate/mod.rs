@@ -131,6 +131,30 @@ impl Checker {
     }
 }
 
+/// Cross-field checks of the worm, the hob and the mesh, run only when the fields involved
+/// are individually valid.
+fn mesh_checks(
+    ck: &mut Checker,
+    warnings: &mut Vec<String>,
+    worm: &ThreadDef,
+    hob: &ThreadDef,
+    (cutting, op, wheel): (&Placement, &OperatingParts, &WheelParts),
+    throat_radius_mm: f64,
+) {
+    hob_matches_worm(ck, worm, hob);
+    if let Some(blank) = BlankRadii::of(op, wheel) {
+        let mesh = Mesh {
+            worm,
+            hob,
+            cutting,
+            blank,
+            worm_offset: op.worm_offset,
+            throat_radius_mm,
+        };
+        mesh.check(ck, warnings);
+    }
+}
+
 pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let mut ck = Checker::default();
     let mut warnings = Vec::new();
@@ -140,38 +164,23 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let cutting = cutting_placement(&mut ck, &f.cutting);
     let op = operating_parts(&mut ck, &f.operating);
     let wheel = wheel_parts(&mut ck, &f.wheel);
-    let worm_material = material(
-        &mut ck,
-        "materials.worm",
-        f.materials.worm.as_ref(),
-        default_worm_material(),
-    );
-    let wheel_material = material(
-        &mut ck,
-        "materials.wheel",
-        f.materials.wheel.as_ref(),
-        default_wheel_material(),
-    );
+    let (worm_material, wheel_material) = materials(&mut ck, &f.materials);
     let lubricant = lubricant(&mut ck, &f.lubricant);
     let conditions = conditions(&mut ck, &f.conditions);
     let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
     let rating = rating_factors(&mut ck, &f.rating);
     let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
     let analysis = analysis_settings(&mut ck, &f.analysis, wheel.teeth, wheel.face_width);
-    // Cross-field checks, only when the fields involved are individually valid.
     if let (Some(wm), Some(hb)) = (&worm, &hob) {
-        hob_matches_worm(&mut ck, wm, hb);
-        if let Some(blank) = BlankRadii::of(&op, &wheel) {
-            let mesh = Mesh {
-                worm: wm,
-                hob: hb,
-                cutting: &cutting,
-                blank,
-                worm_offset: op.worm_offset,
-                throat_radius_mm: f.wheel.throat_radius_mm,
-            };
-            mesh.check(&mut ck, &mut warnings);
-        }
+        let parts = (&cutting, &op, &wheel);
+        mesh_checks(
+            &mut ck,
+            &mut warnings,
+            wm,
+            hb,
+            parts,
+            f.wheel.throat_radius_mm,
+        );
     }
     if !ck.errors.is_empty() {
         return Err(InputError::Invalid(ck.errors));

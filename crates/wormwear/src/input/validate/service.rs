@@ -29,6 +29,26 @@ pub(super) fn default_wheel_material() -> Material {
     }
 }
 
+/// The worm's and the wheel's materials, each its default where the file gives none.
+pub(super) fn materials(
+    ck: &mut Checker,
+    m: &MaterialsSpec,
+) -> (Option<Material>, Option<Material>) {
+    let worm = material(
+        ck,
+        "materials.worm",
+        m.worm.as_ref(),
+        default_worm_material(),
+    );
+    let wheel = material(
+        ck,
+        "materials.wheel",
+        m.wheel.as_ref(),
+        default_wheel_material(),
+    );
+    (worm, wheel)
+}
+
 pub(super) fn material(
     ck: &mut Checker,
     name: &str,
