@@ -77,11 +77,20 @@ impl StateMaps<'_> {
     /// damage, loaded pattern) and the node table, their names ending with `suffix` before
     /// the extension.
     pub(super) fn write(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
-        let (tca, view, dir) = (self.tca, self.view, self.dir);
+        let mut files = self.wear_and_film_maps(suffix)?;
+        files.push(self.damage_map(suffix)?);
+        if suffix.is_empty() {
+            files.extend(self.damage_section()?);
+        }
+        files.extend(self.plastic_and_pattern(suffix)?);
+        Ok(files)
+    }
+
+    /// The maps of the cumulative wear, the wear per cycle and the film ratio and thickness.
+    fn wear_and_film_maps(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
+        let (view, dir) = (self.view, self.dir);
         let state = view.state;
-        let wf = self.geo.wheel_flank(tca.loaded_flank);
         let mut files = Vec::new();
-        let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
         let map = |path: &Path, title: &str, field: &FlankField, scale, bar: &str, top| {
             self.node_map(path, title, field, scale, bar, top)
         };
@@ -150,8 +159,15 @@ impl StateMaps<'_> {
             None,
         )?;
         files.push(path);
-        let path = dir.join(format!("wear_damage_map{suffix}.svg"));
-        map(
+        Ok(files)
+    }
+
+    /// The fatigue damage map (MODEL §8.1).
+    fn damage_map(&self, suffix: &str) -> Result<PathBuf, OutputError> {
+        let state = self.view.state;
+        let r = state.records.last().expect("a state has a record");
+        let path = self.dir.join(format!("wear_damage_map{suffix}.svg"));
+        self.node_map(
             &path,
             &format!(
                 "Fatigue damage at {} cycles (max {:.3}, mesh-dependent; 1: pits; map: cell means)",
@@ -166,13 +182,20 @@ impl StateMaps<'_> {
             "damage (Miner, wear-relieved)",
             Some(1.0),
         )?;
-        files.push(path);
-        if suffix.is_empty() {
-            files.extend(self.damage_section()?);
-        }
+        Ok(path)
+    }
+
+    /// The plastic set's map, the node table and the loaded pattern.
+    fn plastic_and_pattern(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
+        let (tca, view, dir) = (self.tca, self.view, self.dir);
+        let state = view.state;
+        let wf = self.geo.wheel_flank(tca.loaded_flank);
+        let mut files = Vec::new();
+        let overlays = [flank_outline(wf, "active flank", 5), tip_trace_series(tca)];
+        let r = state.records.last().expect("a state has a record");
         let plastic = view.state.plastic_set_nodes_after(view.ltca);
         let path = dir.join(format!("wear_plastic_set_map{suffix}.svg"));
-        map(
+        self.node_map(
             &path,
             &format!(
                 "Plastic set (running-in) at {} cycles (max {:.2} um, mesh-dependent; yielded {:.1} % of the \
