@@ -160,36 +160,7 @@ pub(super) fn pk_inner(
 ) -> Result<Solution, SolverError> {
     const STALL: usize = 400;
     let (mut best, mut best_at) = (f64::INFINITY, 0usize);
-    let n = problem.len();
-    let e = &problem.separation;
-    let open: Vec<bool> = e
-        .iter()
-        .zip(fixed)
-        .map(|(v, f)| v.is_finite() && !f)
-        .collect();
-    let mut q = q0;
-    // The fixed cells' displacements, once.
-    let q_fixed: Vec<f64> = (0..n).map(|i| if fixed[i] { q[i] } else { 0.0 }).collect();
-    let fixed_load: f64 = q_fixed.iter().sum();
-    let load = problem.load - fixed_load;
-    let mut u_fixed = vec![0.0; n];
-    problem.apply(&q_fixed, &mut u_fixed);
-    for i in 0..n {
-        if fixed[i] {
-            q[i] = 0.0;
-        }
-    }
-    let mut g = vec![0.0; n];
-    let mut t = vec![0.0; n];
-    let mut r = vec![0.0; n];
-    let mut u = vec![0.0; n];
-    let mut delta = 0.0;
-    let mut g_old = 1.0;
-    let mut approach = 0.0;
-    let mut last_change = f64::INFINITY;
-    let mut correction = vec![0.0; n];
-    let mut kc = vec![0.0; n];
-    let mut q_old = vec![0.0; n];
+    let mut pk = PkState::new(problem, q0, fixed);
     // u = K q is carried from one iteration to the next (one product K t per iteration, plus
     // a product with the few entries the projection changed) and recomputed exactly every
     // REFRESH iterations and before convergence is accepted (the drift between refreshes is
@@ -200,21 +171,149 @@ pub(super) fn pk_inner(
     while it < settings.max_iterations {
         it += 1;
         if !exact && (it == 1 || it % REFRESH == 0) {
-            problem.apply(&q, &mut u);
+            problem.apply(&pk.q, &mut pk.u);
             exact = true;
         }
-        // (Loops fused where they can be: every sum keeps its order over i, so the results
-        // are those of the separate passes, bit for bit.)
-        let (mut sum, mut count) = (0.0, 0usize);
+        let count = pk.gaps_about_mean()?;
+        let measure = pk.measure();
+        let scale = pk.approach.abs().max(f64::MIN_POSITIVE);
+        if measure.worst / scale < 0.5 * best {
+            (best, best_at) = (measure.worst / scale, it);
+        } else if give_up_on_stall && it > best_at + STALL {
+            break;
+        }
+        if measure.worst / scale < settings.tolerance && pk.last_change < settings.tolerance.sqrt()
+        {
+            if !exact {
+                problem.apply(&pk.q, &mut pk.u);
+                exact = true;
+                it -= 1;
+                continue;
+            }
+            return Ok(pk.solution(it));
+        }
+        pk.direction(measure.gsum);
+        let (tau, tau_overlap) = pk.step_lengths(count, measure.gmax);
+        pk.project(tau, tau_overlap).map_err(|()| {
+            // A projected step that unloads every free cell: a PK breakdown (seen with most of
+            // the load at the flow pressure), not a property of the problem; the callers'
+            // fallback (the active-set method) takes it from the start.
+            SolverError::NotConverged {
+                kind: SolverKind::ConjugateGradient,
+                iterations: it,
+                residual: f64::INFINITY,
+                tolerance: settings.tolerance,
+            }
+        })?;
+        exact = false;
+    }
+    let res = pk.solution(it).residuals;
+    Err(SolverError::NotConverged {
+        kind: SolverKind::ConjugateGradient,
+        iterations: it,
+        residual: res.complementarity.max(-res.min_gap),
+        tolerance: settings.tolerance,
+    })
+}
+
+/// The convergence measures of one PK iteration, from the gaps about their mean on the loaded
+/// set.
+struct PkMeasure {
+    /// Largest violation: |gap| of a loaded cell, or the penetration of an open one.
+    worst: f64,
+    /// Squared gradient (gaps) on the loaded set.
+    gsum: f64,
+    /// Largest |gap| of an open cell.
+    gmax: f64,
+}
+
+/// The iterate of [`pk_inner`] and its work vectors (wheel angles and torques, as the
+/// [`Problem`]). Loops are fused where they can be: every sum keeps its order over i, so the
+/// results are those of separate passes, bit for bit.
+struct PkState<'a> {
+    problem: &'a Problem,
+    /// Cells that may carry load: finite separation and not fixed.
+    open: Vec<bool>,
+    fixed: &'a [bool],
+    /// The fixed cells' loads and their displacements K q_fixed (computed once).
+    q_fixed: Vec<f64>,
+    u_fixed: Vec<f64>,
+    /// The load the free cells carry.
+    load: f64,
+    q: Vec<f64>,
+    /// Gaps about their mean (the gradient).
+    g: Vec<f64>,
+    /// Conjugate direction, K t, and K q carried between iterations.
+    t: Vec<f64>,
+    r: Vec<f64>,
+    u: Vec<f64>,
+    /// The projection's changes and K times them.
+    correction: Vec<f64>,
+    kc: Vec<f64>,
+    q_old: Vec<f64>,
+    delta: f64,
+    g_old: f64,
+    approach: f64,
+    /// Relative change of q in the last step.
+    last_change: f64,
+}
+
+impl<'a> PkState<'a> {
+    /// The start: the fixed cells' loads taken out of q0 (their displacements once), the free
+    /// cells' loads as given.
+    fn new(problem: &'a Problem, q0: Vec<f64>, fixed: &'a [bool]) -> Self {
+        let n = problem.len();
+        let open: Vec<bool> = problem
+            .separation
+            .iter()
+            .zip(fixed)
+            .map(|(v, f)| v.is_finite() && !f)
+            .collect();
+        let mut q = q0;
+        let q_fixed: Vec<f64> = (0..n).map(|i| if fixed[i] { q[i] } else { 0.0 }).collect();
+        let fixed_load: f64 = q_fixed.iter().sum();
+        let load = problem.load - fixed_load;
+        let mut u_fixed = vec![0.0; n];
+        problem.apply(&q_fixed, &mut u_fixed);
         for i in 0..n {
-            // Fixed (capped) cells keep a gap too: the outer loop frees them when it opens.
-            g[i] = if open[i] || fixed[i] {
-                u[i] + u_fixed[i] + e[i]
+            if fixed[i] {
+                q[i] = 0.0;
+            }
+        }
+        Self {
+            problem,
+            open,
+            fixed,
+            q_fixed,
+            u_fixed,
+            load,
+            q,
+            g: vec![0.0; n],
+            t: vec![0.0; n],
+            r: vec![0.0; n],
+            u: vec![0.0; n],
+            correction: vec![0.0; n],
+            kc: vec![0.0; n],
+            q_old: vec![0.0; n],
+            delta: 0.0,
+            g_old: 1.0,
+            approach: 0.0,
+            last_change: f64::INFINITY,
+        }
+    }
+
+    /// Gaps g = K q + e (fixed cells included: the outer loop frees them when one opens), less
+    /// their mean on the loaded set, which is the approach. Returns the loaded cells' count.
+    fn gaps_about_mean(&mut self) -> Result<usize, SolverError> {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (i, e) in self.problem.separation.iter().enumerate() {
+            self.g[i] = if self.open[i] || self.fixed[i] {
+                self.u[i] + self.u_fixed[i] + e
             } else {
                 f64::INFINITY
             };
-            if q[i] > 0.0 {
-                sum += g[i];
+            if self.q[i] > 0.0 {
+                sum += self.g[i];
                 count += 1;
             }
         }
@@ -222,124 +321,120 @@ pub(super) fn pk_inner(
             return Err(SolverError::Invalid("no loaded cell left".into()));
         }
         let gbar = sum / count as f64;
-        approach = gbar;
-        // Convergence measure (loaded cells touch, others do not penetrate), the squared
-        // gradient on the loaded set and the largest open gap, in one pass.
-        let mut worst: f64 = 0.0;
-        let mut gsum = 0.0;
-        let mut gmax = 0.0f64;
-        for i in 0..n {
-            g[i] -= gbar;
-            let gi = g[i];
-            if q[i] > 0.0 {
-                worst = worst.max(gi.abs());
-                gsum += gi * gi;
-            } else if open[i] && gi < 0.0 {
-                worst = worst.max(-gi);
+        self.approach = gbar;
+        self.g.iter_mut().for_each(|g| *g -= gbar);
+        Ok(count)
+    }
+
+    /// Convergence measure (loaded cells touch, others do not penetrate), the squared gradient
+    /// on the loaded set and the largest open gap, in one pass.
+    fn measure(&self) -> PkMeasure {
+        let mut m = PkMeasure {
+            worst: 0.0,
+            gsum: 0.0,
+            gmax: 0.0,
+        };
+        for (i, &gi) in self.g.iter().enumerate() {
+            if self.q[i] > 0.0 {
+                m.worst = m.worst.max(gi.abs());
+                m.gsum += gi * gi;
+            } else if self.open[i] && gi < 0.0 {
+                m.worst = m.worst.max(-gi);
             }
-            if open[i] && gi.is_finite() {
-                gmax = gmax.max(gi.abs());
+            if self.open[i] && gi.is_finite() {
+                m.gmax = m.gmax.max(gi.abs());
             }
         }
-        let scale = approach.abs().max(f64::MIN_POSITIVE);
-        if worst / scale < 0.5 * best {
-            (best, best_at) = (worst / scale, it);
-        } else if give_up_on_stall && it > best_at + STALL {
-            break;
-        }
-        if worst / scale < settings.tolerance && last_change < settings.tolerance.sqrt() {
-            if !exact {
-                problem.apply(&q, &mut u);
-                exact = true;
-                it -= 1;
-                continue;
-            }
-            let gap: Vec<f64> = g.clone();
-            for i in 0..n {
-                q[i] += q_fixed[i];
-            }
-            let residuals = problem.residuals(&q, &gap, approach, it);
-            return Ok(Solution {
-                q,
-                approach,
-                gap,
-                residuals,
-            });
-        }
-        for i in 0..n {
-            t[i] = if q[i] > 0.0 {
-                g[i] + delta * (gsum / g_old) * t[i]
+        m
+    }
+
+    /// The conjugate direction on the loaded set (restarted after an overlap step).
+    fn direction(&mut self, gsum: f64) {
+        for i in 0..self.q.len() {
+            self.t[i] = if self.q[i] > 0.0 {
+                self.g[i] + self.delta * (gsum / self.g_old) * self.t[i]
             } else {
                 0.0
             };
         }
-        g_old = gsum.max(f64::MIN_POSITIVE);
-        problem.apply(&t, &mut r);
-        let rbar = (0..n).filter(|&i| q[i] > 0.0).map(|i| r[i]).sum::<f64>() / count as f64;
+        self.g_old = gsum.max(f64::MIN_POSITIVE);
+    }
+
+    /// The step length along t (r = K t about its mean on the loaded set), and the overlap
+    /// step's length for cells that would penetrate.
+    fn step_lengths(&mut self, count: usize, gmax: f64) -> (f64, f64) {
+        self.problem.apply(&self.t, &mut self.r);
+        let loaded = |i: &usize| self.q[*i] > 0.0;
+        let rbar = (0..self.q.len())
+            .filter(loaded)
+            .map(|i| self.r[i])
+            .sum::<f64>()
+            / count as f64;
         let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..n {
-            if q[i] > 0.0 {
-                num += g[i] * t[i];
-                den += (r[i] - rbar) * t[i];
-            }
+        for i in (0..self.q.len()).filter(loaded) {
+            num += self.g[i] * self.t[i];
+            den += (self.r[i] - rbar) * self.t[i];
         }
         let tau = if den > 0.0 { num / den } else { 0.0 };
         let tau_overlap = if tau > 0.0 {
             tau
         } else {
-            load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
+            self.load / (count as f64 * gmax.max(f64::MIN_POSITIVE))
         };
-        // Projected step on the loaded set; cells outside it that would penetrate join it
-        // (PK's overlap step); the new total load.
-        q_old.copy_from_slice(&q);
+        (tau, tau_overlap)
+    }
+
+    /// Projected step on the loaded set; cells outside it that would penetrate join it (PK's
+    /// overlap step); the loads scaled back to the total, and u = K q updated as
+    /// u <- s (u - tau K t + K c), c the projection's changes. Err when the step unloads
+    /// every free cell.
+    fn project(&mut self, tau: f64, tau_overlap: f64) -> Result<(), ()> {
+        let n = self.q.len();
+        self.q_old.copy_from_slice(&self.q);
         let mut overlap = false;
         let mut total = 0.0;
         for i in 0..n {
-            correction[i] = 0.0;
-            if q[i] > 0.0 {
-                let linear = q[i] - tau * t[i];
-                q[i] = linear.max(0.0);
-                correction[i] = q[i] - linear;
-            } else if open[i] && g[i] < 0.0 {
-                q[i] = -tau_overlap * g[i];
-                correction[i] = q[i];
+            self.correction[i] = 0.0;
+            if self.q[i] > 0.0 {
+                let linear = self.q[i] - tau * self.t[i];
+                self.q[i] = linear.max(0.0);
+                self.correction[i] = self.q[i] - linear;
+            } else if self.open[i] && self.g[i] < 0.0 {
+                self.q[i] = -tau_overlap * self.g[i];
+                self.correction[i] = self.q[i];
                 overlap = true;
             }
-            total += q[i];
+            total += self.q[i];
         }
-        delta = if overlap { 0.0 } else { 1.0 };
+        self.delta = if overlap { 0.0 } else { 1.0 };
         if total <= 0.0 {
-            // A projected step that unloads every free cell: a PK breakdown (seen with most of
-            // the load at the flow pressure), not a property of the problem; the callers'
-            // fallback (the active-set method) takes it from the start.
-            return Err(SolverError::NotConverged {
-                kind: SolverKind::ConjugateGradient,
-                iterations: it,
-                residual: f64::INFINITY,
-                tolerance: settings.tolerance,
-            });
+            return Err(());
         }
-        let s = load / total;
-        q.iter_mut().for_each(|v| *v *= s);
-        // u <- s (u - tau K t + K c), c the projection's changes.
-        problem.apply(&correction, &mut kc);
+        let s = self.load / total;
+        self.q.iter_mut().for_each(|v| *v *= s);
+        self.problem.apply(&self.correction, &mut self.kc);
         let mut change = 0.0;
         for i in 0..n {
-            u[i] = s * (u[i] - tau * r[i] + kc[i]);
-            change += (q[i] - q_old[i]).abs();
+            self.u[i] = s * (self.u[i] - tau * self.r[i] + self.kc[i]);
+            change += (self.q[i] - self.q_old[i]).abs();
         }
-        exact = false;
-        last_change = change / problem.load;
+        self.last_change = change / self.problem.load;
+        Ok(())
     }
-    let gap = g.clone();
-    for i in 0..n {
-        q[i] += q_fixed[i];
+
+    /// The solution at iteration `it`: every cell's load (fixed ones included), the gaps about
+    /// the approach and the residuals.
+    fn solution(mut self, it: usize) -> Solution {
+        let gap = self.g.clone();
+        for (q, f) in self.q.iter_mut().zip(&self.q_fixed) {
+            *q += f;
+        }
+        let residuals = self.problem.residuals(&self.q, &gap, self.approach, it);
+        Solution {
+            q: self.q,
+            approach: self.approach,
+            gap,
+            residuals,
+        }
     }
-    let res = problem.residuals(&q, &gap, approach, it);
-    Err(SolverError::NotConverged {
-        kind: SolverKind::ConjugateGradient,
-        iterations: it,
-        residual: res.complementarity.max(-res.min_gap),
-        tolerance: settings.tolerance,
-    })
 }
