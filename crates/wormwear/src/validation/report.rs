@@ -70,7 +70,16 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
 /// The points a reader needs first, each with its figures from the tables below.
 fn findings(m: &mut String, results: &Results, checks: &[Check]) {
     let _ = writeln!(m, "## Where the model stands\n");
-    // Pressure over life against the published trend (P_max falls as the flank conforms).
+    pressures_over_life(m, results);
+    one_state_pressures(m, results);
+    mesh_finding(m, checks);
+    step_independence(m, results);
+    sensitivity_ranking(m, results);
+    cost_and_magnitude(m, results);
+}
+
+/// Pressure over life against the published trend (P_max falls as the flank conforms).
+fn pressures_over_life(m: &mut String, results: &Results) {
     for (name, id) in [
         (
             "design case to 180 000 cycles (adaptive steps)",
@@ -104,7 +113,10 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             }
         );
     }
-    // How much one state's pressures say: over the last tenth of case B's states.
+}
+
+/// How much one state's pressures say: over the last tenth of case B's states.
+fn one_state_pressures(m: &mut String, results: &Results) {
     if let Some(r) = results
         .get("case-b")
         .filter(|r| r.error.is_none() && r.records.len() >= 20)
@@ -133,6 +145,10 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             largest_step * UM
         );
     }
+}
+
+/// The raw elastic P_max against the plastic one under mesh refinement (section (a)).
+fn mesh_finding(m: &mut String, checks: &[Check]) {
     let find = |what: &str| checks.iter().find(|c| c.what.contains(what));
     if let (Some(elastic), Some(plastic)) = (
         find("raw P_max with the elastic law"),
@@ -144,7 +160,10 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             elastic.computed, plastic.computed
         );
     }
-    // Step independence.
+}
+
+/// Step independence of the design case's life.
+fn step_independence(m: &mut String, results: &Results) {
     let ends: Vec<&StepRecord> = [
         "design-30000",
         "design-15000",
@@ -169,7 +188,10 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             spread(&|r| r.backlash_increase_m)
         );
     }
-    // Sensitivity ranking on case C.
+}
+
+/// Sensitivity ranking on case C's final backlash.
+fn sensitivity_ranking(m: &mut String, results: &Results) {
     if let Some(base) = results.get("case-c").and_then(last) {
         let mut moves: Vec<(String, f64)> = [
             ("roughness 0.2 um", "c-roughness-0.2"),
@@ -206,6 +228,10 @@ fn findings(m: &mut String, results: &Results, checks: &[Check]) {
             );
         }
     }
+}
+
+/// The cost of case B's life, and what the wear's magnitude rests on.
+fn cost_and_magnitude(m: &mut String, results: &Results) {
     if let Some(r) = results.get("case-b").filter(|r| r.error.is_none()) {
         let _ = writeln!(
             m,
