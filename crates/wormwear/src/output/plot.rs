@@ -485,18 +485,7 @@ pub fn flank_map(
             Vec::new()
         };
         if let Some(grid) = iso {
-            let iso_style = RGBColor(25, 25, 25).mix(0.7).stroke_width(1);
-            // Pieces shorter than 6 % of the map's diagonal are noise, not a level line.
-            let min_length = 0.06 * ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
-            for &level in &levels {
-                chart
-                    .draw_series(
-                        without_short_pieces(grid.iso_segments(level), min_length)
-                            .into_iter()
-                            .map(|(a, b)| PathElement::new(vec![a, b], iso_style)),
-                    )
-                    .map_err(plot_err)?;
-            }
+            draw_iso_lines(&mut chart, grid, &levels, (x1 - x0, y1 - y0))?;
         }
         chart
             .draw_series(
@@ -506,49 +495,92 @@ pub fn flank_map(
             )
             .map_err(plot_err)?;
         draw_series_with_legend(&mut chart, overlays, SeriesLabelPosition::UpperMiddle)?;
-        // Colour bar.
-        let mut bar_chart = ChartBuilder::on(&bar)
-            .margin_top(60)
-            .margin_bottom(70)
-            .margin_right(70)
-            .y_label_area_size(0)
-            .right_y_label_area_size(60)
-            .caption(bar_label, ("sans-serif", 15))
-            .build_cartesian_2d(0.0..1.0, lo..lo + span)
-            .map_err(plot_err)?;
-        bar_chart
-            .configure_mesh()
-            .disable_x_axis()
-            .disable_mesh()
-            .y_label_formatter(&|v| tick_label(*v))
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(plot_err)?;
-        let steps = 64;
-        bar_chart
-            .draw_series((0..steps).map(|k| {
-                let (a, b) = (
-                    lo + span * k as f64 / steps as f64,
-                    lo + span * (k + 1) as f64 / steps as f64,
-                );
-                Rectangle::new(
-                    [(0.0, a), (1.0, b)],
-                    scale_color((k as f64 + 0.5) / steps as f64).filled(),
-                )
-            }))
-            .map_err(plot_err)?;
-        // The iso-line levels as ticks across the bar.
-        bar_chart
-            .draw_series(levels.iter().map(|&y| {
-                PathElement::new(
-                    vec![(0.0, y), (1.0, y)],
-                    RGBColor(25, 25, 25).stroke_width(1),
-                )
-            }))
-            .map_err(plot_err)?;
+        colour_bar(&bar, bar_label, (lo, span), &levels)?;
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, svg.as_bytes())
+}
+
+/// Iso-lines of `grid` at `levels` over a map whose extent is `size` (x, y); pieces shorter
+/// than 6 % of the map's diagonal are noise, not a level line, and are left out.
+fn draw_iso_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    grid: &IsoGrid,
+    levels: &[f64],
+    size: (f64, f64),
+) -> Result<(), OutputError>
+where
+    DB::ErrorType: 'static,
+{
+    let iso_style = RGBColor(25, 25, 25).mix(0.7).stroke_width(1);
+    let min_length = 0.06 * (size.0.powi(2) + size.1.powi(2)).sqrt();
+    for &level in levels {
+        chart
+            .draw_series(
+                without_short_pieces(grid.iso_segments(level), min_length)
+                    .into_iter()
+                    .map(|(a, b)| PathElement::new(vec![a, b], iso_style)),
+            )
+            .map_err(plot_err)?;
+    }
+    Ok(())
+}
+
+/// The colour bar of [`flank_map`] on `bar`: the scale from `lo` over `span`, labelled, with
+/// the iso-line `levels` as ticks across it.
+fn colour_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, plotters::coord::Shift>,
+    bar_label: &str,
+    (lo, span): (f64, f64),
+    levels: &[f64],
+) -> Result<(), OutputError>
+where
+    DB::ErrorType: 'static,
+{
+    let mut bar_chart = ChartBuilder::on(bar)
+        .margin_top(60)
+        .margin_bottom(70)
+        .margin_right(70)
+        .y_label_area_size(0)
+        .right_y_label_area_size(60)
+        .caption(bar_label, ("sans-serif", 15))
+        .build_cartesian_2d(0.0..1.0, lo..lo + span)
+        .map_err(plot_err)?;
+    bar_chart
+        .configure_mesh()
+        .disable_x_axis()
+        .disable_mesh()
+        .y_label_formatter(&|v| tick_label(*v))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(plot_err)?;
+    let steps = 64;
+    bar_chart
+        .draw_series((0..steps).map(|k| {
+            let (a, b) = (
+                lo + span * k as f64 / steps as f64,
+                lo + span * (k + 1) as f64 / steps as f64,
+            );
+            Rectangle::new(
+                [(0.0, a), (1.0, b)],
+                scale_color((k as f64 + 0.5) / steps as f64).filled(),
+            )
+        }))
+        .map_err(plot_err)?;
+    // The iso-line levels as ticks across the bar.
+    bar_chart
+        .draw_series(levels.iter().map(|&y| {
+            PathElement::new(
+                vec![(0.0, y), (1.0, y)],
+                RGBColor(25, 25, 25).stroke_width(1),
+            )
+        }))
+        .map_err(plot_err)?;
+    Ok(())
 }
 
 #[cfg(test)]
