@@ -16,7 +16,6 @@ pub fn affine_load_update(
     target: f64,
     settings: &SolverSettings,
 ) -> Option<(Solution, f64)> {
-    let n = problem.len();
     // The free cells (loaded, below their cap) move with the load; capped cells stay.
     let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
     let active: Vec<bool> = solution
@@ -25,10 +24,63 @@ pub fn affine_load_update(
         .enumerate()
         .map(|(i, &q)| q > 0.0 && q < cap(i))
         .collect();
-    // Conjugate gradient on the loaded set for K_AA v = 1, preconditioned by the exact
-    // Cholesky factors of the contact blocks restricted to the loaded set (exact in one step
-    // without bending; the bending term is low rank, so few more steps with it).
-    let preconditioner = BlockPreconditioner::new(problem, &active);
+    let v = unit_load_response(problem, &active, settings)?;
+    let sum_v: f64 = v.iter().sum();
+    if sum_v <= 0.0 {
+        return None;
+    }
+    let t0: f64 = weights.iter().zip(&solution.q).map(|(w, q)| w * q).sum();
+    let slope: f64 = weights.iter().zip(&v).map(|(w, x)| w * x).sum::<f64>() / sum_v;
+    if slope == 0.0 || !slope.is_finite() {
+        return None;
+    }
+    let load = problem.load + (target - t0) / slope;
+    let dw = load - problem.load;
+    let q: Vec<f64> = solution
+        .q
+        .iter()
+        .zip(&v)
+        .map(|(q, x)| q + dw * x / sum_v)
+        .collect();
+    if q.iter()
+        .zip(&active)
+        .enumerate()
+        .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
+    {
+        return None;
+    }
+    let approach = solution.approach + dw / sum_v;
+    let gap = gaps_if_the_set_holds(problem, &q, approach, &active, settings)?;
+    let residuals = residuals_at_load(
+        load,
+        &q,
+        &gap,
+        approach,
+        solution.residuals.iterations,
+        problem.upper.as_deref(),
+    );
+    Some((
+        Solution {
+            q,
+            approach,
+            gap,
+            residuals,
+        },
+        load,
+    ))
+}
+
+/// Conjugate gradient on the loaded set `active` for K_AA v = 1 (v zero elsewhere),
+/// preconditioned by the exact Cholesky factors of the contact blocks restricted to the
+/// loaded set (exact in one step without bending; the bending term is low rank, so few more
+/// steps with it). None when K_AA is not positive on a direction.
+fn unit_load_response(
+    problem: &Problem,
+    active: &[bool],
+    settings: &SolverSettings,
+) -> Option<Vec<f64>> {
+    let n = problem.len();
+    let preconditioner = BlockPreconditioner::new(problem, active);
     let mut v = vec![0.0; n];
     let mut r: Vec<f64> = active.iter().map(|&a| if a { 1.0 } else { 0.0 }).collect();
     let mut z = vec![0.0; n];
@@ -65,33 +117,22 @@ pub fn affine_load_update(
             p[i] = z[i] + beta * p[i];
         }
     }
-    let sum_v: f64 = v.iter().sum();
-    if sum_v <= 0.0 {
-        return None;
-    }
-    let t0: f64 = weights.iter().zip(&solution.q).map(|(w, q)| w * q).sum();
-    let slope: f64 = weights.iter().zip(&v).map(|(w, x)| w * x).sum::<f64>() / sum_v;
-    if slope == 0.0 || !slope.is_finite() {
-        return None;
-    }
-    let load = problem.load + (target - t0) / slope;
-    let dw = load - problem.load;
-    let q: Vec<f64> = solution
-        .q
-        .iter()
-        .zip(&v)
-        .map(|(q, x)| q + dw * x / sum_v)
-        .collect();
-    if q.iter()
-        .zip(&active)
-        .enumerate()
-        .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
-    {
-        return None;
-    }
-    let approach = solution.approach + dw / sum_v;
+    Some(v)
+}
+
+/// The gaps of the loads `q` at `approach`, or None when a cell outside the free loaded set
+/// `active` leaves its state: an unloaded cell penetrates, or a capped one opens.
+fn gaps_if_the_set_holds(
+    problem: &Problem,
+    q: &[f64],
+    approach: f64,
+    active: &[bool],
+    settings: &SolverSettings,
+) -> Option<Vec<f64>> {
+    let n = problem.len();
+    let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
     let mut u = vec![0.0; n];
-    problem.apply(&q, &mut u);
+    problem.apply(q, &mut u);
     let gap: Vec<f64> = (0..n)
         .map(|i| u[i] + problem.separation[i] - approach)
         .collect();
@@ -107,23 +148,7 @@ pub fn affine_load_update(
     }) {
         return None;
     }
-    let residuals = residuals_at_load(
-        load,
-        &q,
-        &gap,
-        approach,
-        solution.residuals.iterations,
-        problem.upper.as_deref(),
-    );
-    Some((
-        Solution {
-            q,
-            approach,
-            gap,
-            residuals,
-        },
-        load,
-    ))
+    Some(gap)
 }
 
 /// Block-Jacobi preconditioner: Cholesky factors of each contact block restricted to a set of
