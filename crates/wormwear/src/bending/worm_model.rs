@@ -46,6 +46,73 @@ pub struct WormBending {
     pub(crate) cores: CoreCache,
 }
 
+/// A fit data point: lattice indices (along, across) of a node of the central thread's flank
+/// and its basis coordinates (r~, theta~).
+type DataPoint = (usize, usize, (f64, f64));
+
+/// The fit's data points (MODEL §5.5): every corner node of the central thread's flank in the
+/// fit zone (radius between 0.1 and 0.9 of the thread height `(r_f1, H)`, m; polar angle within
+/// +-`theta_m`, rad).
+fn fit_data_points(m: &WormMesh, (rf, thread_height): (f64, f64), theta_m: f64) -> Vec<DataPoint> {
+    // Data points: every corner node of the central thread's flank in the fit zone (the
+    // lattice puts the fit grid and the points midway between its points there), about
+    // four per basis function. The worm's kernel is peaked (local bending of the thread
+    // under a point load, over about the thread thickness), and interpolating it through
+    // exactly K points oscillates between them (Runge: 36 % error at 5 x 7, worse with
+    // more points); least squares on the denser set does not.
+    m.loaded[1]
+        .iter()
+        .filter(|f| f.0 % 2 == 0 && f.1 % 2 == 0)
+        .filter_map(|&(li, hi, n)| {
+            let x = m.mesh.nodes[n];
+            let rho = (x[1] * x[1] + x[2] * x[2]).sqrt();
+            let r = (rho - rf) / thread_height;
+            let w = x[2].atan2(x[1]) / (2.0 * theta_m) + 0.5;
+            let inside =
+                (0.1 - 1e-9..=0.9 + 1e-9).contains(&r) && (-1e-9..=1.0 + 1e-9).contains(&w);
+            inside.then_some((li, hi, (r, w)))
+        })
+        .collect()
+}
+
+/// The FE nodes of the data points on the three threads (before, loaded, after), or an error
+/// when a neighbouring thread lacks one.
+fn thread_nodes(m: &WormMesh, data: &[DataPoint]) -> Result<Vec<Vec<usize>>, FeError> {
+    let node = |thread: usize, li: usize, hi: usize| {
+        m.loaded[thread]
+            .iter()
+            .find(|f| f.0 == li && f.1 == hi)
+            .map(|f| f.2)
+    };
+    let ids: Vec<Vec<usize>> = (0..3)
+        .map(|t| {
+            data.iter()
+                .map(|&(li, hi, _)| node(t, li, hi).unwrap_or(usize::MAX))
+                .collect()
+        })
+        .collect();
+    if ids.iter().flatten().any(|&n| n == usize::MAX) {
+        return Err(FeError::Factorisation(
+            "a worm data point has no node on a neighbouring thread".into(),
+        ));
+    }
+    Ok(ids)
+}
+
+/// The loaded flank's axial profile X(rho) at 33 equal steps from 0.2 thread heights below the
+/// root radius to 0.2 above the tip radius `(r_f1, r_a1)`, m.
+fn axial_profile_table(geo: &Geometry, flank: Flank, (rf, ra): (f64, f64)) -> Vec<(f64, f64)> {
+    let thread_height = ra - rf;
+    let steps = 32;
+    let (lo, hi) = (rf - 0.2 * thread_height, ra + 0.2 * thread_height);
+    (0..=steps)
+        .map(|i| {
+            let rho = lo + (hi - lo) * i as f64 / steps as f64;
+            (rho, geo.worm.axial_profile(flank, rho).0)
+        })
+        .collect()
+}
+
 /// The zone half angle theta_m = atan(0.5 b2 / (a - r_e2)) (MODEL §5.5, §12f), rad; pi/2 when
 /// the blank reaches past the worm axis; kept within [0.05, 0.45 pi].
 pub fn zone_half_angle(gear: &GearSet) -> f64 {
@@ -79,25 +146,7 @@ impl WormBending {
             width,
             kind: WidthFunctions::Averaged,
         };
-        // Data points: every corner node of the central thread's flank in the fit zone (the
-        // lattice puts the fit grid and the points midway between its points there), about
-        // four per basis function. The worm's kernel is peaked (local bending of the thread
-        // under a point load, over about the thread thickness), and interpolating it through
-        // exactly K points oscillates between them (Runge: 36 % error at 5 x 7, worse with
-        // more points); least squares on the denser set does not.
-        let data: Vec<(usize, usize, (f64, f64))> = m.loaded[1]
-            .iter()
-            .filter(|f| f.0 % 2 == 0 && f.1 % 2 == 0)
-            .filter_map(|&(li, hi, n)| {
-                let x = m.mesh.nodes[n];
-                let rho = (x[1] * x[1] + x[2] * x[2]).sqrt();
-                let r = (rho - rf) / thread_height;
-                let w = x[2].atan2(x[1]) / (2.0 * theta_m) + 0.5;
-                let inside =
-                    (0.1 - 1e-9..=0.9 + 1e-9).contains(&r) && (-1e-9..=1.0 + 1e-9).contains(&w);
-                inside.then_some((li, hi, (r, w)))
-            })
-            .collect();
+        let data = fit_data_points(&m, (rf, thread_height), theta_m);
         let k = basis.len();
         if data.len() < k {
             return Err(FeError::Factorisation(format!(
@@ -105,24 +154,7 @@ impl WormBending {
                 data.len()
             )));
         }
-        let node = |thread: usize, li: usize, hi: usize| {
-            m.loaded[thread]
-                .iter()
-                .find(|f| f.0 == li && f.1 == hi)
-                .map(|f| f.2)
-        };
-        let ids: Vec<Vec<usize>> = (0..3)
-            .map(|t| {
-                data.iter()
-                    .map(|&(li, hi, _)| node(t, li, hi).unwrap_or(usize::MAX))
-                    .collect()
-            })
-            .collect();
-        if ids.iter().flatten().any(|&n| n == usize::MAX) {
-            return Err(FeError::Factorisation(
-                "a worm data point has no node on a neighbouring thread".into(),
-            ));
-        }
+        let ids = thread_nodes(&m, &data)?;
         // Outward normals at the central thread's points (the same on the neighbours: a thread
         // is its neighbour translated by one pitch).
         let normals: Vec<Vector3<f64>> = ids[1]
@@ -153,14 +185,7 @@ impl WormBending {
             })
         };
         let coords: Vec<(f64, f64)> = data.iter().map(|d| d.2).collect();
-        let steps = 32;
-        let (lo, hi) = (rf - 0.2 * thread_height, ra + 0.2 * thread_height);
-        let profile = (0..=steps)
-            .map(|i| {
-                let rho = lo + (hi - lo) * i as f64 / steps as f64;
-                (rho, geo.worm.axial_profile(flank, rho).0)
-            })
-            .collect();
+        let profile = axial_profile_table(geo, flank, (rf, ra));
         Ok(Self {
             basis,
             same: basis.fit_least_squares(&coords, &relation(1)),
