@@ -10,7 +10,7 @@ use super::basis::{Basis, WidthFunctions};
 use super::fe::{free_minus_blocked, Elastic, FeError};
 use super::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
 use super::wheel_shaft::{wrench, WheelShaft};
-use crate::geometry::{Flank, Geometry};
+use crate::geometry::{Flank, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::ltca::solver::LowRank;
 use crate::ltca::{BendingModel, LocalCell};
@@ -41,6 +41,82 @@ pub struct WheelBending {
     cores: super::relation::CoreCache,
 }
 
+/// Fit points (MODEL §5.5): the basis grid mapped to the nearest flank nodes, as (layer,
+/// height index) of a sector mesh with `n_layers` layers and height indices up to `max_h`.
+fn fit_points(basis: &Basis, (n_layers, max_h): (usize, usize)) -> Vec<(usize, usize)> {
+    let grid = basis.grid();
+    let pick = |(r, w): (f64, f64)| {
+        (
+            (w * (n_layers - 1) as f64).round() as usize,
+            (r * max_h as f64).round() as usize,
+        )
+    };
+    grid.iter().map(|&p| pick(p)).collect()
+}
+
+/// The FE nodes of the fit points on the three teeth (before, loaded, after); usize::MAX
+/// where a tooth lacks one.
+fn tooth_nodes(m: &SectorMesh, points: &[(usize, usize)]) -> Vec<Vec<usize>> {
+    let node = |tooth: usize, (layer, h): (usize, usize)| {
+        m.left_flank[tooth]
+            .iter()
+            .find(|f| f.0 == layer && f.1 == h)
+            .map(|f| f.2)
+            .unwrap_or(usize::MAX)
+    };
+    (0..3)
+        .map(|t| points.iter().map(|&p| node(t, p)).collect())
+        .collect()
+}
+
+/// Unit normals of the left flank at the fit points (`nodes` of the loaded tooth), on each of
+/// the three teeth in that tooth's orientation (the reference normal rotated by the tooth
+/// offset, body frame).
+fn tooth_normals(
+    m: &SectorMesh,
+    wf: &WheelFlank,
+    points: &[(usize, usize)],
+    nodes: &[usize],
+    teeth: u32,
+) -> Vec<Vec<nalgebra::Vector3<f64>>> {
+    let normal = |n: usize, layer: usize| {
+        let p = m.mesh.nodes[n];
+        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        wf.column_normal(m.layer_columns[layer], r)
+    };
+    // Normals of the same (r, z) on each tooth, in that tooth's orientation: rotate the
+    // reference normal by the tooth offset (body frame).
+    let tau = 2.0 * std::f64::consts::PI / teeth as f64;
+    (0..3)
+        .map(|t| {
+            let k = t as f64 - 1.0;
+            points
+                .iter()
+                .zip(nodes)
+                .map(|(&(layer, _), &n)| {
+                    crate::geometry::placement::from_wheel_body(&normal(n, layer), k * tau)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The fit points' basis coordinates at the nodes (r~ = height index / max, w~ = layer / last).
+fn fit_coordinates(
+    points: &[(usize, usize)],
+    (n_layers, max_h): (usize, usize),
+) -> Vec<(f64, f64)> {
+    points
+        .iter()
+        .map(|&(layer, h)| {
+            (
+                h as f64 / max_h as f64,
+                layer as f64 / (n_layers - 1) as f64,
+            )
+        })
+        .collect()
+}
+
 impl WheelBending {
     /// Builds the model: FE of the sector (`mesh` settings) with `height` x `width` fit points,
     /// and the shaft under the hub when given.
@@ -66,45 +142,9 @@ impl WheelBending {
             width,
             kind: WidthFunctions::FreeFree,
         };
-        // Fit points: basis grid mapped to the nearest flank nodes (layers and height indices).
-        let grid = basis.grid();
-        let pick = |(r, w): (f64, f64)| {
-            (
-                (w * (n_layers - 1) as f64).round() as usize,
-                (r * max_h as f64).round() as usize,
-            )
-        };
-        let points: Vec<(usize, usize)> = grid.iter().map(|&p| pick(p)).collect();
-        let node = |tooth: usize, (layer, h): (usize, usize)| {
-            m.left_flank[tooth]
-                .iter()
-                .find(|f| f.0 == layer && f.1 == h)
-                .map(|f| f.2)
-                .unwrap_or(usize::MAX)
-        };
-        let normal = |n: usize, layer: usize| {
-            let p = m.mesh.nodes[n];
-            let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-            wf.column_normal(m.layer_columns[layer], r)
-        };
-        let ids: Vec<Vec<usize>> = (0..3)
-            .map(|t| points.iter().map(|&p| node(t, p)).collect())
-            .collect();
-        // Normals of the same (r, z) on each tooth, in that tooth's orientation: rotate the
-        // reference normal by the tooth offset (body frame).
-        let tau = 2.0 * std::f64::consts::PI / geo.teeth as f64;
-        let normals: Vec<Vec<nalgebra::Vector3<f64>>> = (0..3)
-            .map(|t| {
-                let k = t as f64 - 1.0;
-                points
-                    .iter()
-                    .zip(&ids[1])
-                    .map(|(&(layer, _), &n)| {
-                        crate::geometry::placement::from_wheel_body(&normal(n, layer), k * tau)
-                    })
-                    .collect()
-            })
-            .collect();
+        let points = fit_points(&basis, (n_layers, max_h));
+        let ids = tooth_nodes(&m, &points);
+        let normals = tooth_normals(&m, wf, &points, &ids[1], geo.teeth);
         let material = Elastic {
             youngs_modulus: gear.wheel_material.youngs_modulus,
             poisson_ratio: gear.wheel_material.poisson_ratio,
@@ -126,16 +166,7 @@ impl WheelBending {
             })
         };
         let (u_before, u_same, u_after) = (relation(0), relation(1), relation(2));
-        // Fit at the actual node coordinates (r~ = height index / max, w~ = layer / last).
-        let coords: Vec<(f64, f64)> = points
-            .iter()
-            .map(|&(layer, h)| {
-                (
-                    h as f64 / max_h as f64,
-                    layer as f64 / (n_layers - 1) as f64,
-                )
-            })
-            .collect();
+        let coords = fit_coordinates(&points, (n_layers, max_h));
         let top: Vec<(f64, f64)> = wf.z.iter().zip(&wf.r_high).map(|(&z, &r)| (z, r)).collect();
         Ok(Self {
             basis,
