@@ -884,35 +884,18 @@ fn curvature_radius(
     }
 }
 
-/// Contact kinematics of node (i, j) from the worm's envelope at that node.
-#[allow(clippy::too_many_arguments)]
-fn node_contact(
-    geo: &Geometry,
-    ev: &GapEvaluator,
+/// Surface gradient of the contact moment theta2 at node (i, j) of the wheel flank (body
+/// frame, 1/m), by differences on the node grid over the neighbours the worm flank reaches
+/// (their contact moments are meaningful); tangential part only. None when a direction has no
+/// reachable neighbour.
+fn contact_moment_gradient(
     wf: &WheelFlank,
-    env: &crate::geometry::EnvelopePoint,
     contact_theta2: &[f64],
     reachable_mask: &[bool],
     i: usize,
     j: usize,
-    theta1_dot: f64,
-) -> NodeContact {
+) -> Option<Vector3<f64>> {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
-    let node = wf.node(i, j);
-    let reachable = env.kind == PointKind::Flank;
-    let theta2 = contact_theta2[j * (ni + 1) + i];
-    let p = wheel_point(node.r, node.theta, node.z, theta2);
-    let q = ev.placement.wheel_to_worm(&p);
-    let rho = (q.y * q.y + q.z * q.z).sqrt();
-    let v = material_velocities(&q, &geo.worm, &ev.placement, theta1_dot, ev.ratio);
-    let vg = Vector3::from(v.sliding);
-    // Normal: the wheel node's normal (body) turned to the contact moment, in the worm frame,
-    // oriented like the worm's outward normal (out of the worm, into the wheel).
-    let n = -ev
-        .placement
-        .vector_wheel_to_worm(&from_wheel_body(&node.normal_vec(), theta2));
-    // Surface gradient of the contact moment (body frame), by differences on the node grid.
-    // Neighbours the worm flank reaches (their contact moments are meaningful).
     let idx = |i: usize, j: usize| j * (ni + 1) + i;
     let ok = |i: usize, j: usize| reachable_mask[idx(i, j)];
     let pick = |lo: usize, mid: usize, hi: usize, f: &dyn Fn(usize) -> bool| -> (usize, usize) {
@@ -925,8 +908,30 @@ fn node_contact(
     };
     let (i0, i1) = pick(i.saturating_sub(1), i, (i + 1).min(ni), &|ii| ok(ii, j));
     let (j0, j1) = pick(j.saturating_sub(1), j, (j + 1).min(nj), &|jj| ok(i, jj));
-    if i0 == i1 || j0 == j1 || !reachable {
-        return NodeContact {
+    if i0 == i1 || j0 == j1 {
+        return None;
+    }
+    let pi = (wf.node(i1, j).position() - wf.node(i0, j).position()) / (i1 - i0) as f64;
+    let pj = (wf.node(i, j1).position() - wf.node(i, j0).position()) / (j1 - j0) as f64;
+    let fi = (contact_theta2[idx(i1, j)] - contact_theta2[idx(i0, j)]) / (i1 - i0) as f64;
+    let fj = (contact_theta2[idx(i, j1)] - contact_theta2[idx(i, j0)]) / (j1 - j0) as f64;
+    // grad = a pi + b pj with grad . pi = fi, grad . pj = fj.
+    let (g11, g12, g22) = (pi.dot(&pi), pi.dot(&pj), pj.dot(&pj));
+    let det = g11 * g22 - g12 * g12;
+    let a = (fi * g22 - fj * g12) / det;
+    let b = (fj * g11 - fi * g12) / det;
+    // Keep the tangential part (the chords pi, pj are not exactly tangent).
+    let nb = wf.node(i, j).normal_vec();
+    let grad_body = pi * a + pj * b;
+    Some(grad_body - nb * grad_body.dot(&nb))
+}
+
+impl NodeContact {
+    /// A node the worm flank does not reach (or whose contact moment has no gradient): its
+    /// moment, worm radius `rho` (m), sliding velocity `vg` and normal `n` (worm frame), the
+    /// rest NaN.
+    fn unreachable(theta2: f64, rho: f64, vg: Vector3<f64>, n: Vector3<f64>) -> Self {
+        NodeContact {
             reachable: false,
             theta2,
             worm_radius: rho,
@@ -940,21 +945,41 @@ fn node_contact(
             normal: n.into(),
             line_direction: [f64::NAN; 3],
             line_direction_body: [f64::NAN; 3],
-        };
+        }
     }
-    let pi = (wf.node(i1, j).position() - wf.node(i0, j).position()) / (i1 - i0) as f64;
-    let pj = (wf.node(i, j1).position() - wf.node(i, j0).position()) / (j1 - j0) as f64;
-    let fi = (contact_theta2[idx(i1, j)] - contact_theta2[idx(i0, j)]) / (i1 - i0) as f64;
-    let fj = (contact_theta2[idx(i, j1)] - contact_theta2[idx(i, j0)]) / (j1 - j0) as f64;
-    // grad = a pi + b pj with grad . pi = fi, grad . pj = fj.
-    let (g11, g12, g22) = (pi.dot(&pi), pi.dot(&pj), pj.dot(&pj));
-    let det = g11 * g22 - g12 * g12;
-    let a = (fi * g22 - fj * g12) / det;
-    let b = (fj * g11 - fi * g12) / det;
-    // Keep the tangential part (the chords pi, pj are not exactly tangent).
-    let nb = node.normal_vec();
-    let grad_body = pi * a + pj * b;
-    let grad_body = grad_body - nb * grad_body.dot(&nb);
+}
+
+/// Contact kinematics of node (i, j) from the worm's envelope at that node.
+#[allow(clippy::too_many_arguments)]
+fn node_contact(
+    geo: &Geometry,
+    ev: &GapEvaluator,
+    wf: &WheelFlank,
+    env: &crate::geometry::EnvelopePoint,
+    contact_theta2: &[f64],
+    reachable_mask: &[bool],
+    i: usize,
+    j: usize,
+    theta1_dot: f64,
+) -> NodeContact {
+    let ni = wf.cells_height;
+    let node = wf.node(i, j);
+    let reachable = env.kind == PointKind::Flank;
+    let theta2 = contact_theta2[j * (ni + 1) + i];
+    let p = wheel_point(node.r, node.theta, node.z, theta2);
+    let q = ev.placement.wheel_to_worm(&p);
+    let rho = (q.y * q.y + q.z * q.z).sqrt();
+    let v = material_velocities(&q, &geo.worm, &ev.placement, theta1_dot, ev.ratio);
+    let vg = Vector3::from(v.sliding);
+    // Normal: the wheel node's normal (body) turned to the contact moment, in the worm frame,
+    // oriented like the worm's outward normal (out of the worm, into the wheel).
+    let n = -ev
+        .placement
+        .vector_wheel_to_worm(&from_wheel_body(&node.normal_vec(), theta2));
+    let gradient = contact_moment_gradient(wf, contact_theta2, reachable_mask, i, j);
+    let Some(grad_body) = gradient.filter(|_| reachable) else {
+        return NodeContact::unreachable(theta2, rho, vg, n);
+    };
     let grad = ev
         .placement
         .vector_wheel_to_worm(&from_wheel_body(&grad_body, theta2));
