@@ -181,6 +181,68 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
     ))
 }
 
+/// The worm and wheel torques (N m) of the operating case: the given one, and the other
+/// through the ratio `u` and the total efficiency at the wheel torque (`efficiency_at`; the
+/// losses depend on the output, so a fixed point when the worm torque is given).
+fn operating_torques(
+    torque: &Torque,
+    u: f64,
+    eta_z: f64,
+    efficiency_at: impl Fn(f64) -> f64,
+) -> (f64, f64) {
+    match *torque {
+        Torque::Wheel(t2) => (t2 / (u * efficiency_at(t2)), t2),
+        Torque::Worm(t1) => {
+            // T2 = T1 u eta(T2): fixed point (the losses are nearly linear in T2).
+            let mut t2 = t1 * u * eta_z;
+            for _ in 0..100 {
+                let next = t1 * u * efficiency_at(t2);
+                if (next - t2).abs() <= 1e-12 * t2 {
+                    t2 = next;
+                    break;
+                }
+                t2 = next;
+            }
+            (t1, t2)
+        }
+    }
+}
+
+/// The reduced modulus 2 / ((1 - v1^2)/E1 + (1 - v2^2)/E2) of the worm and wheel materials,
+/// N/mm^2 (MODEL §9).
+fn reduced_modulus_mpa(gear: &GearSet) -> f64 {
+    let e1 = gear.worm_material.youngs_modulus * 1e-6;
+    let e2 = gear.wheel_material.youngs_modulus * 1e-6;
+    let (v1, v2) = (
+        gear.worm_material.poisson_ratio,
+        gear.wheel_material.poisson_ratio,
+    );
+    2.0 / ((1.0 - v1 * v1) / e1 + (1.0 - v2 * v2) / e2)
+}
+
+/// The pitting lives of MODEL §9 (cycles): N_LII to the largest pitted area
+/// `pitted_area_max_percent`, N_LI-II, and N_LI for steel wheels (NaN above 500 N/mm^2), from
+/// the mean Hertz stress and the pitting limit (N/mm^2) and the sliding speed (m/s).
+fn pitting_life_cycles(
+    sigma_hm: f64,
+    sigma_lim: f64,
+    v_g: f64,
+    pitted_area_max_percent: f64,
+) -> (f64, f64, f64) {
+    let v_ref = 3.0;
+    let n_lii = (pitted_area_max_percent - 2.0) * 1e6
+        / (16.212 * (sigma_hm - 180.0) / sigma_lim
+            * (1.541 * sigma_hm / sigma_lim - 0.581 * v_g / v_ref).exp());
+    let n_l_i_ii =
+        3e6 * (v_g / v_ref) * (24.924 - 4.047 * (520.0 * sigma_hm / sigma_lim).ln()).exp();
+    let n_li_stahl = if sigma_hm <= 500.0 {
+        (2650.0 / sigma_hm).powf(7.8)
+    } else {
+        f64::NAN
+    };
+    (n_lii, n_l_i_ii, n_li_stahl)
+}
+
 /// Ratings for the gear's operating case with the file's factors. The wheel torque follows
 /// from the worm torque by the efficiency (fixed point: the losses depend on the output) or is
 /// given.
@@ -213,51 +275,19 @@ pub fn rate(gear: &GearSet) -> Rating {
         let (p2, mesh, churning, bearings, seals) = losses(t2);
         p2 / (p2 + mesh + churning + bearings + seals)
     };
-    let (t1, t2) = match gear.conditions.torque {
-        Torque::Wheel(t2) => (t2 / (u * efficiency_at(t2)), t2),
-        Torque::Worm(t1) => {
-            // T2 = T1 u eta(T2): fixed point (the losses are nearly linear in T2).
-            let mut t2 = t1 * u * eta_z;
-            for _ in 0..100 {
-                let next = t1 * u * efficiency_at(t2);
-                if (next - t2).abs() <= 1e-12 * t2 {
-                    t2 = next;
-                    break;
-                }
-                t2 = next;
-            }
-            (t1, t2)
-        }
-    };
+    let (t1, t2) = operating_torques(&gear.conditions.torque, u, eta_z, efficiency_at);
     let (p2, mesh, churning, bearings, seals) = losses(t2);
     let efficiency = p2 / (p2 + mesh + churning + bearings + seals);
-    // Mean Hertz stress (N/mm^2).
-    let e1 = gear.worm_material.youngs_modulus * 1e-6;
-    let e2 = gear.wheel_material.youngs_modulus * 1e-6;
-    let (v1, v2) = (
-        gear.worm_material.poisson_ratio,
-        gear.wheel_material.poisson_ratio,
-    );
-    let e_red = 2.0 / ((1.0 - v1 * v1) / e1 + (1.0 - v2 * v2) / e2);
     let alpha_deg = match w.profile {
         ProfileType::C => w.axial_pressure_angle.to_degrees(),
         _ => w.normal_pressure_angle.to_degrees(),
     };
     let pm = p_m_star(w.profile, a, d_m1, x2, q1, z1, z2, alpha_deg);
-    let sigma_hm = 4.0 / PI * (pm * t2 * 1e3 * e_red / a.powi(3)).sqrt();
+    let sigma_hm = 4.0 / PI * (pm * t2 * 1e3 * reduced_modulus_mpa(gear) / a.powi(3)).sqrt();
     let sigma_lim = gear.wheel_material.pitting_limit * 1e-6;
     let sigma_hg = sigma_lim * factors.pitting_life_factor;
-    let v_ref = 3.0;
-    let n_lii = (factors.pitted_area_max_percent - 2.0) * 1e6
-        / (16.212 * (sigma_hm - 180.0) / sigma_lim
-            * (1.541 * sigma_hm / sigma_lim - 0.581 * v_g / v_ref).exp());
-    let n_l_i_ii =
-        3e6 * (v_g / v_ref) * (24.924 - 4.047 * (520.0 * sigma_hm / sigma_lim).ln()).exp();
-    let n_li_stahl = if sigma_hm <= 500.0 {
-        (2650.0 / sigma_hm).powf(7.8)
-    } else {
-        f64::NAN
-    };
+    let (n_lii, n_l_i_ii, n_li_stahl) =
+        pitting_life_cycles(sigma_hm, sigma_lim, v_g, factors.pitted_area_max_percent);
     let alpha_0 = w.normal_pressure_angle;
     let n_li = rank_formula(v_g, sigma_hm, sigma_lim).unwrap_or(f64::NAN);
     Rating {
