@@ -255,92 +255,90 @@ fn warnings_section(h: &mut String, summary: &serde_json::Value) {
     h.push_str("</section>\n");
 }
 
+/// The key results: (label, where in summary.json — a stage's section, or `END` for the last
+/// wear state — key, scale to the unit, unit).
+const KEY_RESULTS: [(&str, &str, &str, f64, &str); 14] = [
+    ("Ratio", "geometry", "ratio", 1.0, ""),
+    ("Lead angle", "geometry", "lead_angle_deg", 1.0, "deg"),
+    (
+        "Max contact pressure (unworn)",
+        "ltca",
+        "max_pressure_pa",
+        1e-6,
+        "MPa",
+    ),
+    (
+        "Loaded pattern S0",
+        "ltca",
+        "contact_area_fraction",
+        1.0,
+        "",
+    ),
+    (
+        "Transmission error, peak to peak",
+        "ltca",
+        "te_p2p_rad",
+        1e6,
+        "urad",
+    ),
+    (
+        "Mesh stiffness (mean)",
+        "ltca",
+        "mesh_stiffness_mean_nm_per_rad",
+        1.0,
+        "N m/rad",
+    ),
+    ("Efficiency (ISO/TR 14521)", "rating", "efficiency", 1.0, ""),
+    ("Worm torque", "rating", "worm_torque_nm", 1.0, "N m"),
+    ("Pitting life N_LI", "rating", "n_li_cycles", 1.0, "cycles"),
+    ("Life simulated", END, "cycles", 1.0, "cycles"),
+    (
+        "Max wear at the end (patch mean)",
+        END,
+        "wear_patch_max_m",
+        1e6,
+        "um",
+    ),
+    (
+        "Max wear at the end (one node)",
+        END,
+        "max_wear_m",
+        1e6,
+        "um",
+    ),
+    (
+        "Backlash increase at the end",
+        END,
+        "backlash_increase_m",
+        1e6,
+        "um",
+    ),
+    (
+        "Max contact pressure at the end",
+        END,
+        "max_pressure_pa",
+        1e-6,
+        "MPa",
+    ),
+];
+
+/// The section name of [`KEY_RESULTS`] that stands for the last wear state.
+const END: &str = "";
+
 /// Key results first: what an engineer looks for before the details.
 fn key_results(h: &mut String, summary: &serde_json::Value) {
-    // Key results first: what an engineer looks for before the details.
     let last_step = summary["wear"]["steps"]
         .as_array()
         .and_then(|s| s.last())
         .cloned()
         .unwrap_or(serde_json::Value::Null);
-    let key_results: [(&str, &serde_json::Value, f64, &str); 14] = [
-        ("Ratio", &summary["geometry"]["ratio"], 1.0, ""),
-        (
-            "Lead angle",
-            &summary["geometry"]["lead_angle_deg"],
-            1.0,
-            "deg",
-        ),
-        (
-            "Max contact pressure (unworn)",
-            &summary["ltca"]["max_pressure_pa"],
-            1e-6,
-            "MPa",
-        ),
-        (
-            "Loaded pattern S0",
-            &summary["ltca"]["contact_area_fraction"],
-            1.0,
-            "",
-        ),
-        (
-            "Transmission error, peak to peak",
-            &summary["ltca"]["te_p2p_rad"],
-            1e6,
-            "urad",
-        ),
-        (
-            "Mesh stiffness (mean)",
-            &summary["ltca"]["mesh_stiffness_mean_nm_per_rad"],
-            1.0,
-            "N m/rad",
-        ),
-        (
-            "Efficiency (ISO/TR 14521)",
-            &summary["rating"]["efficiency"],
-            1.0,
-            "",
-        ),
-        (
-            "Worm torque",
-            &summary["rating"]["worm_torque_nm"],
-            1.0,
-            "N m",
-        ),
-        (
-            "Pitting life N_LI",
-            &summary["rating"]["n_li_cycles"],
-            1.0,
-            "cycles",
-        ),
-        ("Life simulated", &last_step["cycles"], 1.0, "cycles"),
-        (
-            "Max wear at the end (patch mean)",
-            &last_step["wear_patch_max_m"],
-            1e6,
-            "um",
-        ),
-        (
-            "Max wear at the end (one node)",
-            &last_step["max_wear_m"],
-            1e6,
-            "um",
-        ),
-        (
-            "Backlash increase at the end",
-            &last_step["backlash_increase_m"],
-            1e6,
-            "um",
-        ),
-        (
-            "Max contact pressure at the end",
-            &last_step["max_pressure_pa"],
-            1e-6,
-            "MPa",
-        ),
-    ];
     h.push_str("<section id=\"key\"><h2>Key results</h2><table>");
-    for (label, value, scale, unit) in key_results {
+    for (label, section, key, scale, unit) in KEY_RESULTS {
+        let value = if section == END {
+            &last_step[key]
+        } else {
+            &summary[section][key]
+        };
         if let Some(x) = value.as_f64() {
             let text = format!("{:.4e}", x * scale)
                 .parse::<f64>()
