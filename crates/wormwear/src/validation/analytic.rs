@@ -347,32 +347,43 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
     let mut out = Vec::new();
     let mut g = design.clone();
     g.bending.kind = crate::input::BendingKind::None;
-    // Conjugate pair: the worm as its own hob leaves no kinematic error.
-    let mut conj = g.clone();
-    conj.hob = conj.worm.clone();
-    if let Ok(geo) = crate::geometry::Geometry::build(&conj) {
-        if let Ok(tca) = crate::kinematics::analyse(&conj, &geo) {
-            let (_, p2p) = tca.kinematic_error_stats();
-            out.push(Check {
-                what: "1/40 conjugate pair (hob = worm): unloaded kinematic error, peak-to-peak"
-                    .into(),
-                computed: format!("{p2p:.2e} rad"),
-                reference: "0 (bound: 1e-7 rad)".into(),
-                error: p2p,
-                bound: 1e-7,
-                test: "tca::conjugate_pair_has_no_kinematic_error_and_full_contact_lines".into(),
-            });
-        }
-    }
+    out.extend(conjugate_pair_check(&g));
     let Ok(geo) = crate::geometry::Geometry::build(&g) else {
         return out;
     };
     let Ok(tca) = crate::kinematics::analyse(&g, &geo) else {
         return out;
     };
+    out.push(uniform_removal_check(&g, &geo, &tca));
+    out.extend(recession_checks(&g, &geo, &tca));
+    out
+}
+
+/// Conjugate pair: the worm as its own hob leaves no kinematic error.
+fn conjugate_pair_check(g: &crate::input::GearSet) -> Option<Check> {
+    let mut conj = g.clone();
+    conj.hob = conj.worm.clone();
+    let geo = crate::geometry::Geometry::build(&conj).ok()?;
+    let tca = crate::kinematics::analyse(&conj, &geo).ok()?;
+    let (_, p2p) = tca.kinematic_error_stats();
+    Some(Check {
+        what: "1/40 conjugate pair (hob = worm): unloaded kinematic error, peak-to-peak".into(),
+        computed: format!("{p2p:.2e} rad"),
+        reference: "0 (bound: 1e-7 rad)".into(),
+        error: p2p,
+        bound: 1e-7,
+        test: "tca::conjugate_pair_has_no_kinematic_error_and_full_contact_lines".into(),
+    })
+}
+
+/// Uniform normal removal d: the tangential backlash at r2 opens by d / (cos an cos gamma).
+fn uniform_removal_check(
+    g: &crate::input::GearSet,
+    geo: &crate::geometry::Geometry,
+    tca: &crate::kinematics::Tca,
+) -> Check {
     let wf = geo.wheel_flank(tca.loaded_flank);
-    // Uniform normal removal d: the tangential backlash at r2 opens by d / (cos an cos gamma).
-    let backlash = crate::wear::Backlash::new(&g, &geo, &tca);
+    let backlash = crate::wear::Backlash::new(g, geo, tca);
     let zero = crate::geometry::FlankField::zeros(wf);
     let mut uniform = zero.clone();
     let d = 10e-6;
@@ -381,16 +392,27 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
     let gamma = g.worm.lead_angle();
     let alpha_n = (g.worm.axial_pressure_angle.tan() * gamma.cos()).atan();
     let expected = d / (alpha_n.cos() * gamma.cos());
-    out.push(Check {
+    Check {
         what: "1/40, backlash of a uniform 10 um removal (tangential at r2)".into(),
         computed: format!("{:.4} um", got * 1e6),
         reference: format!("d / (cos an cos gamma) = {:.4} um", expected * 1e6),
         error: relative(got, expected),
         bound: 0.02,
         test: "wear::uniform_removal_raises_the_tangential_backlash_by_the_normal_depth_over_cos_an_cos_gamma".into(),
-    });
-    // Uniform angular recession delta: pure rigid lag (TE relative to it = unworn TE).
-    let settings = crate::ltca::LtcaSettings::from_gear(&g);
+    }
+}
+
+/// Uniform angular recession delta: pure rigid lag (TE relative to it = unworn TE); then the
+/// peak convergence and the pits' depth on the unworn loaded analysis.
+fn recession_checks(
+    g: &crate::input::GearSet,
+    geo: &crate::geometry::Geometry,
+    tca: &crate::kinematics::Tca,
+) -> Vec<Check> {
+    let mut out = Vec::new();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let zero = crate::geometry::FlankField::zeros(wf);
+    let settings = crate::ltca::LtcaSettings::from_gear(g);
     let delta = 2e-5;
     let mut recession = zero.clone();
     for (k, n) in wf.nodes.iter().enumerate() {
@@ -398,8 +420,8 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             delta * crate::kinematics::GapEvaluator::lever(&n.position(), &n.normal_vec());
     }
     let analyses = (
-        crate::ltca::analyse_with(&g, &geo, &tca, &settings, None),
-        crate::ltca::analyse_worn(&g, &geo, &tca, &settings, None, Some(&recession), None),
+        crate::ltca::analyse_with(g, geo, tca, &settings, None),
+        crate::ltca::analyse_worn(g, geo, tca, &settings, None, Some(&recession), None),
     );
     if let (Ok(unworn), Ok(worn)) = analyses {
         let (te0, _) = unworn.te_stats();
@@ -413,33 +435,37 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
             bound: 1e-4,
             test: "fidelity::a_uniform_angular_recession_is_all_rigid_lag".into(),
         });
-        out.extend(peak_convergence(&g, &geo, &tca, &settings, &unworn));
-        // Hertz half-width against the loaded band's on the unworn flank (the pits' depth).
-        let cw = crate::wear::per_cycle(
-            &g,
-            &geo,
-            &tca,
-            &unworn,
-            crate::input::FilmLoad::LoadedAnalysis,
-        );
-        let e_star = steel_on_bronze().effective_modulus;
-        let mut worst: f64 = 0.0;
-        for k in 0..wf.nodes.len() {
-            let (w, r) = (cw.line_load.values[k], cw.contact_radius.values[k]);
-            if w > 0.0 && r > 0.0 {
-                let a = (4.0 * w * r / (PI * e_star)).sqrt();
-                worst = worst.max(relative(cw.hertz_half_width.values[k], a));
-            }
-        }
-        out.push(Check {
-            what: "1/40 (no bending), pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node"
-                .into(),
-            computed: format!("largest {:.1} um", cw.hertz_half_width.max() * 1e6),
-            reference: "the formula with the node's line load and radius".into(),
-            error: worst,
-            bound: 1e-9,
-            test: "fidelity::pits_are_cut_0_78_hertz_half_widths_deep".into(),
-        });
+        out.extend(peak_convergence(g, geo, tca, &settings, &unworn));
+        out.push(pit_depth_check(g, geo, tca, &unworn));
     }
     out
+}
+
+/// Hertz half-width against the loaded band's on the unworn flank (the pits' depth).
+fn pit_depth_check(
+    g: &crate::input::GearSet,
+    geo: &crate::geometry::Geometry,
+    tca: &crate::kinematics::Tca,
+    unworn: &crate::ltca::Ltca,
+) -> Check {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let cw = crate::wear::per_cycle(g, geo, tca, unworn, crate::input::FilmLoad::LoadedAnalysis);
+    let e_star = steel_on_bronze().effective_modulus;
+    let mut worst: f64 = 0.0;
+    for k in 0..wf.nodes.len() {
+        let (w, r) = (cw.line_load.values[k], cw.contact_radius.values[k]);
+        if w > 0.0 && r > 0.0 {
+            let a = (4.0 * w * r / (PI * e_star)).sqrt();
+            worst = worst.max(relative(cw.hertz_half_width.values[k], a));
+        }
+    }
+    Check {
+        what: "1/40 (no bending), pit depth: Hertz half-width a = sqrt(4 w R / (pi E*)) at every swept node"
+            .into(),
+        computed: format!("largest {:.1} um", cw.hertz_half_width.max() * 1e6),
+        reference: "the formula with the node's line load and radius".into(),
+        error: worst,
+        bound: 1e-9,
+        test: "fidelity::pits_are_cut_0_78_hertz_half_widths_deep".into(),
+    }
 }
