@@ -9,7 +9,40 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     let endurance = endurance(ck, w.endurance.as_ref());
     let mut phases = phases(ck, &w.phases)?;
     let pitting = pitting_mode(ck, w, &w.phases);
-    let onset = match w.pitting_onset_percent {
+    let onset = pitting_onset(ck, w.pitting_onset_percent, pitting);
+    if pitting == Some(Pitting::Off) {
+        phases.retain(|p| matches!(p, Phase::Wear { .. }));
+    }
+    let guard = substep_guard(ck, w.max_substep_wear_um);
+    if let (Some(life), Some(StepControl::Cycles(c))) = (life, step) {
+        if let Some(problem) = fixed_steps_problem(life, c) {
+            ck.fail("wear.step_cycles", Number(c), problem);
+        }
+    }
+    let (film_load, pit_depth, pitting_stress) = model_choices(ck, w);
+    let map_cycles = map_cycles(ck, w.map_cycles.as_ref());
+    let (stop_at, backlash_limit) = life_stop(ck, w);
+    Some(WearPlan {
+        life_cycles: life?,
+        step: step?,
+        max_substep_removal: guard? * 1e-6,
+        phases,
+        pitting: pitting?,
+        pitting_onset_share: onset? * 1e-2,
+        endurance: endurance?,
+        film_load: film_load?,
+        pit_depth: pit_depth?,
+        pitting_stress: pitting_stress?,
+        map_cycles: map_cycles?,
+        stop_at: stop_at?,
+        backlash_limit: backlash_limit?,
+    })
+}
+
+/// The pitting onset share of a forecast (`wear.pitting_onset_percent`, %, default 2); refused
+/// with any other pitting mode.
+fn pitting_onset(ck: &mut Checker, given: Option<f64>, pitting: Option<Pitting>) -> Option<f64> {
+    match given {
         Some(v) if pitting.is_some() && pitting != Some(Pitting::Forecast) => {
             ck.fail(
                 "wear.pitting_onset_percent",
@@ -25,11 +58,12 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             100.0,
             "%",
         ),
-    };
-    if pitting == Some(Pitting::Off) {
-        phases.retain(|p| matches!(p, Phase::Wear { .. }));
     }
-    let guard = match w.max_substep_wear_um.unwrap_or(5.0) {
+}
+
+/// The largest removal of a wear sub-step (`wear.max_substep_wear_um`, um, default 5; 0: off).
+fn substep_guard(ck: &mut Checker, given: Option<f64>) -> Option<f64> {
+    match given.unwrap_or(5.0) {
         0.0 => Some(0.0),
         v => ck.range(
             "wear.max_substep_wear_um",
@@ -38,12 +72,14 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             1000.0,
             "um (or 0: off)",
         ),
-    };
-    if let (Some(life), Some(StepControl::Cycles(c))) = (life, step) {
-        if let Some(problem) = fixed_steps_problem(life, c) {
-            ck.fail("wear.step_cycles", Number(c), problem);
-        }
     }
+}
+
+/// The model options of the life: the film's load, the pits' depth and the pitting stress.
+fn model_choices(
+    ck: &mut Checker,
+    w: &WearSpec,
+) -> (Option<FilmLoad>, Option<PitDepth>, Option<PittingStress>) {
     let film_load = ck.choice(
         "wear.film_load",
         w.film_load.as_deref().unwrap_or("loaded-analysis"),
@@ -69,7 +105,11 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             ("surface-pressure", PittingStress::SurfacePressure),
         ],
     );
-    let map_cycles = map_cycles(ck, w.map_cycles.as_ref());
+    (film_load, pit_depth, pitting_stress)
+}
+
+/// Where the life stops: the criterion and the optional backlash limit (m).
+fn life_stop(ck: &mut Checker, w: &WearSpec) -> (Option<LifeStop>, Option<Option<f64>>) {
     let stop_at = ck.choice(
         "wear.stop_at",
         w.stop_at.as_deref().unwrap_or("pointed-tip"),
@@ -84,21 +124,7 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
             .positive("wear.backlash_limit_um", v, 1e5, "um")
             .map(|v| Some(v * 1e-6)),
     };
-    Some(WearPlan {
-        life_cycles: life?,
-        step: step?,
-        max_substep_removal: guard? * 1e-6,
-        phases,
-        pitting: pitting?,
-        pitting_onset_share: onset? * 1e-2,
-        endurance: endurance?,
-        film_load: film_load?,
-        pit_depth: pit_depth?,
-        pitting_stress: pitting_stress?,
-        map_cycles: map_cycles?,
-        stop_at: stop_at?,
-        backlash_limit: backlash_limit?,
-    })
+    (stop_at, backlash_limit)
 }
 
 /// The step control: adaptive (largest removal, default 4 um) or fixed cycles.
