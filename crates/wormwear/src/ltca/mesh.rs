@@ -131,6 +131,65 @@ pub(super) struct Slice {
     pub(super) line_step: Option<Vector3<f64>>,
 }
 
+/// The contact lines of one position (MODEL §5.1), to follow a tooth's line from one node
+/// column to the next.
+struct PositionLines<'a> {
+    /// Line crossings of every node column, by (tooth, column).
+    crossings: std::collections::HashMap<(i32, usize), &'a crate::kinematics::SliceContact>,
+    ev: &'a GapEvaluator<'a>,
+    /// Wheel angle of the position, rad.
+    theta2: f64,
+    /// The wheel's sense of rotation (+1 or -1, as the TCA's) and the angular pitch 2 pi / z2,
+    /// rad: tooth k sits at sigma k tau.
+    sigma: f64,
+    tau: f64,
+}
+
+impl<'a> PositionLines<'a> {
+    fn new(tca: &'a Tca, ev: &'a GapEvaluator<'a>, n: usize, tau: f64) -> Self {
+        let crossings = tca
+            .contact_lines
+            .iter()
+            .filter(|c| c.position == n && !c.at_end && c.separation.is_finite())
+            .map(|c| ((c.tooth, c.slice), c))
+            .collect();
+        Self {
+            crossings,
+            ev,
+            theta2: tca.positions[n].theta2,
+            sigma: tca.sigma,
+            tau,
+        }
+    }
+
+    /// The angular offset of a tooth, rad.
+    fn offset_of(&self, tooth: i32) -> f64 {
+        self.sigma * tooth as f64 * self.tau
+    }
+
+    fn line_point(&self, c: &crate::kinematics::SliceContact) -> Vector3<f64> {
+        wheel_point(c.r, c.theta + self.offset_of(c.tooth), c.z, self.theta2)
+    }
+
+    /// Line direction at node column j of a tooth, scaled to a face-width advance of 1 m
+    /// (worm frame); None where the column has no crossing or no neighbour has one.
+    fn direction(&self, tooth: i32, j: usize) -> Option<Vector3<f64>> {
+        let here = self.crossings.get(&(tooth, j))?;
+        let before = j
+            .checked_sub(1)
+            .and_then(|i| self.crossings.get(&(tooth, i)));
+        let after = self.crossings.get(&(tooth, j + 1));
+        let (a, b) = match (before, after) {
+            (Some(a), Some(b)) => (self.line_point(a), self.line_point(b)),
+            (Some(a), None) => (self.line_point(a), self.line_point(here)),
+            (None, Some(b)) => (self.line_point(here), self.line_point(b)),
+            (None, None) => return None,
+        };
+        let dz = b.z - a.z;
+        (dz.abs() > 0.0).then(|| self.ev.placement.vector_wheel_to_worm(&((b - a) / dz)))
+    }
+}
+
 /// Builds the local mesh of one position with band half-width `band` (m) (MODEL §5.1):
 /// every `slice_step`-th node column crossed by a tooth's contact line is a slice.
 #[allow(clippy::too_many_arguments)]
@@ -144,38 +203,13 @@ pub(super) fn local_mesh(
     band: f64,
     worn: Option<Worn>,
 ) -> Vec<LocalCell> {
-    let pos = tca.positions[n];
     let tau = 2.0 * PI / teeth as f64;
     let step = settings.slice_step.max(1);
     let base_dz = (wf.z[1] - wf.z[0]) * step as f64;
     // Separation threshold for slices whose minimum is not a crossing (flank edges); on a worn
     // flank the edges left standing can be the first to touch: raised by the deepest wear.
     let edge_threshold = 50e-6 + worn.map_or(0.0, |w| w.deepest);
-    // Line crossings of every node column at this position, to follow the line.
-    let crossings: std::collections::HashMap<(i32, usize), &crate::kinematics::SliceContact> = tca
-        .contact_lines
-        .iter()
-        .filter(|c| c.position == n && !c.at_end && c.separation.is_finite())
-        .map(|c| ((c.tooth, c.slice), c))
-        .collect();
-    let offset_of = |tooth: i32| tca.sigma * tooth as f64 * tau;
-    let line_point = |c: &crate::kinematics::SliceContact| {
-        wheel_point(c.r, c.theta + offset_of(c.tooth), c.z, pos.theta2)
-    };
-    // Line direction at node column j of a tooth, scaled to a face-width advance of 1 m.
-    let direction = |tooth: i32, j: usize| -> Option<Vector3<f64>> {
-        let here = crossings.get(&(tooth, j))?;
-        let before = j.checked_sub(1).and_then(|i| crossings.get(&(tooth, i)));
-        let after = crossings.get(&(tooth, j + 1));
-        let (a, b) = match (before, after) {
-            (Some(a), Some(b)) => (line_point(a), line_point(b)),
-            (Some(a), None) => (line_point(a), line_point(here)),
-            (None, Some(b)) => (line_point(here), line_point(b)),
-            (None, None) => return None,
-        };
-        let dz = b.z - a.z;
-        (dz.abs() > 0.0).then(|| ev.placement.vector_wheel_to_worm(&((b - a) / dz)))
-    };
+    let lines = PositionLines::new(tca, ev, n, tau);
     // Worn material exists only where the worm flank reaches (above the worm-tip trace).
     let tip_floor: Vec<f64> = if worn.is_some() {
         tca.tip_trace.iter().map(|t| t.1).collect()
@@ -208,7 +242,7 @@ pub(super) fn local_mesh(
             line_step: if at_end {
                 None
             } else {
-                direction(line.tooth, line.slice).map(|d| d * base_dz)
+                lines.direction(line.tooth, line.slice).map(|d| d * base_dz)
             },
         });
     }
@@ -222,7 +256,7 @@ pub(super) fn local_mesh(
                 settings,
                 n,
                 band,
-                offset_of(s.tooth),
+                lines.offset_of(s.tooth),
                 worn,
                 &tip_floor,
             )
@@ -365,16 +399,27 @@ pub(super) fn slice_cells(
             worm_lever: centre.cross(&normal).x,
             separation: e
                 + pos.kinematic_error
-                + worn.map_or(0.0, |w| {
-                    // The plastic set also below the worm-tip trace: the tip's edge indents
-                    // the cells it crosses.
-                    let set = w.plastic_set.map_or(0.0, |s| s.at(wf, r, z));
-                    (w.depth.at_above(wf, r, z, Some(tip_floor)) + set) / wheel_lever
-                }),
+                + worn_separation(worn, wf, (r, z), tip_floor, wheel_lever),
             relief,
         });
     }
     cells
+}
+
+/// The angle (rad) a worn flank adds to a cell's separation at (r, z) (m): the wear depth
+/// above the worm-tip trace `tip_floor` plus the plastic set (also below the trace: the tip's
+/// edge indents the cells it crosses), over the wheel's lever (m); 0 on the unworn flank.
+fn worn_separation(
+    worn: Option<Worn>,
+    wf: &WheelFlank,
+    (r, z): (f64, f64),
+    tip_floor: &[f64],
+    wheel_lever: f64,
+) -> f64 {
+    worn.map_or(0.0, |w| {
+        let set = w.plastic_set.map_or(0.0, |s| s.at(wf, r, z));
+        (w.depth.at_above(wf, r, z, Some(tip_floor)) + set) / wheel_lever
+    })
 }
 
 /// d P / d r of the wheel flank point at radius r and body angle theta with d theta / d r =
