@@ -112,61 +112,107 @@ pub(crate) fn band_samples(
     positions: &[PositionResult],
     tau: f64,
 ) -> Vec<Vec<Sample>> {
-    let nj = wf.cells_face;
-    let np = tca.positions.len();
-    // Pressure profiles per (position, tooth, slice) from the local cells: (r, p, width across
-    // the line, column) of the cells. A slice's cells are consecutive in a position's list, so
-    // each (position, tooth, slice) is a list of runs of cells (one, in practice), kept in
-    // order in a table indexed by position, tooth index and node column (no hashing: this
-    // part runs on one thread between two parallel analyses).
-    type Profile = Vec<ProfileCell>;
-    let teeth = tca.teeth.len();
-    let table = |position: usize, tooth_index: usize, slice: usize| {
-        (position * teeth + tooth_index) * (nj + 1) + slice
-    };
-    const NONE: usize = usize::MAX;
-    // Runs: (index in positions, first cell, end, next run of the same key).
-    let mut runs: Vec<(usize, usize, usize, usize)> = Vec::new();
-    let mut head = vec![NONE; np * teeth * (nj + 1)];
-    let mut tail = vec![NONE; np * teeth * (nj + 1)];
-    let mut last_column = 0;
-    for (at, pr) in positions.iter().enumerate() {
-        let cells = &pr.cells;
-        let mut k = 0;
-        while k < cells.len() {
-            let c = &cells[k];
-            let mut end = k + 1;
-            while end < cells.len()
-                && cells[end].tooth_index == c.tooth_index
-                && cells[end].slice == c.slice
-            {
-                end += 1;
-            }
-            last_column = cells[k..end]
-                .iter()
-                .map(|c| c.column)
-                .fold(last_column, usize::max);
-            let key = table(pr.position, c.tooth_index, c.slice);
-            runs.push((at, k, end, NONE));
-            let run = runs.len() - 1;
-            match tail[key] {
-                NONE => head[key] = run,
-                t => runs[t].3 = run,
-            }
-            tail[key] = run;
-            k = end;
-        }
-    }
-    // The profile of a key, once (a second line with the same key gets none).
-    let mut take = |position: usize, tooth: i32, slice: usize| -> Profile {
-        let Some(t) = tca.teeth.iter().position(|&k| k == tooth) else {
-            return Vec::new();
+    let mut runs = CellRuns::index(
+        positions,
+        tca.positions.len(),
+        tca.teeth.len(),
+        wf.cells_face,
+    );
+    // Samples per node column.
+    let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); wf.cells_face + 1];
+    for line in &tca.contact_lines {
+        let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
+        let mut cells = match tca.teeth.iter().position(|&k| k == line.tooth) {
+            Some(t) => runs.take(positions, line.position, t, line.slice),
+            None => Vec::new(),
         };
-        let key = table(position, t, slice);
+        cells.sort_by(|a, b| a.r.total_cmp(&b.r));
+        let time = tca.sigma * theta2;
+        columns[line.slice].push(sample_of(cells, line, time, wf, tca, runs.last_column));
+    }
+    for samples in &mut columns {
+        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+    }
+    columns
+}
+
+/// Pressure profiles per (position, tooth, slice) from the local cells. A slice's cells are
+/// consecutive in a position's list, so each (position, tooth, slice) is a list of runs of
+/// cells (one, in practice), kept in order in a table indexed by position, tooth index and
+/// node column (no hashing: this part runs on one thread between two parallel analyses).
+struct CellRuns {
+    /// (index in positions, first cell, end, next run of the same key).
+    runs: Vec<(usize, usize, usize, usize)>,
+    /// First and last run of each key (NONE: none, or taken).
+    head: Vec<usize>,
+    tail: Vec<usize>,
+    teeth: usize,
+    columns: usize,
+    /// The largest cell column seen.
+    last_column: usize,
+}
+
+impl CellRuns {
+    const NONE: usize = usize::MAX;
+
+    fn key(&self, position: usize, tooth_index: usize, slice: usize) -> usize {
+        (position * self.teeth + tooth_index) * self.columns + slice
+    }
+
+    /// The runs of the positions' cells, for `np` positions, `teeth` teeth and `nj` + 1 node
+    /// columns.
+    fn index(positions: &[PositionResult], np: usize, teeth: usize, nj: usize) -> Self {
+        let mut table = Self {
+            runs: Vec::new(),
+            head: vec![Self::NONE; np * teeth * (nj + 1)],
+            tail: vec![Self::NONE; np * teeth * (nj + 1)],
+            teeth,
+            columns: nj + 1,
+            last_column: 0,
+        };
+        for (at, pr) in positions.iter().enumerate() {
+            let cells = &pr.cells;
+            let mut k = 0;
+            while k < cells.len() {
+                let c = &cells[k];
+                let mut end = k + 1;
+                while end < cells.len()
+                    && cells[end].tooth_index == c.tooth_index
+                    && cells[end].slice == c.slice
+                {
+                    end += 1;
+                }
+                table.last_column = cells[k..end]
+                    .iter()
+                    .map(|c| c.column)
+                    .fold(table.last_column, usize::max);
+                let key = table.key(pr.position, c.tooth_index, c.slice);
+                table.runs.push((at, k, end, Self::NONE));
+                let run = table.runs.len() - 1;
+                match table.tail[key] {
+                    Self::NONE => table.head[key] = run,
+                    t => table.runs[t].3 = run,
+                }
+                table.tail[key] = run;
+                k = end;
+            }
+        }
+        table
+    }
+
+    /// The profile of a key, once (a second line with the same key gets none).
+    fn take(
+        &mut self,
+        positions: &[PositionResult],
+        position: usize,
+        tooth_index: usize,
+        slice: usize,
+    ) -> Vec<ProfileCell> {
+        let key = self.key(position, tooth_index, slice);
         let mut profile = Vec::new();
-        let mut run = std::mem::replace(&mut head[key], NONE);
-        while run != NONE {
-            let (at, start, end, next) = runs[run];
+        let mut run = std::mem::replace(&mut self.head[key], Self::NONE);
+        while run != Self::NONE {
+            let (at, start, end, next) = self.runs[run];
             let pr = &positions[at];
             for (i, c) in (start..end).zip(&pr.cells[start..end]) {
                 profile.push(ProfileCell {
@@ -184,20 +230,7 @@ pub(crate) fn band_samples(
             run = next;
         }
         profile
-    };
-    // Samples per node column.
-    let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); nj + 1];
-    for line in &tca.contact_lines {
-        let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
-        let mut cells = take(line.position, line.tooth, line.slice);
-        cells.sort_by(|a, b| a.r.total_cmp(&b.r));
-        let time = tca.sigma * theta2;
-        columns[line.slice].push(sample_of(cells, line, time, wf, tca, last_column));
     }
-    for samples in &mut columns {
-        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
-    }
-    columns
 }
 
 /// A cell of a band's profile across the line: radius (m), pressure (Pa), width across the
