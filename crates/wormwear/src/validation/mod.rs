@@ -325,19 +325,6 @@ fn variant(base: &GearSet, change: impl FnOnce(&mut GearSet)) -> GearSet {
 /// The study's jobs in order: (b) reference studies, (c) sensitivity, (d) options.
 pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     let scale = if settings.quick { 0.01 } else { 1.0 };
-    let life = |g: &GearSet| -> WearPlan {
-        let mut p = g
-            .wear
-            .clone()
-            .unwrap_or_else(|| WearPlan::with_life(180_000.0));
-        p.life_cycles *= scale;
-        for phase in &mut p.phases {
-            match phase {
-                Phase::Wear { until } | Phase::Pitting { until, .. } => *until *= scale,
-            }
-        }
-        p
-    };
     let design = example(settings, "gear-1x40-design.toml")?;
     let (a, b, c) = (
         example(settings, "gear-1x40-case-a.toml")?,
@@ -345,74 +332,97 @@ pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
         example(settings, "gear-1x40-case-c.toml")?,
     );
     let mut jobs = Vec::new();
-    let mut push = |id: &str, gear: GearSet, plan: Option<WearPlan>| {
-        jobs.push(Job {
-            id: id.to_string(),
-            gear,
-            plan,
-        })
-    };
+    design_jobs(&mut jobs, &design, scale, settings.quick);
+    endurance_jobs(&mut jobs, [&a, &b, &c], scale);
+    // (c) Sensitivity of case C's life to the unpublished inputs; (d) our options.
+    for (id, g, plan) in variants(&c, scaled_life(&c, scale)) {
+        push_job(&mut jobs, &id, g, Some(plan));
+    }
+    Ok(jobs)
+}
+
+/// A gear's life plan (180 000 cycles when the file has none) with its life and phases
+/// scaled by `scale` (the quick study's hundredth).
+fn scaled_life(g: &GearSet, scale: f64) -> WearPlan {
+    let mut p = g
+        .wear
+        .clone()
+        .unwrap_or_else(|| WearPlan::with_life(180_000.0));
+    p.life_cycles *= scale;
+    for phase in &mut p.phases {
+        match phase {
+            Phase::Wear { until } | Phase::Pitting { until, .. } => *until *= scale,
+        }
+    }
+    p
+}
+
+fn push_job(jobs: &mut Vec<Job>, id: &str, gear: GearSet, plan: Option<WearPlan>) {
+    jobs.push(Job {
+        id: id.to_string(),
+        gear,
+        plan,
+    })
+}
+
+/// (b) The design case: its unworn pattern, step controls over 180 000 cycles, and (not in
+/// the quick study) a million cycles.
+fn design_jobs(jobs: &mut Vec<Job>, design: &GearSet, scale: f64, quick: bool) {
     // (b) Unworn patterns (the lives below start with them too).
-    push("unworn-design", design.clone(), None);
-    // (b) Design case: step controls over 180 000 cycles, and a million cycles.
-    let design_life = life(&design);
+    push_job(jobs, "unworn-design", design.clone(), None);
+    let design_life = scaled_life(design, scale);
     for (id, step) in [
         ("design-30000", StepControl::Cycles(30_000.0 * scale)),
         ("design-15000", StepControl::Cycles(15_000.0 * scale)),
         ("design-10000", StepControl::Cycles(10_000.0 * scale)),
         ("design-adaptive", StepControl::MaxRemoval(4e-6)),
     ] {
-        push(
-            id,
-            design.clone(),
-            Some(WearPlan {
-                step,
-                ..design_life.clone()
-            }),
-        );
+        let plan = WearPlan {
+            step,
+            ..design_life.clone()
+        };
+        push_job(jobs, id, design.clone(), Some(plan));
     }
-    if !settings.quick {
+    if !quick {
         for (id, step) in [
             ("design-1e6-fixed", StepControl::Cycles(30_000.0)),
             ("design-1e6-adaptive", StepControl::MaxRemoval(4e-6)),
         ] {
-            push(
-                id,
-                design.clone(),
-                Some(WearPlan {
-                    step,
-                    ..WearPlan::with_life(1e6)
-                }),
-            );
+            let plan = WearPlan {
+                step,
+                ..WearPlan::with_life(1e6)
+            };
+            push_job(jobs, id, design.clone(), Some(plan));
         }
     }
-    // (b) The endurance cases with their schedules, and case B wear only.
-    push("case-a", a.clone(), Some(life(&a)));
-    push("case-b", b.clone(), Some(life(&b)));
-    push("case-c", c.clone(), Some(life(&c)));
-    let mut wear_only = life(&b);
+}
+
+/// (b) The endurance cases A, B, C with their schedules, case B wear only, each case's pitting
+/// forecast, and the speed study on case C.
+fn endurance_jobs(jobs: &mut Vec<Job>, [a, b, c]: [&GearSet; 3], scale: f64) {
+    let life = |g: &GearSet| scaled_life(g, scale);
+    push_job(jobs, "case-a", a.clone(), Some(life(a)));
+    push_job(jobs, "case-b", b.clone(), Some(life(b)));
+    push_job(jobs, "case-c", c.clone(), Some(life(c)));
+    let mut wear_only = life(b);
     wear_only.phases.clear();
-    push("case-b-wear-only", b.clone(), Some(wear_only));
+    push_job(jobs, "case-b-wear-only", b.clone(), Some(wear_only));
     // (b) The pitting forecast of each endurance case: its schedule's phases dropped, found
-    // from the damage (the forecast law of `wear::forecast`; the example's curve, life factor 1, no fit per case).
-    for (id, g) in [("a", &a), ("b", &b), ("c", &c)] {
+    // from the damage (the forecast law of `wear::forecast`; the example's curve, life factor
+    // 1, no fit per case).
+    for (id, g) in [("a", a), ("b", b), ("c", c)] {
         let mut plan = life(g);
         plan.phases.clear();
         plan.pitting = crate::input::Pitting::Forecast;
-        push(&format!("case-{id}-forecast"), g.clone(), Some(plan));
+        push_job(jobs, &format!("case-{id}-forecast"), g.clone(), Some(plan));
     }
     // (b) Speed study: case C's torque at 100 / 600 / 1200 rpm (900 rpm is case C).
     for rpm in [100.0, 600.0, 1200.0] {
-        let g = variant(&c, |g| {
+        let g = variant(c, |g| {
             g.conditions.worm_speed = rpm * 2.0 * std::f64::consts::PI / 60.0
         });
-        push(&format!("speed-{rpm:.0}"), g, Some(life(&c)));
+        push_job(jobs, &format!("speed-{rpm:.0}"), g, Some(life(c)));
     }
-    // (c) Sensitivity of case C's life to the unpublished inputs; (d) our options.
-    for (id, g, plan) in variants(&c, life(&c)) {
-        push(&id, g, Some(plan));
-    }
-    Ok(jobs)
 }
 
 /// The variants of case C for (c) and (d): id, gear, plan.
