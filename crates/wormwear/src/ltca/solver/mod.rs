@@ -140,51 +140,8 @@ impl Problem {
             jobs.push((b, head));
             rest = tail;
         }
-        #[cfg(target_arch = "x86_64")]
-        let wide = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
-        let work = |(b, ys): (&Block, &mut [f64])| {
-            ys.iter_mut().for_each(|v| *v = 0.0);
-            let size = b.size;
-            // Columns of the non-zero loads, four at a time (one pass over y per four),
-            // gathered as they come (no allocation per product).
-            let column = |j: usize| b.row(j);
-            let flush = |ys: &mut [f64], coef: [f64; 4], cols: [&[f64]; 4]| {
-                #[cfg(target_arch = "x86_64")]
-                if wide {
-                    // SAFETY: the CPU has AVX2 and FMA (checked above).
-                    unsafe { axpy4_avx2(ys, coef, cols) };
-                } else {
-                    axpy4(ys, coef, cols);
-                }
-                #[cfg(not(target_arch = "x86_64"))]
-                axpy4(ys, coef, cols);
-            };
-            // (Placeholders, never read: a flush has `filled` real columns and copies of the
-            // first; a lazy block must not assemble a row for them.)
-            let mut cols: [&[f64]; 4] = [&[]; 4];
-            let mut coef = [0.0; 4];
-            let mut filled = 0;
-            for (j, &v) in x[b.start..b.start + size].iter().enumerate() {
-                if v == 0.0 {
-                    continue;
-                }
-                cols[filled] = column(j);
-                coef[filled] = v;
-                filled += 1;
-                if filled == 4 {
-                    flush(ys, coef, cols);
-                    filled = 0;
-                }
-            }
-            if filled > 0 {
-                // Unused slots: zero coefficients on a valid column.
-                for k in filled..4 {
-                    coef[k] = 0.0;
-                    cols[k] = cols[0];
-                }
-                flush(ys, coef, cols);
-            }
-        };
+        let wide = wide_kernels();
+        let work = |(b, ys): (&Block, &mut [f64])| block_product(b, x, ys, wide);
         // Threads only when the product is worth a fork-join (the projection's correction
         // products touch a handful of columns).
         let work_total: usize = self
@@ -206,7 +163,7 @@ impl Problem {
         if let Some(lr) = &self.low_rank {
             #[cfg(target_arch = "x86_64")]
             if wide {
-                // SAFETY: the CPU has AVX2 and FMA (checked above).
+                // SAFETY: the CPU has AVX2 and FMA (checked by wide_kernels).
                 unsafe { low_rank_add_avx2(lr, x, y) };
             } else {
                 low_rank_add(lr, x, y, dot);
@@ -376,6 +333,65 @@ fn check_capacity(problem: &Problem, cap: &[f64]) -> Result<(), SolverError> {
         )));
     }
     Ok(())
+}
+
+/// Whether the AVX2 + FMA kernels can run on this CPU.
+fn wide_kernels() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// ys = B x_B for one symmetric block B (its rows of x): accumulated column by column over the
+/// non-zero entries of x only, four columns at a time (one pass over ys per four), gathered as
+/// they come (no allocation per product); `wide`: the AVX2 kernel.
+fn block_product(b: &Block, x: &[f64], ys: &mut [f64], wide: bool) {
+    ys.iter_mut().for_each(|v| *v = 0.0);
+    let column = |j: usize| b.row(j);
+    let flush = |ys: &mut [f64], coef: [f64; 4], cols: [&[f64]; 4]| {
+        #[cfg(target_arch = "x86_64")]
+        if wide {
+            // SAFETY: the CPU has AVX2 and FMA (checked by wide_kernels).
+            unsafe { axpy4_avx2(ys, coef, cols) };
+        } else {
+            axpy4(ys, coef, cols);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = wide;
+            axpy4(ys, coef, cols);
+        }
+    };
+    // (Placeholders, never read: a flush has `filled` real columns and copies of the first; a
+    // lazy block must not assemble a row for them.)
+    let mut cols: [&[f64]; 4] = [&[]; 4];
+    let mut coef = [0.0; 4];
+    let mut filled = 0;
+    for (j, &v) in x[b.start..b.start + b.size].iter().enumerate() {
+        if v == 0.0 {
+            continue;
+        }
+        cols[filled] = column(j);
+        coef[filled] = v;
+        filled += 1;
+        if filled == 4 {
+            flush(ys, coef, cols);
+            filled = 0;
+        }
+    }
+    if filled > 0 {
+        // Unused slots: zero coefficients on a valid column.
+        for k in filled..4 {
+            coef[k] = 0.0;
+            cols[k] = cols[0];
+        }
+        flush(ys, coef, cols);
+    }
 }
 
 /// Residuals of q with approach alpha under total load `load`.
