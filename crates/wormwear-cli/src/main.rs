@@ -269,6 +269,27 @@ enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     // One run per output directory: the lock lives until the process ends.
+    let _lock = match lock_output(&cli) {
+        Ok(lock) => lock,
+        Err(code) => return code,
+    };
+    let result = dispatch(&cli);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Locks the command's output directory (none for `check` and `import`), and says when an
+/// interrupted run's temporary files were removed; exit code 2 when it cannot.
+fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, ExitCode> {
     let output = match &cli.command {
         Command::Check { .. } | Command::Import { .. } => None,
         Command::Geometry { output, .. }
@@ -288,14 +309,19 @@ fn main() -> ExitCode {
         Ok(lock) => lock,
         Err(e) => {
             eprintln!("error: {e}");
-            return ExitCode::from(2);
+            return Err(ExitCode::from(2));
         }
     };
     let stale = lock.as_ref().map_or(0, |l| l.stale_temporaries_removed);
     if stale > 0 && !cli.quiet {
         eprintln!("note: removed {stale} temporary file(s) left by an interrupted run");
     }
-    let result = match &cli.command {
+    Ok(lock)
+}
+
+/// Runs the command.
+fn dispatch(cli: &Cli) -> Result<(), Failure> {
+    match &cli.command {
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),
@@ -343,17 +369,6 @@ fn main() -> ExitCode {
             no_life,
             life,
         } => rexs_cmd::export(file, output, *json, *no_life, life, cli.quiet, cli.verbose),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Input(e)) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-        Err(Failure::Run(e)) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(1)
-        }
     }
 }
 
