@@ -308,9 +308,21 @@ fn position_charts(
     dir: &Path,
     files: &mut Vec<PathBuf>,
 ) -> Result<(), OutputError> {
+    files.push(load_sharing_chart(tca, ltca, dir)?);
+    files.push(transmission_error_chart(tca, ltca, dir)?);
+    files.push(stiffness_chart(ltca, dir)?);
+    Ok(())
+}
+
+/// The position n as a wheel rotation in tooth pitches from position 0.
+fn pitches(n: usize, np: usize) -> f64 {
+    n as f64 / np as f64
+}
+
+/// The normal force on each tooth that carries load over the positions (kN).
+fn load_sharing_chart(tca: &Tca, ltca: &Ltca, dir: &Path) -> Result<PathBuf, OutputError> {
     let np = ltca.positions.len();
-    let x = |n: usize| n as f64 / np as f64;
-    // Load sharing.
+    let x = |n: usize| pitches(n, np);
     let series: Vec<Series> = tca
         .teeth
         .iter()
@@ -336,8 +348,13 @@ fn position_charts(
         &series,
         false,
     )?;
-    files.push(path);
-    // Transmission error.
+    Ok(path)
+}
+
+/// The loaded transmission error with the unloaded kinematic error (urad, wheel).
+fn transmission_error_chart(tca: &Tca, ltca: &Ltca, dir: &Path) -> Result<PathBuf, OutputError> {
+    let np = ltca.positions.len();
+    let x = |n: usize| pitches(n, np);
     let te = Series {
         label: "loaded TE".into(),
         points: (0..=np)
@@ -369,8 +386,13 @@ fn position_charts(
         false,
         0.02,
     )?;
-    files.push(path);
-    // Stiffness.
+    Ok(path)
+}
+
+/// The angular mesh stiffness over the positions (MN m/rad).
+fn stiffness_chart(ltca: &Ltca, dir: &Path) -> Result<PathBuf, OutputError> {
+    let np = ltca.positions.len();
+    let x = |n: usize| pitches(n, np);
     let k = Series {
         label: String::new(),
         points: (0..=np)
@@ -388,8 +410,7 @@ fn position_charts(
         &[k],
         false,
     )?;
-    files.push(path);
-    Ok(())
+    Ok(path)
 }
 
 /// The loaded pattern: CSV and maps (pressure, equivalent pressure below the flank).
