@@ -25,23 +25,32 @@ pub(super) fn write_tables(
     position_table(tca, &state.records).write(&path)?;
     files.push(path);
     update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
-    // Curves over cycles.
+    let charts = life_charts(&state.records);
+    for (name, title, y, series) in charts {
+        let path = dir.join(name);
+        line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// The curves over cycles: (file, title, y label, series) of the backlash, wear depth,
+/// transmission error and pressure charts.
+fn life_charts(
+    records: &[crate::wear::StepRecord],
+) -> [(&'static str, &'static str, &'static str, Vec<Series>); 4] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
-        points: state
-            .records
-            .iter()
-            .map(|r| (r.cycles * 1e-6, f(r)))
-            .collect(),
+        points: records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
         color,
         bold: true,
     };
-    let charts: [(&str, &str, &str, Vec<Series>); 4] = [
+    [
         (
             "wear_backlash.svg",
             "Backlash increase (tangential at r2, mean over positions)",
             "backlash increase (um)",
-            backlash_series(&state.records),
+            backlash_series(records),
         ),
         (
             "wear_depth.svg",
@@ -86,13 +95,7 @@ pub(super) fn write_tables(
                 curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
             ],
         ),
-    ];
-    for (name, title, y, series) in charts {
-        let path = dir.join(name);
-        line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
-        files.push(path);
-    }
-    Ok(files)
+    ]
 }
 
 /// Per state and position: TE, TE relative to the wear's rigid lag, largest pressure and the
