@@ -221,17 +221,50 @@ pub(super) fn bending_plan(
         ),
         None => Some(0.75 * rf),
     };
+    let body = worm_body_length(ck, b.worm_body_length_mm, worm, wheel, operating);
+    let bearings = worm_bearings(ck, b.worm_bearing_positions_mm.as_deref(), body, rf);
+    Some(BendingPlan {
+        kind: kind?,
+        height_points: height? as usize,
+        width_points: width? as usize,
+        worm_width_points: worm_width? as usize,
+        mesh_refinement: refinement? as usize,
+        worm_shaft_radius: shaft? * MM,
+        worm_body_length: body? * MM,
+        worm_bearings: bearings?,
+    })
+}
+
+/// The worm body's length (`bending.worm_body_length_mm`, mm): given, or by default the chord
+/// of the wheel's outer circle at the worm's tip radius, at least twice the face width.
+fn worm_body_length(
+    ck: &mut Checker,
+    given: Option<f64>,
+    worm: &ThreadSpec,
+    wheel: &WheelSpec,
+    operating: &OperatingSpec,
+) -> Option<f64> {
     let reach = operating.centre_distance_mm - worm.tip_radius_mm;
     let default_body = 2.0
         * (wheel.outer_radius_mm.powi(2) - reach.powi(2))
             .max(0.0)
             .sqrt();
     let default_body = default_body.max(2.0 * wheel.face_width_mm);
-    let body = match b.worm_body_length_mm {
+    match given {
         Some(v) => ck.positive("bending.worm_body_length_mm", v, 10_000.0, "mm"),
         None => Some(default_body),
-    };
-    let bearings = match (&b.worm_bearing_positions_mm, body) {
+    }
+}
+
+/// The worm's bearing positions (`bending.worm_bearing_positions_mm`, m): two, outside the
+/// body of length `body` (mm); by default two root radii `rf` (mm) beyond its ends.
+fn worm_bearings(
+    ck: &mut Checker,
+    given: Option<&[f64]>,
+    body: Option<f64>,
+    rf: f64,
+) -> Option<[f64; 2]> {
+    match (given, body) {
         (Some(v), _) if v.len() != 2 => {
             ck.fail(
                 "bending.worm_bearing_positions_mm",
@@ -261,15 +294,5 @@ pub(super) fn bending_plan(
             Some([-x * MM, x * MM])
         }
         _ => None,
-    };
-    Some(BendingPlan {
-        kind: kind?,
-        height_points: height? as usize,
-        width_points: width? as usize,
-        worm_width_points: worm_width? as usize,
-        mesh_refinement: refinement? as usize,
-        worm_shaft_radius: shaft? * MM,
-        worm_body_length: body? * MM,
-        worm_bearings: bearings?,
-    })
+    }
 }
