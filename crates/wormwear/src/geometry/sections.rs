@@ -37,11 +37,24 @@ pub fn rack_plane_section(
     offset: f64,
     threads_each_side: i64,
 ) -> Result<Section, GeometryError> {
+    let curves = vec![
+        SectionCurve {
+            member: "worm",
+            points: worm_outline(gear, geo, offset, threads_each_side),
+        },
+        SectionCurve {
+            member: "wheel",
+            points: wheel_outline(gear, geo, offset, threads_each_side)?,
+        },
+    ];
+    Ok(Section { offset, curves })
+}
+
+/// The worm's outline in the rack plane at `c` (m; worm frame x, y): for each thread, left flank
+/// up, tip, right flank down, root to the next.
+fn worm_outline(gear: &GearSet, geo: &Geometry, c: f64, threads_each_side: i64) -> Vec<(f64, f64)> {
     let worm = &geo.worm;
     let (rf, ra) = (gear.worm.root_radius, gear.worm.tip_radius);
-    let c = offset;
-    let mut curves = Vec::new();
-    // Worm outline: for each thread, left flank up, tip, right flank down, root to the next.
     let mut outline = Vec::new();
     let point = |flank: Flank, rho: f64, k: i64| -> Option<(f64, f64)> {
         if rho <= c.abs() {
@@ -61,13 +74,18 @@ pub fn rack_plane_section(
             outline.extend(point(Flank::Right, rho, k));
         }
     }
-    curves.push(SectionCurve {
-        member: "worm",
-        points: outline,
-    });
+    outline
+}
 
-    // Wheel teeth: tooth k spans from the left-mating flank of space k (theta_L + k tau) to
-    // the right-mating flank of space k + 1 (theta_R + (k + 1) tau).
+/// The wheel teeth's outline in the rack plane at `c` (m; worm frame x, y): tooth k spans from
+/// the left-mating flank of space k (theta_L + k tau) to the right-mating flank of space k + 1
+/// (theta_R + (k + 1) tau).
+fn wheel_outline(
+    gear: &GearSet,
+    geo: &Geometry,
+    c: f64,
+    threads_each_side: i64,
+) -> Result<Vec<(f64, f64)>, GeometryError> {
     let hobbing: Hobbing = geo.hobbing(gear);
     let tau = 2.0 * PI / geo.teeth as f64;
     let top = geo.blank.top(c);
@@ -110,9 +128,5 @@ pub fn rack_plane_section(
             wheel.push(to_xy(r, th + kt + tau));
         }
     }
-    curves.push(SectionCurve {
-        member: "wheel",
-        points: wheel,
-    });
-    Ok(Section { offset, curves })
+    Ok(wheel)
 }
