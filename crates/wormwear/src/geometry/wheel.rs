@@ -587,27 +587,7 @@ pub fn generate_flank(
         .par_iter()
         .map(|&(r, zz)| flank_point(hobbing, flank, r, zz))
         .collect::<Result<_, _>>()?;
-    // Cell areas: each cell split into four triangles around its centre (exact for planar
-    // cells, second order on the curved flank).
-    let node = |i: usize, j: usize| nodes[j * (ni + 1) + i].position();
-    let mut cell_area = Vec::with_capacity(ni * nj);
-    for j in 0..nj {
-        for i in 0..ni {
-            let c = cells[j * ni + i].position();
-            let corners = [
-                node(i, j),
-                node(i + 1, j),
-                node(i + 1, j + 1),
-                node(i, j + 1),
-            ];
-            let mut area = 0.0;
-            for k in 0..4 {
-                let (a, b) = (corners[k] - c, corners[(k + 1) % 4] - c);
-                area += 0.5 * a.cross(&b).norm();
-            }
-            cell_area.push(area);
-        }
-    }
+    let cell_area = cell_areas(&nodes, &cells, ni, nj);
     let active = vec![true; ni * nj];
     let node_slopes = nodes.iter().map(WheelFlank::slopes_of).collect();
     let column_sign = (0..=nj)
@@ -627,6 +607,31 @@ pub fn generate_flank(
         node_slopes,
         column_sign,
     })
+}
+
+/// Cell areas (m^2) of a flank grid with `ni` x `nj` cells: each cell split into four
+/// triangles around its centre (exact for planar cells, second order on the curved flank).
+fn cell_areas(nodes: &[FlankPoint], cells: &[FlankPoint], ni: usize, nj: usize) -> Vec<f64> {
+    let node = |i: usize, j: usize| nodes[j * (ni + 1) + i].position();
+    let mut cell_area = Vec::with_capacity(ni * nj);
+    for j in 0..nj {
+        for i in 0..ni {
+            let c = cells[j * ni + i].position();
+            let corners = [
+                node(i, j),
+                node(i + 1, j),
+                node(i + 1, j + 1),
+                node(i, j + 1),
+            ];
+            let mut area = 0.0;
+            for k in 0..4 {
+                let (a, b) = (corners[k] - c, corners[(k + 1) % 4] - c);
+                area += 0.5 * a.cross(&b).norm();
+            }
+            cell_area.push(area);
+        }
+    }
+    cell_area
 }
 
 /// The window of width `width` centred on `centre`, moved inside [lo, hi] (all of it when it
