@@ -37,6 +37,35 @@ pub struct QuadSurface {
     pub cell_data: NamedArrays,
 }
 
+/// The points (x, y, z flattened) and the quads (connectivity and offsets, VTK XML) of the
+/// surfaces, one patch after the other.
+fn quads(surfaces: &[&QuadSurface]) -> (Vec<f64>, Vec<u64>, Vec<u64>) {
+    let mut points = Vec::new();
+    let mut connectivity = Vec::new();
+    let mut offsets = Vec::new();
+    let mut base = 0u64;
+    for s in surfaces {
+        for p in &s.points {
+            points.extend_from_slice(p);
+        }
+        let rows = s.rows as u64;
+        for col in 0..s.cols.saturating_sub(1) as u64 {
+            for row in 0..s.rows.saturating_sub(1) as u64 {
+                let at = |r: u64, c: u64| base + c * rows + r;
+                connectivity.extend_from_slice(&[
+                    at(row, col),
+                    at(row + 1, col),
+                    at(row + 1, col + 1),
+                    at(row, col + 1),
+                ]);
+                offsets.push(connectivity.len() as u64);
+            }
+        }
+        base += s.points.len() as u64;
+    }
+    (points, connectivity, offsets)
+}
+
 impl QuadSurface {
     /// Number of quads.
     pub fn cell_count(&self) -> usize {
@@ -63,29 +92,7 @@ impl QuadSurface {
         let surfaces: Vec<&QuadSurface> = std::iter::once(self)
             .chain(others.iter().copied())
             .collect();
-        let mut points = Vec::new();
-        let mut connectivity = Vec::new();
-        let mut offsets = Vec::new();
-        let mut base = 0u64;
-        for s in &surfaces {
-            for p in &s.points {
-                points.extend_from_slice(p);
-            }
-            let rows = s.rows as u64;
-            for col in 0..s.cols.saturating_sub(1) as u64 {
-                for row in 0..s.rows.saturating_sub(1) as u64 {
-                    let at = |r: u64, c: u64| base + c * rows + r;
-                    connectivity.extend_from_slice(&[
-                        at(row, col),
-                        at(row + 1, col),
-                        at(row + 1, col + 1),
-                        at(row, col + 1),
-                    ]);
-                    offsets.push(connectivity.len() as u64);
-                }
-            }
-            base += s.points.len() as u64;
-        }
+        let (points, connectivity, offsets) = quads(&surfaces);
         let scalars = |name: &str, data: Vec<f64>| {
             Attribute::DataArray(DataArray {
                 name: name.to_string(),
