@@ -676,13 +676,81 @@ fn speed_table(m: &mut String, results: &Results) {
     m.push('\n');
 }
 
+/// Rows of section (c): (variant, job id).
+const SENSITIVITY_ROWS: [(&str, &str); 7] = [
+    ("default (case C)", "case-c"),
+    ("composite roughness 0.2 um", "c-roughness-0.2"),
+    ("composite roughness 0.5 um", "c-roughness-0.5"),
+    ("K x 0.5", "c-k-half"),
+    ("K x 2", "c-k-double"),
+    ("no bending", "c-no-bending"),
+    ("20 um tip and edge reliefs over 1 mm", "c-reliefs"),
+];
+
+/// Rows of section (d): (option and its input, job id).
+const OPTION_ROWS: [(&str, &str); 6] = [
+    (
+        "default (plastic limit at the wheel hardness, MODEL §5.7)",
+        "case-c",
+    ),
+    (
+        "reliefs: `tip_relief_um = 20`, `edge_relief_um = 20`",
+        "c-reliefs",
+    ),
+    (
+        "purely elastic contact (the published reading): `contact = \"elastic\"`",
+        "c-elastic",
+    ),
+    (
+        "pits of the loaded band: `pit_depth = \"loaded-band\"`",
+        "c-band-pits",
+    ),
+    (
+        "film load floored: `film_load = \"hertz-peak-floor\"`",
+        "c-film-floor",
+    ),
+    (
+        "pressure along the wheel grid's normal (the other reading of MODEL §5.2's n_i): \
+         `pressure_direction = \"wheel-flank\"`",
+        "c-wheel-flank-pressure",
+    ),
+];
+
 fn section_c_d(m: &mut String, results: &Results) {
     let Some(base) = results.get("case-c").and_then(last) else {
         return;
     };
-    let row = |m: &mut String, name: &str, id: &str| {
-        let Some(r) = results.get(id) else { return };
-        let Some(e) = last(r) else { return };
+    let _ = writeln!(
+        m,
+        "## (c) Sensitivity to the inputs the published data do not give\n"
+    );
+    let _ = writeln!(
+        m,
+        "Case C's life (6.8e6 cycles with its schedule), one input changed at a time; the \
+         default is the example (composite roughness 1 um, assumed; K 2.5e-8; FE bending with \
+         assumed shafts and bearings; sharp edges). Values at the end of the life.\n"
+    );
+    variant_table(m, results, base, &SENSITIVITY_ROWS);
+    let _ = writeln!(m, "## (d) Our refinements against the default\n");
+    let _ = writeln!(
+        m,
+        "Each option of ours alone on case C's life; the published form is the default and \
+         stays one switch away (the option's input in the first column).\n"
+    );
+    variant_table(m, results, base, &OPTION_ROWS);
+}
+
+/// A table of case C's variants at the end of their lives against the default `base`: one row
+/// per (name, job id) that has a result, then a blank line.
+fn variant_table(m: &mut String, results: &Results, base: &StepRecord, rows: &[(&str, &str)]) {
+    let _ = writeln!(
+        m,
+        "| variant | backlash at the end (vs default) | max wear | P_max | P_patch | P_mean | states | analyses | time (s) |"
+    );
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|");
+    for &(name, id) in rows {
+        let Some(r) = results.get(id) else { continue };
+        let Some(e) = last(r) else { continue };
         let _ = writeln!(
             m,
             "| {name} | {:.1} ({:+.0} %) | {:.1} | {:.0} | {:.0} | {:.0} | {} | {} | {:.0} |",
@@ -696,71 +764,7 @@ fn section_c_d(m: &mut String, results: &Results) {
             e.loaded_analyses,
             r.seconds
         );
-    };
-    let head = |m: &mut String| {
-        let _ = writeln!(
-            m,
-            "| variant | backlash at the end (vs default) | max wear | P_max | P_patch | P_mean | states | analyses | time (s) |"
-        );
-        let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|");
-    };
-    let _ = writeln!(
-        m,
-        "## (c) Sensitivity to the inputs the published data do not give\n"
-    );
-    let _ = writeln!(
-        m,
-        "Case C's life (6.8e6 cycles with its schedule), one input changed at a time; the \
-         default is the example (composite roughness 1 um, assumed; K 2.5e-8; FE bending with \
-         assumed shafts and bearings; sharp edges). Values at the end of the life.\n"
-    );
-    head(m);
-    row(m, "default (case C)", "case-c");
-    row(m, "composite roughness 0.2 um", "c-roughness-0.2");
-    row(m, "composite roughness 0.5 um", "c-roughness-0.5");
-    row(m, "K x 0.5", "c-k-half");
-    row(m, "K x 2", "c-k-double");
-    row(m, "no bending", "c-no-bending");
-    row(m, "20 um tip and edge reliefs over 1 mm", "c-reliefs");
-    m.push('\n');
-    let _ = writeln!(m, "## (d) Our refinements against the default\n");
-    let _ = writeln!(
-        m,
-        "Each option of ours alone on case C's life; the published form is the default and \
-         stays one switch away (the option's input in the first column).\n"
-    );
-    head(m);
-    row(
-        m,
-        "default (plastic limit at the wheel hardness, MODEL §5.7)",
-        "case-c",
-    );
-    row(
-        m,
-        "reliefs: `tip_relief_um = 20`, `edge_relief_um = 20`",
-        "c-reliefs",
-    );
-    row(
-        m,
-        "purely elastic contact (the published reading): `contact = \"elastic\"`",
-        "c-elastic",
-    );
-    row(
-        m,
-        "pits of the loaded band: `pit_depth = \"loaded-band\"`",
-        "c-band-pits",
-    );
-    row(
-        m,
-        "film load floored: `film_load = \"hertz-peak-floor\"`",
-        "c-film-floor",
-    );
-    row(
-        m,
-        "pressure along the wheel grid's normal (the other reading of MODEL §5.2's n_i): \
-         `pressure_direction = \"wheel-flank\"`",
-        "c-wheel-flank-pressure",
-    );
+    }
     m.push('\n');
 }
 
