@@ -416,6 +416,12 @@ impl<'a> LifeLoop<'a> {
         (lag, positions)
     }
 
+    /// The unworn backlash, mean over the positions, as a length at the reference radius, m.
+    fn initial_backlash_linear(&self) -> f64 {
+        self.initial_backlash.iter().sum::<f64>() / self.initial_backlash.len().max(1) as f64
+            * self.backlash.reference_radius
+    }
+
     /// The record of a state (MODEL §7.7, §12 j, §12 k).
     fn record(
         &self,
@@ -430,21 +436,12 @@ impl<'a> LifeLoop<'a> {
         let change = state.flank_change();
         let (lag, positions) = self.position_states(l, &change);
         let b = self.backlash.stats(&change);
-        let initial = self.initial_backlash.iter().sum::<f64>()
-            / self.initial_backlash.len().max(1) as f64
-            * self.backlash.reference_radius;
         let (te_mean, te_p2p) = l.te_stats();
         let (te_rel_mean, te_rel_p2p) = stats(positions.iter().map(|p| p.te_relative_rad));
         let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
         let volume = state.removal.integral(wf);
         let worst_node = argmax(&state.removal.values).map(|k| &wf.nodes[k]);
         let worst_cell = argmax(&l.pattern).map(|k| &wf.cells[k]);
-        let previous = state
-            .records
-            .iter()
-            .rev()
-            .find(|r| r.step < state.step)
-            .map_or(0, |r| r.loaded_analyses);
         StepRecord {
             step: state.step,
             cycles: state.cycles,
@@ -466,7 +463,7 @@ impl<'a> LifeLoop<'a> {
             mean_wear_m: volume / self.active_area,
             worn_volume_m3: volume,
             backlash_m: b.linear_mean_m,
-            backlash_increase_m: b.linear_mean_m - initial,
+            backlash_increase_m: b.linear_mean_m - self.initial_backlash_linear(),
             backlash_min_rad: b.min_rad,
             backlash_max_rad: b.max_rad,
             max_pressure_pa: l.max_pressure,
@@ -491,7 +488,7 @@ impl<'a> LifeLoop<'a> {
                 l.mean_pressure * 1e-6,
                 self.pitting_limit * 1e-6,
             ),
-            loaded_analyses: previous + substeps.max(1),
+            loaded_analyses: state.loaded_analyses_before() + substeps.max(1),
             thinnest_tooth_m: self.limits.thinnest(&state.removal).0,
             worn_through_loaded: self
                 .limits

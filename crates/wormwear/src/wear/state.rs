@@ -50,6 +50,15 @@ pub struct WearState {
 }
 
 impl WearState {
+    /// The loaded analyses counted up to the last record before this state's step.
+    pub(crate) fn loaded_analyses_before(&self) -> usize {
+        self.records
+            .iter()
+            .rev()
+            .find(|r| r.step < self.step)
+            .map_or(0, |r| r.loaded_analyses)
+    }
+
     /// Unworn start.
     pub fn new(wf: &WheelFlank) -> Self {
         Self {
