@@ -479,11 +479,7 @@ pub fn flank_map(
                 PathElement::new(ring, cell_color(c).stroke_width(1))
             }))
             .map_err(plot_err)?;
-        let levels = if iso.is_some() {
-            nice_levels(lo, hi, 6)
-        } else {
-            Vec::new()
-        };
+        let levels = iso.map_or_else(Vec::new, |_| nice_levels(lo, hi, 6));
         if let Some(grid) = iso {
             draw_iso_lines(&mut chart, grid, &levels, (x1 - x0, y1 - y0))?;
         }
