@@ -636,6 +636,19 @@ fn print_ltca(results: &wormwear::Results) {
             result.stiffness_without_shaft_torsion_mean()
         );
     }
+    if let Some(t) = &results.thermal {
+        println!(
+            "friction (MODEL §13): mu mean {:.4}, mesh loss {:.1} W, mesh efficiency {:.4}, \
+             total {:.4}; oil {:.1} C ({}), viscosity {:.4} Pa s",
+            t.friction.mean_coefficient,
+            t.friction.mesh_loss_w,
+            t.efficiency.mesh_efficiency,
+            t.efficiency.total_efficiency,
+            t.oil_temperature_k - 273.15,
+            t.mode,
+            t.viscosity_pa_s
+        );
+    }
 }
 
 /// The file's life plan with the command-line overrides applied.

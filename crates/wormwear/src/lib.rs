@@ -22,6 +22,7 @@ pub mod bending;
 pub mod calibration;
 pub mod contact;
 pub mod files;
+pub mod friction;
 pub mod geometry;
 pub mod input;
 pub mod integrity;
@@ -56,6 +57,7 @@ pub fn run(
     let tca = pipeline.unloaded_analysis(&geometry)?;
     let bending = pipeline.bending_model(&geometry)?;
     let ltca = pipeline.loaded_analysis(&geometry, tca.as_ref(), &bending)?;
+    let thermal = pipeline.friction(&geometry, tca.as_ref(), ltca.as_ref())?;
     let life = pipeline.life(&geometry, tca.as_ref(), &bending)?;
-    Ok(pipeline.results(geometry, tca, bending, ltca, life))
+    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal), life))
 }

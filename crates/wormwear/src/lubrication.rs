@@ -1,5 +1,6 @@
 //! Stage 4a — lubricant film at a contact line (MODEL §6): Moes–Venner minimum film thickness
-//! of a line contact, Gupta's thermal reduction, film ratio and the local wear coefficient.
+//! of a line contact, Gupta's thermal reduction, film ratio, the local wear coefficient and the
+//! asperity contact of the mixed regime (MODEL §10).
 //! SI units throughout (m, Pa, m/s, N/m, K).
 
 use crate::input::Lubricant;
@@ -114,11 +115,35 @@ pub fn wear_coefficient(k_dry: f64, lambda: f64) -> f64 {
     }
 }
 
+/// Fraction of the apparent contact area in asperity contact (MODEL §10):
+/// A_c / A_0 = (1/2)(1/2)(1 - erf(h / (sqrt(2) sigma))), h the film thickness Phi_T h_min and
+/// sigma the composite RMS roughness R_q (both m). 1/4 with no film, tends to 0 as h >> sigma.
+pub fn asperity_area_fraction(film_thickness: f64, roughness_rq: f64) -> f64 {
+    0.25 * (1.0 - libm::erf(film_thickness / (std::f64::consts::SQRT_2 * roughness_rq)))
+}
+
+/// Load carried by the asperities, N (MODEL §10): W_asp = (W_sec / A_c)(A_c / A_0) A_0 with
+/// W_sec / A_c = 0.2 E' sqrt(m2 / pi), m2 = Rdq^2 the mean square profile slope. `e_prime` the
+/// reduced modulus E' (Pa, MODEL §6), `apparent_area` A_0 (m^2).
+pub fn asperity_load(
+    e_prime: f64,
+    slope_rdq: f64,
+    film_thickness: f64,
+    roughness_rq: f64,
+    apparent_area: f64,
+) -> f64 {
+    0.2 * e_prime
+        * (slope_rdq * slope_rdq / std::f64::consts::PI).sqrt()
+        * asperity_area_fraction(film_thickness, roughness_rq)
+        * apparent_area
+}
+
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn oil() -> Lubricant {
+    /// MODEL §11's polyglycol at 333 K, composite roughness 1 um (also the friction tests').
+    pub(crate) fn oil() -> Lubricant {
         // MODEL §11 polyglycol at 333 K, composite roughness 1 um.
         Lubricant {
             name: "polyglycol".into(),

@@ -369,6 +369,8 @@ pub struct Results {
     pub life: Option<Life>,
     /// The standard's ratings (MODEL §9), with the loaded stages.
     pub rating: Option<Rating>,
+    /// Friction, efficiency and oil temperature from the loaded analysis (MODEL §13).
+    pub thermal: Option<crate::friction::Thermal>,
     /// Warnings of the stages, each with its stage's prefix where the CLI prints one.
     pub warnings: Vec<String>,
 }
@@ -389,6 +391,8 @@ pub enum RunError {
     Bending(#[source] crate::bending::model::BendingError),
     #[error("loaded tooth contact analysis")]
     Ltca(#[source] crate::ltca::LtcaError),
+    #[error("heat balance")]
+    Friction(#[source] crate::friction::FrictionError),
     #[error("{}", wear_context(.0))]
     Wear(#[source] WearError),
     /// The caller's event handler stopped the run (an interrupt, a file that cannot be
@@ -413,6 +417,7 @@ impl RunError {
             self,
             RunError::Request(_)
                 | RunError::Geometry(_)
+                | RunError::Friction(_)
                 | RunError::Bending(crate::bending::model::BendingError::TooLarge { .. })
                 | RunError::Ltca(crate::ltca::LtcaError::TooManyCells { .. })
                 | RunError::Wear(WearError::Ltca {
@@ -510,16 +515,42 @@ impl<'a> Pipeline<'a> {
         life(gear, source, geo, tca, model, plan, resume, self.on_event).map(Some)
     }
 
+    /// Friction, efficiency and oil temperature of the loaded analysis (MODEL §13).
+    pub(crate) fn friction(
+        &mut self,
+        geo: &Geometry,
+        tca: Option<&Tca>,
+        ltca: Option<&Ltca>,
+    ) -> Result<Option<crate::friction::Thermal>, RunError> {
+        let (Some(tca), Some(ltca)) = (tca, ltca) else {
+            return Ok(None);
+        };
+        let gear = self.gear;
+        let rating = crate::rating::rate(gear);
+        let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
+        let contacts = crate::friction::MeshContacts::new(gear, geo, tca, ltca);
+        crate::friction::heat_balance(
+            &contacts,
+            &gear.lubricant,
+            &gear.friction,
+            &gear.housing,
+            other,
+        )
+        .map(Some)
+        .map_err(RunError::Friction)
+    }
+
     /// The results of the run, with the ratings (MODEL §9) beside a loaded stage.
     pub(crate) fn results(
         self,
         geometry: Geometry,
         tca: Option<Tca>,
         bending: Bending,
-        ltca: Option<Ltca>,
+        (ltca, thermal): (Option<Ltca>, Option<crate::friction::Thermal>),
         life: Option<Life>,
     ) -> Results {
         Results {
+            thermal,
             rating: self
                 .request
                 .needs_bending()

@@ -886,3 +886,54 @@ fn relations_name_the_fields_they_depend_on() {
         );
     }
 }
+
+#[test]
+fn friction_and_heat_balance_inputs_are_checked_by_name() {
+    // A viscosity that would grow with the temperature (beta* < 0), an unknown temperature
+    // mode, a negative housing area, a cooler that cannot be a heat flow, and friction
+    // constants out of range: each named with its value and range.
+    let with = |lubricant: &str, housing: &str| {
+        let text = design().replace("[lubricant]\n", &format!("[lubricant]\n{lubricant}\n"));
+        format!("{text}\n[housing]\n{housing}\n")
+    };
+    let e = error_of(&set(
+        &design(),
+        "lubricant",
+        "thermo_viscosity_k",
+        "thermo_viscosity_k = -3200",
+    ));
+    assert_mentions(&e, &["lubricant.thermo_viscosity_k", "-3200"]);
+    let e = error_of(&with("temperature = \"hot\"", ""));
+    assert_mentions(&e, &["lubricant.temperature", "hot", "balance"]);
+    let e = error_of(&with("", "area_m2 = -1.0"));
+    assert_mentions(&e, &["housing.area_m2", "-1"]);
+    let e = error_of(&with("", "cooler_w = -5.0\nheat_transfer_w_m2k = 0.0"));
+    assert_mentions(&e, &["housing.cooler_w", "housing.heat_transfer_w_m2k"]);
+    let e = error_of(&with(
+        "boundary_friction = 1.5\nroughness_slope_rad = 0.0",
+        "",
+    ));
+    assert_mentions(
+        &e,
+        &[
+            "lubricant.boundary_friction",
+            "lubricant.roughness_slope_rad",
+        ],
+    );
+    let e = error_of(&with(
+        "eyring_stress_mpa = 0.0\nlimiting_shear_coefficient = -0.1",
+        "",
+    ));
+    assert_mentions(
+        &e,
+        &[
+            "lubricant.eyring_stress_mpa",
+            "lubricant.limiting_shear_coefficient",
+        ],
+    );
+    // And the defaults validate: a balance with the default housing is a valid file.
+    let gear =
+        input::load_from_str(&with("temperature = \"balance\"", "ambient_c = 25.0")).unwrap();
+    assert!(gear.housing.balance && (gear.housing.ambient - 298.15).abs() < 1e-12);
+    assert!(gear.housing.area > 0.0 && gear.housing.heat_transfer > 0.0);
+}

@@ -209,6 +209,48 @@ pub struct Lubricant {
     pub composite_roughness: f64,
 }
 
+impl Lubricant {
+    /// The lubricant at oil temperature `temperature` (K): eta0 from the thermo-viscosity law
+    /// eta = eta_ref exp(beta* (1/T - 1/T_ref)) of MODEL §6 (`viscosity` holds at
+    /// `self.temperature`).
+    pub fn at_temperature(&self, temperature: f64) -> Self {
+        let shift = self.thermo_viscosity * (1.0 / temperature - 1.0 / self.temperature);
+        Self {
+            viscosity: self.viscosity * shift.exp(),
+            temperature,
+            ..self.clone()
+        }
+    }
+}
+
+/// Friction of the mixed lubrication (MODEL §13), SI.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FrictionLaw {
+    /// Boundary friction coefficient mu_b of the asperity contacts.
+    pub boundary: f64,
+    /// RMS slope Rdq of the composite roughness, rad.
+    pub roughness_slope: f64,
+    /// Eyring stress tau_0, Pa.
+    pub eyring_stress: f64,
+    /// Limiting shear stress over pressure, Lambda.
+    pub limiting_shear: f64,
+}
+
+/// The housing's heat balance (MODEL §13), SI.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Housing {
+    /// The oil temperature from the heat balance (else the lubricant's, fixed).
+    pub balance: bool,
+    /// Heat-transferring area A_H, m^2.
+    pub area: f64,
+    /// Heat transfer coefficient alpha_L, W/(m^2 K).
+    pub heat_transfer: f64,
+    /// Ambient temperature theta_0, K.
+    pub ambient: f64,
+    /// Heat removed by a cooler, W.
+    pub cooler: f64,
+}
+
 /// How the cycles of a wear step are chosen (MODEL §7.3).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum StepControl {
@@ -592,6 +634,10 @@ pub struct GearSet {
     pub worm_material: Material,
     pub wheel_material: Material,
     pub lubricant: Lubricant,
+    /// Friction of the mixed lubrication (MODEL §13).
+    pub friction: FrictionLaw,
+    /// The housing's heat balance (MODEL §13).
+    pub housing: Housing,
     pub conditions: Conditions,
     pub analysis: Analysis,
     /// Life to simulate, when the file asks for one.

@@ -22,6 +22,9 @@ pub struct GearFile {
     pub materials: MaterialsSpec,
     #[serde(default)]
     pub lubricant: LubricantSpec,
+    /// The housing's heat transfer (MODEL §13).
+    #[serde(default)]
+    pub housing: HousingSpec,
     pub conditions: ConditionsSpec,
     #[serde(default)]
     pub analysis: AnalysisSpec,
@@ -389,6 +392,41 @@ pub struct LubricantSpec {
     /// Composite RMS roughness R_q of worm and wheel, um.
     #[serde(default)]
     pub composite_roughness_um: Option<f64>,
+    /// "fixed" (default: the oil at `temperature_c`) or "balance": the steady sump temperature
+    /// of the housing's heat balance (MODEL §13, `[housing]`); `viscosity_pa_s` then holds at
+    /// `temperature_c` and follows the thermo-viscosity law.
+    #[serde(default)]
+    pub temperature: Option<String>,
+    /// Boundary friction coefficient mu_b of the asperity contacts (MODEL §13).
+    #[serde(default)]
+    pub boundary_friction: Option<f64>,
+    /// RMS slope Rdq of the composite roughness, rad (MODEL §10, §13).
+    #[serde(default)]
+    pub roughness_slope_rad: Option<f64>,
+    /// Eyring stress tau_0 of the film's shear, MPa (MODEL §13).
+    #[serde(default)]
+    pub eyring_stress_mpa: Option<f64>,
+    /// Limiting shear stress over pressure, Lambda (MODEL §13).
+    #[serde(default)]
+    pub limiting_shear_coefficient: Option<f64>,
+}
+
+/// The gear case's heat transfer (MODEL §13), used when `lubricant.temperature = "balance"`.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HousingSpec {
+    /// Heat-transferring area of the housing A_H, m^2.
+    #[serde(default)]
+    pub area_m2: Option<f64>,
+    /// Heat transfer coefficient alpha_L of the housing to the air, W/(m^2 K).
+    #[serde(default)]
+    pub heat_transfer_w_m2k: Option<f64>,
+    /// Ambient temperature, degrees Celsius.
+    #[serde(default)]
+    pub ambient_c: Option<f64>,
+    /// Heat removed by a cooler, W.
+    #[serde(default)]
+    pub cooler_w: Option<f64>,
 }
 
 /// Operating conditions.

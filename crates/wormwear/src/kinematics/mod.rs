@@ -193,6 +193,35 @@ pub struct Tca {
 }
 
 impl Tca {
+    /// Rolling velocities of every node of the loaded flank (u1, u2; m/s); where the TCA has
+    /// none (nodes at the border of the region the worm flank reaches, whose surface gradient is
+    /// undefined), the nearest node of the same column that has them.
+    pub fn rolling_velocities(&self, wf: &WheelFlank) -> Vec<(f64, f64)> {
+        let (ni, nj) = (wf.cells_height, wf.cells_face);
+        (0..=nj)
+            .flat_map(|j| {
+                let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
+                let valid: Vec<usize> = column
+                    .iter()
+                    .copied()
+                    .filter(|&k| self.node_contact[k].u2.is_finite())
+                    .collect();
+                column
+                    .iter()
+                    .map(|&k| {
+                        let src = valid
+                            .iter()
+                            .copied()
+                            .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
+                            .unwrap_or(k);
+                        let c = &self.node_contact[src];
+                        (c.u1, c.u2)
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
     /// Number of teeth studied.
     pub fn tooth_count(&self) -> usize {
         self.teeth.len()

@@ -226,6 +226,9 @@ pub fn write_results(
         if let Some(r) = results.rating.as_ref() {
             update_summary(dir, "rating", to_json("rating", r)?)?;
         }
+        if let Some(t) = results.thermal.as_ref() {
+            update_summary(dir, "friction", to_json("friction", t)?)?;
+        }
         match results.life.as_ref() {
             Some(life) if !life_written => files.extend(wear::write_life(gear, geo, t, life, dir)?),
             _ => {}
@@ -239,7 +242,7 @@ pub fn write_results(
 }
 
 /// The sections of summary.json that [`write_results`] writes for `results` (into an empty
-/// directory), by name: `input`, `geometry`, `tca`, `ltca`, `rating`, `wear` as the stages
+/// directory), by name: `input`, `geometry`, `tca`, `ltca`, `rating`, `friction`, `wear` as the stages
 /// ran.
 pub fn summary_sections(
     results: &crate::Results,
@@ -262,6 +265,9 @@ pub fn summary_sections(
     }
     if let Some(r) = results.rating.as_ref() {
         map.insert("rating".into(), to_json("rating", r)?);
+    }
+    if let Some(t) = results.thermal.as_ref() {
+        map.insert("friction".into(), to_json("friction", t)?);
     }
     if let Some((life, last)) = results
         .life

@@ -35,35 +35,6 @@ pub struct CycleWear {
     pub hertz_half_width: FlankField,
 }
 
-/// Rolling velocities of every node of the loaded flank (u1, u2; m/s); where the TCA has
-/// none (nodes at the border of the region the worm flank reaches, whose surface gradient is
-/// undefined), the nearest node of the same column that has them.
-fn rolling_velocities(wf: &WheelFlank, tca: &Tca) -> Vec<(f64, f64)> {
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
-    (0..=nj)
-        .flat_map(|j| {
-            let column: Vec<usize> = (0..=ni).map(|i| j * (ni + 1) + i).collect();
-            let valid: Vec<usize> = column
-                .iter()
-                .copied()
-                .filter(|&k| tca.node_contact[k].u2.is_finite())
-                .collect();
-            column
-                .iter()
-                .map(|&k| {
-                    let src = valid
-                        .iter()
-                        .copied()
-                        .min_by_key(|&v| (v as isize - k as isize).unsigned_abs())
-                        .unwrap_or(k);
-                    let c = &tca.node_contact[src];
-                    (c.u1, c.u2)
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect()
-}
-
 /// What the wear of one cycle reads at every passage of the band over a node ([`per_cycle`]):
 /// the gear, the flank, the TCA's sliding, the rolling velocities, the time between positions
 /// (rad of wheel rotation) and the wheel speed (rad/s), E' (Pa), the dry wear coefficient,
@@ -209,7 +180,7 @@ pub fn per_cycle(
         gear,
         wf,
         tca,
-        rolling: rolling_velocities(wf, tca),
+        rolling: tca.rolling_velocities(wf),
         dt,
         wheel_speed,
         e_prime,

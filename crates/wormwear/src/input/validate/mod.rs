@@ -155,6 +155,15 @@ fn mesh_checks(
     }
 }
 
+/// The lubricant, its friction law and the housing's heat balance (MODEL §6, §13); each is
+/// checked, so their errors all come.
+fn oil_parts(ck: &mut Checker, f: &GearFile) -> Option<(Lubricant, FrictionLaw, Housing)> {
+    let lubricant = lubricant(ck, &f.lubricant);
+    let friction = friction_law(ck, &f.lubricant);
+    let housing = housing(ck, &f.housing, &f.lubricant, &f.operating, &f.conditions);
+    Some((lubricant?, friction?, housing?))
+}
+
 pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let mut ck = Checker::default();
     let mut warnings = Vec::new();
@@ -165,22 +174,15 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let op = operating_parts(&mut ck, &f.operating);
     let wheel = wheel_parts(&mut ck, &f.wheel);
     let (worm_material, wheel_material) = materials(&mut ck, &f.materials);
-    let lubricant = lubricant(&mut ck, &f.lubricant);
+    let oil = oil_parts(&mut ck, f);
     let conditions = conditions(&mut ck, &f.conditions);
     let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
     let rating = rating_factors(&mut ck, &f.rating);
     let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
     let analysis = analysis_settings(&mut ck, &f.analysis, wheel.teeth, wheel.face_width);
     if let (Some(wm), Some(hb)) = (&worm, &hob) {
-        let parts = (&cutting, &op, &wheel);
-        mesh_checks(
-            &mut ck,
-            &mut warnings,
-            wm,
-            hb,
-            parts,
-            f.wheel.throat_radius_mm,
-        );
+        let (parts, throat) = ((&cutting, &op, &wheel), f.wheel.throat_radius_mm);
+        mesh_checks(&mut ck, &mut warnings, wm, hb, parts, throat);
     }
     if !ck.errors.is_empty() {
         return Err(InputError::Invalid(ck.errors));
@@ -195,11 +197,12 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     ) else {
         unreachable_input()?
     };
-    let (Some(worm_material), Some(wheel_material), Some(lubricant), Some(conditions)) =
-        (worm_material, wheel_material, lubricant, conditions)
+    let (Some(worm_material), Some(wheel_material), Some(oil), Some(conditions)) =
+        (worm_material, wheel_material, oil, conditions)
     else {
         unreachable_input()?
     };
+    let (lubricant, friction, housing) = oil;
     let (Some(wheel), Some(mut analysis), Some(bending)) = (wheel.blank(), analysis, bending)
     else {
         unreachable_input()?
@@ -221,6 +224,8 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         worm_material,
         wheel_material,
         lubricant,
+        friction,
+        housing,
         conditions,
         analysis,
         wear,

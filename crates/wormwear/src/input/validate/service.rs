@@ -163,6 +163,105 @@ pub(super) fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant
     })
 }
 
+/// The friction law of the mixed lubrication (MODEL §13) from `[lubricant]`, with its
+/// defaults: mu_b 0.094 (the low-speed cap of MODEL §9's mu_0T for a bronze wheel with
+/// polyglycol, dip lubricated: the boundary regime); Rdq 0.1 rad (assumed, typical of ground
+/// worms and hobbed wheels; measure it); tau_0 5 MPa (Eyring stresses of a few MPa, Johnson &
+/// Tevaarwerk 1977); Lambda 0.02 (the limiting shear stress over pressure of Bair & Winer 1979;
+/// the value bounds the film's friction by MODEL §9's own level for polyglycol, whose
+/// mu_0T is 0.018 at 4 m/s of sliding; mineral oils shear higher, 0.05 and more).
+pub(super) fn friction_law(ck: &mut Checker, l: &LubricantSpec) -> Option<FrictionLaw> {
+    let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
+        Some(v) => ck.range(&format!("lubricant.{f}"), v, lo, hi, unit),
+        None => Some(d),
+    };
+    let boundary = get(
+        "boundary_friction",
+        l.boundary_friction,
+        0.094,
+        0.0,
+        1.0,
+        "",
+    );
+    let slope = get(
+        "roughness_slope_rad",
+        l.roughness_slope_rad,
+        0.1,
+        1e-4,
+        1.0,
+        "rad",
+    );
+    let eyring = get(
+        "eyring_stress_mpa",
+        l.eyring_stress_mpa,
+        5.0,
+        1e-3,
+        1e3,
+        "MPa",
+    );
+    let limiting = get(
+        "limiting_shear_coefficient",
+        l.limiting_shear_coefficient,
+        0.02,
+        0.0,
+        1.0,
+        "",
+    );
+    Some(FrictionLaw {
+        boundary: boundary?,
+        roughness_slope: slope?,
+        eyring_stress: eyring? * 1e6,
+        limiting_shear: limiting?,
+    })
+}
+
+/// The housing's heat balance (MODEL §13) from `[housing]` and `lubricant.temperature`, with
+/// its defaults: the area 43.2 a^1.7 in^2 (a the centre distance in inches) and, for a case
+/// without fan, the coefficient n1/6494 + 0.13 ft lbf/(min in^2 F) (n1 the worm speed in rpm)
+/// — AGMA's estimates as given in Shigley's Mechanical Engineering Design (worm gearing) —
+/// 20 C ambient and no cooler.
+pub(super) fn housing(
+    ck: &mut Checker,
+    h: &HousingSpec,
+    l: &LubricantSpec,
+    op: &OperatingSpec,
+    c: &ConditionsSpec,
+) -> Option<Housing> {
+    let balance = ck.choice(
+        "lubricant.temperature",
+        l.temperature.as_deref().unwrap_or("fixed"),
+        &[("fixed", false), ("balance", true)],
+    );
+    const INCH: f64 = 0.0254;
+    // 1 ft lbf/(min in^2 F) in W/(m^2 K).
+    let shigley_unit = 1.355_817_948 / 60.0 / (INCH * INCH) * 1.8;
+    let a_inch = (op.centre_distance_mm * 1e-3 / INCH).max(0.0);
+    let default_area = 43.2 * a_inch.powf(1.7) * INCH * INCH;
+    let default_coefficient = (c.worm_speed_rpm.max(0.0) / 6494.0 + 0.13) * shigley_unit;
+    let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
+        Some(v) => ck.range(&format!("housing.{f}"), v, lo, hi, unit),
+        None => Some(d),
+    };
+    let area = get("area_m2", h.area_m2, default_area, 1e-4, 1e3, "m^2");
+    let coefficient = get(
+        "heat_transfer_w_m2k",
+        h.heat_transfer_w_m2k,
+        default_coefficient,
+        0.1,
+        1e4,
+        "W/(m^2 K)",
+    );
+    let ambient = get("ambient_c", h.ambient_c, 20.0, -60.0, 80.0, "degC");
+    let cooler = get("cooler_w", h.cooler_w, 0.0, 0.0, 1e7, "W");
+    Some(Housing {
+        balance: balance?,
+        area: area?,
+        heat_transfer: coefficient?,
+        ambient: ambient? + 273.15,
+        cooler: cooler?,
+    })
+}
+
 pub(super) fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
     let mut factor = |name: &str, v: Option<f64>, d: f64, lo: f64, hi: f64| match v {
         Some(v) => ck.range(&format!("rating.{name}"), v, lo, hi, ""),

@@ -1,0 +1,678 @@
+//! Stage 5a — friction, mesh power loss, efficiency and oil temperature (MODEL §13).
+//!
+//! Mixed lubrication at every loaded cell of every position of the loaded analysis: the
+//! asperities carry the share f_a of the local pressure (MODEL §10's Greenwood–Williamson
+//! form), the fluid film the rest with Eyring's shear stress bounded by the limiting shear
+//! stress; the local friction coefficient is mu = f_a mu_b + (1 - f_a) tau_f / p. The mesh
+//! loss is the cycle mean of sum mu p |v_g| S over the cells; with the no-load, bearing and
+//! seal losses of MODEL §9 it gives the efficiency, and with the housing's heat transfer the
+//! steady oil temperature: the fixed point temperature -> viscosity -> film -> friction ->
+//! loss ([`heat_balance`]).
+//!
+//! The loaded analysis stays frictionless (MODEL §5.2, §12): friction changes the worm torque
+//! the mesh needs, not the normal pressures it carries (a first-order reading, stated in the
+//! README). SI units throughout (Pa, m, m/s, W, K).
+
+use crate::geometry::Geometry;
+use crate::input::{FrictionLaw, GearSet, Housing, Lubricant};
+use crate::kinematics::{material_velocities, Tca};
+use crate::ltca::Ltca;
+use crate::lubrication::{self, LineContact};
+use std::f64::consts::PI;
+
+/// Errors of the heat balance; each names the input that decides it.
+#[derive(Debug, thiserror::Error)]
+pub enum FrictionError {
+    #[error(
+        "housing.cooler_w = {cooler:.1} W removes more than the gear loses at the ambient \
+         temperature ({loss:.1} W): the oil would be colder than the air around the housing (a \
+         cooler held at a temperature is lubricant.temperature = \"fixed\"); give a cooler of \
+         at most the loss, or none (0)"
+    )]
+    CoolerExceedsLoss { cooler: f64, loss: f64 },
+    #[error(
+        "no steady oil temperature below {limit_c:.0} C: at that temperature the gear still \
+         loses {loss:.0} W and the housing (housing.area_m2 = {area:.3} m^2, \
+         housing.heat_transfer_w_m2k = {coefficient:.1} W/(m^2 K)) with its cooler rejects \
+         {rejected:.0} W; enlarge the area or the coefficient, or give a cooler \
+         (housing.cooler_w)"
+    )]
+    NoEquilibrium {
+        limit_c: f64,
+        loss: f64,
+        rejected: f64,
+        area: f64,
+        coefficient: f64,
+    },
+}
+
+impl FrictionError {
+    /// Every heat-balance failure is decided by the housing's inputs.
+    pub fn is_input(&self) -> bool {
+        true
+    }
+}
+
+/// The asperities' contact pressure W_sec / A_c = 0.2 E' sqrt(m2 / pi) (MODEL §10), Pa, with
+/// E' the reduced modulus (Pa) and m2 = Rdq^2 the mean square roughness slope (Rdq in rad).
+pub fn asperity_pressure(e_prime: f64, slope_rdq: f64) -> f64 {
+    0.2 * e_prime * (slope_rdq * slope_rdq / PI).sqrt()
+}
+
+/// Share of the local pressure `pressure` (Pa) the asperities carry (MODEL §13):
+/// f_a = min(1, (W_sec / A_c)(A_c / A_0) / p), A_c / A_0 from the film thickness
+/// h = Phi_T h_min and the composite roughness R_q (both m; MODEL §10). 1 where p <= 0.
+pub fn asperity_share(
+    pressure: f64,
+    film_thickness: f64,
+    roughness_rq: f64,
+    e_prime: f64,
+    slope_rdq: f64,
+) -> f64 {
+    if pressure <= 0.0 || pressure.is_nan() {
+        return 1.0;
+    }
+    let carried = asperity_pressure(e_prime, slope_rdq)
+        * lubrication::asperity_area_fraction(film_thickness, roughness_rq);
+    (carried / pressure).min(1.0)
+}
+
+/// Shear stress of the lubricant film, Pa, at pressure `pressure` (Pa), sliding speed
+/// `sliding_speed` (m/s) and film thickness `film_thickness` (m): Eyring's law
+/// tau = tau_0 asinh(eta(p) gamma / tau_0), gamma = v_s / h, with the Barus viscosity
+/// eta(p) = eta_0 exp(alpha p) (`viscosity` eta_0 in Pa s, `pressure_viscosity` alpha in
+/// 1/Pa), bounded by the limiting shear stress Lambda p (Bair & Winer). A film of no
+/// thickness shears at the limit.
+pub fn fluid_shear(
+    pressure: f64,
+    sliding_speed: f64,
+    film_thickness: f64,
+    viscosity: f64,
+    pressure_viscosity: f64,
+    law: &FrictionLaw,
+) -> f64 {
+    let p = pressure.max(0.0);
+    let limit = law.limiting_shear * p;
+    let speed = sliding_speed.abs();
+    if speed == 0.0 {
+        return 0.0;
+    }
+    if film_thickness.is_nan() || film_thickness <= 0.0 {
+        return limit;
+    }
+    let eta = viscosity * (pressure_viscosity * p).exp();
+    let rate = speed / film_thickness;
+    let eyring = law.eyring_stress * (eta * rate / law.eyring_stress).asinh();
+    eyring.min(limit)
+}
+
+/// The friction at one point of the contact (MODEL §13).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LocalFriction {
+    /// mu = f_a mu_b + (1 - f_a) tau_f / p.
+    pub coefficient: f64,
+    /// f_a, the asperities' share of the pressure.
+    pub asperity_share: f64,
+    /// tau_f, the film's shear stress, Pa.
+    pub fluid_shear: f64,
+}
+
+/// Local friction at pressure `pressure` (Pa) and sliding speed (m/s) over a film of thickness
+/// `film_thickness` (Phi_T h_min, m) of `lubricant` (its viscosity at the oil temperature),
+/// with the reduced modulus `e_prime` (Pa) (MODEL §13).
+pub fn local_friction(
+    pressure: f64,
+    sliding_speed: f64,
+    film_thickness: f64,
+    lubricant: &Lubricant,
+    law: &FrictionLaw,
+    e_prime: f64,
+) -> LocalFriction {
+    let share = asperity_share(
+        pressure,
+        film_thickness,
+        lubricant.composite_roughness,
+        e_prime,
+        law.roughness_slope,
+    );
+    let tau = fluid_shear(
+        pressure,
+        sliding_speed,
+        film_thickness,
+        lubricant.viscosity,
+        lubricant.pressure_viscosity,
+        law,
+    );
+    let fluid = if pressure > 0.0 { tau / pressure } else { 0.0 };
+    LocalFriction {
+        coefficient: share * law.boundary + (1.0 - share) * fluid,
+        asperity_share: share,
+        fluid_shear: tau,
+    }
+}
+
+/// One loaded cell of one position with what its friction needs that the oil temperature does
+/// not change.
+#[derive(Debug, Clone, Copy)]
+struct CellContact {
+    /// Index of the position in the loaded analysis.
+    position: usize,
+    /// Index of the cell in its position's list.
+    cell: usize,
+    /// Pressure (Pa), sliding speed |v_g| (m/s) and area (m^2).
+    pressure: f64,
+    sliding_speed: f64,
+    area: f64,
+    /// The line contact of the cell's slice: relative radius, rolling velocities, line load
+    /// (the sum of p times the width across the line over the slice's cells) and peak pressure.
+    line: LineContact,
+}
+
+/// The loaded cells of a loaded analysis with their sliding speeds and line contacts
+/// (MODEL §13), ready to give the friction at any oil temperature.
+#[derive(Debug, Clone)]
+pub struct MeshContacts {
+    cells: Vec<CellContact>,
+    positions: usize,
+    e_prime: f64,
+    /// Output power P2 = omega2 x mean wheel torque of the positions, W.
+    pub output_power: f64,
+}
+
+/// The end of the slice that starts at cell `start` of a position (a slice's cells are
+/// consecutive: same tooth, same node column).
+fn slice_end(pr: &crate::ltca::PositionResult, start: usize) -> usize {
+    let first = &pr.cells[start];
+    (start..pr.cells.len())
+        .find(|&k| pr.cells[k].tooth_index != first.tooth_index || pr.cells[k].slice != first.slice)
+        .unwrap_or(pr.cells.len())
+}
+
+/// The line contact of one slice's cells `slice` (MODEL §6): the curvature radius (m), the
+/// rolling velocities (u1, u2; m/s), the line load sum p x (width across the line) (N/m) and
+/// the peak pressure (Pa).
+fn slice_line(
+    pr: &crate::ltca::PositionResult,
+    slice: std::ops::Range<usize>,
+    radius: f64,
+    (u1, u2): (f64, f64),
+) -> LineContact {
+    let line_load: f64 = slice
+        .clone()
+        .map(|k| pr.pressure[k] * 2.0 * pr.cells[k].cell.half_nu)
+        .sum();
+    let peak = slice.map(|k| pr.pressure[k]).fold(0.0, f64::max);
+    LineContact {
+        radius,
+        u1,
+        u2,
+        line_load,
+        pressure: peak,
+    }
+}
+
+/// Friction over the mesh cycle (MODEL §13).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MeshFriction {
+    /// Mesh power loss sum mu p |v_g| S at each position, W.
+    pub position_loss_w: Vec<f64>,
+    /// Cycle mean P_Vz, W.
+    pub mesh_loss_w: f64,
+    /// Load-weighted mean friction coefficient sum mu p S / sum p S.
+    pub mean_coefficient: f64,
+    /// Load-weighted mean share of the asperities.
+    pub asperity_share: f64,
+    /// Per loaded cell: (position, cell index, mu, friction power density mu p |v_g| in W/m^2).
+    #[serde(skip)]
+    pub cells: Vec<(usize, usize, f64, f64)>,
+}
+
+impl MeshContacts {
+    /// The loaded cells of `ltca` (on the gear's operating placement and speed, MODEL §4.5):
+    /// sliding speed at each cell centre, the film's line contact of each slice (its
+    /// curvature from the TCA's contact line, the rolling velocities of the nearest flank node).
+    pub fn new(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Self {
+        let wf = geo.wheel_flank(tca.loaded_flank);
+        let rolling = tca.rolling_velocities(wf);
+        let radius: std::collections::HashMap<(usize, i32, usize), f64> = tca
+            .contact_lines
+            .iter()
+            .map(|c| ((c.position, c.tooth, c.slice), c.curvature_radius))
+            .collect();
+        let ni = wf.cells_height;
+        let node = |j: usize, r: f64| {
+            let t = (r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]);
+            let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
+            j * (ni + 1) + i
+        };
+        let mut cells = Vec::new();
+        for (n, pr) in ltca.positions.iter().enumerate() {
+            let mut start = 0;
+            while start < pr.cells.len() {
+                let first = &pr.cells[start];
+                let end = slice_end(pr, start);
+                let slice = start..end;
+                let curvature = radius
+                    .get(&(pr.position, first.tooth, first.slice))
+                    .copied()
+                    .unwrap_or(f64::NAN);
+                let line = slice_line(
+                    pr,
+                    slice.clone(),
+                    curvature,
+                    rolling[node(first.slice, first.r)],
+                );
+                for k in slice.filter(|&k| pr.pressure[k] > 0.0) {
+                    let c = &pr.cells[k];
+                    let v = material_velocities(
+                        &c.cell.centre,
+                        &geo.worm,
+                        &gear.operating,
+                        gear.conditions.worm_speed,
+                        gear.ratio(),
+                    );
+                    let vg = nalgebra::Vector3::from(v.sliding).norm();
+                    cells.push(CellContact {
+                        position: n,
+                        cell: k,
+                        pressure: pr.pressure[k],
+                        sliding_speed: vg,
+                        area: c.cell.area(),
+                        line,
+                    });
+                }
+                start = end;
+            }
+        }
+        let torque = ltca
+            .positions
+            .iter()
+            .map(|p| p.wheel_torque.abs())
+            .sum::<f64>()
+            / ltca.positions.len().max(1) as f64;
+        Self {
+            cells,
+            positions: ltca.positions.len(),
+            e_prime: lubrication::reduced_modulus(
+                gear.worm_material.youngs_modulus,
+                gear.worm_material.poisson_ratio,
+                gear.wheel_material.youngs_modulus,
+                gear.wheel_material.poisson_ratio,
+            ),
+            output_power: torque * gear.conditions.worm_speed / gear.ratio(),
+        }
+    }
+
+    /// The friction of every loaded cell with `lubricant` (its viscosity and temperature as
+    /// given) and `law`, and the mesh loss over the cycle (MODEL §13).
+    pub fn friction(&self, lubricant: &Lubricant, law: &FrictionLaw) -> MeshFriction {
+        let mut position_loss = vec![0.0; self.positions];
+        let (mut weighted, mut share, mut load) = (0.0, 0.0, 0.0);
+        let mut cells = Vec::with_capacity(self.cells.len());
+        for c in &self.cells {
+            let film = lubrication::film(lubricant, self.e_prime, &c.line);
+            let thickness = film.h_min * film.thermal_factor;
+            let f = local_friction(
+                c.pressure,
+                c.sliding_speed,
+                thickness,
+                lubricant,
+                law,
+                self.e_prime,
+            );
+            let density = f.coefficient * c.pressure * c.sliding_speed;
+            position_loss[c.position] += density * c.area;
+            let force = c.pressure * c.area;
+            weighted += f.coefficient * force;
+            share += f.asperity_share * force;
+            load += force;
+            cells.push((c.position, c.cell, f.coefficient, density));
+        }
+        let mesh_loss_w = position_loss.iter().sum::<f64>() / self.positions.max(1) as f64;
+        let mean = |x: f64| if load > 0.0 { x / load } else { 0.0 };
+        MeshFriction {
+            position_loss_w: position_loss,
+            mesh_loss_w,
+            mean_coefficient: mean(weighted),
+            asperity_share: mean(share),
+            cells,
+        }
+    }
+}
+
+/// Powers and efficiencies of the gear, worm driving (MODEL §13, §9).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Efficiency {
+    /// P2, W.
+    pub output_power_w: f64,
+    /// P_Vz from the contact, W.
+    pub mesh_loss_w: f64,
+    /// P_V0 + P_VLP + P_VD of MODEL §9 (no-load, bearings, seals), W.
+    pub other_losses_w: f64,
+    /// eta_z = 1 - P_Vz / P1 = P2 / (P2 + P_Vz).
+    pub mesh_efficiency: f64,
+    /// eta = P2 / (P2 + P_V).
+    pub total_efficiency: f64,
+}
+
+impl Efficiency {
+    /// From the output power P2 (W), the mesh loss P_Vz and the other losses (W).
+    pub fn new(output_power: f64, mesh_loss: f64, other_losses: f64) -> Self {
+        Self {
+            output_power_w: output_power,
+            mesh_loss_w: mesh_loss,
+            other_losses_w: other_losses,
+            mesh_efficiency: output_power / (output_power + mesh_loss),
+            total_efficiency: output_power / (output_power + mesh_loss + other_losses),
+        }
+    }
+
+    /// The total loss P_V, W.
+    pub fn total_loss_w(&self) -> f64 {
+        self.mesh_loss_w + self.other_losses_w
+    }
+}
+
+/// Friction, efficiency and the oil temperature of one loaded analysis (MODEL §13).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Thermal {
+    /// "fixed" (the lubricant's temperature) or "balance" (the housing's heat balance).
+    pub mode: &'static str,
+    /// Oil (sump) temperature, K.
+    pub oil_temperature_k: f64,
+    /// Viscosity eta0 at that temperature, Pa s.
+    pub viscosity_pa_s: f64,
+    /// Loss evaluations the balance took (1 with a fixed temperature).
+    pub evaluations: usize,
+    pub friction: MeshFriction,
+    pub efficiency: Efficiency,
+}
+
+/// Highest oil temperature the heat balance looks for, K (200 C: beyond any lubricant's range).
+pub const BALANCE_LIMIT_K: f64 = 473.15;
+
+/// Step of the heat balance's scan up from the ambient temperature, K.
+pub const BALANCE_SCAN_K: f64 = 5.0;
+
+/// Tolerance of the heat balance's fixed point on the oil temperature, K.
+pub const BALANCE_TOLERANCE_K: f64 = 0.01;
+
+/// The friction and efficiency at the gear's oil temperature: the lubricant's, or with
+/// `housing.mode` = balance the steady temperature where the housing rejects the total loss,
+/// P_V(theta) = alpha_L A_H (theta - theta_0) + Q_cooler: the first such temperature up from
+/// the ambient one (what a cold start reaches), bracketed in steps of [`BALANCE_SCAN_K`] and
+/// bisected to [`BALANCE_TOLERANCE_K`] (MODEL §13). `other_losses` P_V0 + P_VLP + P_VD, W.
+pub fn heat_balance(
+    contacts: &MeshContacts,
+    lubricant: &Lubricant,
+    law: &FrictionLaw,
+    housing: &Housing,
+    other_losses: f64,
+) -> Result<Thermal, FrictionError> {
+    let at = |t: f64| {
+        let lub = lubricant.at_temperature(t);
+        let friction = contacts.friction(&lub, law);
+        let efficiency = Efficiency::new(contacts.output_power, friction.mesh_loss_w, other_losses);
+        (lub.viscosity, friction, efficiency)
+    };
+    let thermal = |mode, t: f64, evaluations| {
+        let (viscosity, friction, efficiency) = at(t);
+        Thermal {
+            mode,
+            oil_temperature_k: t,
+            viscosity_pa_s: viscosity,
+            evaluations,
+            friction,
+            efficiency,
+        }
+    };
+    if !housing.balance {
+        return Ok(thermal("fixed", lubricant.temperature, 1));
+    }
+    let conductance = housing.heat_transfer * housing.area;
+    let evaluations = std::cell::Cell::new(0usize);
+    // Excess of the loss over what the housing rejects at t, W (decreasing through the root).
+    let excess = |t: f64| {
+        evaluations.set(evaluations.get() + 1);
+        at(t).2.total_loss_w() - housing.cooler - conductance * (t - housing.ambient)
+    };
+    let cold = excess(housing.ambient);
+    if cold < 0.0 {
+        return Err(FrictionError::CoolerExceedsLoss {
+            cooler: housing.cooler,
+            loss: cold + housing.cooler,
+        });
+    }
+    // From a cold start the oil warms while the loss exceeds what the housing rejects: the
+    // steady temperature is the first where it no longer does (the loss may grow with the
+    // temperature, thinner films, so a later crossing is not the one reached).
+    let mut lo = housing.ambient;
+    let hot = loop {
+        let hi = (lo + BALANCE_SCAN_K).min(BALANCE_LIMIT_K);
+        if excess(hi) <= 0.0 {
+            break Some(hi);
+        }
+        if hi >= BALANCE_LIMIT_K {
+            break None;
+        }
+        lo = hi;
+    };
+    let Some(hi) = hot else {
+        let rejected = conductance * (BALANCE_LIMIT_K - housing.ambient) + housing.cooler;
+        let loss = excess(BALANCE_LIMIT_K) + rejected;
+        return Err(FrictionError::NoEquilibrium {
+            limit_c: BALANCE_LIMIT_K - 273.15,
+            loss,
+            rejected,
+            area: housing.area,
+            coefficient: housing.heat_transfer,
+        });
+    };
+    let t = crate::geometry::roots::bisect(excess, lo, hi, BALANCE_TOLERANCE_K).unwrap_or(hi);
+    Ok(thermal("balance", t, evaluations.get() + 1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lubrication::tests::oil;
+
+    const E_PRIME: f64 = 1.557e11;
+
+    fn law() -> FrictionLaw {
+        FrictionLaw {
+            boundary: 0.094,
+            roughness_slope: 0.1,
+            eyring_stress: 5e6,
+            limiting_shear: 0.04,
+        }
+    }
+
+    #[test]
+    fn the_asperities_carry_all_without_a_film_and_nothing_under_a_thick_one() {
+        let capacity = 0.25 * asperity_pressure(E_PRIME, 0.1);
+        // Below the asperities' capacity at contact (A_c/A_0 = 1/4), all of the load.
+        assert_eq!(asperity_share(0.9 * capacity, 0.0, 1e-6, E_PRIME, 0.1), 1.0);
+        // Above it, what they can carry: (W_sec/A_c)(1/4) / p.
+        let p = 2.0 * capacity;
+        assert!((asperity_share(p, 0.0, 1e-6, E_PRIME, 0.1) - 0.5).abs() < 1e-15);
+        // A film of lambda 3, 6, 10: the share falls with erfc(lambda / sqrt 2).
+        let shares: Vec<f64> = [3.0, 6.0, 10.0]
+            .iter()
+            .map(|l| asperity_share(0.9 * capacity, l * 1e-6, 1e-6, E_PRIME, 0.1))
+            .collect();
+        let expected = 0.25 * libm::erfc(3.0 / 2f64.sqrt()) * capacity * 4.0 / (0.9 * capacity);
+        assert!((shares[0] / expected - 1.0).abs() < 1e-12, "{shares:?}");
+        assert!(shares[1] < 1e-8 && shares[2] < 1e-22, "{shares:?}");
+        // With no asperity contact left the friction is the film's alone.
+        let lub = oil();
+        let f = local_friction(0.9 * capacity, 2.0, 10e-6, &lub, &law(), E_PRIME);
+        assert!((f.coefficient - f.fluid_shear / (0.9 * capacity)).abs() < 1e-15);
+        // And with no film the boundary friction where the asperities carry all.
+        let f = local_friction(0.9 * capacity, 2.0, 0.0, &lub, &law(), E_PRIME);
+        assert_eq!(f.coefficient, law().boundary);
+    }
+
+    /// The film's traction over a smooth Hertz line contact, p = p0 sqrt(1 - (x/a)^2), by the
+    /// midpoint rule on `n` strips: F / w, the friction coefficient of the contact.
+    fn hertz_traction(
+        p0: f64,
+        speed: f64,
+        film: f64,
+        viscosity: f64,
+        alpha: f64,
+        law: &FrictionLaw,
+    ) -> f64 {
+        let n = 200_000;
+        let (mut force, mut load) = (0.0, 0.0);
+        for k in 0..n {
+            let x = -1.0 + (k as f64 + 0.5) * 2.0 / n as f64;
+            let p = p0 * (1.0 - x * x).sqrt();
+            force += fluid_shear(p, speed, film, viscosity, alpha, law);
+            load += p;
+        }
+        force / load
+    }
+
+    #[test]
+    fn a_newtonian_film_over_a_hertz_line_contact_has_its_closed_form_traction() {
+        // tau_0 and Lambda out of reach, no pressure-viscosity: tau = eta v / h everywhere,
+        // so F = eta v / h x 2a and w = pi a p0 / 2: mu = 4 eta v / (pi h p0).
+        let newtonian = FrictionLaw {
+            eyring_stress: 1e15,
+            limiting_shear: 1.0,
+            ..law()
+        };
+        let (p0, v, h, eta) = (5e8, 2.0, 1e-6, 0.227);
+        let mu = hertz_traction(p0, v, h, eta, 0.0, &newtonian);
+        let exact = 4.0 * eta * v / (PI * h * p0);
+        assert!((mu / exact - 1.0).abs() < 1e-5, "{mu} vs {exact}");
+    }
+
+    #[test]
+    fn a_saturated_eyring_film_over_a_hertz_line_contact_has_its_closed_form_traction() {
+        // Where eta(p) gamma >> tau_0, tau = tau_0 ln(2 eta0 gamma / tau_0) + tau_0 alpha p:
+        // mu = tau_0 alpha + (4 tau_0 / (pi p0)) ln(2 eta0 gamma / tau_0).
+        let eyring = FrictionLaw {
+            limiting_shear: 1.0,
+            ..law()
+        };
+        let (p0, v, h, eta, alpha) = (5e8, 10.0, 1e-6, 10.0, 9.5e-9);
+        let mu = hertz_traction(p0, v, h, eta, alpha, &eyring);
+        let tau0 = eyring.eyring_stress;
+        let exact = tau0 * alpha + 4.0 * tau0 / (PI * p0) * (2.0 * eta * v / h / tau0).ln();
+        assert!((mu / exact - 1.0).abs() < 1e-3, "{mu} vs {exact}");
+        // And the limiting shear bounds it: mu <= Lambda.
+        let limited = hertz_traction(p0, v, h, eta, alpha, &law());
+        assert!(
+            limited <= law().limiting_shear + 1e-12 && limited < mu,
+            "{limited}"
+        );
+    }
+
+    #[test]
+    fn the_viscosity_follows_the_thermo_viscosity_law_both_ways() {
+        let lub = oil();
+        let hot = lub.at_temperature(353.0);
+        let expected = 0.227 * (3200.0f64 * (1.0 / 353.0 - 1.0 / 333.0)).exp();
+        assert!((hot.viscosity / expected - 1.0).abs() < 1e-14);
+        let back = hot.at_temperature(333.0);
+        assert!((back.viscosity / lub.viscosity - 1.0).abs() < 1e-14);
+    }
+
+    /// One loaded cell: 500 MPa over 1 mm^2 sliding at 4 m/s, on a line contact of 20 mm
+    /// radius, 2 m/s of entrainment and 200 N/mm.
+    fn one_cell(output_power: f64) -> MeshContacts {
+        MeshContacts {
+            cells: vec![CellContact {
+                position: 0,
+                cell: 0,
+                pressure: 5e8,
+                sliding_speed: 4.0,
+                area: 1e-6,
+                line: LineContact {
+                    radius: 0.02,
+                    u1: 2.0,
+                    u2: 2.0,
+                    line_load: 2e5,
+                    pressure: 5e8,
+                },
+            }],
+            positions: 1,
+            e_prime: E_PRIME,
+            output_power,
+        }
+    }
+
+    fn housing() -> Housing {
+        Housing {
+            balance: true,
+            area: 0.3,
+            heat_transfer: 17.0,
+            ambient: 293.15,
+            cooler: 50.0,
+        }
+    }
+
+    #[test]
+    fn a_temperature_independent_loss_balances_at_the_hand_solution() {
+        // Boundary friction on every asperity (Rdq 1 rad: the asperities carry all at any film
+        // of this contact), no film shear: P_Vz = mu_b p |v_g| S whatever the temperature, so
+        // theta = theta_0 + (P_Vz + P_other - Q) / (alpha A).
+        let boundary = FrictionLaw {
+            roughness_slope: 1.0,
+            limiting_shear: 0.0,
+            ..law()
+        };
+        let contacts = one_cell(10_000.0);
+        let h = housing();
+        let t = heat_balance(&contacts, &oil(), &boundary, &h, 300.0).unwrap();
+        let loss = 0.094 * 5e8 * 4.0 * 1e-6;
+        let hand = h.ambient + (loss + 300.0 - h.cooler) / (h.heat_transfer * h.area);
+        assert!((t.friction.mesh_loss_w - loss).abs() < 1e-9);
+        assert!(
+            (t.oil_temperature_k - hand).abs() <= BALANCE_TOLERANCE_K,
+            "{} vs {hand}",
+            t.oil_temperature_k
+        );
+        assert!((t.efficiency.mesh_efficiency - 10_000.0 / (10_000.0 + loss)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_balance_holds_at_its_temperature_and_refuses_what_has_no_equilibrium() {
+        let contacts = one_cell(10_000.0);
+        let h = housing();
+        let t = heat_balance(&contacts, &oil(), &law(), &h, 300.0).unwrap();
+        // The loss at the returned temperature is what the housing rejects there.
+        let rejected = h.heat_transfer * h.area * (t.oil_temperature_k - h.ambient) + h.cooler;
+        let slope = h.heat_transfer * h.area * BALANCE_TOLERANCE_K;
+        assert!(
+            (t.efficiency.total_loss_w() - rejected).abs() <= slope,
+            "{t:?}"
+        );
+        // A cooler larger than the loss, and a housing too small for it, are named.
+        let big_cooler = Housing { cooler: 1e6, ..h };
+        let e = heat_balance(&contacts, &oil(), &law(), &big_cooler, 300.0).unwrap_err();
+        assert!(e.to_string().contains("housing.cooler_w"), "{e}");
+        let tiny = Housing {
+            area: 1e-4,
+            cooler: 0.0,
+            ..h
+        };
+        let e = heat_balance(&contacts, &oil(), &law(), &tiny, 3000.0).unwrap_err();
+        assert!(e.to_string().contains("housing.area_m2"), "{e}");
+        // With a fixed temperature the lubricant's is used as given.
+        let fixed = heat_balance(
+            &contacts,
+            &oil(),
+            &law(),
+            &Housing {
+                balance: false,
+                ..h
+            },
+            300.0,
+        )
+        .unwrap();
+        assert_eq!((fixed.oil_temperature_k, fixed.mode), (333.0, "fixed"));
+    }
+}

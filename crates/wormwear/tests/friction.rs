@@ -1,0 +1,125 @@
+//! Friction, mesh loss and efficiency from the loaded contact (MODEL §13) on the design gear:
+//! the friction's power is the power of its moments about the two axes (energy), no friction
+//! leaves no loss, and the contact's efficiency beside ISO/TR 14521's.
+
+use std::path::Path;
+use wormwear::friction::{heat_balance, MeshContacts};
+use wormwear::geometry::Geometry;
+use wormwear::input::{self, BendingKind, FrictionLaw, GearSet};
+use wormwear::kinematics::{self, material_velocities};
+use wormwear::ltca;
+
+fn design() -> GearSet {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
+    let mut g = input::load(&path).unwrap();
+    g.bending.kind = BendingKind::None;
+    g
+}
+
+#[test]
+fn the_friction_loss_is_the_power_of_its_moments_about_the_worm_and_wheel_axes() {
+    let g = design();
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let l = ltca::analyse(&g, &geo, &tca).unwrap();
+    let contacts = MeshContacts::new(&g, &geo, &tca, &l);
+    let friction = contacts.friction(&g.lubricant, &g.friction);
+    // Friction on the wheel at a cell: -mu p S along the sliding velocity Vg = V2 - V1; on
+    // the worm the opposite. The power it takes is minus the power of these forces on the
+    // moving bodies, from their moments: spin (q x f_worm)_x about the worm axis (+x1 for
+    // the worm's physical spin, MODEL §2.1) and -omega2 (p x f_wheel)_z about the wheel's
+    // (the wheel turns about -z2 at theta1_dot z1 / z2, MODEL §4.5), p the point in the
+    // wheel frame.
+    let spin = geo.worm.hand_sign() * g.conditions.worm_speed;
+    let omega2 = g.conditions.worm_speed / g.ratio();
+    let mut moments = vec![0.0; l.positions.len()];
+    for &(n, k, mu, _) in &friction.cells {
+        let pr = &l.positions[n];
+        let c = &pr.cells[k].cell;
+        let v = material_velocities(
+            &c.centre,
+            &geo.worm,
+            &g.operating,
+            g.conditions.worm_speed,
+            g.ratio(),
+        );
+        let vg = nalgebra::Vector3::from(v.sliding);
+        let f_wheel = -vg.normalize() * (mu * pr.pressure[k] * c.area());
+        let p = g.operating.worm_to_wheel(&c.centre);
+        let f_wheel_frame = g.operating.vector_worm_to_wheel(&f_wheel);
+        let worm_power = spin * c.centre.cross(&(-f_wheel)).x;
+        let wheel_power = -omega2 * p.cross(&f_wheel_frame).z;
+        moments[n] -= worm_power + wheel_power;
+    }
+    for (n, (by_moments, loss)) in moments.iter().zip(&friction.position_loss_w).enumerate() {
+        assert!(
+            (by_moments - loss).abs() <= 1e-9 * loss,
+            "position {n}: {by_moments} W from the moments, {loss} W from mu p |vg| S"
+        );
+    }
+    assert!(friction.mesh_loss_w > 0.0);
+}
+
+#[test]
+fn without_friction_there_is_no_loss_and_the_mesh_efficiency_is_one() {
+    let g = design();
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let l = ltca::analyse(&g, &geo, &tca).unwrap();
+    let contacts = MeshContacts::new(&g, &geo, &tca, &l);
+    let frictionless = FrictionLaw {
+        boundary: 0.0,
+        limiting_shear: 0.0,
+        ..g.friction
+    };
+    let t = heat_balance(&contacts, &g.lubricant, &frictionless, &g.housing, 0.0).unwrap();
+    assert_eq!(t.friction.mesh_loss_w, 0.0);
+    assert_eq!(t.efficiency.mesh_efficiency, 1.0);
+    // The output power is the loaded analysis' wheel torque at the wheel speed, and the
+    // frictionless analysis balances the worm's power with it (MODEL §5.2).
+    let p1 = l.worm_torque * g.conditions.worm_speed;
+    assert!(
+        (t.efficiency.output_power_w / p1 - 1.0).abs() < 0.01,
+        "{} W vs {p1} W",
+        t.efficiency.output_power_w
+    );
+}
+
+#[test]
+fn the_contacts_efficiency_of_the_reference_gears_beside_iso_tr_14521() {
+    // Not a bound: the model's figure and the standard's side by side (VALIDATION.md). Both
+    // must be efficiencies, and the contact's loss must grow with the roughness.
+    for name in ["gear-1x40-design.toml", "gear-k-2x25.toml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples")
+            .join(name);
+        let mut g = input::load(&path).unwrap();
+        g.bending.kind = BendingKind::None;
+        let geo = Geometry::build(&g).unwrap();
+        let tca = kinematics::analyse(&g, &geo).unwrap();
+        let l = ltca::analyse(&g, &geo, &tca).unwrap();
+        let contacts = MeshContacts::new(&g, &geo, &tca, &l);
+        let iso = wormwear::rating::rate(&g);
+        let ours = contacts.friction(&g.lubricant, &g.friction);
+        let smooth = input::Lubricant {
+            composite_roughness: 0.2e-6,
+            ..g.lubricant.clone()
+        };
+        let smoother = contacts.friction(&smooth, &g.friction);
+        let eta = |loss: f64| contacts.output_power / (contacts.output_power + loss);
+        eprintln!(
+            "{name}: mesh efficiency ISO/TR 14521 {:.4} (mu {:.4}); contact {:.4} (mu {:.4}, \
+             asperity share {:.2}); with R_q 0.2 um {:.4} (mu {:.4})",
+            iso.mesh_efficiency,
+            iso.friction_coefficient,
+            eta(ours.mesh_loss_w),
+            ours.mean_coefficient,
+            ours.asperity_share,
+            eta(smoother.mesh_loss_w),
+            smoother.mean_coefficient
+        );
+        assert!(eta(ours.mesh_loss_w) > 0.0 && eta(ours.mesh_loss_w) < 1.0);
+        assert!(smoother.mesh_loss_w < ours.mesh_loss_w);
+        assert!(smoother.asperity_share < ours.asperity_share);
+    }
+}
