@@ -163,9 +163,8 @@ struct CellContact {
     pressure: f64,
     sliding_speed: f64,
     area: f64,
-    /// The line contact of the cell's slice: relative radius, rolling velocities, line load
-    /// (the sum of p times the width across the line over the slice's cells) and peak pressure.
-    line: LineContact,
+    /// Index of the cell's slice in [`MeshContacts::lines`].
+    line: usize,
 }
 
 /// The loaded cells of a loaded analysis with their sliding speeds and line contacts
@@ -173,6 +172,9 @@ struct CellContact {
 #[derive(Debug, Clone)]
 pub struct MeshContacts {
     cells: Vec<CellContact>,
+    /// The line contact of each loaded slice: relative radius, rolling velocities, line load
+    /// (the sum of p times the width across the line over the slice's cells), peak pressure.
+    lines: Vec<LineContact>,
     positions: usize,
     e_prime: f64,
     /// Output power P2 = omega2 x mean wheel torque of the positions, W.
@@ -245,7 +247,7 @@ impl MeshContacts {
             let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
             j * (ni + 1) + i
         };
-        let mut cells = Vec::new();
+        let (mut cells, mut lines) = (Vec::new(), Vec::new());
         for (n, pr) in ltca.positions.iter().enumerate() {
             let mut start = 0;
             while start < pr.cells.len() {
@@ -256,12 +258,13 @@ impl MeshContacts {
                     .get(&(pr.position, first.tooth, first.slice))
                     .copied()
                     .unwrap_or(f64::NAN);
-                let line = slice_line(
+                lines.push(slice_line(
                     pr,
                     slice.clone(),
                     curvature,
                     rolling[node(first.slice, first.r)],
-                );
+                ));
+                let line = lines.len() - 1;
                 for k in slice.filter(|&k| pr.pressure[k] > 0.0) {
                     let c = &pr.cells[k];
                     let v = material_velocities(
@@ -292,6 +295,7 @@ impl MeshContacts {
             / ltca.positions.len().max(1) as f64;
         Self {
             cells,
+            lines,
             positions: ltca.positions.len(),
             e_prime: lubrication::reduced_modulus(
                 gear.worm_material.youngs_modulus,
@@ -309,9 +313,17 @@ impl MeshContacts {
         let mut position_loss = vec![0.0; self.positions];
         let (mut weighted, mut share, mut load) = (0.0, 0.0, 0.0);
         let mut cells = Vec::with_capacity(self.cells.len());
+        // The film of each slice, once.
+        let films: Vec<f64> = self
+            .lines
+            .iter()
+            .map(|line| {
+                let film = lubrication::film(lubricant, self.e_prime, line);
+                film.h_min * film.thermal_factor
+            })
+            .collect();
         for c in &self.cells {
-            let film = lubrication::film(lubricant, self.e_prime, &c.line);
-            let thickness = film.h_min * film.thermal_factor;
+            let thickness = films[c.line];
             let f = local_friction(
                 c.pressure,
                 c.sliding_speed,
@@ -398,16 +410,29 @@ pub const BALANCE_SCAN_K: f64 = 5.0;
 pub const BALANCE_TOLERANCE_K: f64 = 0.01;
 
 /// The friction and efficiency at the gear's oil temperature: the lubricant's, or with
-/// `housing.mode` = balance the steady temperature where the housing rejects the total loss,
+/// `housing.balance` the steady temperature where the housing rejects the total loss,
 /// P_V(theta) = alpha_L A_H (theta - theta_0) + Q_cooler: the first such temperature up from
 /// the ambient one (what a cold start reaches), bracketed in steps of [`BALANCE_SCAN_K`] and
-/// bisected to [`BALANCE_TOLERANCE_K`] (MODEL §13). `other_losses` P_V0 + P_VLP + P_VD, W.
+/// refined to [`BALANCE_TOLERANCE_K`] (MODEL §13). `other_losses` P_V0 + P_VLP + P_VD, W.
 pub fn heat_balance(
     contacts: &MeshContacts,
     lubricant: &Lubricant,
     law: &FrictionLaw,
     housing: &Housing,
     other_losses: f64,
+) -> Result<Thermal, FrictionError> {
+    heat_balance_from(contacts, (lubricant, law, housing), other_losses, None)
+}
+
+/// [`heat_balance`], its bracket searched from `start` (K, e.g. the previous wear state's
+/// temperature: a few evaluations where the loss changed little) when given and above the
+/// ambient temperature: the crossing next to it, which is the first one up from the ambient
+/// temperature unless the loss has changed enough between the two calls to open another.
+pub fn heat_balance_from(
+    contacts: &MeshContacts,
+    (lubricant, law, housing): (&Lubricant, &FrictionLaw, &Housing),
+    other_losses: f64,
+    start: Option<f64>,
 ) -> Result<Thermal, FrictionError> {
     let at = |t: f64| {
         let lub = lubricant.at_temperature(t);
@@ -443,21 +468,10 @@ pub fn heat_balance(
             loss: cold + housing.cooler,
         });
     }
-    // From a cold start the oil warms while the loss exceeds what the housing rejects: the
-    // steady temperature is the first where it no longer does (the loss may grow with the
-    // temperature, thinner films, so a later crossing is not the one reached).
-    let mut lo = housing.ambient;
-    let hot = loop {
-        let hi = (lo + BALANCE_SCAN_K).min(BALANCE_LIMIT_K);
-        if excess(hi) <= 0.0 {
-            break Some(hi);
-        }
-        if hi >= BALANCE_LIMIT_K {
-            break None;
-        }
-        lo = hi;
-    };
-    let Some(hi) = hot else {
+    let start = start
+        .filter(|t| *t > housing.ambient && *t < BALANCE_LIMIT_K)
+        .unwrap_or(housing.ambient);
+    let Some(((lo, f_lo), (hi, f_hi))) = bracket(&excess, (housing.ambient, cold), start) else {
         let rejected = conductance * (BALANCE_LIMIT_K - housing.ambient) + housing.cooler;
         let loss = excess(BALANCE_LIMIT_K) + rejected;
         return Err(FrictionError::NoEquilibrium {
@@ -468,8 +482,86 @@ pub fn heat_balance(
             coefficient: housing.heat_transfer,
         });
     };
-    let t = crate::geometry::roots::bisect(excess, lo, hi, BALANCE_TOLERANCE_K).unwrap_or(hi);
+    let t = illinois(&excess, (lo, f_lo), (hi, f_hi), BALANCE_TOLERANCE_K);
     Ok(thermal("balance", t, evaluations.get() + 1))
+}
+
+/// The first downward crossing of `excess` above the ambient temperature `(ambient, f)`
+/// (f > 0 there), as a bracket (lo, f(lo) > 0), (hi, f(hi) <= 0): searched from `start` down
+/// while the excess there is not positive (the first crossing is below it), then up, in steps
+/// of [`BALANCE_SCAN_K`]. None below [`BALANCE_LIMIT_K`].
+fn bracket(
+    excess: &dyn Fn(f64) -> f64,
+    ambient: (f64, f64),
+    start: f64,
+) -> Option<((f64, f64), (f64, f64))> {
+    let mut lo = if start > ambient.0 {
+        (start, excess(start))
+    } else {
+        ambient
+    };
+    while lo.1 <= 0.0 {
+        let down = (lo.0 - BALANCE_SCAN_K).max(ambient.0);
+        let below = if down <= ambient.0 {
+            ambient
+        } else {
+            (down, excess(down))
+        };
+        if below.1 > 0.0 {
+            return Some((below, lo));
+        }
+        lo = below;
+    }
+    loop {
+        let t = (lo.0 + BALANCE_SCAN_K).min(BALANCE_LIMIT_K);
+        let hi = (t, excess(t));
+        if hi.1 <= 0.0 {
+            return Some((lo, hi));
+        }
+        if t >= BALANCE_LIMIT_K {
+            return None;
+        }
+        lo = hi;
+    }
+}
+
+/// Root of `f` in the bracket (a, f(a) > 0), (b, f(b) <= 0) by the Illinois variant of
+/// regula falsi, to `tol` in x.
+fn illinois(
+    f: &dyn Fn(f64) -> f64,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    tol: f64,
+) -> f64 {
+    let mut side = 0i8;
+    for _ in 0..100 {
+        if (b - a).abs() <= tol {
+            break;
+        }
+        let c = if fa != fb {
+            (a * fb - b * fa) / (fb - fa)
+        } else {
+            0.5 * (a + b)
+        };
+        let fc = f(c);
+        if fc > 0.0 {
+            (a, fa) = (c, fc);
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        } else {
+            (b, fb) = (c, fc);
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        }
+        if fc.abs() <= f64::EPSILON * fa.abs().max(fb.abs()) {
+            return c;
+        }
+    }
+    0.5 * (a + b)
 }
 
 #[cfg(test)]
@@ -590,13 +682,14 @@ mod tests {
                 pressure: 5e8,
                 sliding_speed: 4.0,
                 area: 1e-6,
-                line: LineContact {
-                    radius: 0.02,
-                    u1: 2.0,
-                    u2: 2.0,
-                    line_load: 2e5,
-                    pressure: 5e8,
-                },
+                line: 0,
+            }],
+            lines: vec![LineContact {
+                radius: 0.02,
+                u1: 2.0,
+                u2: 2.0,
+                line_load: 2e5,
+                pressure: 5e8,
             }],
             positions: 1,
             e_prime: E_PRIME,

@@ -424,7 +424,9 @@ impl RunError {
                     source: crate::ltca::LtcaError::TooManyCells { .. },
                     ..
                 })
-                | RunError::Wear(WearError::Checkpoint(_) | WearError::Plan(_))
+                | RunError::Wear(
+                    WearError::Checkpoint(_) | WearError::Plan(_) | WearError::Friction { .. }
+                )
         )
     }
 }

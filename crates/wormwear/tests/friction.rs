@@ -2,7 +2,8 @@
 //! the friction's power is the power of its moments about the two axes (energy), no friction
 //! leaves no loss, and the contact's efficiency beside ISO/TR 14521's.
 
-use std::path::Path;
+mod common;
+
 use wormwear::friction::{heat_balance, MeshContacts};
 use wormwear::geometry::Geometry;
 use wormwear::input::{self, BendingKind, FrictionLaw, GearSet};
@@ -10,8 +11,7 @@ use wormwear::kinematics::{self, material_velocities};
 use wormwear::ltca;
 
 fn design() -> GearSet {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
-    let mut g = input::load(&path).unwrap();
+    let mut g = common::example("gear-1x40-design.toml");
     g.bending.kind = BendingKind::None;
     g
 }
@@ -90,10 +90,7 @@ fn the_contacts_efficiency_of_the_reference_gears_beside_iso_tr_14521() {
     // Not a bound: the model's figure and the standard's side by side (VALIDATION.md). Both
     // must be efficiencies, and the contact's loss must grow with the roughness.
     for name in ["gear-1x40-design.toml", "gear-k-2x25.toml"] {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples")
-            .join(name);
-        let mut g = input::load(&path).unwrap();
+        let mut g = common::example(name);
         g.bending.kind = BendingKind::None;
         let geo = Geometry::build(&g).unwrap();
         let tca = kinematics::analyse(&g, &geo).unwrap();
@@ -122,4 +119,61 @@ fn the_contacts_efficiency_of_the_reference_gears_beside_iso_tr_14521() {
         assert!(smoother.mesh_loss_w < ours.mesh_loss_w);
         assert!(smoother.asperity_share < ours.asperity_share);
     }
+}
+
+#[test]
+fn a_life_with_the_heat_balance_holds_it_at_every_state_and_the_film_follows_the_oil() {
+    // The design gear in a forced-air housing (so that a steady temperature exists), four
+    // fixed steps: at every state the total loss is what the housing rejects at the oil
+    // temperature recorded, and that temperature's viscosity is the one the film used; the
+    // fixed-temperature life beside it records the lubricant's.
+    let mut g = design();
+    g.housing = input::Housing {
+        balance: true,
+        area: 1.0,
+        heat_transfer: 200.0,
+        ambient: 293.15,
+        cooler: 0.0,
+    };
+    let plan = wormwear::wear::WearPlan {
+        step: wormwear::wear::StepControl::Cycles(45_000.0),
+        ..wormwear::wear::WearPlan::with_life(180_000.0)
+    };
+    let bench = common::Bench::new(&g);
+    let end = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
+    let conductance = g.housing.heat_transfer * g.housing.area;
+    for r in &end.records {
+        // P2 from the mesh efficiency and loss, then P_V from the total efficiency.
+        let p2 = r.friction.mesh_loss_w * r.friction.mesh_efficiency
+            / (1.0 - r.friction.mesh_efficiency);
+        let total_loss = p2 * (1.0 / r.friction.total_efficiency - 1.0);
+        let rejected = conductance * (r.friction.oil_temperature_k - g.housing.ambient);
+        assert!(
+            (total_loss - rejected).abs() <= conductance * 0.011,
+            "state {}: loss {total_loss} W, rejected {rejected} W at {} K",
+            r.step,
+            r.friction.oil_temperature_k
+        );
+        let viscosity = g
+            .lubricant
+            .at_temperature(r.friction.oil_temperature_k)
+            .viscosity;
+        assert!((r.friction.viscosity_pa_s / viscosity - 1.0).abs() < 1e-12);
+        assert!(r.friction.oil_temperature_k > g.housing.ambient + 1.0);
+    }
+    let mut fixed = g.clone();
+    fixed.housing.balance = false;
+    let fixed_end = common::Bench::new(&fixed)
+        .simulate(&plan, None, &mut |_| Ok(()))
+        .unwrap();
+    assert!(fixed_end
+        .records
+        .iter()
+        .all(|r| r.friction.oil_temperature_k == g.lubricant.temperature));
+    // A different oil temperature is a different film, hence a different wear.
+    let (a, b) = (
+        end.records.last().unwrap(),
+        fixed_end.records.last().unwrap(),
+    );
+    assert_ne!(a.backlash_increase_m, b.backlash_increase_m);
 }

@@ -6,6 +6,7 @@ use super::{
     cut_pits, forecast, per_cycle, pit_depths, pitted_fraction, Backlash, CycleWear, Phase,
     Pitting, PositionState, StepControl, StepRecord, WearError, WearLimits, WearPlan, WearState,
 };
+use crate::friction::{heat_balance_from, MeshContacts, Thermal};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::kinematics::Tca;
@@ -67,7 +68,7 @@ pub fn simulate(
     let mut stalled = 0;
     loop {
         let (l, band) = life_loop.analyse(&state)?;
-        let cw = per_cycle(gear, geo, tca, &l, life.film_load);
+        let (cw, thermal) = life_loop.cycle_wear(&state, &l)?;
         let loads = forecast::NodeLoads::new(
             wf,
             &l,
@@ -78,7 +79,7 @@ pub fn simulate(
         );
         life_loop.start_forecast_phase(&mut state, &loads);
         let phase = life_loop.phase_at(&state, state.cycles);
-        let record = life_loop.record(&state, &l, &cw, phase, step_cycles, substeps);
+        let record = life_loop.record(&state, (&l, &thermal), &cw, phase, (step_cycles, substeps));
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
         state.stopped = life_loop.limits.passed(&record);
@@ -198,6 +199,8 @@ struct LifeLoop<'a> {
     sliding_speed: f64,
     pitting_limit: f64,
     limits: WearLimits,
+    /// MODEL §9's no-load, bearing and seal losses beside the mesh's, W (MODEL §13).
+    other_losses: f64,
 }
 
 impl<'a> LifeLoop<'a> {
@@ -212,6 +215,7 @@ impl<'a> LifeLoop<'a> {
         let wf = geo.wheel_flank(tca.loaded_flank);
         let backlash = Backlash::new(gear, geo, tca);
         let initial_backlash = backlash.per_position(&FlankField::zeros(wf));
+        let rating = crate::rating::rate(gear);
         Self {
             gear,
             geo,
@@ -223,9 +227,10 @@ impl<'a> LifeLoop<'a> {
             backlash,
             initial_backlash,
             active_area: wf.active_area(),
-            sliding_speed: crate::rating::rate(gear).sliding_speed_m_s,
+            sliding_speed: rating.sliding_speed_m_s,
             pitting_limit: gear.wheel_material.pitting_limit,
             limits: WearLimits::new(gear, geo, tca, life),
+            other_losses: rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w,
         }
     }
 
@@ -422,15 +427,42 @@ impl<'a> LifeLoop<'a> {
             * self.backlash.reference_radius
     }
 
-    /// The record of a state (MODEL §7.7, §12 j, §12 k).
+    /// The wear of one cycle of a state's loaded analysis `l` (MODEL §7.2) and its friction
+    /// (MODEL §13): with the heat balance, the film of the wear at the balance's oil
+    /// temperature (from the last record's, the temperature it starts from).
+    fn cycle_wear(&self, state: &WearState, l: &Ltca) -> Result<(CycleWear, Thermal), WearError> {
+        let gear = self.gear;
+        let contacts = MeshContacts::new(gear, self.geo, self.tca, l);
+        let start = state.records.last().map(|r| r.friction.oil_temperature_k);
+        let thermal = heat_balance_from(
+            &contacts,
+            (&gear.lubricant, &gear.friction, &gear.housing),
+            self.other_losses,
+            start.filter(|t| *t > 0.0),
+        )
+        .map_err(|source| WearError::Friction {
+            step: state.step,
+            cycles: state.cycles,
+            source,
+        })?;
+        let cw = if gear.housing.balance {
+            let mut at = gear.clone();
+            at.lubricant = gear.lubricant.at_temperature(thermal.oil_temperature_k);
+            per_cycle(&at, self.geo, self.tca, l, self.life.film_load)
+        } else {
+            per_cycle(gear, self.geo, self.tca, l, self.life.film_load)
+        };
+        Ok((cw, thermal))
+    }
+
+    /// The record of a state (MODEL §7.7, §12 j, §12 k) from its loaded analysis and friction.
     fn record(
         &self,
         state: &WearState,
-        l: &Ltca,
+        (l, thermal): (&Ltca, &Thermal),
         cw: &CycleWear,
         phase: Option<(usize, Phase, f64)>,
-        step_cycles: f64,
-        substeps: usize,
+        (step_cycles, substeps): (f64, usize),
     ) -> StepRecord {
         let wf = self.wf;
         let change = state.flank_change();
@@ -500,6 +532,7 @@ impl<'a> LifeLoop<'a> {
             max_plastic_indentation_m: l.plastic_indentation.max(),
             yielded_area_fraction: l.yielded_area_fraction,
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            friction: super::StateFriction::of(thermal),
             positions,
         }
     }
@@ -589,7 +622,7 @@ impl<'a> LifeLoop<'a> {
             state.band_factor = band;
             state.warm = Some(l.warm_start());
             state.run_in(&l);
-            rate_map = per_cycle(self.gear, self.geo, self.tca, &l, self.life.film_load);
+            rate_map = self.cycle_wear(state, &l)?.0;
         }
     }
 }

@@ -69,6 +69,13 @@ pub enum WearError {
         #[source]
         source: crate::ltca::LtcaError,
     },
+    #[error("at {cycles} cycles (step {step}): heat balance")]
+    Friction {
+        step: usize,
+        cycles: f64,
+        #[source]
+        source: crate::friction::FrictionError,
+    },
     #[error("the checkpoint does not match this gear's flank grid ({0})")]
     Checkpoint(String),
     /// A plan that could not end in a practical number of loaded analyses.

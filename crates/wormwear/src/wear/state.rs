@@ -224,10 +224,46 @@ pub struct StepRecord {
     /// records of earlier versions).
     #[serde(default)]
     pub equivalent_pressure_max_pa: f64,
+    /// Friction of this state's contact (MODEL §13; zeros in records of earlier versions).
+    #[serde(flatten, default)]
+    pub friction: StateFriction,
     /// Per position: TE, TE relative to the rigid lag, load per tooth (not in summary.json;
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub positions: Vec<PositionState>,
+}
+
+/// Friction of a state's contact (MODEL §13): load-weighted mean coefficient, mesh loss P_Vz
+/// (W), mesh and total efficiency, oil temperature (K) and its viscosity (Pa s) — the
+/// lubricant's with a fixed temperature, the heat balance's otherwise.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StateFriction {
+    #[serde(default)]
+    pub friction_coefficient_mean: f64,
+    #[serde(default)]
+    pub mesh_loss_w: f64,
+    #[serde(default)]
+    pub mesh_efficiency: f64,
+    #[serde(default)]
+    pub total_efficiency: f64,
+    #[serde(default)]
+    pub oil_temperature_k: f64,
+    #[serde(default)]
+    pub viscosity_pa_s: f64,
+}
+
+impl StateFriction {
+    /// The figures of a heat balance's result.
+    pub fn of(thermal: &crate::friction::Thermal) -> Self {
+        Self {
+            friction_coefficient_mean: thermal.friction.mean_coefficient,
+            mesh_loss_w: thermal.friction.mesh_loss_w,
+            mesh_efficiency: thermal.efficiency.mesh_efficiency,
+            total_efficiency: thermal.efficiency.total_efficiency,
+            oil_temperature_k: thermal.oil_temperature_k,
+            viscosity_pa_s: thermal.viscosity_pa_s,
+        }
+    }
 }
 
 /// One position of a state's loaded analysis (MODEL §7.7: load sharing and TE over life).

@@ -135,83 +135,72 @@ pub fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
     csv
 }
 
-/// The table of states (`wear_steps.csv`): one row per record (units in the names).
+/// The columns of `wear_steps.csv` (units in the names) and how each reads a record.
+type StepColumn = (&'static str, fn(&crate::wear::StepRecord) -> f64);
+
+const STEP_COLUMNS: [StepColumn; 41] = [
+    ("step", |r| r.step as f64),
+    ("cycles", |r| r.cycles),
+    ("step_cycles", |r| r.step_cycles),
+    ("max_wear_m", |r| r.max_wear_m),
+    ("wear_patch_max_m", |r| r.wear_patch_max_m),
+    ("mean_wear_m", |r| r.mean_wear_m),
+    ("worn_volume_m3", |r| r.worn_volume_m3),
+    ("backlash_m", |r| r.backlash_m),
+    ("backlash_increase_m", |r| r.backlash_increase_m),
+    ("max_pressure_pa", |r| r.max_pressure_pa),
+    ("mean_pressure_pa", |r| r.mean_pressure_pa),
+    ("contact_area_fraction", |r| r.contact_area_fraction),
+    ("s1", |r| r.s1),
+    ("s2", |r| r.s2),
+    ("te_mean_rad", |r| r.te_mean_rad),
+    ("te_p2p_rad", |r| r.te_p2p_rad),
+    ("mesh_stiffness_mean_nm_per_rad", |r| {
+        r.mesh_stiffness_mean_nm_per_rad
+    }),
+    ("max_wear_per_cycle_m", |r| r.max_wear_per_cycle_m),
+    ("lambda_min", |r| r.lambda_min),
+    ("substeps", |r| r.substeps as f64),
+    ("loaded_analyses", |r| r.loaded_analyses as f64),
+    ("pressure_patch_max_pa", |r| r.pressure_patch_max_pa),
+    ("rigid_lag_rad", |r| r.rigid_lag_rad),
+    ("te_mean_relative_rad", |r| r.te_mean_relative_rad),
+    ("te_p2p_relative_rad", |r| r.te_p2p_relative_rad),
+    ("n_li_model_cycles", |r| {
+        r.n_li_model_cycles.unwrap_or(f64::NAN)
+    }),
+    ("pitted_area_fraction", |r| r.pitted_area_fraction),
+    ("thinnest_tooth_um", |r| r.thinnest_tooth_m * UM),
+    ("worn_through_loaded", |r| {
+        f64::from(u8::from(r.worn_through_loaded))
+    }),
+    ("power_balance", |r| r.power_balance),
+    ("max_damage", |r| r.max_damage),
+    ("max_plastic_set_m", |r| r.max_plastic_set_m),
+    ("max_plastic_indentation_m", |r| r.max_plastic_indentation_m),
+    ("yielded_area_fraction", |r| r.yielded_area_fraction),
+    ("equivalent_pressure_max_pa", |r| {
+        r.equivalent_pressure_max_pa
+    }),
+    ("friction_coefficient_mean", |r| {
+        r.friction.friction_coefficient_mean
+    }),
+    ("mesh_loss_w", |r| r.friction.mesh_loss_w),
+    ("mesh_efficiency", |r| r.friction.mesh_efficiency),
+    ("total_efficiency", |r| r.friction.total_efficiency),
+    ("oil_temperature_c", |r| {
+        r.friction.oil_temperature_k - 273.15
+    }),
+    ("viscosity_pa_s", |r| r.friction.viscosity_pa_s),
+];
+
+/// The table of states (`wear_steps.csv`): one row per record ([`STEP_COLUMNS`]).
 pub fn steps_table(state: &WearState) -> Csv {
-    let mut csv = Csv::new(&[
-        "step",
-        "cycles",
-        "step_cycles",
-        "max_wear_m",
-        "wear_patch_max_m",
-        "mean_wear_m",
-        "worn_volume_m3",
-        "backlash_m",
-        "backlash_increase_m",
-        "max_pressure_pa",
-        "mean_pressure_pa",
-        "contact_area_fraction",
-        "s1",
-        "s2",
-        "te_mean_rad",
-        "te_p2p_rad",
-        "mesh_stiffness_mean_nm_per_rad",
-        "max_wear_per_cycle_m",
-        "lambda_min",
-        "substeps",
-        "loaded_analyses",
-        "pressure_patch_max_pa",
-        "rigid_lag_rad",
-        "te_mean_relative_rad",
-        "te_p2p_relative_rad",
-        "n_li_model_cycles",
-        "pitted_area_fraction",
-        "thinnest_tooth_um",
-        "worn_through_loaded",
-        "power_balance",
-        "max_damage",
-        "max_plastic_set_m",
-        "max_plastic_indentation_m",
-        "yielded_area_fraction",
-        "equivalent_pressure_max_pa",
-    ]);
+    let names: Vec<&str> = STEP_COLUMNS.iter().map(|c| c.0).collect();
+    let mut csv = Csv::new(&names);
     for r in &state.records {
-        csv.row(&[
-            r.step as f64,
-            r.cycles,
-            r.step_cycles,
-            r.max_wear_m,
-            r.wear_patch_max_m,
-            r.mean_wear_m,
-            r.worn_volume_m3,
-            r.backlash_m,
-            r.backlash_increase_m,
-            r.max_pressure_pa,
-            r.mean_pressure_pa,
-            r.contact_area_fraction,
-            r.s1,
-            r.s2,
-            r.te_mean_rad,
-            r.te_p2p_rad,
-            r.mesh_stiffness_mean_nm_per_rad,
-            r.max_wear_per_cycle_m,
-            r.lambda_min,
-            r.substeps as f64,
-            r.loaded_analyses as f64,
-            r.pressure_patch_max_pa,
-            r.rigid_lag_rad,
-            r.te_mean_relative_rad,
-            r.te_p2p_relative_rad,
-            r.n_li_model_cycles.unwrap_or(f64::NAN),
-            r.pitted_area_fraction,
-            r.thinnest_tooth_m * UM,
-            f64::from(u8::from(r.worn_through_loaded)),
-            r.power_balance,
-            r.max_damage,
-            r.max_plastic_set_m,
-            r.max_plastic_indentation_m,
-            r.yielded_area_fraction,
-            r.equivalent_pressure_max_pa,
-        ]);
+        let row: Vec<f64> = STEP_COLUMNS.iter().map(|c| (c.1)(r)).collect();
+        csv.row(&row);
     }
     csv
 }
