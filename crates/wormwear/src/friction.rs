@@ -165,6 +165,8 @@ struct CellContact {
     area: f64,
     /// Index of the cell's slice in [`MeshContacts::lines`].
     line: usize,
+    /// The loaded flank's grid cells under the local cell, with their shares of it.
+    flank_cells: [(usize, f64); 3],
 }
 
 /// The loaded cells of a loaded analysis with their sliding speeds and line contacts
@@ -172,6 +174,8 @@ struct CellContact {
 #[derive(Debug, Clone)]
 pub struct MeshContacts {
     cells: Vec<CellContact>,
+    /// Areas of the loaded flank's grid cells, m^2.
+    flank_areas: Vec<f64>,
     /// The line contact of each loaded slice: relative radius, rolling velocities, line load
     /// (the sum of p times the width across the line over the slice's cells), peak pressure.
     lines: Vec<LineContact>,
@@ -179,6 +183,41 @@ pub struct MeshContacts {
     e_prime: f64,
     /// Output power P2 = omega2 x mean wheel torque of the positions, W.
     pub output_power: f64,
+}
+
+/// The grid cells of the wheel flank `wf` under a local cell at (r, z) that spans
+/// z +- `half_dz` (m), with the share of that strip each takes: the cell columns the strip
+/// overlaps (a slice on a node column is half in the column on each side), in the row of r
+/// between the column's interpolated radial limits (clamped to the grid). Unused entries have
+/// share 0.
+fn flank_cells_at(
+    wf: &crate::geometry::WheelFlank,
+    (r, z): (f64, f64),
+    half_dz: f64,
+) -> [(usize, f64); 3] {
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let (z0, z1) = (wf.z[0], wf.z[nj]);
+    let column = |z: f64| ((z - z0) / (z1 - z0) * nj as f64).clamp(0.0, nj as f64);
+    let (a, b) = (column(z - half_dz), column(z + half_dz));
+    let row = |j: usize| {
+        let w = (column(z) - j as f64).clamp(0.0, 1.0);
+        let lo = wf.r_low[j] + w * (wf.r_low[j + 1] - wf.r_low[j]);
+        let hi = wf.r_high[j] + w * (wf.r_high[j + 1] - wf.r_high[j]);
+        let u = ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64 - 1e-9);
+        j * ni + (u.floor() as usize).min(ni - 1)
+    };
+    let mut out = [(0, 0.0); 3];
+    if b - a <= 0.0 {
+        let j = (a.floor() as usize).min(nj - 1);
+        out[0] = (row(j), 1.0);
+        return out;
+    }
+    let first = (a.floor() as usize).min(nj - 1);
+    for (slot, j) in (first..nj).take(3).enumerate() {
+        let overlap = (b.min(j as f64 + 1.0) - a.max(j as f64)).max(0.0);
+        out[slot] = (row(j), overlap / (b - a));
+    }
+    out
 }
 
 /// The end of the slice that starts at cell `start` of a position (a slice's cells are
@@ -227,6 +266,14 @@ pub struct MeshFriction {
     /// Per loaded cell: (position, cell index, mu, friction power density mu p |v_g| in W/m^2).
     #[serde(skip)]
     pub cells: Vec<(usize, usize, f64, f64)>,
+    /// On the loaded flank's grid cells: the load-weighted friction coefficient over the
+    /// cycle (NaN where nothing loads the cell) and the friction power density, mean over the
+    /// mesh cycle of every tooth's contact there, W/m^2 (its integral over the flank is the
+    /// mesh loss).
+    #[serde(skip)]
+    pub flank_coefficient: Vec<f64>,
+    #[serde(skip)]
+    pub flank_power_density: Vec<f64>,
 }
 
 impl MeshContacts {
@@ -276,6 +323,7 @@ impl MeshContacts {
                     );
                     let vg = nalgebra::Vector3::from(v.sliding).norm();
                     cells.push(CellContact {
+                        flank_cells: flank_cells_at(wf, (c.r, c.z), c.half_dz),
                         position: n,
                         cell: k,
                         pressure: pr.pressure[k],
@@ -295,6 +343,7 @@ impl MeshContacts {
             / ltca.positions.len().max(1) as f64;
         Self {
             cells,
+            flank_areas: wf.cell_area.clone(),
             lines,
             positions: ltca.positions.len(),
             e_prime: lubrication::reduced_modulus(
@@ -341,6 +390,7 @@ impl MeshContacts {
             cells.push((c.position, c.cell, f.coefficient, density));
         }
         let mesh_loss_w = position_loss.iter().sum::<f64>() / self.positions.max(1) as f64;
+        let (flank_coefficient, flank_power_density) = self.flank_fields(&cells);
         let mean = |x: f64| if load > 0.0 { x / load } else { 0.0 };
         MeshFriction {
             position_loss_w: position_loss,
@@ -348,7 +398,39 @@ impl MeshContacts {
             mean_coefficient: mean(weighted),
             asperity_share: mean(share),
             cells,
+            flank_coefficient,
+            flank_power_density,
         }
+    }
+
+    /// The friction of the loaded cells `friction` ((position, cell, mu, density) in the
+    /// order of [`Self::cells`]) gathered on the flank's grid cells: the load-weighted mu and
+    /// the power density, sum of density x local area / (positions x grid cell area).
+    fn flank_fields(&self, friction: &[(usize, usize, f64, f64)]) -> (Vec<f64>, Vec<f64>) {
+        let n = self.flank_areas.len();
+        let (mut mu_load, mut load, mut power) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        for (c, &(_, _, mu, density)) in self.cells.iter().zip(friction) {
+            for &(g, share) in &c.flank_cells {
+                let force = c.pressure * c.area * share;
+                mu_load[g] += mu * force;
+                load[g] += force;
+                power[g] += density * c.area * share;
+            }
+        }
+        let positions = self.positions.max(1) as f64;
+        let coefficient = (0..n)
+            .map(|g| {
+                if load[g] > 0.0 {
+                    mu_load[g] / load[g]
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        let density = (0..n)
+            .map(|g| power[g] / (positions * self.flank_areas[g]))
+            .collect();
+        (coefficient, density)
     }
 }
 
@@ -683,7 +765,9 @@ mod tests {
                 sliding_speed: 4.0,
                 area: 1e-6,
                 line: 0,
+                flank_cells: [(0, 1.0), (0, 0.0), (0, 0.0)],
             }],
+            flank_areas: vec![1e-6],
             lines: vec![LineContact {
                 radius: 0.02,
                 u1: 2.0,

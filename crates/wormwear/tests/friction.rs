@@ -58,6 +58,18 @@ fn the_friction_loss_is_the_power_of_its_moments_about_the_worm_and_wheel_axes()
         );
     }
     assert!(friction.mesh_loss_w > 0.0);
+    // Gathered on the flank's grid, the power density integrates to the mesh loss.
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let on_flank: f64 = friction
+        .flank_power_density
+        .iter()
+        .zip(&wf.cell_area)
+        .map(|(d, a)| d * a)
+        .sum();
+    assert!(
+        (on_flank / friction.mesh_loss_w - 1.0).abs() < 1e-12,
+        "{on_flank} W on the flank"
+    );
 }
 
 #[test]

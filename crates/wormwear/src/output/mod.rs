@@ -4,6 +4,7 @@
 //! never leaves a half-written file. `summary.json` is one JSON object; each command adds or
 //! replaces its own section and keeps the others.
 
+pub mod friction;
 pub mod geometry;
 pub mod ltca;
 pub mod plot;
@@ -226,8 +227,10 @@ pub fn write_results(
         if let Some(r) = results.rating.as_ref() {
             update_summary(dir, "rating", to_json("rating", r)?)?;
         }
-        if let Some(t) = results.thermal.as_ref() {
-            update_summary(dir, "friction", to_json("friction", t)?)?;
+        if let Some(thermal) = results.thermal.as_ref() {
+            update_summary(dir, "friction", to_json("friction", thermal)?)?;
+            let wf = geo.wheel_flank(t.loaded_flank);
+            files.extend(friction::write_friction(wf, thermal, dir)?);
         }
         match results.life.as_ref() {
             Some(life) if !life_written => files.extend(wear::write_life(gear, geo, t, life, dir)?),

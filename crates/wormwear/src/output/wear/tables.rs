@@ -35,10 +35,10 @@ pub(super) fn write_tables(
 }
 
 /// The curves over cycles: (file, title, y label, series) of the backlash, wear depth,
-/// transmission error and pressure charts.
+/// transmission error, pressure, efficiency and oil temperature charts.
 fn life_charts(
     records: &[crate::wear::StepRecord],
-) -> [(&'static str, &'static str, &'static str, Vec<Series>); 4] {
+) -> [(&'static str, &'static str, &'static str, Vec<Series>); 6] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
         points: records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
@@ -94,6 +94,21 @@ fn life_charts(
                 ),
                 curve(&|r| r.mean_pressure_pa * MPA, "P_mean", 0),
             ],
+        ),
+        (
+            "wear_efficiency.svg",
+            "Efficiency over life, from the contact's friction (MODEL §13)",
+            "efficiency (%)",
+            vec![
+                curve(&|r| 100.0 * r.friction.mesh_efficiency, "mesh", 0),
+                curve(&|r| 100.0 * r.friction.total_efficiency, "total", 1),
+            ],
+        ),
+        (
+            "wear_oil_temperature.svg",
+            "Oil temperature over life (fixed, or the heat balance of each state)",
+            "oil temperature (C)",
+            vec![curve(&|r| r.friction.oil_temperature_k - 273.15, "sump", 4)],
         ),
     ]
 }
