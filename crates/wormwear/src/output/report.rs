@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 /// Sections of the report: title, summary.json section, figures in order: a file stem, or a
 /// name prefix ending with `*` (all the files it starts, numbers in order).
-const SECTIONS: [(&str, &str, &[&str]); 5] = [
+const SECTIONS: [(&str, &str, &[&str]); 6] = [
     (
         "Geometry",
         "geometry",
@@ -45,6 +45,8 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "wear_depth",
             "wear_transmission_error",
             "wear_pressure",
+            "wear_efficiency",
+            "wear_oil_temperature",
             "wear_map",
             "wear_per_cycle_map",
             "wear_film_ratio_map",
@@ -56,6 +58,11 @@ const SECTIONS: [(&str, &str, &[&str]); 5] = [
             "wear_pattern_step*",
             "wear_damage_map_step*",
         ],
+    ),
+    (
+        "Friction, efficiency and oil temperature (MODEL §13)",
+        "friction",
+        &["friction_coefficient_map", "friction_power_map"],
     ),
     ("Ratings (ISO/TR 14521)", "rating", &[]),
 ];
@@ -256,8 +263,8 @@ fn warnings_section(h: &mut String, summary: &serde_json::Value) {
 }
 
 /// The key results: (label, where in summary.json — a stage's section, or `END` for the last
-/// wear state — key, scale to the unit, unit).
-const KEY_RESULTS: [(&str, &str, &str, f64, &str); 14] = [
+/// wear state — key (dotted: nested), scale to the unit, unit).
+const KEY_RESULTS: [(&str, &str, &str, f64, &str); 16] = [
     ("Ratio", "geometry", "ratio", 1.0, ""),
     ("Lead angle", "geometry", "lead_angle_deg", 1.0, "deg"),
     (
@@ -289,6 +296,14 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 14] = [
         "N m/rad",
     ),
     ("Efficiency (ISO/TR 14521)", "rating", "efficiency", 1.0, ""),
+    (
+        "Efficiency from the contact's friction",
+        "friction",
+        "efficiency.total_efficiency",
+        1.0,
+        "",
+    ),
+    ("Oil temperature", "friction", "oil_temperature_k", 1.0, "K"),
     ("Worm torque", "rating", "worm_torque_nm", 1.0, "N m"),
     ("Pitting life N_LI", "rating", "n_li_cycles", 1.0, "cycles"),
     ("Life simulated", END, "cycles", 1.0, "cycles"),
@@ -337,7 +352,8 @@ fn key_results(h: &mut String, summary: &serde_json::Value) {
         let value = if section == END {
             &last_step[key]
         } else {
-            &summary[section][key]
+            // A dotted key reads a nested value.
+            key.split('.').fold(&summary[section], |v, part| &v[part])
         };
         if let Some(x) = value.as_f64() {
             let text = format!("{:.4e}", x * scale)
