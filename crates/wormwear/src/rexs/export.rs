@@ -689,6 +689,29 @@ fn result_attributes(
     if let Some(k) = get("ltca", "mesh_stiffness_mean_nm_per_rad") {
         v.push(custom("mesh_stiffness_n_m_per_rad", "none", k));
     }
+    if let Some(t) = results.thermal.as_ref() {
+        // The contact's friction (MODEL §13): REXS's efficiency ids are the standard's
+        // method, so ours are custom.
+        v.extend([
+            custom(
+                "mesh_efficiency_contact",
+                "none",
+                t.efficiency.mesh_efficiency,
+            ),
+            custom(
+                "total_efficiency_contact",
+                "none",
+                t.efficiency.total_efficiency,
+            ),
+            custom("meshing_power_loss_contact", "W", t.friction.mesh_loss_w),
+            custom(
+                "mean_coefficient_of_friction_contact",
+                "none",
+                t.friction.mean_coefficient,
+            ),
+            custom("oil_temperature", "C", t.oil_temperature_k - 273.15),
+        ]);
+    }
     if let Some(last) = results.life.as_ref().and_then(|l| l.end.records.last()) {
         v.extend([
             float(
