@@ -334,6 +334,7 @@ pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     let mut jobs = Vec::new();
     design_jobs(&mut jobs, &design, scale, settings.quick);
     endurance_jobs(&mut jobs, [&a, &b, &c], scale);
+    thermal_jobs(&mut jobs, &c, scale);
     // (c) Sensitivity of case C's life to the unpublished inputs; (d) our options.
     for (id, g, plan) in variants(&c, scaled_life(&c, scale)) {
         push_job(&mut jobs, &id, g, Some(plan));
@@ -422,6 +423,36 @@ fn endurance_jobs(jobs: &mut Vec<Job>, [a, b, c]: [&GearSet; 3], scale: f64) {
             g.conditions.worm_speed = rpm * 2.0 * std::f64::consts::PI / 60.0
         });
         push_job(jobs, &format!("speed-{rpm:.0}"), g, Some(life(c)));
+    }
+}
+
+/// The housing of the study's heat balances (MODEL §13): forced air, 200 W/(m^2 K) over
+/// 1 m^2, 20 C, no cooler — one in which the reference gears' 4-9 kW losses find a steady
+/// temperature (natural convection over the default area cannot reject them).
+pub fn study_housing() -> input::Housing {
+    input::Housing {
+        balance: true,
+        area: 1.0,
+        heat_transfer: 200.0,
+        ambient: 293.15,
+        cooler: 0.0,
+    }
+}
+
+/// (e) Case C's life and the speed study with the oil temperature from the heat balance
+/// ([`study_housing`]) instead of the fixed 60 C.
+fn thermal_jobs(jobs: &mut Vec<Job>, c: &GearSet, scale: f64) {
+    for rpm in [100.0, 600.0, 900.0, 1200.0] {
+        let g = variant(c, |g| {
+            g.conditions.worm_speed = rpm * 2.0 * std::f64::consts::PI / 60.0;
+            g.housing = study_housing();
+        });
+        let id = if rpm == 900.0 {
+            "c-balance".to_string()
+        } else {
+            format!("speed-{rpm:.0}-balance")
+        };
+        push_job(jobs, &id, g, Some(scaled_life(c, scale)));
     }
 }
 

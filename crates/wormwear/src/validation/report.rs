@@ -19,6 +19,7 @@ pub fn markdown(settings: &Settings, results: &Results, analytic: &[Check]) -> S
     section_a(&mut m, analytic);
     section_b(&mut m, results);
     section_c_d(&mut m, results);
+    section_e(&mut m, settings, results);
     failures(&mut m, results);
     run_times(&mut m, results);
     m
@@ -763,6 +764,119 @@ fn variant_table(m: &mut String, results: &Results, base: &StepRecord, rows: &[(
             r.records.len(),
             e.loaded_analyses,
             r.seconds
+        );
+    }
+    m.push('\n');
+}
+
+/// (e) Friction, efficiency and oil temperature from the contact (MODEL §13).
+fn section_e(m: &mut String, settings: &Settings, results: &Results) {
+    let _ = writeln!(
+        m,
+        "## (e) Friction, efficiency and oil temperature from the contact\n\n\
+         The contact's friction (MODEL §13: asperities at mu_b = 0.094 on MODEL §10's share, \
+         Eyring film shear bounded at 0.02 p) on every loaded cell of the unworn gear's loaded \
+         analysis, against ISO/TR 14521's formula (MODEL §9) and the published torques \
+         (wheel torque / (u x worm torque); REFERENCE_GEARS.md derived them with that same \
+         formula). The reference gears' roughness (1 um) is assumed.\n"
+    );
+    let _ = writeln!(
+        m,
+        "| case | mesh efficiency, contact | ISO/TR 14521 | total, contact | ISO/TR 14521 | published torques | mu contact | mu ISO |"
+    );
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|");
+    for (name, id, file, published) in [
+        (
+            "design",
+            "design-adaptive",
+            "gear-1x40-design.toml",
+            f64::NAN,
+        ),
+        (
+            "A",
+            "case-a",
+            "gear-1x40-case-a.toml",
+            1250.0 / (40.0 * 40.0),
+        ),
+        (
+            "B",
+            "case-b",
+            "gear-1x40-case-b.toml",
+            1375.0 / (40.0 * 44.0),
+        ),
+        (
+            "C",
+            "case-c",
+            "gear-1x40-case-c.toml",
+            1700.0 / (40.0 * 54.0),
+        ),
+    ] {
+        let Some(first) = results.get(id).and_then(|r| r.records.first()) else {
+            continue;
+        };
+        let Ok(gear) = super::example(settings, file) else {
+            continue;
+        };
+        let iso = crate::rating::rate(&gear);
+        let f = &first.friction;
+        let _ = writeln!(
+            m,
+            "| {name} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {:.4} | {:.4} |",
+            f.mesh_efficiency,
+            iso.mesh_efficiency,
+            f.total_efficiency,
+            iso.efficiency,
+            if published.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{published:.3}")
+            },
+            f.friction_coefficient_mean,
+            iso.friction_coefficient
+        );
+    }
+    thermal_life_table(m, results);
+}
+
+/// Case C and the speed study with the heat balance against the fixed 60 C: oil temperature
+/// and efficiency at the start and the end, and the final backlash of both.
+fn thermal_life_table(m: &mut String, results: &Results) {
+    let _ = writeln!(
+        m,
+        "\nWith the oil temperature from the heat balance of a forced-air housing (200 W/(m^2 K) \
+         over 1 m^2, 20 C ambient; the default housing cannot reject these losses), each wear \
+         state's viscosity drives its film and local wear coefficient:\n"
+    );
+    let _ = writeln!(
+        m,
+        "| worm speed | oil at start -> end (C) | total efficiency start -> end | backlash at the end, balance | at 60 C |"
+    );
+    let _ = writeln!(m, "|---|---|---|---|---|");
+    for (rpm, balance, fixed) in [
+        (100, "speed-100-balance", "speed-100"),
+        (600, "speed-600-balance", "speed-600"),
+        (900, "c-balance", "case-c"),
+        (1200, "speed-1200-balance", "speed-1200"),
+    ] {
+        let Some(r) = results.get(balance) else {
+            continue;
+        };
+        let (Some(s), Some(e)) = (r.records.first(), r.records.last()) else {
+            continue;
+        };
+        let fixed = results.get(fixed).and_then(last);
+        let _ = writeln!(
+            m,
+            "| {rpm} rpm | {:.1} -> {:.1} | {:.3} -> {:.3} | {:.1} um | {} |",
+            s.friction.oil_temperature_k - 273.15,
+            e.friction.oil_temperature_k - 273.15,
+            s.friction.total_efficiency,
+            e.friction.total_efficiency,
+            e.backlash_increase_m * UM,
+            fixed.map_or("-".to_string(), |f| format!(
+                "{:.1} um",
+                f.backlash_increase_m * UM
+            ))
         );
     }
     m.push('\n');
