@@ -251,6 +251,13 @@ pub struct Housing {
     pub cooler: f64,
 }
 
+impl Housing {
+    /// With a fixed oil temperature nothing reads the housing.
+    pub fn is_unused(&self) -> bool {
+        !self.balance
+    }
+}
+
 /// How the cycles of a wear step are chosen (MODEL §7.3).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum StepControl {
@@ -636,7 +643,9 @@ pub struct GearSet {
     pub lubricant: Lubricant,
     /// Friction of the mixed lubrication (MODEL §13).
     pub friction: FrictionLaw,
-    /// The housing's heat balance (MODEL §13).
+    /// The housing's heat balance (MODEL §13); left out of the serialised gear (fingerprints of
+    /// checkpoints and caches) when the oil temperature is fixed, as nothing then reads it.
+    #[serde(skip_serializing_if = "Housing::is_unused")]
     pub housing: Housing,
     pub conditions: Conditions,
     pub analysis: Analysis,
