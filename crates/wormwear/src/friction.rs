@@ -185,17 +185,32 @@ pub struct MeshContacts {
     pub output_power: f64,
 }
 
+/// The node columns of a flank grid: their z and radial limits (m), and the cell rows.
+struct FlankGrid<'a> {
+    z: &'a [f64],
+    r_low: &'a [f64],
+    r_high: &'a [f64],
+    rows: usize,
+}
+
+impl<'a> FlankGrid<'a> {
+    fn of(wf: &'a crate::geometry::WheelFlank) -> Self {
+        Self {
+            z: &wf.z,
+            r_low: &wf.r_low,
+            r_high: &wf.r_high,
+            rows: wf.cells_height,
+        }
+    }
+}
+
 /// The grid cells of the wheel flank `wf` under a local cell at (r, z) that spans
 /// z +- `half_dz` (m), with the share of that strip each takes: the cell columns the strip
 /// overlaps (a slice on a node column is half in the column on each side), in the row of r
 /// between the column's interpolated radial limits (clamped to the grid). Unused entries have
 /// share 0.
-fn flank_cells_at(
-    wf: &crate::geometry::WheelFlank,
-    (r, z): (f64, f64),
-    half_dz: f64,
-) -> [(usize, f64); 3] {
-    let (ni, nj) = (wf.cells_height, wf.cells_face);
+fn flank_cells_at(wf: &FlankGrid, (r, z): (f64, f64), half_dz: f64) -> [(usize, f64); 3] {
+    let (ni, nj) = (wf.rows, wf.z.len() - 1);
     let (z0, z1) = (wf.z[0], wf.z[nj]);
     let column = |z: f64| ((z - z0) / (z1 - z0) * nj as f64).clamp(0.0, nj as f64);
     let (a, b) = (column(z - half_dz), column(z + half_dz));
@@ -289,6 +304,7 @@ impl MeshContacts {
             .map(|c| ((c.position, c.tooth, c.slice), c.curvature_radius))
             .collect();
         let ni = wf.cells_height;
+        let grid = FlankGrid::of(wf);
         let node = |j: usize, r: f64| {
             let t = (r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]);
             let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
@@ -323,7 +339,7 @@ impl MeshContacts {
                     );
                     let vg = nalgebra::Vector3::from(v.sliding).norm();
                     cells.push(CellContact {
-                        flank_cells: flank_cells_at(wf, (c.r, c.z), c.half_dz),
+                        flank_cells: flank_cells_at(&grid, (c.r, c.z), c.half_dz),
                         position: n,
                         cell: k,
                         pressure: pr.pressure[k],
@@ -851,5 +867,29 @@ mod tests {
         )
         .unwrap();
         assert_eq!((fixed.oil_temperature_k, fixed.mode), (333.0, "fixed"));
+    }
+
+    #[test]
+    fn a_local_cell_is_shared_among_the_grid_columns_it_overlaps() {
+        // A flat flank grid: 4 columns over z in [-2, 2] mm, radii 0..10 mm in 5 rows.
+        let z = [-2e-3, -1e-3, 0.0, 1e-3, 2e-3];
+        let (r_low, r_high) = ([0.0; 5], [10e-3; 5]);
+        let wf = FlankGrid {
+            z: &z,
+            r_low: &r_low,
+            r_high: &r_high,
+            rows: 5,
+        };
+        // A strip on the node column z = 0 (half 0.5 mm): half in column 1, half in column 2.
+        let shares = flank_cells_at(&wf, (5e-3, 0.0), 0.5e-3);
+        let total: f64 = shares.iter().map(|s| s.1).sum();
+        assert!((total - 1.0).abs() < 1e-12, "{shares:?}");
+        assert_eq!((shares[0].0, shares[1].0), (5 + 2, 2 * 5 + 2));
+        assert!((shares[0].1 - 0.5).abs() < 1e-12 && (shares[1].1 - 0.5).abs() < 1e-12);
+        // Inside one column, all of it there; past the face end, clamped to the last column.
+        let inside = flank_cells_at(&wf, (1e-3, -1.5e-3), 0.2e-3);
+        assert_eq!(inside[0], (0, 1.0));
+        let beyond = flank_cells_at(&wf, (9.9e-3, 2e-3), 0.5e-3);
+        assert_eq!(beyond[0], (3 * 5 + 4, 1.0));
     }
 }
