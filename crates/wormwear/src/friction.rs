@@ -378,33 +378,14 @@ impl MeshContacts {
         let mut position_loss = vec![0.0; self.positions];
         let (mut weighted, mut share, mut load) = (0.0, 0.0, 0.0);
         let mut cells = Vec::with_capacity(self.cells.len());
-        // The film of each slice, once.
-        let films: Vec<f64> = self
-            .lines
-            .iter()
-            .map(|line| {
-                let film = lubrication::film(lubricant, self.e_prime, line);
-                film.h_min * film.thermal_factor
-            })
-            .collect();
-        for c in &self.cells {
-            let thickness = films[c.line];
-            let f = local_friction(
-                c.pressure,
-                c.sliding_speed,
-                thickness,
-                lubricant,
-                law,
-                self.e_prime,
-            );
-            let density = f.coefficient * c.pressure * c.sliding_speed;
+        self.each_cell(lubricant, law, |c, f, density| {
             position_loss[c.position] += density * c.area;
             let force = c.pressure * c.area;
             weighted += f.coefficient * force;
             share += f.asperity_share * force;
             load += force;
             cells.push((c.position, c.cell, f.coefficient, density));
-        }
+        });
         let mesh_loss_w = position_loss.iter().sum::<f64>() / self.positions.max(1) as f64;
         let (flank_coefficient, flank_power_density) = self.flank_fields(&cells);
         let mean = |x: f64| if load > 0.0 { x / load } else { 0.0 };
@@ -416,6 +397,46 @@ impl MeshContacts {
             cells,
             flank_coefficient,
             flank_power_density,
+        }
+    }
+
+    /// The mesh loss P_Vz alone (W), as [`Self::friction`] sums it: what the heat balance's
+    /// search evaluates, without the per-cell lists and flank fields.
+    pub fn mesh_loss(&self, lubricant: &Lubricant, law: &FrictionLaw) -> f64 {
+        let mut position_loss = vec![0.0; self.positions];
+        self.each_cell(lubricant, law, |c, _, density| {
+            position_loss[c.position] += density * c.area;
+        });
+        position_loss.iter().sum::<f64>() / self.positions.max(1) as f64
+    }
+
+    /// Calls `visit` with every loaded cell, its local friction and its friction power density
+    /// mu p |v_g| (W/m^2), the film of each slice computed once (MODEL §6, §13).
+    fn each_cell(
+        &self,
+        lubricant: &Lubricant,
+        law: &FrictionLaw,
+        mut visit: impl FnMut(&CellContact, LocalFriction, f64),
+    ) {
+        let films: Vec<f64> = self
+            .lines
+            .iter()
+            .map(|line| {
+                let film = lubrication::film(lubricant, self.e_prime, line);
+                film.h_min * film.thermal_factor
+            })
+            .collect();
+        for c in &self.cells {
+            let f = local_friction(
+                c.pressure,
+                c.sliding_speed,
+                films[c.line],
+                lubricant,
+                law,
+                self.e_prime,
+            );
+            let density = f.coefficient * c.pressure * c.sliding_speed;
+            visit(c, f, density);
         }
     }
 
@@ -557,7 +578,8 @@ pub fn heat_balance_from(
     // Excess of the loss over what the housing rejects at t, W (decreasing through the root).
     let excess = |t: f64| {
         evaluations.set(evaluations.get() + 1);
-        at(t).2.total_loss_w() - housing.cooler - conductance * (t - housing.ambient)
+        let mesh = contacts.mesh_loss(&lubricant.at_temperature(t), law);
+        mesh + other_losses - housing.cooler - conductance * (t - housing.ambient)
     };
     let cold = excess(housing.ambient);
     if cold < 0.0 {
