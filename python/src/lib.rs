@@ -302,7 +302,7 @@ impl NativeResults {
     }
 
     /// A table by name as (column names, columns of numbers): ltca_positions, ltca_pattern,
-    /// ltca_pressures, wear_steps, wear_positions, wear_map; None when its stage did not run.
+    /// ltca_pressures, friction_map, wear_steps, wear_positions, wear_map; None when its stage did not run.
     fn table(&self, name: &str) -> PyResult<Option<Columns>> {
         use wormwear::output::{ltca, wear};
         let r = &self.results;
@@ -317,6 +317,9 @@ impl NativeResults {
                 .zip(r.ltca.as_ref())
                 .map(|(w, l)| ltca::pattern_table(w, l)),
             "ltca_pressures" => r.ltca.as_ref().map(ltca::pressures_table),
+            "friction_map" => wf
+                .zip(r.thermal.as_ref())
+                .map(|(w, t)| wormwear::output::friction::friction_table(w, t)),
             "wear_steps" => life.map(|l| wear::steps_table(&l.end)),
             "wear_positions" => tca
                 .zip(life)
@@ -329,7 +332,7 @@ impl NativeResults {
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "no table {name:?}: ltca_positions, ltca_pattern, ltca_pressures, \
-                     wear_steps, wear_positions, wear_map"
+                     friction_map, wear_steps, wear_positions, wear_map"
                 )))
             }
         };

@@ -86,6 +86,15 @@ def test_ltca_equals_the_cli_in_numbers_and_files(cli, design_file, tmp_path):
     # The equivalent pressure below the flank (MODEL §8.1) as a map and per cell.
     assert np.nanmax(r.ltca.equivalent.values) == r.ltca.equivalent_pressure_max_pa
     assert r.ltca.pressures["equivalent_pressure_pa"].max() > 0
+    # The friction (MODEL §13): the section and the table equal the file's, on the flank grid;
+    # the local coefficient is positive where a cell is loaded.
+    assert r.friction.efficiency == written["friction"]["efficiency"]
+    file = pd.read_csv(tmp_path / "cli" / "friction_map.csv")
+    assert list(r.friction.table.columns) == list(file.columns)
+    np.testing.assert_allclose(r.friction.table.to_numpy(float), file.to_numpy(float), rtol=6e-11, atol=0, equal_nan=True)
+    assert r.friction.coefficient.values.shape == (40, 60)
+    mu = r.friction.coefficient.values
+    assert 0 < np.nanmin(mu) <= np.nanmax(mu) <= r.friction.friction["mean_coefficient"] * 10
     r.write(tmp_path / "py")
     assert_same_files(tmp_path / "cli", tmp_path / "py")
 

@@ -189,6 +189,10 @@ class Results:
     - ``wear``: the ``wear`` section's values and the DataFrames ``records`` (one row per
       state: cycles, max_wear_m, backlash_increase_m, max_pressure_pa, ...), ``positions``
       (TE and loads per state and position) and the map ``depth`` (wear depth at the end, m);
+    - ``friction``: the ``friction`` section's values (friction, efficiency, oil temperature
+      from the contact, MODEL §13), the DataFrame ``table`` (every flank cell: r_mm, z_mm,
+      friction_coefficient, friction_power_density_w_m2) and the maps ``coefficient``
+      (load-weighted friction coefficient over the cycle) and ``power_density`` (W/m^2);
     - ``rating``: the standard's ratings (efficiency, sigma_Hm, lives...);
     - ``warnings``: list of str.
 
@@ -203,6 +207,16 @@ class Results:
         self.geometry = _namespace(self.summary.get("geometry"))
         self.tca = _namespace(self.summary.get("tca"))
         self.rating = _namespace(self.summary.get("rating"))
+        friction = self.summary.get("friction")
+        self.friction = None
+        if friction is not None:
+            table = self.table("friction_map")
+            self.friction = _namespace(
+                friction,
+                table=table,
+                coefficient=FlankMap._from_table(table, "friction_coefficient", "1"),
+                power_density=FlankMap._from_table(table, "friction_power_density_w_m2", "W/m^2"),
+            )
         ltca = self.summary.get("ltca")
         self.ltca = None
         if ltca is not None:
@@ -228,7 +242,7 @@ class Results:
 
     def table(self, name: str) -> Optional[pd.DataFrame]:
         """A table by its file's name without ``.csv`` (ltca_positions, ltca_pattern,
-        ltca_pressures, wear_steps, wear_positions, wear_map), at full precision (the files
+        ltca_pressures, friction_map, wear_steps, wear_positions, wear_map), at full precision (the files
         round to 11 digits); None if its stage did not run."""
         got = self._native.table(name)
         if got is None:

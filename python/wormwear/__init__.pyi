@@ -48,6 +48,9 @@ class Results:
     ltca: Optional[types.SimpleNamespace]
     #: wear section values and records / positions / nodes (DataFrame), depth (FlankMap, m).
     wear: Optional[types.SimpleNamespace]
+    #: friction section values (efficiency, oil temperature, MODEL §13) and table (DataFrame),
+    #: coefficient / power_density (FlankMap, 1 and W/m^2).
+    friction: Optional[types.SimpleNamespace]
     rating: Optional[types.SimpleNamespace]
     def table(self, name: str) -> Optional[pd.DataFrame]: ...
     def to_rexs(self, path: str | os.PathLike[str]) -> None: ...

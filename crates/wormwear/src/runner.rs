@@ -304,12 +304,13 @@ pub struct LifeView<'a> {
 }
 
 /// A wear state kept for its maps: the state (with its last record only), the loaded
-/// analysis and the wear of one cycle on its geometry.
+/// analysis, the wear of one cycle and the friction (MODEL §13) on its geometry.
 #[derive(Debug, Clone)]
 pub struct MapState {
     pub state: WearState,
     pub ltca: Ltca,
     pub cycle: CycleWear,
+    pub thermal: crate::friction::Thermal,
     /// A map state of the plan (`map_cycles`).
     pub map: bool,
     /// The last state of the run.
@@ -328,6 +329,7 @@ impl MapState {
             state,
             ltca: view.ltca.clone(),
             cycle: view.cycle.clone(),
+            thermal: view.thermal.clone(),
             map: view.map,
             last: view.last,
         }
@@ -339,6 +341,7 @@ impl MapState {
             state: &self.state,
             ltca: &self.ltca,
             cycle: &self.cycle,
+            thermal: &self.thermal,
             last: self.last,
             map: self.map,
         }

@@ -152,7 +152,28 @@ fn a_life_with_the_heat_balance_holds_it_at_every_state_and_the_film_follows_the
         ..wormwear::wear::WearPlan::with_life(180_000.0)
     };
     let bench = common::Bench::new(&g);
-    let end = bench.simulate(&plan, None, &mut |_| Ok(())).unwrap();
+    let wf = bench.geo.wheel_flank(bench.tca.loaded_flank);
+    // Each state hands its friction to the writers (the maps of the worn flank): the one its
+    // record states, whose flank map integrates to its mesh loss.
+    let mut views = 0;
+    let end = bench
+        .simulate(&plan, None, &mut |view| {
+            let f = &view.thermal.friction;
+            let r = view.state.records.last().unwrap();
+            assert_eq!(f.mesh_loss_w, r.friction.mesh_loss_w);
+            assert_eq!(view.thermal.oil_temperature_k, r.friction.oil_temperature_k);
+            let on_flank: f64 = f
+                .flank_power_density
+                .iter()
+                .zip(&wf.cell_area)
+                .map(|(d, a)| d * a)
+                .sum();
+            assert!((on_flank / f.mesh_loss_w - 1.0).abs() < 1e-12);
+            views += 1;
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(views, end.records.len());
     let conductance = g.housing.heat_transfer * g.housing.area;
     for r in &end.records {
         // P2 from the mesh efficiency and loss, then P_V from the total efficiency.

@@ -159,22 +159,13 @@ fn flank_grid_csv(
     let path = dir.join(format!("wheel_flank_{name}_nodes.csv"));
     nodes.write(&path)?;
     files.push(path);
-    let mut cells = Csv::new(&["i", "j", "r_mm", "z_mm", "theta_rad", "area_mm2", "active"]);
-    for j in 0..wf.cells_face {
-        for i in 0..wf.cells_height {
-            let k = j * wf.cells_height + i;
-            let c = &wf.cells[k];
-            cells.row(&[
-                i as f64,
-                j as f64,
-                c.r * MM,
-                c.z * MM,
-                c.theta,
-                wf.cell_area[k] * MM * MM,
-                if wf.active[k] { 1.0 } else { 0.0 },
-            ]);
-        }
-    }
+    let cells = super::flank_cell_table(wf, &["theta_rad", "area_mm2", "active"], |k| {
+        vec![
+            wf.cells[k].theta,
+            wf.cell_area[k] * MM * MM,
+            if wf.active[k] { 1.0 } else { 0.0 },
+        ]
+    });
     let path = dir.join(format!("wheel_flank_{name}_cells.csv"));
     cells.write(&path)?;
     files.push(path);

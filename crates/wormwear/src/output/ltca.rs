@@ -603,31 +603,21 @@ pub fn positions_table(tca: &Tca, ltca: &Ltca) -> Csv {
 /// The loaded pattern per flank cell (`ltca_pattern.csv`): the largest pressure over the
 /// cycle, Pa, at the cell's (r, z), mm.
 pub fn pattern_table(wf: &WheelFlank, ltca: &Ltca) -> Csv {
-    let mut csv = Csv::new(&[
-        "i",
-        "j",
-        "r_mm",
-        "z_mm",
-        "max_pressure_pa",
-        "equivalent_pressure_pa",
-        "equivalent_depth_mm",
-    ]);
-    for j in 0..wf.cells_face {
-        for i in 0..wf.cells_height {
-            let k = j * wf.cells_height + i;
-            let c = &wf.cells[k];
-            csv.row(&[
-                i as f64,
-                j as f64,
-                c.r * MM,
-                c.z * MM,
+    super::flank_cell_table(
+        wf,
+        &[
+            "max_pressure_pa",
+            "equivalent_pressure_pa",
+            "equivalent_depth_mm",
+        ],
+        |k| {
+            vec![
                 ltca.pattern[k],
                 ltca.equivalent_pattern.get(k).copied().unwrap_or(0.0),
                 ltca.equivalent_depth.get(k).copied().unwrap_or(0.0) * MM,
-            ]);
-        }
-    }
-    csv
+            ]
+        },
+    )
 }
 
 /// The local pressures of every position (`ltca_pressures.csv`): per contact cell its tooth,

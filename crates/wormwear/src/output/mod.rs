@@ -350,6 +350,31 @@ pub fn write_rating(
     Ok(r)
 }
 
+/// A table of the flank grid's cells, face column by face column: i (up the height), j
+/// (across the face), the cell centre's r_mm and z_mm, then `columns` with the values
+/// `values(k)` of cell k.
+pub(crate) fn flank_cell_table(
+    wf: &crate::geometry::WheelFlank,
+    columns: &[&str],
+    values: impl Fn(usize) -> Vec<f64>,
+) -> Csv {
+    let header: Vec<&str> = ["i", "j", "r_mm", "z_mm"]
+        .into_iter()
+        .chain(columns.iter().copied())
+        .collect();
+    let mut csv = Csv::new(&header);
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let k = j * wf.cells_height + i;
+            let c = &wf.cells[k];
+            let mut row = vec![i as f64, j as f64, c.r * 1e3, c.z * 1e3];
+            row.extend(values(k));
+            csv.row(&row);
+        }
+    }
+    csv
+}
+
 /// A CSV table built in memory and written atomically.
 #[derive(Debug, Clone)]
 pub struct Csv {

@@ -53,6 +53,8 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
             "wear_film_thickness_map",
             "wear_damage_map",
             "wear_pattern",
+            "wear_friction_coefficient_map",
+            "wear_friction_power_map",
             "wear_map_step*",
             "wear_film_ratio_map_step*",
             "wear_pattern_step*",

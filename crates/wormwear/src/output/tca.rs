@@ -281,21 +281,9 @@ fn pattern_files(
     dir: &Path,
     files: &mut Vec<PathBuf>,
 ) -> Result<(), OutputError> {
-    let mut csv = Csv::new(&["i", "j", "r_mm", "z_mm", "min_separation_um", "marked"]);
-    for j in 0..wf.cells_face {
-        for i in 0..wf.cells_height {
-            let k = j * wf.cells_height + i;
-            let c = &wf.cells[k];
-            csv.row(&[
-                i as f64,
-                j as f64,
-                c.r * MM,
-                c.z * MM,
-                tca.min_separation[k] * UM,
-                tca.marked[k] as u8 as f64,
-            ]);
-        }
-    }
+    let csv = super::flank_cell_table(wf, &["min_separation_um", "marked"], |k| {
+        vec![tca.min_separation[k] * UM, tca.marked[k] as u8 as f64]
+    });
     let path = dir.join("tca_pattern.csv");
     csv.write(&path)?;
     files.push(path);

@@ -13,11 +13,13 @@ use crate::kinematics::Tca;
 use crate::ltca::{stats, Ltca};
 
 /// What the life loop hands out after each completed state: the state (to checkpoint), the
-/// loaded analysis and the per-cycle wear on that geometry.
+/// loaded analysis, the per-cycle wear and the friction on that geometry.
 pub struct StepView<'a> {
     pub state: &'a WearState,
     pub ltca: &'a Ltca,
     pub cycle: &'a CycleWear,
+    /// The friction, efficiency and oil temperature of that loaded analysis (MODEL §13).
+    pub thermal: &'a Thermal,
     /// The last state of the run (the life is reached).
     pub last: bool,
     /// A state whose maps are written (`map_cycles`, or 0, 1, 2, 4, ... by default).
@@ -90,6 +92,7 @@ pub fn simulate(
             state: &state,
             ltca: &l,
             cycle: &cw,
+            thermal: &thermal,
             last,
             map: life_loop.is_map_state(&state),
         })?;

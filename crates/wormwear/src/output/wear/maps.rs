@@ -1,5 +1,5 @@
 //! The maps of a map state (`[wear] map_cycles`): cumulative wear, wear per cycle, film thickness
-//! and ratio, the loaded pattern, the damage, and `wheel_flank_wear.vtp` with them.
+//! and ratio, the loaded pattern, the damage, the friction, and `wheel_flank_wear.vtp` with them.
 
 use super::*;
 
@@ -83,7 +83,32 @@ impl StateMaps<'_> {
             files.extend(self.damage_section()?);
         }
         files.extend(self.plastic_and_pattern(suffix)?);
+        files.extend(self.friction_maps(suffix)?);
         Ok(files)
+    }
+
+    /// The friction of this state's loaded analysis (MODEL §13): `wear_friction_coefficient_map`
+    /// and `wear_friction_power_map` with `suffix`.
+    fn friction_maps(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
+        let wf = self.geo.wheel_flank(self.tca.loaded_flank);
+        let r = self
+            .view
+            .state
+            .records
+            .last()
+            .expect("a state has a record");
+        let overlays = [
+            flank_outline(wf, "active flank", 5),
+            tip_trace_series(self.tca),
+        ];
+        crate::output::friction::friction_maps(
+            wf,
+            self.view.thermal,
+            self.dir,
+            ("wear_friction", suffix),
+            &format!(" at {} cycles", crate::output::cycles_label(r.cycles)),
+            &overlays,
+        )
     }
 
     /// The maps of the cumulative wear, the wear per cycle and the film ratio and thickness.
