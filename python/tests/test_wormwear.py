@@ -95,6 +95,12 @@ def test_ltca_equals_the_cli_in_numbers_and_files(cli, design_file, tmp_path):
     assert r.friction.coefficient.values.shape == (40, 60)
     mu = r.friction.coefficient.values
     assert 0 < np.nanmin(mu) <= np.nanmax(mu) <= r.friction.friction["mean_coefficient"] * 10
+    # The safety table (MODEL §9.1) as a DataFrame, the file's rows.
+    safety = r.rating.safety
+    file = pd.read_csv(tmp_path / "cli" / "rating.csv")
+    assert list(safety["symbol"]) == list(file["symbol"]) and "S_H" in list(safety["symbol"])
+    np.testing.assert_allclose(safety["value"].to_numpy(float), file["value"].to_numpy(float), rtol=1e-6)
+    assert list(safety["verdict"]) == list(file["verdict"])
     r.write(tmp_path / "py")
     assert_same_files(tmp_path / "cli", tmp_path / "py")
 

@@ -174,6 +174,22 @@ def _namespace(section: Optional[dict], **extra: Any) -> Optional[types.SimpleNa
     return ns
 
 
+def _safety_frame(table: dict) -> pd.DataFrame:
+    """The safety table of summary.json as a DataFrame, the verdicts as text."""
+    def verdict(v: Any) -> str:
+        if isinstance(v, dict):
+            return "; ".join(f"{k.replace('_', ' ')}: {t}" for k, t in v.items())
+        return "FAIL" if v == "fail" else str(v)
+
+    rows = [dict(r, verdict=verdict(r["verdict"])) for r in table["rows"]]
+    frame = pd.DataFrame.from_records(rows)
+    for c in ("value", "allowable", "safety", "minimum"):
+        frame[c] = pd.to_numeric(frame[c], errors="coerce")
+    frame.attrs["application_factor"] = table["application_factor"]
+    frame.attrs["required_cycles"] = table["required_cycles"]
+    return frame
+
+
 class Results:
     """What a run computed, by stage (None where the stage did not run).
 
@@ -193,7 +209,10 @@ class Results:
       from the contact, MODEL §13), the DataFrame ``table`` (every flank cell: r_mm, z_mm,
       friction_coefficient, friction_power_density_w_m2) and the maps ``coefficient``
       (load-weighted friction coefficient over the cycle) and ``power_density`` (W/m^2);
-    - ``rating``: the standard's ratings (efficiency, sigma_Hm, lives...);
+    - ``rating``: the standard's ratings (efficiency, sigma_Hm, lives...) and ``safety``, the
+      safety table from the model (MODEL §9.1) as a DataFrame: one row per quantity (quantity,
+      symbol, unit, value, allowable, safety, minimum, verdict, source; ``attrs`` holds
+      ``application_factor`` and ``required_cycles``);
     - ``warnings``: list of str.
 
     ``write(directory)`` writes the files the CLI writes for the same stages.
@@ -206,7 +225,11 @@ class Results:
         self.warnings: list = native.warnings()
         self.geometry = _namespace(self.summary.get("geometry"))
         self.tca = _namespace(self.summary.get("tca"))
-        self.rating = _namespace(self.summary.get("rating"))
+        rating = self.summary.get("rating")
+        self.rating = None
+        if rating is not None:
+            table = rating.get("safety")
+            self.rating = _namespace(rating, safety=None if table is None else _safety_frame(table))
         friction = self.summary.get("friction")
         self.friction = None
         if friction is not None:

@@ -51,6 +51,7 @@ class Results:
     #: friction section values (efficiency, oil temperature, MODEL §13) and table (DataFrame),
     #: coefficient / power_density (FlankMap, 1 and W/m^2).
     friction: Optional[types.SimpleNamespace]
+    #: the standard's ratings and safety (DataFrame: the safety table from the model).
     rating: Optional[types.SimpleNamespace]
     def table(self, name: str) -> Optional[pd.DataFrame]: ...
     def to_rexs(self, path: str | os.PathLike[str]) -> None: ...

@@ -89,6 +89,22 @@ enum Command {
         #[command(flatten)]
         life: LifeArgs,
     },
+    /// The safety table from the model (MODEL §9.1): tooth root, worm deflection, pitting,
+    /// wear at the required life, oil temperature, against the [rating] table's allowables and
+    /// minimums; runs the loaded analysis, and the life when the file has a [wear] section (or
+    /// --cycles is given). Writes rating.csv and summary.json's `rating` section.
+    #[command(
+        after_help = "Example:\n  wormwear rating examples/gear-1x40-design.toml -o out/rating"
+    )]
+    Rating {
+        /// Gear file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        life: LifeArgs,
+    },
     /// The whole pipeline the file asks for: geometry, unloaded and loaded analyses, ratings,
     /// the life when the file has a [wear] section (or --cycles is given), and report.html.
     #[command(
@@ -297,6 +313,7 @@ fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, Exi
         | Command::Ltca { output, .. }
         | Command::Wear { output, .. }
         | Command::Run { output, .. }
+        | Command::Rating { output, .. }
         | Command::Calibrate { output, .. }
         | Command::Sweep { output, .. }
         | Command::ExportRexs { output, .. }
@@ -332,6 +349,9 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
         } => ltca(file, output, *map_position, cli.quiet),
         Command::Wear { file, output, life } => wear(file, output, life, cli.quiet, cli.verbose),
         Command::Run { file, output, life } => run(file, output, life, cli.quiet, cli.verbose),
+        Command::Rating { file, output, life } => {
+            rating(file, output, life, cli.quiet, cli.verbose)
+        }
         Command::Calibrate {
             file,
             output,
@@ -751,6 +771,20 @@ fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearSt
     }
 }
 
+/// The request of `run` and `rating`: the stages `with_life` and the life request when the
+/// file has a `[wear]` section or the command line asks for a life, else `without`.
+fn planned_request(
+    dir: &Path,
+    gear: &GearSet,
+    args: &LifeArgs,
+    (with_life, without): (&[wormwear::Stage], &[wormwear::Stage]),
+) -> Result<wormwear::Request, Failure> {
+    match gear.wear.is_some() || args.overrides().asks_for_life() {
+        true => life_request(dir, gear, args, with_life),
+        false => Ok(wormwear::Request::new(without.iter().copied())),
+    }
+}
+
 fn run(
     file: &Path,
     dir: &Path,
@@ -760,10 +794,8 @@ fn run(
 ) -> Result<(), Failure> {
     use wormwear::Stage;
     let gear = load(file)?;
-    let request = match gear.wear.is_some() || args.overrides().asks_for_life() {
-        true => life_request(dir, &gear, args, &Stage::ALL)?,
-        false => wormwear::Request::new([Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report]),
-    };
+    let without_life = [Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report];
+    let request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
     let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
     if !quiet {
         print_geometry(&results, dir);
@@ -772,11 +804,70 @@ fn run(
     }
     finish_life(&results, dir, quiet);
     if !quiet {
+        if let Some(table) = &results.safety {
+            print_safety(table);
+        }
         if let Some(report) = files.iter().find(|f| f.ends_with("report.html")) {
             println!("report: {}", report.display());
         }
     }
     Ok(())
+}
+
+/// The safety table (MODEL §9.1): the loaded analysis and, with a life plan, the life.
+fn rating(
+    file: &Path,
+    dir: &Path,
+    args: &LifeArgs,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(), Failure> {
+    use wormwear::Stage;
+    let gear = load(file)?;
+    let request = planned_request(
+        dir,
+        &gear,
+        args,
+        (&[Stage::Ltca, Stage::Wear], &[Stage::Ltca]),
+    )?;
+    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    if let (Some(table), false) = (&results.safety, quiet) {
+        print_safety(table);
+        println!("results in {}", dir.display());
+    }
+    Ok(())
+}
+
+/// The safety table on stdout, one line per row.
+fn print_safety(table: &wormwear::safety::SafetyTable) {
+    let cell = |v: Option<f64>| match v {
+        Some(x) if x.is_finite() => format!("{x:.4}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    };
+    println!(
+        "safety (MODEL §9.1; K_A {}, required life {}):",
+        table.application_factor,
+        table
+            .required_cycles
+            .map_or("not given".into(), |n| format!("{n:.4e} wheel cycles"))
+    );
+    println!(
+        "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} verdict",
+        "symbol", "value", "allowable", "safety", "minimum", "unit"
+    );
+    for r in &table.rows {
+        println!(
+            "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} {}",
+            r.symbol,
+            cell(r.value),
+            cell(r.allowable),
+            cell(r.safety),
+            r.minimum,
+            r.unit,
+            r.verdict.text()
+        );
+    }
 }
 
 /// K from wear tests or from a backlash curve; writes the `calibration` section.

@@ -35,6 +35,7 @@ pub use output::plot;
 pub mod rating;
 pub mod rexs;
 pub mod runner;
+pub mod safety;
 pub mod subsurface;
 pub mod sweep;
 pub mod validation;
@@ -59,5 +60,7 @@ pub fn run(
     let ltca = pipeline.loaded_analysis(&geometry, tca.as_ref(), &bending)?;
     let thermal = pipeline.friction(&geometry, tca.as_ref(), ltca.as_ref())?;
     let life = pipeline.life(&geometry, tca.as_ref(), &bending)?;
-    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal), life))
+    let analyses = (ltca.as_ref(), thermal.as_ref(), life.as_ref());
+    let safety = pipeline.safety(&geometry, tca.as_ref(), &bending, analyses)?;
+    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal, safety), life))
 }

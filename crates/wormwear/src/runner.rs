@@ -374,6 +374,8 @@ pub struct Results {
     pub rating: Option<Rating>,
     /// Friction, efficiency and oil temperature from the loaded analysis (MODEL §13).
     pub thermal: Option<crate::friction::Thermal>,
+    /// The safety table from the model (MODEL §9.1), with a loaded analysis.
+    pub safety: Option<crate::safety::SafetyTable>,
     /// Warnings of the stages, each with its stage's prefix where the CLI prints one.
     pub warnings: Vec<String>,
 }
@@ -545,17 +547,81 @@ impl<'a> Pipeline<'a> {
         .map_err(RunError::Friction)
     }
 
+    /// The safety table (MODEL §9.1) beside a loaded analysis: its strength rows from a
+    /// loaded analysis at K_A times the torque (the run's own when K_A is 1), the wear and
+    /// temperature rows from the run's life and heat balance at the nominal torque.
+    pub(crate) fn safety(
+        &mut self,
+        geo: &Geometry,
+        tca: Option<&Tca>,
+        bending: &Bending,
+        (ltca, thermal, life): (
+            Option<&Ltca>,
+            Option<&crate::friction::Thermal>,
+            Option<&Life>,
+        ),
+    ) -> Result<Option<crate::safety::SafetyTable>, RunError> {
+        let (Some(tca), Some(ltca)) = (tca, ltca) else {
+            return Ok(None);
+        };
+        let gear = self.gear;
+        let ka = gear.rating.safety.application_factor;
+        let scaled = (ka != 1.0).then(|| crate::safety::scaled_torque(gear, ka));
+        let ltca_ka = match &scaled {
+            Some(g) => {
+                let mut ignored = Vec::new();
+                Some(loaded_analysis(
+                    g,
+                    geo,
+                    tca,
+                    bending.model.as_ref(),
+                    &mut ignored,
+                )?)
+            }
+            None => None,
+        };
+        let endurance = self
+            .request
+            .life
+            .as_ref()
+            .or(gear.wear.as_ref())
+            .map_or(crate::input::Endurance::DEFAULT, |p| p.endurance);
+        let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
+            gear,
+            iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
+            ltca: ltca_ka.as_ref().unwrap_or(ltca),
+            thermal,
+            records: life.map(|l| l.end.records.as_slice()),
+            endurance,
+        });
+        self.warnings.extend(table.failed().map(|r| {
+            format!(
+                "safety: {} = {:.2} is below its minimum {} ({})",
+                r.symbol,
+                r.safety.unwrap_or(f64::NAN),
+                r.minimum,
+                r.quantity
+            )
+        }));
+        Ok(Some(table))
+    }
+
     /// The results of the run, with the ratings (MODEL §9) beside a loaded stage.
     pub(crate) fn results(
         self,
         geometry: Geometry,
         tca: Option<Tca>,
         bending: Bending,
-        (ltca, thermal): (Option<Ltca>, Option<crate::friction::Thermal>),
+        (ltca, thermal, safety): (
+            Option<Ltca>,
+            Option<crate::friction::Thermal>,
+            Option<crate::safety::SafetyTable>,
+        ),
         life: Option<Life>,
     ) -> Results {
         Results {
             thermal,
+            safety,
             rating: self
                 .request
                 .needs_bending()

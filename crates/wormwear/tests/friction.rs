@@ -140,13 +140,7 @@ fn a_life_with_the_heat_balance_holds_it_at_every_state_and_the_film_follows_the
     // temperature recorded, and that temperature's viscosity is the one the film used; the
     // fixed-temperature life beside it records the lubricant's.
     let mut g = design();
-    g.housing = input::Housing {
-        balance: true,
-        area: 1.0,
-        heat_transfer: 200.0,
-        ambient: 293.15,
-        cooler: 0.0,
-    };
+    g.housing = wormwear::validation::study_housing();
     let plan = wormwear::wear::WearPlan {
         step: wormwear::wear::StepControl::Cycles(45_000.0),
         ..wormwear::wear::WearPlan::with_life(180_000.0)

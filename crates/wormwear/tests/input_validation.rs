@@ -937,3 +937,41 @@ fn friction_and_heat_balance_inputs_are_checked_by_name() {
     assert!(gear.housing.balance && (gear.housing.ambient - 298.15).abs() < 1e-12);
     assert!(gear.housing.area > 0.0 && gear.housing.heat_transfer > 0.0);
 }
+
+#[test]
+fn safety_table_inputs_are_checked_by_name_and_converted_to_si() {
+    // Each bad value named with its field and value, all reported at once; good ones in SI.
+    let with = |lines: &str| design().replace("[rating]\n", &format!("[rating]\n{lines}\n"));
+    let e = error_of(&with(
+        "required_life_h = -5.0\napplication_factor = 0.5\ndeflection_limit_um = 0.0\n\
+         oil_temperature_limit_c = 400.0\nminimum_safety_wear = 0.0\nstarts_per_hour = -1.0",
+    ));
+    assert_mentions(
+        &e,
+        &[
+            "rating.required_life_h",
+            "-5",
+            "rating.application_factor",
+            "0.5",
+            "rating.deflection_limit_um",
+            "rating.oil_temperature_limit_c",
+            "400",
+            "rating.minimum_safety_wear",
+            "rating.starts_per_hour",
+        ],
+    );
+    let gear = input::load_from_str(&with(
+        "required_life_h = 2000.0\nroot_stress_allowable_mpa = 80.0\ndeflection_limit_um = 40.0\n\
+         thickness_loss_limit_mm = 0.5\nmass_loss_limit_g = 30.0\noil_temperature_limit_c = 90.0\n\
+         application_factor = 1.25\nminimum_safety_pitting = 1.5",
+    ))
+    .unwrap();
+    let s = gear.rating.safety;
+    assert_eq!(s.required_life_hours, Some(2000.0));
+    assert_eq!(s.root_stress_allowable, Some(80e6));
+    assert!((s.deflection_limit.unwrap() - 40e-6).abs() < 1e-18);
+    assert!((s.thickness_loss_limit.unwrap() - 0.5e-3).abs() < 1e-18);
+    assert!((s.mass_loss_limit.unwrap() - 0.03).abs() < 1e-15);
+    assert!((s.oil_temperature_limit.unwrap() - 363.15).abs() < 1e-12);
+    assert_eq!((s.application_factor, s.minimum[2]), (1.25, 1.5));
+}

@@ -483,6 +483,10 @@ pub struct RatingFactors {
     pub pitting_life_factor: f64,
     /// Allowable pitted flank share at the end of the growth phase A_p10,max, %.
     pub pitted_area_max_percent: f64,
+    /// The safety table's inputs (MODEL §9.1); left out of the gear's JSON when all default,
+    /// so that gears without them keep their fingerprints.
+    #[serde(skip_serializing_if = "SafetyInputs::is_default")]
+    pub safety: SafetyInputs,
 }
 
 impl Default for RatingFactors {
@@ -492,7 +496,58 @@ impl Default for RatingFactors {
             friction_factor: 1.0,
             pitting_life_factor: 1.0,
             pitted_area_max_percent: 8.0,
+            safety: SafetyInputs::default(),
         }
+    }
+}
+
+/// The safety table's inputs (MODEL §9.1), SI. A limit left out (None) leaves its safety
+/// "needs input": none of them has a citable default.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SafetyInputs {
+    /// Required life, h.
+    pub required_life_hours: Option<f64>,
+    /// Application factor K_A on the torque of the strength checks (root, deflection,
+    /// pitting).
+    pub application_factor: f64,
+    /// Starts per hour N_S (MODEL §9: W_NS = 1 + 0.015 N_S on the flank loss).
+    pub starts_per_hour: f64,
+    /// Allowable root stress of the wheel, Pa.
+    pub root_stress_allowable: Option<f64>,
+    /// Worm deflection limit at the mesh point, m.
+    pub deflection_limit: Option<f64>,
+    /// Allowable tooth thickness loss Delta_s_lim, m (MODEL §9 (b)).
+    pub thickness_loss_limit: Option<f64>,
+    /// Allowable wheel mass loss Delta_m_lim, kg (MODEL §9 (c)).
+    pub mass_loss_limit: Option<f64>,
+    /// Allowed oil sump temperature, K.
+    pub oil_temperature_limit: Option<f64>,
+    /// Minimum safeties, in the table's order: root S_F, deflection S_delta, pitting S_H,
+    /// wear S_W, temperature S_T.
+    pub minimum: [f64; 5],
+}
+
+impl Default for SafetyInputs {
+    /// No required life and no limits, K_A 1, no starts, every minimum 1.
+    fn default() -> Self {
+        Self {
+            required_life_hours: None,
+            application_factor: 1.0,
+            starts_per_hour: 0.0,
+            root_stress_allowable: None,
+            deflection_limit: None,
+            thickness_loss_limit: None,
+            mass_loss_limit: None,
+            oil_temperature_limit: None,
+            minimum: [1.0; 5],
+        }
+    }
+}
+
+impl SafetyInputs {
+    /// Whether every input is its default.
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
     }
 }
 

@@ -89,6 +89,28 @@ pub struct RatingSpec {
     pub pitting_life_factor: Option<f64>,
     /// Allowable pitted flank share at the end of pitting growth A_p10,max, %.
     pub pitted_area_max_percent: Option<f64>,
+    /// Safety table (MODEL §9.1): required life, hours (no default: S_H and S_W need it).
+    pub required_life_h: Option<f64>,
+    /// Application factor K_A on the torque of the strength checks (default 1).
+    pub application_factor: Option<f64>,
+    /// Starts per hour N_S (default 0): W_NS = 1 + 0.015 N_S on the flank loss (MODEL §9).
+    pub starts_per_hour: Option<f64>,
+    /// Allowable root stress of the wheel, MPa (no default: S_F needs it).
+    pub root_stress_allowable_mpa: Option<f64>,
+    /// Worm deflection limit at the mesh point, um (no default: S_delta needs it).
+    pub deflection_limit_um: Option<f64>,
+    /// Allowable tooth thickness loss Delta_s_lim, mm (MODEL §9 (b); optional).
+    pub thickness_loss_limit_mm: Option<f64>,
+    /// Allowable wheel mass loss Delta_m_lim, g (MODEL §9 (c); optional).
+    pub mass_loss_limit_g: Option<f64>,
+    /// Allowed oil sump temperature, degC (no default: S_T needs it).
+    pub oil_temperature_limit_c: Option<f64>,
+    /// Minimum safeties (default 1 each: the computed value reaches the allowable).
+    pub minimum_safety_root: Option<f64>,
+    pub minimum_safety_deflection: Option<f64>,
+    pub minimum_safety_pitting: Option<f64>,
+    pub minimum_safety_wear: Option<f64>,
+    pub minimum_safety_temperature: Option<f64>,
 }
 
 /// Life simulation (MODEL §7.3, §8).

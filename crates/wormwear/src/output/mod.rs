@@ -9,6 +9,7 @@ pub mod geometry;
 pub mod ltca;
 pub mod plot;
 pub mod report;
+pub mod safety;
 pub mod tca;
 pub mod vtk;
 pub mod wear;
@@ -227,6 +228,9 @@ pub fn write_results(
         if let Some(r) = results.rating.as_ref() {
             update_summary(dir, "rating", to_json("rating", r)?)?;
         }
+        if let Some(table) = results.safety.as_ref() {
+            files.extend(safety::write_safety(table, dir)?);
+        }
         if let Some(thermal) = results.thermal.as_ref() {
             update_summary(dir, "friction", to_json("friction", thermal)?)?;
             let wf = geo.wheel_flank(t.loaded_flank);
@@ -267,7 +271,11 @@ pub fn summary_sections(
         map.insert("ltca".into(), ltca::summary_value(t, wf, l)?);
     }
     if let Some(r) = results.rating.as_ref() {
-        map.insert("rating".into(), to_json("rating", r)?);
+        let mut rating = to_json("rating", r)?;
+        if let (Some(m), Some(table)) = (rating.as_object_mut(), results.safety.as_ref()) {
+            m.insert("safety".into(), safety::safety_value(table)?);
+        }
+        map.insert("rating".into(), rating);
     }
     if let Some(t) = results.thermal.as_ref() {
         map.insert("friction".into(), to_json("friction", t)?);

@@ -189,6 +189,7 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
     let mut h = String::new();
     page_head(&mut h, title);
     contents(&mut h, &summary);
+    safety_section(&mut h, &summary);
     warnings_section(&mut h, &summary);
     key_results(&mut h, &summary);
     for (name, key, prefixes) in SECTIONS {
@@ -218,7 +219,7 @@ fn page_head(h: &mut String, title: &str) {
          table{{border-collapse:collapse;margin:.5em 0 1em}} td,th{{border:1px solid #ccc;padding:.2em .6em;text-align:left}}\
          td.n{{text-align:right;font-variant-numeric:tabular-nums}} figure{{margin:1em 0}}\
          figcaption{{color:#555;font-size:.9em}} pre{{background:#f6f6f6;padding:1em;overflow-x:auto;font-size:.85em}}\
-         .warn{{color:#a40}} nav a{{margin-right:1em}}</style></head><body>\n\
+         .warn{{color:#a40}} .fail{{color:#b00}} tr.fail td{{background:#fdd}} nav a{{margin-right:1em}}</style></head><body>\n\
          <h1>wormwear — {t}</h1>\n",
         t = escape(title)
     );
@@ -227,13 +228,81 @@ fn page_head(h: &mut String, title: &str) {
 /// The contents bar: the key results, the stages the summary holds, files and input.
 fn contents(h: &mut String, summary: &serde_json::Value) {
     // Contents.
-    h.push_str("<nav><a href=\"#key\">Key results</a>");
+    h.push_str("<nav>");
+    if summary["rating"]["safety"].is_object() {
+        h.push_str("<a href=\"#safety\">Safety</a>");
+    }
+    h.push_str("<a href=\"#key\">Key results</a>");
     for (name, key, _) in SECTIONS {
         if summary.get(key).is_some() {
             let _ = write!(h, "<a href=\"#{key}\">{}</a>", escape(name));
         }
     }
     h.push_str("<a href=\"#files\">Files</a><a href=\"#input\">Input</a></nav>\n");
+}
+
+/// The verdict of a safety row of summary.json as text ("pass", "FAIL", "needs input: ...").
+fn verdict_text(v: &serde_json::Value) -> String {
+    match v {
+        serde_json::Value::String(s) if s == "fail" => "FAIL".into(),
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Object(m) => m
+            .iter()
+            .map(|(k, v)| format!("{}: {}", k.replace('_', " "), v.as_str().unwrap_or("")))
+            .collect(),
+        _ => String::new(),
+    }
+}
+
+/// The safety table (MODEL §9.1) at the top of the page, a row in red where its safety falls
+/// below its minimum.
+fn safety_section(h: &mut String, summary: &serde_json::Value) {
+    let table = &summary["rating"]["safety"];
+    let Some(rows) = table["rows"].as_array() else {
+        return;
+    };
+    let number = |v: &serde_json::Value| match v.as_f64() {
+        Some(x) => format!("{x:.4}"),
+        None => "-".into(),
+    };
+    let failed = rows.iter().filter(|r| r["verdict"] == "fail").count();
+    let _ = writeln!(
+        h,
+        "<section id=\"safety\"><h2>Safety</h2><p>From the model (MODEL §9.1): K_A {}, required \
+         life {}. {}</p><table><tr><th>quantity</th><th>symbol</th><th>value</th>\
+         <th>allowable</th><th>unit</th><th>safety</th><th>minimum</th><th>verdict</th>\
+         <th>how</th></tr>",
+        table["application_factor"],
+        table["required_cycles"]
+            .as_f64()
+            .map_or("not given".into(), |n| format!("{n:.4e} wheel cycles")),
+        match failed {
+            0 => String::new(),
+            n => format!("<b class=\"fail\">{n} safety value(s) below the minimum.</b>"),
+        }
+    );
+    for r in rows {
+        let class = if r["verdict"] == "fail" {
+            " class=\"fail\""
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            h,
+            "<tr{class}><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>\
+             <td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
+            escape(r["quantity"].as_str().unwrap_or("")),
+            escape(r["symbol"].as_str().unwrap_or("")),
+            number(&r["value"]),
+            number(&r["allowable"]),
+            escape(r["unit"].as_str().unwrap_or("")),
+            number(&r["safety"]),
+            number(&r["minimum"]),
+            escape(&verdict_text(&r["verdict"])),
+            escape(r["source"].as_str().unwrap_or(""))
+        );
+    }
+    h.push_str("</table></section>\n");
 }
 
 /// The warnings of every stage.

@@ -309,10 +309,82 @@ pub(super) fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingF
         2.0 + 1e-9,
         100.0,
     );
+    let safety = safety_inputs(ck, r);
     Some(RatingFactors {
         friction_factor: ys? * yg? * yw? * yr?,
         pitting_life_factor: z?,
         pitted_area_max_percent: ap?,
+        safety: safety?,
+    })
+}
+
+/// The safety table's inputs of `[rating]` (MODEL §9.1), in SI.
+fn safety_inputs(ck: &mut Checker, r: &RatingSpec) -> Option<SafetyInputs> {
+    let mut limit = |name: &str, v: Option<f64>, hi: f64, unit: &str, scale: f64| match v {
+        Some(v) => ck
+            .positive(&format!("rating.{name}"), v, hi, unit)
+            .map(|v| Some(v * scale)),
+        None => Some(None),
+    };
+    let hours = limit("required_life_h", r.required_life_h, 1e7, "h", 1.0);
+    let root = limit(
+        "root_stress_allowable_mpa",
+        r.root_stress_allowable_mpa,
+        1e4,
+        "MPa",
+        1e6,
+    );
+    let deflection = limit(
+        "deflection_limit_um",
+        r.deflection_limit_um,
+        1e5,
+        "um",
+        1e-6,
+    );
+    let thickness = limit(
+        "thickness_loss_limit_mm",
+        r.thickness_loss_limit_mm,
+        100.0,
+        "mm",
+        1e-3,
+    );
+    let mass = limit("mass_loss_limit_g", r.mass_loss_limit_g, 1e6, "g", 1e-3);
+    let temperature = match r.oil_temperature_limit_c {
+        Some(t) => ck
+            .range("rating.oil_temperature_limit_c", t, 0.0, 200.0, "degC")
+            .map(|t| Some(t + 273.15)),
+        None => Some(None),
+    };
+    let mut factor = |name: &str, v: Option<f64>, d: f64, lo: f64, hi: f64| match v {
+        Some(v) => ck.range(&format!("rating.{name}"), v, lo, hi, ""),
+        None => Some(d),
+    };
+    let ka = factor("application_factor", r.application_factor, 1.0, 1.0, 10.0);
+    let starts = factor("starts_per_hour", r.starts_per_hour, 0.0, 0.0, 3600.0);
+    let minimum = [
+        ("minimum_safety_root", r.minimum_safety_root),
+        ("minimum_safety_deflection", r.minimum_safety_deflection),
+        ("minimum_safety_pitting", r.minimum_safety_pitting),
+        ("minimum_safety_wear", r.minimum_safety_wear),
+        ("minimum_safety_temperature", r.minimum_safety_temperature),
+    ]
+    .map(|(name, v)| factor(name, v, 1.0, 0.1, 10.0));
+    Some(SafetyInputs {
+        required_life_hours: hours?,
+        application_factor: ka?,
+        starts_per_hour: starts?,
+        root_stress_allowable: root?,
+        deflection_limit: deflection?,
+        thickness_loss_limit: thickness?,
+        mass_loss_limit: mass?,
+        oil_temperature_limit: temperature?,
+        minimum: [
+            minimum[0]?,
+            minimum[1]?,
+            minimum[2]?,
+            minimum[3]?,
+            minimum[4]?,
+        ],
     })
 }
 

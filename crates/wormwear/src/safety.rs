@@ -1,0 +1,470 @@
+//! The safety table from the model (MODEL §9.1, the standards' method A): pitting from the
+//! equivalent pressure below the flank against the bronze's pressure–life curve, wear from the
+//! simulated flank loss at the required life against the limits of MODEL §9 (a)-(d), the oil
+//! temperature of the heat balance (MODEL §13), the worm's deflection and the wheel's root
+//! stress. Each row: the computed value, its allowable, the safety, the minimum and a verdict;
+//! an allowable without a citable default is an input, and without it the row says so.
+
+use crate::friction::Thermal;
+use crate::input::{Endurance, GearSet, SafetyInputs, Torque};
+use crate::ltca::Ltca;
+use crate::rating::Rating;
+use crate::wear::StepRecord;
+use std::f64::consts::PI;
+
+/// What a safety row concludes.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// The safety reaches its minimum.
+    Pass,
+    /// The safety is below its minimum.
+    Fail,
+    /// An input the row needs is missing (named).
+    NeedsInput(String),
+    /// The model cannot give the value (why).
+    NotComputed(String),
+}
+
+impl Verdict {
+    /// The verdict as table text: "pass", "FAIL", "needs input: ...", "not computed: ...".
+    pub fn text(&self) -> String {
+        match self {
+            Verdict::Pass => "pass".into(),
+            Verdict::Fail => "FAIL".into(),
+            Verdict::NeedsInput(what) => format!("needs input: {what}"),
+            Verdict::NotComputed(why) => format!("not computed: {why}"),
+        }
+    }
+}
+
+/// One row of the safety table. Values and allowables in `unit`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SafetyRow {
+    pub quantity: String,
+    pub symbol: String,
+    pub unit: String,
+    pub value: Option<f64>,
+    pub allowable: Option<f64>,
+    /// allowable / value (None where either is missing).
+    pub safety: Option<f64>,
+    pub minimum: f64,
+    pub verdict: Verdict,
+    /// How the value and the allowable were obtained, with the figures beside it.
+    pub source: String,
+}
+
+/// The safety table of one operating case (MODEL §9.1).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SafetyTable {
+    /// Application factor K_A on the torque of the strength rows.
+    pub application_factor: f64,
+    /// Required life in wheel cycles (revolutions), None without a required life.
+    pub required_cycles: Option<f64>,
+    pub rows: Vec<SafetyRow>,
+}
+
+impl SafetyTable {
+    /// The rows whose safety is below its minimum.
+    pub fn failed(&self) -> impl Iterator<Item = &SafetyRow> {
+        self.rows.iter().filter(|r| r.verdict == Verdict::Fail)
+    }
+}
+
+/// What the table reads from the other stages: the gear, the standard's ratings at K_A times
+/// the torque (its torques, and the figures shown beside), the loaded analysis at K_A times
+/// the torque, the
+/// friction and oil temperature at the nominal torque, the life's records (nominal torque) and
+/// the bronze's pressure–life curve.
+pub struct SafetyInputsOf<'a> {
+    pub gear: &'a GearSet,
+    pub iso: &'a Rating,
+    pub ltca: &'a Ltca,
+    pub thermal: Option<&'a Thermal>,
+    pub records: Option<&'a [StepRecord]>,
+    pub endurance: Endurance,
+}
+
+/// The gear with its torque times `factor` (the rating case of K_A).
+pub fn scaled_torque(gear: &GearSet, factor: f64) -> GearSet {
+    let mut g = gear.clone();
+    g.conditions.torque = match g.conditions.torque {
+        Torque::Worm(t) => Torque::Worm(t * factor),
+        Torque::Wheel(t) => Torque::Wheel(t * factor),
+    };
+    g
+}
+
+/// The wheel cycles (revolutions) of `hours` at the gear's speed.
+pub fn cycles_of_hours(gear: &GearSet, hours: f64) -> f64 {
+    let u = gear.wheel.teeth as f64 / gear.worm.starts as f64;
+    hours * 3600.0 * gear.conditions.worm_speed / (2.0 * PI * u)
+}
+
+/// The safety table (MODEL §9.1) in the order root, deflection, pitting, wear, temperature.
+pub fn safety_table(s: &SafetyInputsOf) -> SafetyTable {
+    let inputs = &s.gear.rating.safety;
+    let required_cycles = inputs
+        .required_life_hours
+        .map(|h| cycles_of_hours(s.gear, h));
+    let mut rows = vec![root_row(inputs), deflection_row(s)];
+    rows.push(pitting_row(s, required_cycles));
+    rows.extend(wear_rows(s, required_cycles));
+    rows.push(temperature_row(s));
+    SafetyTable {
+        application_factor: inputs.application_factor,
+        required_cycles,
+        rows,
+    }
+}
+
+/// A row from its value and allowable: the safety allowable / value against `minimum`.
+fn row(
+    (quantity, symbol, unit): (&str, &str, &str),
+    value: Option<f64>,
+    allowable: Result<f64, Verdict>,
+    minimum: f64,
+    source: String,
+) -> SafetyRow {
+    let (allowable, verdict) = match (value, allowable) {
+        (_, Err(v)) => (None, Some(v)),
+        (None, Ok(a)) => (Some(a), None),
+        (Some(_), Ok(a)) => (Some(a), None),
+    };
+    let safety = match (value, allowable) {
+        (Some(v), Some(a)) if v > 0.0 => Some(a / v),
+        (Some(_), Some(_)) => Some(f64::INFINITY),
+        _ => None,
+    };
+    let verdict = verdict.unwrap_or_else(|| match safety {
+        Some(x) if x >= minimum => Verdict::Pass,
+        Some(_) => Verdict::Fail,
+        None => Verdict::NotComputed("no value".into()),
+    });
+    SafetyRow {
+        quantity: quantity.into(),
+        symbol: symbol.into(),
+        unit: unit.into(),
+        value,
+        allowable,
+        safety,
+        minimum,
+        verdict,
+        source,
+    }
+}
+
+/// Tooth root (S_F): the FE stress recovery at the wheel's root fillet is not in this build.
+fn root_row(inputs: &SafetyInputs) -> SafetyRow {
+    let mut r = row(
+        ("Wheel tooth root stress", "S_F", "MPa"),
+        None,
+        inputs
+            .root_stress_allowable
+            .map(|a| a * 1e-6)
+            .ok_or_else(|| Verdict::NeedsInput("rating.root_stress_allowable_mpa".into())),
+        inputs.minimum[0],
+        "FE wheel model under the loaded contact's pressures at every position (MODEL §9.1)".into(),
+    );
+    if r.allowable.is_some() {
+        r.verdict = Verdict::NotComputed(
+            "the stress recovery at the wheel's root fillet is not in this build".into(),
+        );
+    }
+    r
+}
+
+/// Worm deflection (S_delta) at the mesh point: the shaft as a simply supported beam of the
+/// root diameter between the bearings under the resultant of the tangential and radial mesh
+/// forces at K_A times the torque (Roark's Formulas for Stress and Strain, simply supported
+/// beam under a concentrated load: y = F a^2 b^2 / (3 E I l)), m.
+pub fn simple_beam_deflection(gear: &GearSet, worm_torque: f64, wheel_torque: f64) -> f64 {
+    let w = &gear.worm;
+    let d_m1 = 2.0 * w.reference_radius;
+    let d_m2 = 2.0 * gear.wheel_reference_radius();
+    let gamma = (w.lead() / (PI * d_m1)).atan();
+    let tangential = 2.0 * worm_torque / d_m1;
+    let axial = 2.0 * wheel_torque / d_m2;
+    let radial = axial * w.normal_pressure_angle.tan() / gamma.cos();
+    let force = tangential.hypot(radial);
+    let [b1, b2] = gear.bending.worm_bearings;
+    let (a, b) = ((0.0 - b1).abs(), (b2 - 0.0).abs());
+    let l = a + b;
+    let inertia = PI * (2.0 * w.root_radius).powi(4) / 64.0;
+    force * a * a * b * b / (3.0 * gear.worm_material.youngs_modulus * inertia * l)
+}
+
+fn deflection_row(s: &SafetyInputsOf) -> SafetyRow {
+    let inputs = &s.gear.rating.safety;
+    let beam = simple_beam_deflection(s.gear, s.iso.worm_torque_nm, s.iso.wheel_torque_nm);
+    row(
+        ("Worm deflection at the mesh point", "S_delta", "um"),
+        Some(beam * 1e6),
+        inputs
+            .deflection_limit
+            .map(|d| d * 1e6)
+            .ok_or_else(|| Verdict::NeedsInput("rating.deflection_limit_um".into())),
+        inputs.minimum[1],
+        "simply supported shaft of the root diameter between the bearings under the tangential \
+         and radial mesh forces (Roark); the worm FE model's value is not in this build"
+            .into(),
+    )
+}
+
+/// Pitting (S_H): the largest equivalent pressure below the flank (MODEL §8.1) of the
+/// loaded analysis at K_A times the torque against the bronze's pressure–life curve at the
+/// required cycles (MODEL §8); the standard's sigma_Hm and S_H beside it.
+fn pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
+    let inputs = &s.gear.rating.safety;
+    let iso = format!(
+        "; beside it ISO/TR 14521 (MODEL §9, at K_A T): sigma_Hm {:.0} MPa, S_H {:.2}, \
+         N_LI {:.3e} cycles",
+        s.iso.sigma_hm_mpa, s.iso.pitting_safety, s.iso.n_li_cycles
+    );
+    row(
+        ("Pitting: equivalent pressure below the flank", "S_H", "MPa"),
+        Some(s.ltca.equivalent_pressure_max * 1e-6),
+        required_cycles
+            .map(|n| s.endurance.pressure(n) * 1e-6)
+            .ok_or_else(|| Verdict::NeedsInput("rating.required_life_h".into())),
+        inputs.minimum[2],
+        format!(
+            "largest p_eq = max over depth tau_1 / 0.300 of the unworn loaded analysis (MODEL \
+             §8.1) against p_lim(N) = {:.0} MPa (N / {:.3e})^-{} at the required cycles{iso}",
+            s.endurance.reference_pressure * 1e-6,
+            s.endurance.life_factor * s.endurance.reference_cycles,
+            s.endurance.exponent
+        ),
+    )
+}
+
+/// A record quantity at `cycles` ([`along`] the records' (cycles, value) points).
+fn at_cycles(records: &[StepRecord], cycles: f64, f: impl Fn(&StepRecord) -> f64) -> (f64, String) {
+    let points: Vec<(f64, f64)> = records.iter().map(|r| (r.cycles, f(r))).collect();
+    along(&points, cycles)
+}
+
+/// The value at `cycles` of the (cycles, value) points: interpolated between them, or
+/// extrapolated along the slope of the last two beyond the last (the text says which).
+fn along(points: &[(f64, f64)], cycles: f64) -> (f64, String) {
+    let last = points[points.len() - 1];
+    if let Some(k) = points.iter().position(|p| p.0 >= cycles) {
+        if k == 0 {
+            return (points[0].1, "simulated".into());
+        }
+        let (a, b) = (points[k - 1], points[k]);
+        let t = (cycles - a.0) / (b.0 - a.0);
+        return (a.1 + t * (b.1 - a.1), "simulated".into());
+    }
+    if points.len() < 2 {
+        return (
+            last.1,
+            format!("held at its value at {:.3e} cycles", last.0),
+        );
+    }
+    let before = points[points.len() - 2];
+    let slope = (last.1 - before.1) / (last.0 - before.0);
+    (
+        last.1 + slope * (cycles - last.0),
+        format!(
+            "extrapolated from the life's last {:.3e} cycles along its last slope",
+            last.0
+        ),
+    )
+}
+
+/// Wear (S_W): each limit of MODEL §9 (a)-(d) against its simulated counterpart at the
+/// required cycles (times W_NS = 1 + 0.015 N_S), then the governing (smallest) one.
+fn wear_rows(s: &SafetyInputsOf, required_cycles: Option<f64>) -> Vec<SafetyRow> {
+    let inputs = &s.gear.rating.safety;
+    let minimum = inputs.minimum[3];
+    let Some(cycles) = required_cycles else {
+        return vec![row(
+            ("Wear: flank loss at the required life", "S_W", "um"),
+            None,
+            Err(Verdict::NeedsInput("rating.required_life_h".into())),
+            minimum,
+            "MODEL §9.1".into(),
+        )];
+    };
+    let Some(records) = s.records.filter(|r| !r.is_empty()) else {
+        return vec![row(
+            ("Wear: flank loss at the required life", "S_W", "um"),
+            None,
+            Err(Verdict::NotComputed(
+                "needs a life: a [wear] section (`wormwear rating` and `run` simulate it)".into(),
+            )),
+            minimum,
+            "MODEL §9.1".into(),
+        )];
+    };
+    let starts = 1.0 + 0.015 * inputs.starts_per_hour;
+    let w = &s.gear.worm;
+    let gamma = (w.lead() / (2.0 * PI * w.reference_radius)).atan();
+    let (peak, how) = at_cycles(records, cycles, |r| r.wear_patch_max_m);
+    let (backlash, _) = at_cycles(records, cycles, |r| r.backlash_increase_m);
+    let (volume, _) = at_cycles(records, cycles, |r| r.worn_volume_m3);
+    let equivalent = backlash * w.normal_pressure_angle.cos() * gamma.cos();
+    let mass = volume * s.gear.wheel.teeth as f64 * s.gear.wheel_material.density;
+    let note = format!(
+        "at {cycles:.3e} wheel cycles, {how}; times W_NS = {starts:.3} (MODEL §9, {} starts/h)",
+        inputs.starts_per_hour
+    );
+    let um = |m: f64| m * 1e6;
+    let mut rows = vec![
+        row(
+            ("Wear (a): pointed tooth tip", "S_W,a", "um"),
+            Some(um(starts * peak)),
+            Ok(um(s.iso.wear_limit_pointed_tip_m)),
+            minimum,
+            format!("largest flank loss (patch mean) against m_x cos(gamma) (pi/2 - 2 tan(alpha_0)), MODEL §9 (a); {note}"),
+        ),
+        row(
+            ("Wear (b): tooth thickness loss", "S_W,b", "um"),
+            Some(um(starts * peak)),
+            inputs
+                .thickness_loss_limit
+                .map(|d| um(d * gamma.cos()))
+                .ok_or_else(|| Verdict::NeedsInput("rating.thickness_loss_limit_mm".into())),
+            minimum,
+            format!("largest flank loss (patch mean) against Delta_s_lim cos(gamma), MODEL §9 (b); {note}"),
+        ),
+        row(
+            ("Wear (c): wheel mass loss", "S_W,c", "g"),
+            Some(starts * mass * 1e3),
+            inputs
+                .mass_loss_limit
+                .map(|m| m * 1e3)
+                .ok_or_else(|| Verdict::NeedsInput("rating.mass_loss_limit_g".into())),
+            minimum,
+            format!("worn volume of a flank x z2 x the bronze's density against Delta_m_lim, MODEL §9 (c); {note}"),
+        ),
+        row(
+            ("Wear (d): backlash", "S_W,d", "um"),
+            Some(um(starts * equivalent)),
+            Ok(um(s.iso.wear_limit_backlash_m)),
+            minimum,
+            format!("the simulated backlash increase as a normal flank loss (x cos(alpha_n) cos(gamma)) against 0.3 m_x cos(gamma), MODEL §9 (d); {note}"),
+        ),
+    ];
+    let governing = rows
+        .iter()
+        .filter(|r| r.safety.is_some())
+        .min_by(|a, b| {
+            a.safety
+                .partial_cmp(&b.safety)
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .cloned();
+    if let Some(mut g) = governing {
+        g.source = format!("the smallest of (a)-(d): {}", g.symbol);
+        g.quantity = "Wear: flank loss at the required life".into();
+        g.symbol = "S_W".into();
+        rows.insert(0, g);
+    }
+    rows
+}
+
+/// Temperature (S_T): the sump temperature of the heat balance (MODEL §13, nominal torque)
+/// against the allowed oil temperature, both in degC.
+fn temperature_row(s: &SafetyInputsOf) -> SafetyRow {
+    let inputs = &s.gear.rating.safety;
+    let balance = s.thermal.filter(|t| t.mode == "balance");
+    let value = balance.map(|t| t.oil_temperature_k - 273.15);
+    let allowable = match (balance, inputs.oil_temperature_limit) {
+        (None, _) => Err(Verdict::NotComputed(
+            "needs the heat balance: [lubricant] temperature = \"balance\"".into(),
+        )),
+        (_, None) => Err(Verdict::NeedsInput("rating.oil_temperature_limit_c".into())),
+        (_, Some(t)) => Ok(t - 273.15),
+    };
+    row(
+        ("Oil sump temperature", "S_T", "degC"),
+        value,
+        allowable,
+        inputs.minimum[4],
+        "steady sump temperature of the housing's heat balance at the nominal torque (MODEL §13), ratio in degC"
+            .into(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_simple_beam_matches_the_unit_load_integral_of_the_bending_moment() {
+        // An independent route to the deflection under the load: y = integral of M m / (E I)
+        // over the span (unit-load method), by the midpoint rule.
+        let gear = crate::input::load(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../examples/gear-1x40-design.toml"),
+        )
+        .unwrap();
+        for bearings in [[-0.1, 0.1], [-0.06, 0.14]] {
+            let mut g = gear.clone();
+            g.bending.worm_bearings = bearings;
+            let (t1, t2) = (60.0, 1500.0);
+            let y = simple_beam_deflection(&g, t1, t2);
+            let w = &g.worm;
+            let d_m1 = 2.0 * w.reference_radius;
+            let gamma = (w.lead() / (PI * d_m1)).atan();
+            let axial = 2.0 * t2 / (2.0 * g.wheel_reference_radius());
+            let f = (2.0 * t1 / d_m1).hypot(axial * w.normal_pressure_angle.tan() / gamma.cos());
+            let (a, l) = (-bearings[0], bearings[1] - bearings[0]);
+            let moment = |x: f64, load: f64| {
+                // Simply supported, load at x = a from the first bearing.
+                let left = load * (l - a) / l;
+                if x <= a {
+                    left * x
+                } else {
+                    left * x - load * (x - a)
+                }
+            };
+            let ei = g.worm_material.youngs_modulus * PI * (2.0 * w.root_radius).powi(4) / 64.0;
+            let n = 200_000;
+            let dx = l / n as f64;
+            let integral: f64 = (0..n)
+                .map(|k| {
+                    let x = (k as f64 + 0.5) * dx;
+                    moment(x, f) * moment(x, 1.0) * dx / ei
+                })
+                .sum();
+            assert!(
+                (y / integral - 1.0).abs() < 1e-8,
+                "{y} m against {integral} m"
+            );
+        }
+    }
+
+    #[test]
+    fn the_wear_at_the_required_life_is_interpolated_or_extrapolated_along_the_last_slope() {
+        let points = [(0.0, 0.0), (10.0, 2.0), (20.0, 3.0)];
+        let (v, how) = along(&points, 15.0);
+        assert!((v - 2.5).abs() < 1e-15 && how == "simulated");
+        let (v, how) = along(&points, 40.0);
+        assert!(
+            (v - 5.0).abs() < 1e-15 && how.starts_with("extrapolated"),
+            "{v} {how}"
+        );
+    }
+
+    #[test]
+    fn a_row_passes_at_its_minimum_and_fails_below() {
+        let r = |value: f64| row(("q", "S", "u"), Some(value), Ok(2.0), 1.25, String::new());
+        assert_eq!(r(1.6).verdict, Verdict::Pass);
+        assert_eq!(r(1.6).safety, Some(1.25));
+        assert_eq!(r(1.7).verdict, Verdict::Fail);
+        let missing = row(
+            ("q", "S", "u"),
+            Some(1.0),
+            Err(Verdict::NeedsInput("x".into())),
+            1.0,
+            String::new(),
+        );
+        assert_eq!(
+            (missing.safety, missing.verdict),
+            (None, Verdict::NeedsInput("x".into()))
+        );
+    }
+}

@@ -1,0 +1,124 @@
+//! The safety table from the model (MODEL §9.1): trends with torque and required life, the
+//! application factor as a torque factor, and the rows that need an input saying so.
+
+mod common;
+
+use wormwear::input::{BendingKind, GearSet, SafetyInputs};
+use wormwear::safety::{SafetyTable, Verdict};
+use wormwear::{Request, Source, Stage};
+
+/// The design gear without bending (fast), in a forced-air housing with the heat balance,
+/// every limit given.
+fn rated() -> GearSet {
+    let mut g = common::example("gear-1x40-design.toml");
+    g.bending.kind = BendingKind::None;
+    g.housing = wormwear::validation::study_housing();
+    g.rating.safety = SafetyInputs {
+        required_life_hours: Some(100.0),
+        root_stress_allowable: Some(100e6),
+        deflection_limit: Some(50e-6),
+        thickness_loss_limit: Some(1e-3),
+        mass_loss_limit: Some(0.05),
+        oil_temperature_limit: Some(373.15),
+        ..SafetyInputs::default()
+    };
+    g
+}
+
+/// The table of a loaded analysis and a two-step life of 60 000 cycles.
+fn table(g: &GearSet) -> SafetyTable {
+    let plan = wormwear::wear::WearPlan {
+        step: wormwear::wear::StepControl::Cycles(30_000.0),
+        ..wormwear::wear::WearPlan::with_life(60_000.0)
+    };
+    let request = Request::new([Stage::Ltca, Stage::Wear]).with_life(plan);
+    wormwear::run(g, Source::default(), request, &mut |_| Ok(()))
+        .unwrap()
+        .safety
+        .unwrap()
+}
+
+fn safety(t: &SafetyTable, symbol: &str) -> f64 {
+    t.rows
+        .iter()
+        .find(|r| r.symbol == symbol)
+        .and_then(|r| r.safety)
+        .unwrap_or_else(|| panic!("no {symbol} safety in {t:#?}"))
+}
+
+fn scaled(g: &GearSet, factor: f64) -> GearSet {
+    wormwear::safety::scaled_torque(g, factor)
+}
+
+#[test]
+fn more_torque_lowers_the_safeties_and_k_a_is_a_torque_factor_on_the_strength_rows() {
+    let g = rated();
+    let base = table(&g);
+    let heavy = table(&scaled(&g, 1.5));
+    for symbol in ["S_delta", "S_H", "S_W", "S_T"] {
+        assert!(
+            safety(&heavy, symbol) < safety(&base, symbol),
+            "{symbol}: {} at 1.5 T, {} at T",
+            safety(&heavy, symbol),
+            safety(&base, symbol)
+        );
+    }
+    // K_A = 1.5 rates the strength rows at 1.5 T; wear and temperature stay at the nominal
+    // torque the life and the heat balance run at.
+    let mut ka = g.clone();
+    ka.rating.safety.application_factor = 1.5;
+    let with_ka = table(&ka);
+    for symbol in ["S_delta", "S_H"] {
+        let (a, b) = (safety(&with_ka, symbol), safety(&heavy, symbol));
+        assert!(
+            (a / b - 1.0).abs() < 1e-9,
+            "{symbol}: {a} with K_A, {b} at 1.5 T"
+        );
+    }
+    for symbol in ["S_W", "S_T"] {
+        assert_eq!(safety(&with_ka, symbol), safety(&base, symbol), "{symbol}");
+    }
+}
+
+#[test]
+fn a_longer_required_life_lowers_the_wear_and_pitting_safeties() {
+    let g = rated();
+    let short = table(&g);
+    let mut long = g.clone();
+    long.rating.safety.required_life_hours = Some(400.0);
+    let long = table(&long);
+    for symbol in ["S_H", "S_W", "S_W,a", "S_W,b", "S_W,c", "S_W,d"] {
+        assert!(safety(&long, symbol) < safety(&short, symbol), "{symbol}");
+    }
+    // The pressure–life curve's exponent: S_H scales with the life ratio^0.176.
+    let ratio = safety(&short, "S_H") / safety(&long, "S_H");
+    assert!((ratio / 4f64.powf(0.176) - 1.0).abs() < 1e-12, "{ratio}");
+    // S_W is the smallest of (a)-(d).
+    let smallest = ["S_W,a", "S_W,b", "S_W,c", "S_W,d"]
+        .map(|s| safety(&long, s))
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(safety(&long, "S_W"), smallest);
+}
+
+#[test]
+fn rows_without_their_input_say_which_and_never_show_a_safety() {
+    let mut g = rated();
+    g.rating.safety = SafetyInputs::default();
+    g.housing.balance = false;
+    let t = table(&g);
+    let verdict = |symbol: &str| t.rows.iter().find(|r| r.symbol == symbol).unwrap();
+    for (symbol, field) in [
+        ("S_F", "rating.root_stress_allowable_mpa"),
+        ("S_delta", "rating.deflection_limit_um"),
+        ("S_H", "rating.required_life_h"),
+        ("S_W", "rating.required_life_h"),
+    ] {
+        let row = verdict(symbol);
+        assert_eq!(row.verdict, Verdict::NeedsInput(field.into()), "{symbol}");
+        assert!(row.safety.is_none(), "{symbol}");
+    }
+    // Without the heat balance the sump temperature is the lubricant's input, not a result.
+    assert!(matches!(verdict("S_T").verdict, Verdict::NotComputed(_)));
+    assert!(verdict("S_T").safety.is_none());
+}
