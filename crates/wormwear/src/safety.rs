@@ -274,79 +274,27 @@ fn along(points: &[(f64, f64)], cycles: f64) -> (f64, String) {
 }
 
 /// Wear (S_W): each limit of MODEL §9 (a)-(d) against its simulated counterpart at the
-/// required cycles (times W_NS = 1 + 0.015 N_S), then the governing (smallest) one.
+/// required cycles (times W_NS = 1 + 0.015 N_S), then the governing (smallest) one first.
 fn wear_rows(s: &SafetyInputsOf, required_cycles: Option<f64>) -> Vec<SafetyRow> {
-    let inputs = &s.gear.rating.safety;
-    let minimum = inputs.minimum[3];
-    let Some(cycles) = required_cycles else {
-        return vec![row(
+    let minimum = s.gear.rating.safety.minimum[3];
+    let missing = |verdict: Verdict| {
+        vec![row(
             ("Wear: flank loss at the required life", "S_W", "um"),
             None,
-            Err(Verdict::NeedsInput("rating.required_life_h".into())),
+            Err(verdict),
             minimum,
             "MODEL §9.1".into(),
-        )];
+        )]
+    };
+    let Some(cycles) = required_cycles else {
+        return missing(Verdict::NeedsInput("rating.required_life_h".into()));
     };
     let Some(records) = s.records.filter(|r| !r.is_empty()) else {
-        return vec![row(
-            ("Wear: flank loss at the required life", "S_W", "um"),
-            None,
-            Err(Verdict::NotComputed(
-                "needs a life: a [wear] section (`wormwear rating` and `run` simulate it)".into(),
-            )),
-            minimum,
-            "MODEL §9.1".into(),
-        )];
+        return missing(Verdict::NotComputed(
+            "needs a life: a [wear] section (`wormwear rating` and `run` simulate it)".into(),
+        ));
     };
-    let starts = 1.0 + 0.015 * inputs.starts_per_hour;
-    let w = &s.gear.worm;
-    let gamma = (w.lead() / (2.0 * PI * w.reference_radius)).atan();
-    let (peak, how) = at_cycles(records, cycles, |r| r.wear_patch_max_m);
-    let (backlash, _) = at_cycles(records, cycles, |r| r.backlash_increase_m);
-    let (volume, _) = at_cycles(records, cycles, |r| r.worn_volume_m3);
-    let equivalent = backlash * w.normal_pressure_angle.cos() * gamma.cos();
-    let mass = volume * s.gear.wheel.teeth as f64 * s.gear.wheel_material.density;
-    let note = format!(
-        "at {cycles:.3e} wheel cycles, {how}; times W_NS = {starts:.3} (MODEL §9, {} starts/h)",
-        inputs.starts_per_hour
-    );
-    let um = |m: f64| m * 1e6;
-    let mut rows = vec![
-        row(
-            ("Wear (a): pointed tooth tip", "S_W,a", "um"),
-            Some(um(starts * peak)),
-            Ok(um(s.iso.wear_limit_pointed_tip_m)),
-            minimum,
-            format!("largest flank loss (patch mean) against m_x cos(gamma) (pi/2 - 2 tan(alpha_0)), MODEL §9 (a); {note}"),
-        ),
-        row(
-            ("Wear (b): tooth thickness loss", "S_W,b", "um"),
-            Some(um(starts * peak)),
-            inputs
-                .thickness_loss_limit
-                .map(|d| um(d * gamma.cos()))
-                .ok_or_else(|| Verdict::NeedsInput("rating.thickness_loss_limit_mm".into())),
-            minimum,
-            format!("largest flank loss (patch mean) against Delta_s_lim cos(gamma), MODEL §9 (b); {note}"),
-        ),
-        row(
-            ("Wear (c): wheel mass loss", "S_W,c", "g"),
-            Some(starts * mass * 1e3),
-            inputs
-                .mass_loss_limit
-                .map(|m| m * 1e3)
-                .ok_or_else(|| Verdict::NeedsInput("rating.mass_loss_limit_g".into())),
-            minimum,
-            format!("worn volume of a flank x z2 x the bronze's density against Delta_m_lim, MODEL §9 (c); {note}"),
-        ),
-        row(
-            ("Wear (d): backlash", "S_W,d", "um"),
-            Some(um(starts * equivalent)),
-            Ok(um(s.iso.wear_limit_backlash_m)),
-            minimum,
-            format!("the simulated backlash increase as a normal flank loss (x cos(alpha_n) cos(gamma)) against 0.3 m_x cos(gamma), MODEL §9 (d); {note}"),
-        ),
-    ];
+    let mut rows = wear_limit_rows(s, records, cycles);
     let governing = rows
         .iter()
         .filter(|r| r.safety.is_some())
@@ -363,6 +311,62 @@ fn wear_rows(s: &SafetyInputsOf, required_cycles: Option<f64>) -> Vec<SafetyRow>
         rows.insert(0, g);
     }
     rows
+}
+
+/// The rows of the wear limits (a)-(d) of MODEL §9 at `cycles` of the life's `records`.
+fn wear_limit_rows(s: &SafetyInputsOf, records: &[StepRecord], cycles: f64) -> Vec<SafetyRow> {
+    let inputs = &s.gear.rating.safety;
+    let minimum = inputs.minimum[3];
+    let starts = 1.0 + 0.015 * inputs.starts_per_hour;
+    let w = &s.gear.worm;
+    let gamma = (w.lead() / (2.0 * PI * w.reference_radius)).atan();
+    let (peak, how) = at_cycles(records, cycles, |r| r.wear_patch_max_m);
+    let (backlash, _) = at_cycles(records, cycles, |r| r.backlash_increase_m);
+    let (volume, _) = at_cycles(records, cycles, |r| r.worn_volume_m3);
+    let equivalent = backlash * w.normal_pressure_angle.cos() * gamma.cos();
+    let mass = volume * s.gear.wheel.teeth as f64 * s.gear.wheel_material.density;
+    let note = format!(
+        "at {cycles:.3e} wheel cycles, {how}; times W_NS = {starts:.3} (MODEL §9, {} starts/h)",
+        inputs.starts_per_hour
+    );
+    let um = |m: f64| m * 1e6;
+    let needs = |field: &str| Verdict::NeedsInput(format!("rating.{field}"));
+    vec![
+        row(
+            ("Wear (a): pointed tooth tip", "S_W,a", "um"),
+            Some(um(starts * peak)),
+            Ok(um(s.iso.wear_limit_pointed_tip_m)),
+            minimum,
+            format!("largest flank loss (patch mean) against m_x cos(gamma) (pi/2 - 2 tan(alpha_0)), MODEL §9 (a); {note}"),
+        ),
+        row(
+            ("Wear (b): tooth thickness loss", "S_W,b", "um"),
+            Some(um(starts * peak)),
+            inputs
+                .thickness_loss_limit
+                .map(|d| um(d * gamma.cos()))
+                .ok_or_else(|| needs("thickness_loss_limit_mm")),
+            minimum,
+            format!("largest flank loss (patch mean) against Delta_s_lim cos(gamma), MODEL §9 (b); {note}"),
+        ),
+        row(
+            ("Wear (c): wheel mass loss", "S_W,c", "g"),
+            Some(starts * mass * 1e3),
+            inputs
+                .mass_loss_limit
+                .map(|m| m * 1e3)
+                .ok_or_else(|| needs("mass_loss_limit_g")),
+            minimum,
+            format!("worn volume of a flank x z2 x the bronze's density against Delta_m_lim, MODEL §9 (c); {note}"),
+        ),
+        row(
+            ("Wear (d): backlash", "S_W,d", "um"),
+            Some(um(starts * equivalent)),
+            Ok(um(s.iso.wear_limit_backlash_m)),
+            minimum,
+            format!("the simulated backlash increase as a normal flank loss (x cos(alpha_n) cos(gamma)) against 0.3 m_x cos(gamma), MODEL §9 (d); {note}"),
+        ),
+    ]
 }
 
 /// Temperature (S_T): the sump temperature of the heat balance (MODEL §13, nominal torque)

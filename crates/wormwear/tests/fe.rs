@@ -3,7 +3,8 @@
 //! beam theory (bending + shear).
 
 use wormwear::bending::fe::{
-    box_mesh, free_minus_blocked, solve, solve_with_springs, Elastic, Load, Spring,
+    box_mesh, element_stress, free_minus_blocked, principal_stresses, solve, solve_with_springs,
+    Elastic, Load, Mesh, Spring,
 };
 use wormwear::validation::analytic;
 
@@ -67,6 +68,18 @@ fn patch_test_linear_field_is_exact_on_a_distorted_mesh() {
 
 /// Tip deflection of a cantilever (clamped at x = 0, uniform shear traction P on x = L).
 fn cantilever(l: f64, h: f64, b: f64, n: (usize, usize, usize), p: f64) -> f64 {
+    cantilever_solution(l, h, b, n, p).2
+}
+
+/// The cantilever of [`cantilever`]: its mesh, the displacement of every node and the tip
+/// deflection.
+fn cantilever_solution(
+    l: f64,
+    h: f64,
+    b: f64,
+    n: (usize, usize, usize),
+    p: f64,
+) -> (Mesh, Vec<[f64; 3]>, f64) {
     let (mesh, lattice) = box_mesh((l, h, b), n, |x| x);
     let (mx, my, mz) = (2 * n.0, 2 * n.1, 2 * n.2);
     let mut fixed = Vec::new();
@@ -114,14 +127,15 @@ fn cantilever(l: f64, h: f64, b: f64, n: (usize, usize, usize), p: f64) -> f64 {
         (total + p).abs() < 1e-9 * p,
         "consistent loads sum to {total}"
     );
-    let u = &solve(&mesh, &STEEL, &fixed, &[loads]).unwrap()[0];
+    let u = solve(&mesh, &STEEL, &fixed, &[loads]).unwrap().remove(0);
     // Mean deflection of the end face (its nodes are spaced evenly in both directions).
     let mid: Vec<f64> = end_nodes
         .iter()
         .filter(|&&k| lattice[k][1] == my / 2 && lattice[k][2] == mz / 2)
         .map(|&k| u[k][1])
         .collect();
-    -mid[0]
+    let tip = -mid[0];
+    (mesh, u, tip)
 }
 
 #[test]
@@ -307,4 +321,86 @@ fn free_minus_blocked_from_one_factorisation_equals_two_solves() {
         worst < 1e-9 * scale,
         "difference {worst:e} m against displacements {scale:e} m"
     );
+}
+
+#[test]
+fn stresses_are_exact_for_a_linear_field_and_match_beam_bending() {
+    // Patch: a linear displacement field on a distorted element gives its constant stress
+    // D epsilon at every point, to round-off.
+    let (l, h, w) = (0.02, 0.015, 0.01);
+    let (mesh, _) = box_mesh((l, h, w), (1, 1, 1), |p| {
+        [
+            p[0] + 0.002 * p[1] / h,
+            p[1] + 0.001 * p[2] / w,
+            p[2] + 0.0015 * p[0] / l,
+        ]
+    });
+    let grad = [
+        [2e-3, -1e-3, 5e-4],
+        [1e-3, 3e-3, -2e-3],
+        [-5e-4, 2e-3, 1e-3],
+    ];
+    let u: Vec<[f64; 3]> = mesh
+        .nodes
+        .iter()
+        .map(|x| std::array::from_fn(|i| (0..3).map(|j| grad[i][j] * x[j]).sum()))
+        .collect();
+    let (e, v) = (STEEL.youngs_modulus, STEEL.poisson_ratio);
+    let (lam, mu) = (e * v / ((1.0 + v) * (1.0 - 2.0 * v)), e / (2.0 * (1.0 + v)));
+    let trace = grad[0][0] + grad[1][1] + grad[2][2];
+    let exact = [
+        lam * trace + 2.0 * mu * grad[0][0],
+        lam * trace + 2.0 * mu * grad[1][1],
+        lam * trace + 2.0 * mu * grad[2][2],
+        mu * (grad[1][2] + grad[2][1]),
+        mu * (grad[0][2] + grad[2][0]),
+        mu * (grad[0][1] + grad[1][0]),
+    ];
+    for xi in [[0.3, -0.7, 0.1], [-1.0, 1.0, -1.0], [0.0, 0.0, 0.0]] {
+        let s = element_stress(&mesh, 0, &STEEL, &u, xi).unwrap();
+        for k in 0..6 {
+            assert!(
+                (s[k] - exact[k]).abs() < 1e-6 * exact[0].abs(),
+                "{k}: {} vs {}",
+                s[k],
+                exact[k]
+            );
+        }
+    }
+    // Principal stresses of a plane shear tau: +tau, 0, -tau.
+    let p = principal_stresses([0.0, 0.0, 0.0, 0.0, 0.0, 7.0]);
+    assert!((p[0] - 7.0).abs() < 1e-12 && p[1].abs() < 1e-12 && (p[2] + 7.0).abs() < 1e-12);
+    // Beam bending: a cantilever (L/h = 20, tip load P) at the Gauss point nearest the top
+    // fibre at mid-span: sigma_xx = M y / I with M = P (L - x).
+    let (l, h, b, p) = (0.2, 0.01, 0.01, 100.0);
+    let n = (40, 4, 2);
+    let (mesh, u, _) = cantilever_solution(l, h, b, n, p);
+    let g = (0.6f64).sqrt();
+    let inertia = b * h * h * h / 12.0;
+    let mut checked = 0;
+    for (e, nodes) in mesh.elements.iter().enumerate() {
+        let centre = |d: usize| nodes[..8].iter().map(|&k| mesh.nodes[k][d]).sum::<f64>() / 8.0;
+        let (xc, yc) = (centre(0), centre(1));
+        if (xc - 0.5 * l).abs() > 0.5 * l / n.0 as f64 || yc < h * (1.0 - 1.0 / n.1 as f64) {
+            continue;
+        }
+        let s = element_stress(&mesh, e, &STEEL, &u, [-g, g, 0.0]).unwrap();
+        let dx = l / n.0 as f64;
+        let dy = h / n.1 as f64;
+        let (x, y) = (xc - 0.5 * g * dx, yc + 0.5 * g * dy);
+        let beam = p * (l - x) * (y - 0.5 * h) / inertia;
+        eprintln!(
+            "mid-span top Gauss point: sigma_xx {:.6e} Pa, M y / I {beam:.6e} Pa, ratio {:.6}",
+            s[0],
+            s[0] / beam
+        );
+        assert!(
+            (s[0] / beam - 1.0).abs() < 0.005,
+            "sigma_xx {} Pa against M y / I {} Pa",
+            s[0],
+            beam
+        );
+        checked += 1;
+    }
+    assert!(checked >= 2, "{checked} elements checked");
 }

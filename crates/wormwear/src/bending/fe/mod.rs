@@ -168,6 +168,44 @@ pub fn element_stiffness(mesh: &Mesh, e: usize, material: &Elastic) -> Result<Ve
     Ok(k)
 }
 
+/// Stress at the natural point `xi` of element `e` from the nodal displacements `u` (m, every
+/// node of the mesh): sigma = D B u_e, Voigt order xx, yy, zz, yz, xz, xy, Pa.
+pub fn element_stress(
+    mesh: &Mesh,
+    e: usize,
+    material: &Elastic,
+    u: &[[f64; 3]],
+    xi: [f64; 3],
+) -> Result<[f64; 6], FeError> {
+    let x: Vec<[f64; 3]> = mesh.elements[e].iter().map(|&n| mesh.nodes[n]).collect();
+    let (_, dn) = shape(xi);
+    let (inv, _) = inverse(&jacobian(&dn, &x)).ok_or(FeError::Jacobian(e))?;
+    let b = strain_displacement(&dn, &inv);
+    let mut strain = [0.0; 6];
+    for (k, &n) in mesh.elements[e].iter().enumerate() {
+        for d in 0..3 {
+            let un = u[n][d];
+            for (i, row) in b.iter().enumerate() {
+                strain[i] += row[3 * k + d] * un;
+            }
+        }
+    }
+    let d = material.d();
+    let mut stress = [0.0; 6];
+    for (i, si) in stress.iter_mut().enumerate() {
+        *si = (0..6).map(|j| d[i][j] * strain[j]).sum();
+    }
+    Ok(stress)
+}
+
+/// The principal stresses of a Voigt stress (xx, yy, zz, yz, xz, xy), largest first, Pa.
+pub fn principal_stresses(s: [f64; 6]) -> [f64; 3] {
+    let m = nalgebra::Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2]);
+    let mut v: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+    v.sort_by(|a, b| b.total_cmp(a));
+    [v[0], v[1], v[2]]
+}
+
 /// Jacobian J_ij = d x_j / d xi_i of the map from natural to physical coordinates.
 fn jacobian(dn: &[[f64; 3]; 20], x: &[[f64; 3]]) -> [[f64; 3]; 3] {
     let mut jac = [[0.0; 3]; 3];
