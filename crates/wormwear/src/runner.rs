@@ -586,13 +586,19 @@ impl<'a> Pipeline<'a> {
             .as_ref()
             .or(gear.wear.as_ref())
             .map_or(crate::input::Endurance::DEFAULT, |p| p.endurance);
+        let strength = ltca_ka.as_ref().unwrap_or(ltca);
+        let worm_deflection = match bending.model {
+            Some(_) => Some(self.worm_deflection(geo, strength)?),
+            None => None,
+        };
         let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
             gear,
             iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
-            ltca: ltca_ka.as_ref().unwrap_or(ltca),
+            ltca: strength,
             thermal,
             records: life.map(|l| l.end.records.as_slice()),
             endurance,
+            worm_deflection,
         });
         self.warnings.extend(table.failed().map(|r| {
             format!(
@@ -604,6 +610,20 @@ impl<'a> Pipeline<'a> {
             )
         }));
         Ok(Some(table))
+    }
+
+    /// The worm FE model's largest deflection at the mesh point over the positions of `ltca`
+    /// (MODEL §9.1), m; its compliance from the cache or computed once.
+    fn worm_deflection(&mut self, geo: &Geometry, ltca: &Ltca) -> Result<f64, RunError> {
+        let (compliance, warnings) =
+            crate::bending::worm_deflection::mesh_point_compliance(self.gear, geo)
+                .map_err(RunError::Bending)?;
+        self.warnings.extend(warnings);
+        Ok(ltca
+            .positions
+            .iter()
+            .map(|p| compliance.lateral_deflection(&p.worm_force()))
+            .fold(0.0, f64::max))
     }
 
     /// The results of the run, with the ratings (MODEL §9) beside a loaded stage.

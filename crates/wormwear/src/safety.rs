@@ -83,6 +83,9 @@ pub struct SafetyInputsOf<'a> {
     pub thermal: Option<&'a Thermal>,
     pub records: Option<&'a [StepRecord]>,
     pub endurance: Endurance,
+    /// The worm FE model's largest deflection at the mesh point over the positions of the
+    /// loaded analysis at K_A T, m (None without FE bending).
+    pub worm_deflection: Option<f64>,
 }
 
 /// The gear with its torque times `factor` (the rating case of K_A).
@@ -197,17 +200,34 @@ pub fn simple_beam_deflection(gear: &GearSet, worm_torque: f64, wheel_torque: f6
 fn deflection_row(s: &SafetyInputsOf) -> SafetyRow {
     let inputs = &s.gear.rating.safety;
     let beam = simple_beam_deflection(s.gear, s.iso.worm_torque_nm, s.iso.wheel_torque_nm);
+    let (value, source) = match s.worm_deflection {
+        Some(fe) => (
+            fe,
+            format!(
+                "the worm FE model with its shaft and bearings (MODEL §5.5) under the loaded \
+                 analysis's mesh force at each position, the largest lateral displacement of the \
+                 axis in the mesh plane; beside it the simple beam of the root diameter between \
+                 the bearings (Roark): {:.2} um, FE / beam {:.3}",
+                beam * 1e6,
+                fe / beam
+            ),
+        ),
+        None => (
+            beam,
+            "the simple beam of the root diameter between the bearings under the tangential and \
+             radial mesh forces (Roark): [bending] model = \"none\" has no worm FE model"
+                .to_string(),
+        ),
+    };
     row(
         ("Worm deflection at the mesh point", "S_delta", "um"),
-        Some(beam * 1e6),
+        Some(value * 1e6),
         inputs
             .deflection_limit
             .map(|d| d * 1e6)
             .ok_or_else(|| Verdict::NeedsInput("rating.deflection_limit_um".into())),
         inputs.minimum[1],
-        "simply supported shaft of the root diameter between the bearings under the tangential \
-         and radial mesh forces (Roark); the worm FE model's value is not in this build"
-            .into(),
+        source,
     )
 }
 

@@ -257,3 +257,71 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
     );
     assert!(worst < 0.05 * umax);
 }
+
+#[test]
+fn the_mesh_point_compliance_lies_between_the_threaded_bodys_root_and_tip_shafts() {
+    // The worm of the design case under a lateral force on its loaded flank at the mesh point
+    // (MODEL §9.1), the axis read in the mesh plane, against the unit-load integral of a
+    // stepped Timoshenko shaft between the bearings: the shaft section beyond the threaded
+    // body, and over the body a solid section of the root radius (the threads left out: an
+    // upper bound of the compliance) or of the tip radius (the threads as solid: a lower
+    // bound); all with the model's bore (a quarter of the shaft radius) and the thick tube's
+    // shear coefficient (Cowper).
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let (c, _) = wormwear::bending::worm_deflection::compliance_in(&g, &geo, None).unwrap();
+    let root = stepped_shaft_compliance(&g, g.worm.root_radius);
+    let tip = stepped_shaft_compliance(&g, g.worm.tip_radius);
+    for (axis, name) in [(1, "radial (y)"), (2, "tangential (z)")] {
+        let fe = c.columns[axis][axis];
+        eprintln!(
+            "{name}: FE {fe:.5e} m/N; stepped shafts: root body {root:.5e} ({:+.2} %), tip body {tip:.5e} m/N",
+            100.0 * (fe / root - 1.0)
+        );
+        assert!(
+            tip < fe && fe < root,
+            "{name}: {fe:e} outside [{tip:e}, {root:e}]"
+        );
+    }
+    // A lateral force displaces the axis laterally: the axial response is small beside it.
+    assert!(c.columns[1][0].abs() < 0.01 * c.columns[1][1]);
+}
+
+/// Lateral compliance at x1 = 0 of the worm's shaft between its bearings (unit-load integral
+/// of the bending moment and shear force, Timoshenko): radius `body` over the threaded body,
+/// the shaft radius beyond, both bored to a quarter of the shaft radius, m/N.
+fn stepped_shaft_compliance(g: &GearSet, body: f64) -> f64 {
+    let e = g.worm_material.youngs_modulus;
+    let nu = g.worm_material.poisson_ratio;
+    let shear_modulus = e / (2.0 * (1.0 + nu));
+    let [b1, b2] = g.bending.worm_bearings;
+    let half_body = 0.5 * g.bending.worm_body_length;
+    let shaft = g.bending.worm_shaft_radius.min(g.worm.root_radius);
+    let bore = 0.25 * shaft;
+    let section = |x: f64| {
+        let r = if x.abs() <= half_body { body } else { shaft };
+        let m2 = (bore / r).powi(2);
+        let kappa = 6.0 * (1.0 + nu) * (1.0 + m2).powi(2)
+            / ((7.0 + 6.0 * nu) * (1.0 + m2).powi(2) + (20.0 + 12.0 * nu) * m2);
+        (
+            PI / 4.0 * (r.powi(4) - bore.powi(4)),
+            kappa * PI * (r * r - bore * bore),
+        )
+    };
+    let (a, l) = (-b1, b2 - b1);
+    let n = 100_000;
+    let dx = l / n as f64;
+    (0..n)
+        .map(|k| {
+            let x = b1 + (k as f64 + 0.5) * dx;
+            // Unit load at x = 0: bending moment and shear force.
+            let (m, v) = if x <= 0.0 {
+                ((l - a) / l * (x - b1), (l - a) / l)
+            } else {
+                (a / l * (b2 - x), a / l)
+            };
+            let (i, shear_area) = section(x);
+            (m * m / (e * i) + v * v / (shear_modulus * shear_area)) * dx
+        })
+        .sum()
+}

@@ -9,6 +9,7 @@ pub(crate) mod relation;
 pub mod wheel_mesh;
 pub mod wheel_model;
 pub mod wheel_shaft;
+pub mod worm_deflection;
 pub mod worm_mesh;
 pub mod worm_model;
 

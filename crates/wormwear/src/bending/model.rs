@@ -51,7 +51,7 @@ pub enum BendingError {
 
 impl BendingError {
     /// The error of `member`'s FE model built at `refinement`.
-    fn of(member: &'static str, refinement: usize, source: FeError) -> Self {
+    pub(crate) fn of(member: &'static str, refinement: usize, source: FeError) -> Self {
         match (&source, member) {
             (FeError::TooLarge { .. }, _) => Self::TooLarge {
                 member,
@@ -217,36 +217,45 @@ pub fn cache_dir() -> PathBuf {
 }
 
 #[derive(serde::Serialize, serde::Deserialize)]
-struct CacheFile {
+struct CacheFile<T> {
     key: String,
-    model: FeBending,
+    model: T,
 }
 
-fn cache_path(dir: &Path, key: &str) -> PathBuf {
+/// The cache file of `key` in `dir`: `{prefix}-{hash of the key}.json`.
+pub(crate) fn cache_path(dir: &Path, prefix: &str, key: &str) -> PathBuf {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     key.hash(&mut h);
-    dir.join(format!("bending-{:016x}.json", h.finish()))
+    dir.join(format!("{prefix}-{:016x}.json", h.finish()))
 }
 
-/// The cached model for `key`: None when there is no entry or it is of another key; an error
+/// The cached value for `key`: None when there is no entry or it is of another key; an error
 /// (the reason) when the entry cannot be trusted: unreadable, or its checksum fails.
-fn read_cache(path: &Path, key: &str) -> Result<Option<FeBending>, String> {
+pub(crate) fn read_cache<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    key: &str,
+) -> Result<Option<T>, String> {
     let text = match crate::files::read_text(path, crate::files::OWN_FILE_LIMIT) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(e.to_string()),
     };
-    let file: CacheFile = crate::integrity::open(&text).map_err(|e| e.to_string())?;
+    let file: CacheFile<T> = crate::integrity::open(&text).map_err(|e| e.to_string())?;
     Ok((file.key == key).then_some(file.model))
 }
 
-fn write_cache(path: &Path, key: &str, model: &FeBending) -> std::io::Result<()> {
+/// Writes a cache entry atomically (temporary file, then rename), sealed with its checksum.
+pub(crate) fn write_cache<T: serde::Serialize>(
+    path: &Path,
+    key: &str,
+    model: &T,
+) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
     let text = crate::integrity::seal(&CacheFile {
         key: key.to_string(),
-        model: model.clone(),
+        model,
     })
     .map_err(std::io::Error::other)?;
     let tmp = path.with_extension(format!("tmp{}", std::process::id()));
@@ -275,7 +284,7 @@ pub fn build_in(
 ) -> Result<(BuiltBending, Vec<String>), BendingError> {
     let start = std::time::Instant::now();
     let key = cache_key(gear);
-    let path = dir.map(|d| cache_path(d, &key));
+    let path = dir.map(|d| cache_path(d, "bending", &key));
     let mut warnings = Vec::new();
     let cached = match path.as_deref().map(|p| read_cache(p, &key)) {
         Some(Ok(model)) => model,

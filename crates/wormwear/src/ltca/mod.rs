@@ -170,6 +170,18 @@ pub struct PositionResult {
     pub band_widenings: usize,
 }
 
+impl PositionResult {
+    /// The mesh force on the worm at this position: the sum over the loaded cells of pressure
+    /// x area along the cell's normal (worm frame, N; its sign is the normal's convention).
+    pub fn worm_force(&self) -> nalgebra::Vector3<f64> {
+        self.cells
+            .iter()
+            .zip(&self.pressure)
+            .map(|(c, &p)| c.cell.normal * (p * c.cell.area()))
+            .sum()
+    }
+}
+
 /// Result of the loaded analysis over the mesh cycle.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Ltca {
