@@ -1150,8 +1150,14 @@ fn ltca_with_fe_bending_uses_the_cache() {
     let first = run("a");
     assert!(first.contains("models computed in"), "{first}");
     assert!(first.contains("ltca (fe)"), "{first}");
-    let files: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
-    assert_eq!(files.len(), 1, "one cache file");
+    // Two cache files: the bending models and the worm's mesh-point compliance (S_delta).
+    let mut files: Vec<String> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|f| f.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 2, "{files:?}");
+    assert!(files[0].starts_with("bending-") && files[1].starts_with("worm-deflection-"));
     let second = run("b");
     assert!(second.contains("bending (fe): read in"), "{second}");
     let summary = |out: &str| -> serde_json::Value {
@@ -1167,6 +1173,11 @@ fn ltca_with_fe_bending_uses_the_cache() {
         a["ltca"]["mesh_stiffness_mean_nm_per_rad"],
         b["ltca"]["mesh_stiffness_mean_nm_per_rad"]
     );
+    // The worm deflection of the safety table, computed then read back.
+    let deflection = |s: &serde_json::Value| s["rating"]["safety"]["rows"][1].clone();
+    assert_eq!(deflection(&a)["symbol"], "S_delta");
+    assert!(deflection(&a)["value"].as_f64().unwrap() > 0.0);
+    assert_eq!(deflection(&a), deflection(&b));
 }
 
 #[test]

@@ -8,6 +8,7 @@ pub mod model;
 pub(crate) mod relation;
 pub mod wheel_mesh;
 pub mod wheel_model;
+pub mod wheel_root;
 pub mod wheel_shaft;
 pub mod worm_deflection;
 pub mod worm_mesh;
