@@ -8,15 +8,22 @@
 //! fillet's tension side, normal to the largest tensile stress, and the tensile root stress is
 //! what gear root allowables (pulsating tension tests on tooth roots) refer to.
 //!
-//! Status (issue 34): not used by the safety table yet. On the design case the largest root
-//! stress does not converge under refinement (levels 1-4: 94, 140, 98, 157 MPa, its place
-//! jumping between the face middle and the face ends): the contact reaches 1.2 mm above the
-//! root (the worm's tip edge at the flow pressure), and its forces, lumped at the flank nodes,
-//! put their own singular stresses into the fillet. Next: the pressures as consistent face
-//! tractions instead of nodal lumps, and the fillet stress read at a physical distance from
-//! the loaded zone (or as the section's bending stress).
+//! Status (issue 34): not used by the safety table yet; neither reading converges on the
+//! design case under the sector's refinement (levels 1-4):
+//! - the largest principal stress at the Gauss points of the root region: 94, 140, 98,
+//!   157 MPa, its place jumping between the face middle and the face ends. The contact reaches
+//!   1.2 mm above the root (the worm's tip edge at the flow pressure) and its forces, lumped at
+//!   the flank nodes, put their own singular stresses into the root;
+//! - the linearised stress across the root section (membrane + bending, [`linearised`]):
+//!   25.2, 49.5, 59.1, 65.5 MPa, always at the face middle, position 13; the last step is still
+//!   +10.7 %. The flank meets the root circle at a corner (the hob's tip is sharp, MODEL §12),
+//!   a re-entrant notch whose stress is singular, which slows the section's convergence.
+//!
+//! Next: a hob tip radius (a filleted root), the pressures as consistent face tractions.
 
-use super::fe::{element_stress, principal_stresses, solve, Elastic, FeError, Load};
+use super::fe::{
+    element_stress, natural_coordinates, principal_stresses, solve, Elastic, FeError, Load, Mesh,
+};
 use super::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};
 use crate::geometry::placement::from_wheel_body;
 use crate::geometry::{Flank, Geometry, WheelFlank};
@@ -55,6 +62,17 @@ pub struct RootStress {
     /// The Gauss point: radius and face coordinate (wheel body frame), m.
     pub r: f64,
     pub z: f64,
+}
+
+impl RootStress {
+    /// No stress found yet (-infinity, nowhere).
+    const NONE: RootStress = RootStress {
+        max_principal: f64::NEG_INFINITY,
+        position: 0,
+        tooth: 0,
+        r: f64::NAN,
+        z: f64::NAN,
+    };
 }
 
 /// Radius of the root circle at face coordinate z: the hob's tip torus, m.
@@ -237,6 +255,53 @@ fn central_tooth_angle(m: &SectorMesh) -> f64 {
     y.atan2(x)
 }
 
+/// The sector of refinement `level` solved under every (position, tooth in the middle) load
+/// case of `ltca` on the wheel's `flank`: its mesh, material, cases, their labels and
+/// displacements.
+struct LoadedSector {
+    mesh: SectorMesh,
+    material: Elastic,
+    cases: Vec<Vec<Load>>,
+    labels: Vec<(usize, i32)>,
+    solutions: Vec<Vec<[f64; 3]>>,
+}
+
+impl LoadedSector {
+    fn solve(
+        gear: &GearSet,
+        geo: &Geometry,
+        ltca: &Ltca,
+        flank: Flank,
+        level: usize,
+    ) -> Result<Self, FeError> {
+        let mesh = sector_mesh(
+            geo,
+            &root_mesh_settings(gear, level),
+            gear.hob.tip_radius,
+            gear.cutting.centre_distance,
+        );
+        let nodes = FlankNodes::new(gear, geo, &mesh, flank);
+        let (cases, labels) = load_cases(ltca, &nodes);
+        let fixed: Vec<(usize, usize, f64)> = mesh
+            .inner
+            .iter()
+            .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
+            .collect();
+        let material = Elastic {
+            youngs_modulus: gear.wheel_material.youngs_modulus,
+            poisson_ratio: gear.wheel_material.poisson_ratio,
+        };
+        let solutions = solve(&mesh.mesh, &material, &fixed, &cases)?;
+        Ok(Self {
+            mesh,
+            material,
+            cases,
+            labels,
+            solutions,
+        })
+    }
+}
+
 /// The largest principal stress at the central tooth's root over every position and tooth of
 /// `ltca` (MODEL §9.1), on the sector of refinement `level` loaded on the wheel's `flank`.
 pub fn root_stress(
@@ -246,38 +311,22 @@ pub fn root_stress(
     flank: Flank,
     level: usize,
 ) -> Result<RootStress, FeError> {
-    let m = sector_mesh(
-        geo,
-        &root_mesh_settings(gear, level),
-        gear.hob.tip_radius,
-        gear.cutting.centre_distance,
+    let loaded = LoadedSector::solve(gear, geo, ltca, flank, level)?;
+    let (m, material, solutions, labels) = (
+        &loaded.mesh,
+        &loaded.material,
+        &loaded.solutions,
+        &loaded.labels,
     );
-    let nodes = FlankNodes::new(gear, geo, &m, flank);
-    let (cases, labels) = load_cases(ltca, &nodes);
-    let fixed: Vec<(usize, usize, f64)> = m
-        .inner
-        .iter()
-        .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
-        .collect();
-    let material = Elastic {
-        youngs_modulus: gear.wheel_material.youngs_modulus,
-        poisson_ratio: gear.wheel_material.poisson_ratio,
-    };
-    let solutions = solve(&m.mesh, &material, &fixed, &cases)?;
-    let mut loaded: Vec<usize> = cases.iter().flatten().map(|l| l.0).collect();
-    loaded.sort_unstable();
-    loaded.dedup();
-    let points = root_points(gear, &m, (central_tooth_angle(&m), nodes.tau), &loaded);
-    let mut best = RootStress {
-        max_principal: f64::NEG_INFINITY,
-        position: 0,
-        tooth: 0,
-        r: f64::NAN,
-        z: f64::NAN,
-    };
-    for (u, &(position, tooth)) in solutions.iter().zip(&labels) {
+    let mut loaded_nodes: Vec<usize> = loaded.cases.iter().flatten().map(|l| l.0).collect();
+    loaded_nodes.sort_unstable();
+    loaded_nodes.dedup();
+    let tau = 2.0 * std::f64::consts::PI / geo.teeth as f64;
+    let points = root_points(gear, m, (central_tooth_angle(m), tau), &loaded_nodes);
+    let mut best = RootStress::NONE;
+    for (u, &(position, tooth)) in solutions.iter().zip(labels) {
         for &(e, xi) in &points {
-            let s = principal_stresses(element_stress(&m.mesh, e, &material, u, xi)?)[0];
+            let s = principal_stresses(element_stress(&m.mesh, e, material, u, xi)?)[0];
             if s > best.max_principal {
                 let (n, _) = super::fe::shape(xi);
                 let x: [f64; 3] = std::array::from_fn(|d| {
@@ -293,6 +342,153 @@ pub fn root_stress(
                     tooth,
                     r: x[0].hypot(x[1]),
                     z: x[2],
+                };
+            }
+        }
+    }
+    Ok(best)
+}
+
+/// A root section of the central tooth at one face layer: the chord between its two flanks'
+/// nodes on the root circle, sampled at Gauss-Legendre points, each located in its element.
+struct RootSection {
+    /// (element, natural point, weight on [0, 1], position s in [0, 1] from the left flank).
+    points: Vec<(usize, [f64; 3], f64, f64)>,
+    /// Unit normal of the section (radial at the chord's middle), wheel body frame.
+    normal: [f64; 3],
+    /// Face coordinate of the layer, m.
+    z: f64,
+    radius: f64,
+}
+
+/// Gauss-Legendre points and weights on [0, 1] (8 points).
+fn gauss_legendre_8() -> [(f64, f64); 8] {
+    let x = [
+        0.183_434_642_495_649_8,
+        0.525_532_409_916_329,
+        0.796_666_477_413_626_7,
+        0.960_289_856_497_536_3,
+    ];
+    let w = [
+        0.362_683_783_378_362,
+        0.313_706_645_877_887_3,
+        0.222_381_034_453_374_5,
+        0.101_228_536_290_376_3,
+    ];
+    std::array::from_fn(|k| {
+        let (i, sign) = if k < 4 { (3 - k, -1.0) } else { (k - 4, 1.0) };
+        (0.5 + 0.5 * sign * x[i], 0.5 * w[i])
+    })
+}
+
+/// The root sections of the central tooth, one per face layer with both flanks' root nodes.
+fn root_sections(m: &SectorMesh) -> Vec<RootSection> {
+    let at_root = |list: &[(usize, usize, usize)], layer: usize| {
+        list.iter().find(|f| f.0 == layer && f.1 == 0).map(|f| f.2)
+    };
+    let mut sections = Vec::new();
+    for layer in 0..m.layer_columns.len() {
+        let (Some(a), Some(b)) = (
+            at_root(&m.left_flank[1], layer),
+            at_root(&m.right_flank[1], layer),
+        ) else {
+            continue;
+        };
+        let (pa, pb) = (m.mesh.nodes[a], m.mesh.nodes[b]);
+        let mid: [f64; 3] = std::array::from_fn(|d| 0.5 * (pa[d] + pb[d]));
+        let radius = mid[0].hypot(mid[1]);
+        let normal = [mid[0] / radius, mid[1] / radius, 0.0];
+        let mut points = Vec::new();
+        for (s, w) in gauss_legendre_8() {
+            let p: [f64; 3] = std::array::from_fn(|d| pa[d] + s * (pb[d] - pa[d]));
+            if let Some((e, xi)) = locate(&m.mesh, p) {
+                points.push((e, xi, w, s));
+            }
+        }
+        if points.len() == 8 {
+            sections.push(RootSection {
+                points,
+                normal,
+                z: mid[2],
+                radius,
+            });
+        }
+    }
+    sections
+}
+
+/// The element holding `p` and its natural coordinates there (elements whose bounding box
+/// holds the point, first that inverts).
+fn locate(mesh: &Mesh, p: [f64; 3]) -> Option<(usize, [f64; 3])> {
+    mesh.elements.iter().enumerate().find_map(|(e, nodes)| {
+        let inside = (0..3).all(|d| {
+            let (lo, hi) = nodes
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
+                    (lo.min(mesh.nodes[n][d]), hi.max(mesh.nodes[n][d]))
+                });
+            let pad = 1e-9 * (hi - lo).abs().max(1e-6);
+            p[d] >= lo - pad && p[d] <= hi + pad
+        });
+        if !inside {
+            return None;
+        }
+        natural_coordinates(mesh, e, p).map(|xi| (e, xi))
+    })
+}
+
+/// The linearised root stress of one section under the displacements `u` (ASME BPVC VIII-2
+/// Annex 5-A stress linearisation): the normal stress across the chord's membrane part
+/// sigma_m = integral sigma ds and bending part sigma_b = 6 integral sigma (s - 1/2) ds; the
+/// larger extreme fibre sigma_m + |sigma_b|, Pa.
+fn linearised(
+    m: &SectorMesh,
+    material: &Elastic,
+    u: &[[f64; 3]],
+    section: &RootSection,
+) -> Result<f64, FeError> {
+    let n = section.normal;
+    let (mut membrane, mut bending) = (0.0, 0.0);
+    for &(e, xi, w, s) in &section.points {
+        let t = element_stress(&m.mesh, e, material, u, xi)?;
+        let sigma = [[t[0], t[5], t[4]], [t[5], t[1], t[3]], [t[4], t[3], t[2]]];
+        let normal: f64 = (0..3)
+            .map(|i| (0..3).map(|j| n[i] * sigma[i][j] * n[j]).sum::<f64>())
+            .sum();
+        membrane += w * normal;
+        bending += 6.0 * w * normal * (s - 0.5);
+    }
+    Ok(membrane + bending.abs())
+}
+
+/// The largest linearised root stress ([`linearised`]) over the central tooth's root sections,
+/// every position and tooth of `ltca` (MODEL §9.1), on the sector of refinement `level`.
+pub fn linearised_root_stress(
+    gear: &GearSet,
+    geo: &Geometry,
+    ltca: &Ltca,
+    flank: Flank,
+    level: usize,
+) -> Result<RootStress, FeError> {
+    let loaded = LoadedSector::solve(gear, geo, ltca, flank, level)?;
+    let (m, material, solutions, labels) = (
+        &loaded.mesh,
+        &loaded.material,
+        &loaded.solutions,
+        &loaded.labels,
+    );
+    let sections = root_sections(m);
+    let mut best = RootStress::NONE;
+    for (u, &(position, tooth)) in solutions.iter().zip(labels) {
+        for section in &sections {
+            let s = linearised(m, material, u, section)?;
+            if s > best.max_principal {
+                best = RootStress {
+                    max_principal: s,
+                    position,
+                    tooth,
+                    r: section.radius,
+                    z: section.z,
                 };
             }
         }

@@ -198,6 +198,36 @@ pub fn element_stress(
     Ok(stress)
 }
 
+/// The natural coordinates of the physical point `p` (m) in element `e`, by Newton's method on
+/// x(xi) = sum N_i(xi) x_i from the element's centre; None when it does not converge or the
+/// point lies outside the element (beyond 1e-6 of its natural cube).
+pub fn natural_coordinates(mesh: &Mesh, e: usize, p: [f64; 3]) -> Option<[f64; 3]> {
+    let x: Vec<[f64; 3]> = mesh.elements[e].iter().map(|&n| mesh.nodes[n]).collect();
+    let mut xi = [0.0; 3];
+    for _ in 0..30 {
+        let (n, dn) = shape(xi);
+        let mut r = p;
+        for (w, xn) in n.iter().zip(&x) {
+            for d in 0..3 {
+                r[d] -= w * xn[d];
+            }
+        }
+        let (inv, _) = inverse(&jacobian(&dn, &x))?;
+        // dxi_i = sum_j (J^-T)_ij r_j with J_ij = dx_j / dxi_i: inv[j][i] = d xi_i / d x_j.
+        let step: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| inv[j][i] * r[j]).sum());
+        for i in 0..3 {
+            xi[i] += step[i];
+        }
+        if step.iter().all(|s| s.abs() < 1e-12) {
+            return xi.iter().all(|v| v.abs() <= 1.0 + 1e-6).then_some(xi);
+        }
+        if xi.iter().any(|v| v.abs() > 3.0) {
+            return None;
+        }
+    }
+    None
+}
+
 /// The principal stresses of a Voigt stress (xx, yy, zz, yz, xz, xy), largest first, Pa.
 pub fn principal_stresses(s: [f64; 6]) -> [f64; 3] {
     let m = nalgebra::Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2]);
