@@ -592,6 +592,18 @@ fn export_writes_the_results_under_the_standard_ids() {
         .attributes
         .iter()
         .any(|a| a.id.starts_with("custom_wormwear_")));
+    // The safety table from the model (MODEL §9.1): the worm's deflection; no safety without
+    // the [rating] limits.
+    let safety = results.safety.as_ref().unwrap();
+    let deflection = safety.rows.iter().find(|r| r.symbol == "S_delta").unwrap();
+    assert!(close(
+        value("custom_wormwear_worm_deflection_mesh_point"),
+        deflection.value.unwrap(),
+        1e-11
+    ));
+    assert!(stage
+        .attribute("custom_wormwear_safety_deflection_model")
+        .is_none());
     // With results the file still re-imports to the same gear.
     let back = rexs::parse_bytes(rexs::to_string(&model, Encoding::Xml).as_bytes(), "x").unwrap();
     let again = input::load_from_str(&import::import(&back, None, "x").unwrap().text).unwrap();

@@ -724,6 +724,34 @@ fn result_attributes(
             custom("worn_volume", "mm^3", last.worn_volume_m3 * 1e9),
         ]);
     }
+    if let Some(table) = results.safety.as_ref() {
+        v.extend(safety_attributes(table));
+    }
+    v
+}
+
+/// The safety table from the model (MODEL §9.1) as custom attributes: REXS's safety ids are
+/// the standard's method, ours is its method A. Only the safeties with a value, and the worm's
+/// deflection at the mesh point.
+fn safety_attributes(table: &crate::safety::SafetyTable) -> Vec<Attribute> {
+    let mut v = Vec::new();
+    for (symbol, name) in [
+        ("S_F", "root"),
+        ("S_delta", "deflection"),
+        ("S_H", "pitting"),
+        ("S_W", "wear"),
+        ("S_T", "temperature"),
+    ] {
+        let Some(row) = table.rows.iter().find(|r| r.symbol == symbol) else {
+            continue;
+        };
+        if let Some(x) = row.safety.filter(|x| x.is_finite()) {
+            v.push(custom(&format!("safety_{name}_model"), "none", x));
+        }
+        if let (Some(d), "S_delta") = (row.value, symbol) {
+            v.push(custom("worm_deflection_mesh_point", "mum", d));
+        }
+    }
     v
 }
 
