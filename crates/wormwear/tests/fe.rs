@@ -2,6 +2,7 @@
 //! field is reproduced to round-off on a distorted mesh) and a cantilever against Timoshenko
 //! beam theory (bending + shear).
 
+use std::f64::consts::PI;
 use wormwear::bending::fe::{
     box_mesh, element_stress, free_minus_blocked, principal_stresses, solve, solve_with_springs,
     Elastic, Load, Mesh, Spring,
@@ -403,4 +404,68 @@ fn stresses_are_exact_for_a_linear_field_and_match_beam_bending() {
         checked += 1;
     }
     assert!(checked >= 2, "{checked} elements checked");
+}
+
+/// A plate with a circular hole under uniaxial tension (plane strain), Kirsch's solution imposed
+/// as displacements on a concentric outer circle of 5 hole radii, so the exact field in the
+/// annulus is Kirsch's (G. Kirsch 1898; e.g. Timoshenko & Goodier, Theory of Elasticity, §35):
+/// the hoop stress at the hole is 3 sigma where the hole's edge is parallel to the load and
+/// -sigma where it faces it. A quarter annulus, radii graded geometrically towards the hole;
+/// the stress recovered at the hole's surface from the element's shape functions. Returns
+/// (sigma_xx at (0, a), sigma_yy at (a, 0)) / sigma.
+fn kirsch_hole(n_r: usize, n_theta: usize) -> (f64, f64) {
+    let (a, b, t, sigma): (f64, f64, f64, f64) = (0.01, 0.05, 0.002, 100e6);
+    let (mesh, lattice) = box_mesh((1.0, 1.0, 1.0), (n_r, n_theta, 1), |p| {
+        let r = a * (b / a).powf(p[0]);
+        let theta = 0.5 * PI * p[1];
+        [r * theta.cos(), r * theta.sin(), t * p[2]]
+    });
+    let (mx, my) = (2 * n_r, 2 * n_theta);
+    let g = STEEL.youngs_modulus / (2.0 * (1.0 + STEEL.poisson_ratio));
+    let kappa = 3.0 - 4.0 * STEEL.poisson_ratio;
+    let kirsch = |x: f64, y: f64| {
+        let (r, th) = (x.hypot(y), y.atan2(x));
+        let (c2, s2) = ((2.0 * th).cos(), (2.0 * th).sin());
+        let ur = sigma / (4.0 * g)
+            * (r * ((kappa - 1.0) / 2.0 + c2) + a * a / r * (1.0 + (1.0 + kappa) * c2)
+                - a.powi(4) / r.powi(3) * c2);
+        let ut = sigma / (4.0 * g) * ((1.0 - kappa) * a * a / r - r - a.powi(4) / r.powi(3)) * s2;
+        [ur * th.cos() - ut * th.sin(), ur * th.sin() + ut * th.cos()]
+    };
+    let mut fixed = Vec::new();
+    for (n, ijk) in lattice.iter().enumerate() {
+        let x = mesh.nodes[n];
+        fixed.push((n, 2, 0.0));
+        if ijk[0] == mx {
+            let u = kirsch(x[0], x[1]);
+            fixed.push((n, 0, u[0]));
+            fixed.push((n, 1, u[1]));
+        } else if ijk[1] == 0 {
+            fixed.push((n, 1, 0.0));
+        } else if ijk[1] == my {
+            fixed.push((n, 0, 0.0));
+        }
+    }
+    let u = solve(&mesh, &STEEL, &fixed, &[vec![]]).unwrap().remove(0);
+    let element = |i: usize, j: usize| j * n_r + i;
+    let top = element_stress(&mesh, element(0, n_theta - 1), &STEEL, &u, [-1.0, 1.0, 0.0]).unwrap();
+    let side = element_stress(&mesh, element(0, 0), &STEEL, &u, [-1.0, -1.0, 0.0]).unwrap();
+    (top[0] / sigma, side[1] / sigma)
+}
+
+#[test]
+fn the_stress_at_a_hole_converges_to_kirschs_concentration() {
+    // The notch test of the root stress's recovery (issue 34): 3.0114 / -1.0133 at 6 x 6,
+    // 3.0082 / -1.0084 at 12 x 12.
+    let coarse = kirsch_hole(6, 6);
+    let fine = kirsch_hole(12, 12);
+    eprintln!(
+        "hoop stress at the hole / sigma: 6 x 6 elements {:.4} and {:.4}, 12 x 12 {:.4} and {:.4} (Kirsch: 3 and -1)",
+        coarse.0, coarse.1, fine.0, fine.1
+    );
+    assert!((fine.0 / 3.0 - 1.0).abs() < 0.01, "{fine:?}");
+    assert!((fine.1 + 1.0).abs() < 0.01, "{fine:?}");
+    // Refinement brings both closer.
+    assert!((fine.0 - 3.0).abs() < (coarse.0 - 3.0).abs());
+    assert!((fine.1 + 1.0).abs() < (coarse.1 + 1.0).abs());
 }
