@@ -283,6 +283,7 @@ enum Failure {
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     // One run per output directory: the lock lives until the process ends.
     let _lock = match lock_output(&cli) {
@@ -300,6 +301,19 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// Gives SIGPIPE back its default action (end the process quietly), as Unix tools have: the
+/// Rust runtime ignores it, so a print to a closed pipe (`wormwear check FILE | head`) would
+/// panic. Output files are written atomically and a life resumes from its checkpoint, so
+/// ending on a closed pipe loses nothing.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in main, before any thread exists; SIG_DFL is a valid action for
+    // SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -1619,3 +1619,28 @@ fn export_rexs_writes_the_stage_with_results_and_imports_back() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `wormwear check FILE | head -1`: the reader closes the pipe after a line; the process ends
+/// quietly (SIGPIPE's default action, or done before the close), never with a panic.
+#[test]
+fn a_closed_stdout_ends_the_output_without_a_panic() {
+    use std::io::BufRead;
+    for _ in 0..5 {
+        let mut child = bin()
+            .arg("check")
+            .arg(example("gear-1x40-design.toml"))
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        assert!(first.contains("valid"), "{first}");
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        assert_ne!(out.status.code(), Some(101), "{err}");
+    }
+}
