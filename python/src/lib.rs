@@ -10,14 +10,14 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueEr
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 use std::path::Path;
-use wormwear::input::{self, GearSet, InputError};
+use wormwear::input::{self, GearSet, InputError as GearInputError};
 use wormwear::runner::{error_chain, LifeOverrides, OverrideNames};
 use wormwear::sweep::{Row, Settings, Sweep, Variant};
 use wormwear::{Request, Results, RunError, Source, Stage};
 
 pyo3::create_exception!(
     _native,
-    InputError_,
+    InputError,
     PyValueError,
     "An invalid gear input: every problem with its field, value and allowed range."
 );
@@ -30,12 +30,12 @@ pyo3::create_exception!(
 
 /// An input error as the Python exception: the message as the CLI prints it, and
 /// `problems`, a list of (field, value, problem) tuples (empty for a syntax error).
-fn input_error(py: Python<'_>, e: &InputError, context: &str) -> PyErr {
+fn input_error(py: Python<'_>, e: &GearInputError, context: &str) -> PyErr {
     let message = match context.is_empty() {
         true => e.to_string(),
         false => format!("{context}: {e}"),
     };
-    let err = InputError_::new_err(message);
+    let err = InputError::new_err(message);
     let problems: Vec<(String, String, String)> = e
         .field_errors()
         .iter()
@@ -53,7 +53,7 @@ fn run_error(py: Python<'_>, e: &RunError) -> PyErr {
     match e {
         RunError::Stopped(m) if m == INTERRUPTED => PyKeyboardInterrupt::new_err("run interrupted"),
         e if e.is_input() => {
-            let err = InputError_::new_err(error_chain(e));
+            let err = InputError::new_err(error_chain(e));
             let _ = err.value(py).setattr("problems", PyList::empty(py));
             err
         }
@@ -101,6 +101,31 @@ impl NativeGear {
     }
 }
 
+/// A change whose name the gear file does not know: the TOML reader's error points at a line of
+/// the document `with_` built, which the user never wrote; name the dotted field instead.
+fn unknown_change(
+    py: Python<'_>,
+    e: PyErr,
+    changes: &serde_json::Map<String, serde_json::Value>,
+) -> PyErr {
+    let text = e.value(py).to_string();
+    let Some(problem) = text.lines().rev().find(|l| l.contains("unknown field")) else {
+        return e;
+    };
+    let Some(name) = changes.keys().find(|name| {
+        let last = name.rsplit('.').next().unwrap_or(name);
+        problem.contains(&format!("`{last}`"))
+    }) else {
+        return e;
+    };
+    let err = InputError::new_err(format!("with_({name}): {}", problem.trim()));
+    let value = changes.get(name).map_or(String::new(), |v| v.to_string());
+    if let Ok(list) = PyList::new(py, [(name.clone(), value, problem.trim().to_string())]) {
+        let _ = err.value(py).setattr("problems", list);
+    }
+    err
+}
+
 /// A JSON text as a TOML value (null: None).
 fn toml_value(json: &serde_json::Value) -> Result<Option<toml::Value>, String> {
     match json {
@@ -132,7 +157,7 @@ impl NativeGear {
     #[staticmethod]
     fn from_json(py: Python<'_>, json: &str, file: String) -> PyResult<Self> {
         let document: toml::Table = serde_json::from_str(json).map_err(|e| {
-            InputError_::new_err(format!("the gear document is not a table of values: {e}"))
+            InputError::new_err(format!("the gear document is not a table of values: {e}"))
         })?;
         Self::from_document(py, document, file)
     }
@@ -142,13 +167,12 @@ impl NativeGear {
     fn with_changes(&self, py: Python<'_>, changes_json: &str) -> PyResult<Self> {
         let changes: serde_json::Map<String, serde_json::Value> =
             serde_json::from_str(changes_json)
-                .map_err(|e| InputError_::new_err(format!("changes: {e}")))?;
+                .map_err(|e| InputError::new_err(format!("changes: {e}")))?;
         let mut document = self.document.clone();
         let mut described = Vec::new();
         for (name, value) in &changes {
-            let value = toml_value(value).map_err(|e| {
-                InputError_::new_err(format!("{name} = {e}: not a gear file value"))
-            })?;
+            let value = toml_value(value)
+                .map_err(|e| InputError::new_err(format!("{name} = {e}: not a gear file value")))?;
             input::set_dotted(&mut document, name, value.clone())
                 .map_err(|e| input_error(py, &e, ""))?;
             described.push(format!(
@@ -157,7 +181,7 @@ impl NativeGear {
             ));
         }
         let file = format!("{} with {}", self.source.file, described.join(", "));
-        Self::from_document(py, document, file)
+        Self::from_document(py, document, file).map_err(|e| unknown_change(py, e, &changes))
     }
 
     /// The gear document as JSON (the file's tables as objects, the units of its names).
@@ -548,7 +572,7 @@ fn write_sweep_csv(path: &str, parameters: Vec<String>, rows_json: &str) -> PyRe
 #[pyfunction]
 fn rexs_stages(path: &str) -> PyResult<Vec<(u64, String, u64, u64)>> {
     let model =
-        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError_::new_err(e.to_string()))?;
+        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError::new_err(e.to_string()))?;
     Ok(wormwear::rexs::import::worm_stages(&model)
         .into_iter()
         .map(|s| (s.id, s.name, s.worm, s.wheel))
@@ -561,15 +585,15 @@ fn rexs_stages(path: &str) -> PyResult<Vec<(u64, String, u64, u64)>> {
 #[pyo3(signature = (path, stage=None))]
 fn import_rexs(path: &str, stage: Option<u64>) -> PyResult<(String, Vec<String>)> {
     let model =
-        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError_::new_err(e.to_string()))?;
+        wormwear::rexs::read(Path::new(path)).map_err(|e| InputError::new_err(e.to_string()))?;
     let imported = wormwear::rexs::import::import(&model, stage, path)
-        .map_err(|e| InputError_::new_err(format!("in {path}: {e}")))?;
+        .map_err(|e| InputError::new_err(format!("in {path}: {e}")))?;
     Ok((imported.text, imported.warnings))
 }
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add("InputError", m.py().get_type::<InputError_>())?;
+    m.add("InputError", m.py().get_type::<InputError>())?;
     m.add("ComputationError", m.py().get_type::<ComputationError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<NativeGear>()?;

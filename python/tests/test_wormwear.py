@@ -139,8 +139,12 @@ def test_input_errors_raise_with_the_cli_message_and_every_problem(cli, design_f
         wormwear.load(str(bad))
     assert str(e.value) in out.stderr
     # Variants: an unknown field, a value out of range, a path through a value.
-    with pytest.raises(wormwear.InputError, match="worm_torq_nm"):
+    with pytest.raises(wormwear.InputError, match="worm_torq_nm") as e:
         gear.with_(**{"conditions.worm_torq_nm": 5})
+    # The dotted name, not a line of a document the user never wrote; the class's own name.
+    assert str(e.value).startswith("with_(conditions.worm_torq_nm): unknown field"), str(e.value)
+    assert "line" not in str(e.value) and e.value.problems[0][0] == "conditions.worm_torq_nm"
+    assert wormwear.InputError.__name__ == "InputError"
     with pytest.raises(wormwear.InputError, match="conditions.worm_speed_rpm"):
         gear.with_(**{"conditions.worm_speed_rpm": -1})
     with pytest.raises(wormwear.InputError, match="is a value"):
