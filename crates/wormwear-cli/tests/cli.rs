@@ -3,6 +3,12 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+// The library tests' helpers (the skipped-test log).
+#[allow(dead_code)]
+#[path = "../../wormwear/tests/common/mod.rs"]
+mod common;
+use common::skipped;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_wormwear"))
 }
@@ -499,7 +505,10 @@ fn chromium() -> Option<PathBuf> {
 #[test]
 fn report_renders_in_a_headless_browser() {
     let Some(browser) = chromium() else {
-        eprintln!("SKIPPED: no chromium on the PATH (apt-get install chromium)");
+        skipped(
+            "cli::report_renders_in_a_headless_browser",
+            "no chromium on the PATH (apt-get install chromium)",
+        );
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -981,7 +990,10 @@ fn python_with_vtk() -> Option<PathBuf> {
 #[test]
 fn vtk_files_load_in_vtk_and_carry_the_results() {
     let Some(python) = python_with_vtk() else {
-        eprintln!("SKIPPED: no Python with VTK (apt-get install python3-vtk9)");
+        skipped(
+            "cli::vtk_files_load_in_vtk_and_carry_the_results",
+            "no Python with VTK (apt-get install python3-vtk9)",
+        );
         return;
     };
     let dir = tempfile::tempdir().unwrap();

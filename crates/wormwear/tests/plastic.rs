@@ -114,7 +114,10 @@ fn a_sphere_beyond_yield_agrees_with_tamaas_kato_saturated() {
     // difference, and the bounded solutions may differ by no more than it, with the plateau's
     // and the contact's radii equal to within one cell.
     let Some(python) = tamaas_python() else {
-        eprintln!("SKIPPED: no Python with tamaas 2.9 (pip install tamaas==2.9.0)");
+        common::skipped(
+            "plastic::tamaas",
+            "no Python with tamaas 2.9 (pip install tamaas==2.9.0)",
+        );
         return;
     };
     let (n, span) = (64, 2.8);

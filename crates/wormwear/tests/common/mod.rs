@@ -4,6 +4,7 @@ use std::path::Path;
 use wormwear::input::{self, GearSet};
 
 /// A reference case from `examples/`, validated.
+#[allow(dead_code)]
 pub fn example(name: &str) -> GearSet {
     input::load(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -22,6 +23,24 @@ pub const EXAMPLES: [&str; 5] = [
     "gear-1x40-case-c.toml",
     "gear-k-2x25.toml",
 ];
+
+/// A test that cannot run without an optional independent reader: says so on stderr and, when
+/// the runner asks for it (`WORMWEAR_SKIP_LOG`, set by `scripts/test-all`), appends a line to
+/// that file so that the run's summary lists it.
+#[allow(dead_code)]
+pub fn skipped(test: &str, reason: &str) {
+    eprintln!("SKIPPED: {reason}");
+    if let Some(path) = std::env::var_os("WORMWEAR_SKIP_LOG").filter(|p| !p.is_empty()) {
+        use std::io::Write;
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
+            let _ = writeln!(f, "{test}: {reason}");
+        }
+    }
+}
 
 /// A gear ready for life runs: geometry and unloaded analysis built once.
 #[allow(dead_code)]
