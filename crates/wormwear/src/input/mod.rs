@@ -848,8 +848,53 @@ fn cut_long_lines(message: &str) -> String {
 
 /// Parses and validates a gear file given as TOML text.
 pub fn load_from_str(text: &str) -> Result<GearSet, InputError> {
-    let file: GearFile = toml::from_str(text).map_err(|e| syntax_error(&e, text))?;
+    let file = parse_gear_file(text)?;
     validate::validate(&file)
+}
+
+/// The most unknown keys [`parse_gear_file`] collects before it reports them.
+const MAX_UNKNOWN_KEYS: usize = 64;
+
+/// The gear file's tables, or every unknown key at once: the TOML reader stops at the first
+/// unknown key, so each one (a `key = value` line) is commented out in a copy of the text,
+/// which keeps the line numbers, and the text read again; the errors are reported together,
+/// with the first error of another kind (a missing key, a wrong type) if one follows.
+fn parse_gear_file(text: &str) -> Result<GearFile, InputError> {
+    let first = match toml::from_str::<GearFile>(text) {
+        Ok(file) => return Ok(file),
+        Err(e) => e,
+    };
+    let mut errors = vec![syntax_error(&first, text).to_string()];
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut current = first;
+    while errors.len() < MAX_UNKNOWN_KEYS && current.message().starts_with("unknown field") {
+        let joined = lines.join("\n");
+        let Some(line) = current
+            .span()
+            .map(|s| joined[..s.start].matches('\n').count())
+        else {
+            break;
+        };
+        // Only a one-line `key = value`: a table header or a value over several lines would
+        // leave a text whose next error is not the user's.
+        let key_line = lines.get(line).is_some_and(|l| {
+            let t = l.trim_start();
+            !t.starts_with('[') && t.contains('=') && !t.trim_end().ends_with('[')
+        });
+        if !key_line {
+            break;
+        }
+        lines[line] = format!("# {}", lines[line]);
+        let joined = lines.join("\n");
+        match toml::from_str::<GearFile>(&joined) {
+            Ok(_) => break,
+            Err(e) => {
+                errors.push(syntax_error(&e, &joined).to_string());
+                current = e;
+            }
+        }
+    }
+    Err(InputError::Syntax(errors.join("\n")))
 }
 
 /// A parse error of `text` as an input error, its long lines cut.
