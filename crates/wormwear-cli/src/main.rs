@@ -10,6 +10,7 @@ use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
 mod calibrate_cmd;
+mod rating_cmd;
 mod rexs_cmd;
 
 #[derive(Parser)]
@@ -364,7 +365,7 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
         Command::Wear { file, output, life } => wear(file, output, life, cli.quiet, cli.verbose),
         Command::Run { file, output, life } => run(file, output, life, cli.quiet, cli.verbose),
         Command::Rating { file, output, life } => {
-            rating(file, output, life, cli.quiet, cli.verbose)
+            rating_cmd::rating(file, output, life, cli.quiet, cli.verbose)
         }
         Command::Calibrate {
             file,
@@ -819,69 +820,13 @@ fn run(
     finish_life(&results, dir, quiet);
     if !quiet {
         if let Some(table) = &results.safety {
-            print_safety(table);
+            rating_cmd::print_safety(table);
         }
         if let Some(report) = files.iter().find(|f| f.ends_with("report.html")) {
             println!("report: {}", report.display());
         }
     }
     Ok(())
-}
-
-/// The safety table (MODEL §9.1): the loaded analysis and, with a life plan, the life.
-fn rating(
-    file: &Path,
-    dir: &Path,
-    args: &LifeArgs,
-    quiet: bool,
-    verbose: bool,
-) -> Result<(), Failure> {
-    use wormwear::Stage;
-    let gear = load(file)?;
-    let request = planned_request(
-        dir,
-        &gear,
-        args,
-        (&[Stage::Ltca, Stage::Wear], &[Stage::Ltca]),
-    )?;
-    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
-    if let (Some(table), false) = (&results.safety, quiet) {
-        print_safety(table);
-        println!("results in {}", dir.display());
-    }
-    Ok(())
-}
-
-/// The safety table on stdout, one line per row.
-fn print_safety(table: &wormwear::safety::SafetyTable) {
-    let cell = |v: Option<f64>| match v {
-        Some(x) if x.is_finite() => format!("{x:.4}"),
-        Some(_) => "inf".into(),
-        None => "-".into(),
-    };
-    println!(
-        "safety (MODEL §9.1; K_A {}, required life {}):",
-        table.application_factor,
-        table
-            .required_cycles
-            .map_or("not given".into(), |n| format!("{n:.4e} wheel cycles"))
-    );
-    println!(
-        "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} verdict",
-        "symbol", "value", "allowable", "safety", "minimum", "unit"
-    );
-    for r in &table.rows {
-        println!(
-            "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} {}",
-            r.symbol,
-            cell(r.value),
-            cell(r.allowable),
-            cell(r.safety),
-            r.minimum,
-            r.unit,
-            r.verdict.text()
-        );
-    }
 }
 
 /// K from wear tests or from a backlash curve; writes the `calibration` section.

@@ -1,0 +1,60 @@
+//! `wormwear rating`: the safety table from the model (MODEL §9.1) of the loaded analysis and,
+//! with a life plan, the life; printed and written with the run's files.
+use super::{analyse, load, planned_request, Failure, LifeArgs};
+use std::path::Path;
+
+/// The safety table (MODEL §9.1): the loaded analysis and, with a life plan, the life.
+pub(crate) fn rating(
+    file: &Path,
+    dir: &Path,
+    args: &LifeArgs,
+    quiet: bool,
+    verbose: bool,
+) -> Result<(), Failure> {
+    use wormwear::Stage;
+    let gear = load(file)?;
+    let request = planned_request(
+        dir,
+        &gear,
+        args,
+        (&[Stage::Ltca, Stage::Wear], &[Stage::Ltca]),
+    )?;
+    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    if let (Some(table), false) = (&results.safety, quiet) {
+        print_safety(table);
+        println!("results in {}", dir.display());
+    }
+    Ok(())
+}
+
+/// The safety table on stdout, one line per row.
+pub(crate) fn print_safety(table: &wormwear::safety::SafetyTable) {
+    let cell = |v: Option<f64>| match v {
+        Some(x) if x.is_finite() => format!("{x:.4}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    };
+    println!(
+        "safety (MODEL §9.1; K_A {}, required life {}):",
+        table.application_factor,
+        table
+            .required_cycles
+            .map_or("not given".into(), |n| format!("{n:.4e} wheel cycles"))
+    );
+    println!(
+        "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} verdict",
+        "symbol", "value", "allowable", "safety", "minimum", "unit"
+    );
+    for r in &table.rows {
+        println!(
+            "  {:<8} {:>12} {:>12} {:>8} {:>8}  {:<6} {}",
+            r.symbol,
+            cell(r.value),
+            cell(r.allowable),
+            cell(r.safety),
+            r.minimum,
+            r.unit,
+            r.verdict.text()
+        );
+    }
+}
