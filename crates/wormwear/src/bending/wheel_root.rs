@@ -300,6 +300,31 @@ impl LoadedSector {
             solutions,
         })
     }
+
+    /// The largest stress over every load case and every `candidate`: `stress(u, candidate)`
+    /// gives the stress (Pa) under the displacements `u` and its place (r, z; m).
+    fn largest<T>(
+        &self,
+        candidates: &[T],
+        stress: impl Fn(&[[f64; 3]], &T) -> Result<(f64, f64, f64), FeError>,
+    ) -> Result<RootStress, FeError> {
+        let mut best = RootStress::NONE;
+        for (u, &(position, tooth)) in self.solutions.iter().zip(&self.labels) {
+            for candidate in candidates {
+                let (s, r, z) = stress(u, candidate)?;
+                if s > best.max_principal {
+                    best = RootStress {
+                        max_principal: s,
+                        position,
+                        tooth,
+                        r,
+                        z,
+                    };
+                }
+            }
+        }
+        Ok(best)
+    }
 }
 
 /// The largest principal stress at the central tooth's root over every position and tooth of
@@ -312,41 +337,24 @@ pub fn root_stress(
     level: usize,
 ) -> Result<RootStress, FeError> {
     let loaded = LoadedSector::solve(gear, geo, ltca, flank, level)?;
-    let (m, material, solutions, labels) = (
-        &loaded.mesh,
-        &loaded.material,
-        &loaded.solutions,
-        &loaded.labels,
-    );
     let mut loaded_nodes: Vec<usize> = loaded.cases.iter().flatten().map(|l| l.0).collect();
     loaded_nodes.sort_unstable();
     loaded_nodes.dedup();
+    let m = &loaded.mesh;
     let tau = 2.0 * std::f64::consts::PI / geo.teeth as f64;
     let points = root_points(gear, m, (central_tooth_angle(m), tau), &loaded_nodes);
-    let mut best = RootStress::NONE;
-    for (u, &(position, tooth)) in solutions.iter().zip(labels) {
-        for &(e, xi) in &points {
-            let s = principal_stresses(element_stress(&m.mesh, e, material, u, xi)?)[0];
-            if s > best.max_principal {
-                let (n, _) = super::fe::shape(xi);
-                let x: [f64; 3] = std::array::from_fn(|d| {
-                    m.mesh.elements[e]
-                        .iter()
-                        .zip(n)
-                        .map(|(&k, w)| w * m.mesh.nodes[k][d])
-                        .sum()
-                });
-                best = RootStress {
-                    max_principal: s,
-                    position,
-                    tooth,
-                    r: x[0].hypot(x[1]),
-                    z: x[2],
-                };
-            }
-        }
-    }
-    Ok(best)
+    loaded.largest(&points, |u, &(e, xi)| {
+        let s = principal_stresses(element_stress(&m.mesh, e, &loaded.material, u, xi)?)[0];
+        let (n, _) = super::fe::shape(xi);
+        let x: [f64; 3] = std::array::from_fn(|d| {
+            m.mesh.elements[e]
+                .iter()
+                .zip(n)
+                .map(|(&k, w)| w * m.mesh.nodes[k][d])
+                .sum()
+        });
+        Ok((s, x[0].hypot(x[1]), x[2]))
+    })
 }
 
 /// A root section of the central tooth at one face layer: the chord between its two flanks'
@@ -471,27 +479,9 @@ pub fn linearised_root_stress(
     level: usize,
 ) -> Result<RootStress, FeError> {
     let loaded = LoadedSector::solve(gear, geo, ltca, flank, level)?;
-    let (m, material, solutions, labels) = (
-        &loaded.mesh,
-        &loaded.material,
-        &loaded.solutions,
-        &loaded.labels,
-    );
-    let sections = root_sections(m);
-    let mut best = RootStress::NONE;
-    for (u, &(position, tooth)) in solutions.iter().zip(labels) {
-        for section in &sections {
-            let s = linearised(m, material, u, section)?;
-            if s > best.max_principal {
-                best = RootStress {
-                    max_principal: s,
-                    position,
-                    tooth,
-                    r: section.radius,
-                    z: section.z,
-                };
-            }
-        }
-    }
-    Ok(best)
+    let sections = root_sections(&loaded.mesh);
+    loaded.largest(&sections, |u, section| {
+        let s = linearised(&loaded.mesh, &loaded.material, u, section)?;
+        Ok((s, section.radius, section.z))
+    })
 }
