@@ -6,6 +6,7 @@ pub mod basis;
 pub mod fe;
 pub mod model;
 pub(crate) mod relation;
+pub mod root_mesh;
 pub mod wheel_mesh;
 pub mod wheel_model;
 pub mod wheel_root;

@@ -224,8 +224,8 @@ impl Sections<'_> {
 
 /// Nodes merged where they coincide (to a nanometre).
 #[derive(Default)]
-struct Nodes {
-    points: Vec<[f64; 3]>,
+pub(super) struct Nodes {
+    pub(super) points: Vec<[f64; 3]>,
     index: HashMap<(i64, i64, i64), usize>,
 }
 
@@ -239,7 +239,7 @@ impl Nodes {
     }
 
     /// The node at p, added when new.
-    fn at(&mut self, p: [f64; 3]) -> usize {
+    pub(super) fn at(&mut self, p: [f64; 3]) -> usize {
         let points = &mut self.points;
         *self.index.entry(Self::key(p)).or_insert_with(|| {
             points.push(p);
@@ -383,23 +383,9 @@ fn layer_block(
         for iu in 0..nu {
             let mut e = [0usize; 20];
             for (a, c) in NATURAL.iter().enumerate() {
-                let u = (iu as f64 + 0.5 + 0.5 * c[0]) / nu as f64;
-                let v = (iv as f64 + 0.5 + 0.5 * c[1]) / nv as f64;
-                let p = if c[2] < 0.0 {
-                    sections.point(j0, block, u, v)
-                } else if c[2] > 0.0 {
-                    sections.point(j1, block, u, v)
-                } else {
-                    let (pa, pb) = (
-                        sections.point(j0, block, u, v),
-                        sections.point(j1, block, u, v),
-                    );
-                    [
-                        (pa[0] + pb[0]) / 2.0,
-                        (pa[1] + pb[1]) / 2.0,
-                        (pa[2] + pb[2]) / 2.0,
-                    ]
-                };
+                let (u, v, p) = lattice_point(c, (iu, iv), (nu, nv), |layer, u, v| {
+                    sections.point([j0, j1][layer], block, u, v)
+                });
                 let id = nodes.at(p);
                 e[a] = id;
                 // Clamped: the hub (web bottom) with a web, else the rim's inner surface.
@@ -427,6 +413,32 @@ fn layer_block(
             elements.push(e);
         }
     }
+}
+
+/// Natural node `c` of element (iu, iv) of a block of nu x nv elements between two layers:
+/// its parameters (u, v) on the block's half-step lattice and its point, `point(layer, u, v)`
+/// on the layer below (0) or above (1), or their mean at mid-layer. m.
+pub(super) fn lattice_point(
+    c: &[f64; 3],
+    (iu, iv): (usize, usize),
+    (nu, nv): (usize, usize),
+    point: impl Fn(usize, f64, f64) -> [f64; 3],
+) -> (f64, f64, [f64; 3]) {
+    let u = (iu as f64 + 0.5 + 0.5 * c[0]) / nu as f64;
+    let v = (iv as f64 + 0.5 + 0.5 * c[1]) / nv as f64;
+    let p = if c[2] < 0.0 {
+        point(0, u, v)
+    } else if c[2] > 0.0 {
+        point(1, u, v)
+    } else {
+        let (pa, pb) = (point(0, u, v), point(1, u, v));
+        [
+            (pa[0] + pb[0]) / 2.0,
+            (pa[1] + pb[1]) / 2.0,
+            (pa[2] + pb[2]) / 2.0,
+        ]
+    };
+    (u, v, p)
 }
 
 /// The last layer's flank nodes (far face) are not first corners of any element: registered

@@ -516,6 +516,9 @@ pub struct SafetyInputs {
     pub starts_per_hour: f64,
     /// Allowable root stress of the wheel, Pa.
     pub root_stress_allowable: Option<f64>,
+    /// Radius of the wheel's root fillet in the FE root-stress model (the hob's tip edge
+    /// radius), m.
+    pub root_fillet_radius: Option<f64>,
     /// Worm deflection limit at the mesh point, m.
     pub deflection_limit: Option<f64>,
     /// Allowable tooth thickness loss Delta_s_lim, m (MODEL §9 (b)).
@@ -537,6 +540,7 @@ impl Default for SafetyInputs {
             application_factor: 1.0,
             starts_per_hour: 0.0,
             root_stress_allowable: None,
+            root_fillet_radius: None,
             deflection_limit: None,
             thickness_loss_limit: None,
             mass_loss_limit: None,

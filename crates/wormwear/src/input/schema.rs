@@ -97,6 +97,9 @@ pub struct RatingSpec {
     pub starts_per_hour: Option<f64>,
     /// Allowable root stress of the wheel, MPa (no default: S_F needs it).
     pub root_stress_allowable_mpa: Option<f64>,
+    /// Radius of the wheel's root fillet in the FE model of the root stress (the hob's tip
+    /// edge radius), mm (no default: S_F needs it).
+    pub root_fillet_radius_mm: Option<f64>,
     /// Worm deflection limit at the mesh point, um (no default: S_delta needs it).
     pub deflection_limit_um: Option<f64>,
     /// Allowable tooth thickness loss Delta_s_lim, mm (MODEL §9 (b); optional).

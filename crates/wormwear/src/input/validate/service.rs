@@ -334,6 +334,13 @@ fn safety_inputs(ck: &mut Checker, r: &RatingSpec) -> Option<SafetyInputs> {
         "MPa",
         1e6,
     );
+    let fillet = limit(
+        "root_fillet_radius_mm",
+        r.root_fillet_radius_mm,
+        20.0,
+        "mm",
+        1e-3,
+    );
     let deflection = limit(
         "deflection_limit_um",
         r.deflection_limit_um,
@@ -374,6 +381,7 @@ fn safety_inputs(ck: &mut Checker, r: &RatingSpec) -> Option<SafetyInputs> {
         application_factor: ka?,
         starts_per_hour: starts?,
         root_stress_allowable: root?,
+        root_fillet_radius: fillet?,
         deflection_limit: deflection?,
         thickness_loss_limit: thickness?,
         mass_loss_limit: mass?,
