@@ -591,6 +591,7 @@ impl<'a> Pipeline<'a> {
             Some(_) => Some(self.worm_deflection(geo, strength)?),
             None => None,
         };
+        let root_stress = self.root_stress(geo, tca, strength);
         let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
             gear,
             iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
@@ -599,6 +600,7 @@ impl<'a> Pipeline<'a> {
             records: life.map(|l| l.end.records.as_slice()),
             endurance,
             worm_deflection,
+            root_stress,
         });
         self.warnings.extend(table.failed().map(|r| {
             format!(
@@ -610,6 +612,42 @@ impl<'a> Pipeline<'a> {
             )
         }));
         Ok(Some(table))
+    }
+
+    /// The wheel's root stresses under `ltca` (MODEL §9.1) when the safety table asks for them
+    /// (an allowable and a fillet radius given); a failure is the row's reason and a warning.
+    fn root_stress(
+        &mut self,
+        geo: &Geometry,
+        tca: &Tca,
+        ltca: &Ltca,
+    ) -> Option<Result<crate::bending::wheel_root::RootStresses, String>> {
+        let inputs = &self.gear.rating.safety;
+        let (Some(_), Some(radius)) = (inputs.root_stress_allowable, inputs.root_fillet_radius)
+        else {
+            return None;
+        };
+        let level = crate::bending::wheel_root::ROOT_LEVEL;
+        let result = crate::bending::wheel_root::root_stress(
+            self.gear,
+            geo,
+            ltca,
+            tca.loaded_flank,
+            (level, radius),
+        )
+        .map_err(|e| e.to_string());
+        match &result {
+            Err(e) => self.warnings.push(format!("safety: S_F not computed: {e}")),
+            Ok(r) if r.face_ends.stress > r.interior.stress => self.warnings.push(format!(
+                "safety: the root stress within a module of a face end ({:.1} MPa) exceeds the \
+                 one inside ({:.1} MPa) that S_F uses; near the face ends it depends on the \
+                 mesh (the face edges' contact load), so S_F may be optimistic there",
+                r.face_ends.stress * 1e-6,
+                r.interior.stress * 1e-6
+            )),
+            Ok(_) => {}
+        }
+        Some(result)
     }
 
     /// The worm FE model's largest deflection at the mesh point over the positions of `ltca`

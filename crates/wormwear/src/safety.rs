@@ -5,6 +5,7 @@
 //! stress. Each row: the computed value, its allowable, the safety, the minimum and a verdict;
 //! an allowable without a citable default is an input, and without it the row says so.
 
+use crate::bending::wheel_root::{RootStresses, ROOT_LEVEL};
 use crate::friction::Thermal;
 use crate::input::{Endurance, GearSet, SafetyInputs, Torque};
 use crate::ltca::Ltca;
@@ -86,6 +87,9 @@ pub struct SafetyInputsOf<'a> {
     /// The worm FE model's largest deflection at the mesh point over the positions of the
     /// loaded analysis at K_A T, m (None without FE bending).
     pub worm_deflection: Option<f64>,
+    /// The wheel's root stresses at K_A T (None: not asked for, i.e. no allowable or no fillet
+    /// radius; an error: why they could not be computed).
+    pub root_stress: Option<Result<RootStresses, String>>,
 }
 
 /// The gear with its torque times `factor` (the rating case of K_A).
@@ -110,7 +114,7 @@ pub fn safety_table(s: &SafetyInputsOf) -> SafetyTable {
     let required_cycles = inputs
         .required_life_hours
         .map(|h| cycles_of_hours(s.gear, h));
-    let mut rows = vec![root_row(inputs), deflection_row(s)];
+    let mut rows = vec![root_row(inputs, s.root_stress.as_ref()), deflection_row(s)];
     rows.push(pitting_row(s, required_cycles));
     rows.extend(wear_rows(s, required_cycles));
     rows.push(temperature_row(s));
@@ -157,22 +161,51 @@ fn row(
     }
 }
 
-/// Tooth root (S_F): the FE stress recovery at the wheel's root fillet is not in this build.
-fn root_row(inputs: &SafetyInputs) -> SafetyRow {
+/// Tooth root (S_F): the linearised root stress of the FE wheel sector with filleted roots
+/// under the loaded analysis at K_A T (MODEL §9.1, [`crate::bending::wheel_root`]) against
+/// the allowable; computed when both the allowable and the fillet radius are given.
+fn root_row(inputs: &SafetyInputs, root: Option<&Result<RootStresses, String>>) -> SafetyRow {
+    let allowable = inputs
+        .root_stress_allowable
+        .map(|a| a * 1e-6)
+        .ok_or_else(|| Verdict::NeedsInput("rating.root_stress_allowable_mpa".into()));
+    let fillet = inputs.root_fillet_radius.unwrap_or(f64::NAN) * 1e3;
+    let (value, source, failure) = match root {
+        Some(Ok(r)) => (
+            Some(r.interior.stress * 1e-6),
+            format!(
+                "FE wheel sector (three teeth on the rim, roots filleted with radius {fillet} mm, \
+                 refinement {ROOT_LEVEL}) under the loaded analysis's pressures at K_A T at every \
+                 position: the linearised normal stress (membrane + bending, ASME VIII-2 5-A) \
+                 across the tooth's section between its fillets' mid points, largest over the \
+                 positions and the sections from one module inside the face ends (position {}, \
+                 z = {:.1} mm); within a module of the face ends {:.1} MPa (information: not \
+                 converged under refinement)",
+                r.interior.position,
+                r.interior.z * 1e3,
+                r.face_ends.stress * 1e-6
+            ),
+            None,
+        ),
+        Some(Err(e)) => (None, String::new(), Some(Verdict::NotComputed(e.clone()))),
+        None => (
+            None,
+            "FE wheel sector with filleted roots (MODEL §9.1)".into(),
+            inputs
+                .root_fillet_radius
+                .is_none()
+                .then(|| Verdict::NeedsInput("rating.root_fillet_radius_mm".into())),
+        ),
+    };
     let mut r = row(
         ("Wheel tooth root stress", "S_F", "MPa"),
-        None,
-        inputs
-            .root_stress_allowable
-            .map(|a| a * 1e-6)
-            .ok_or_else(|| Verdict::NeedsInput("rating.root_stress_allowable_mpa".into())),
+        value,
+        allowable,
         inputs.minimum[0],
-        "FE wheel model under the loaded contact's pressures at every position (MODEL §9.1)".into(),
+        source,
     );
-    if r.allowable.is_some() {
-        r.verdict = Verdict::NotComputed(
-            "the stress recovery at the wheel's root fillet is not in this build".into(),
-        );
+    if let (Some(v), true) = (failure, r.allowable.is_some()) {
+        r.verdict = v;
     }
     r
 }

@@ -16,6 +16,7 @@ fn rated() -> GearSet {
     g.rating.safety = SafetyInputs {
         required_life_hours: Some(100.0),
         root_stress_allowable: Some(100e6),
+        root_fillet_radius: Some(1e-3),
         deflection_limit: Some(50e-6),
         thickness_loss_limit: Some(1e-3),
         mass_loss_limit: Some(0.05),
@@ -55,7 +56,7 @@ fn more_torque_lowers_the_safeties_and_k_a_is_a_torque_factor_on_the_strength_ro
     let g = rated();
     let base = table(&g);
     let heavy = table(&scaled(&g, 1.5));
-    for symbol in ["S_delta", "S_H", "S_W", "S_T"] {
+    for symbol in ["S_F", "S_delta", "S_H", "S_W", "S_T"] {
         assert!(
             safety(&heavy, symbol) < safety(&base, symbol),
             "{symbol}: {} at 1.5 T, {} at T",
@@ -68,7 +69,7 @@ fn more_torque_lowers_the_safeties_and_k_a_is_a_torque_factor_on_the_strength_ro
     let mut ka = g.clone();
     ka.rating.safety.application_factor = 1.5;
     let with_ka = table(&ka);
-    for symbol in ["S_delta", "S_H"] {
+    for symbol in ["S_F", "S_delta", "S_H"] {
         let (a, b) = (safety(&with_ka, symbol), safety(&heavy, symbol));
         assert!(
             (a / b - 1.0).abs() < 1e-9,
@@ -118,6 +119,15 @@ fn rows_without_their_input_say_which_and_never_show_a_safety() {
         assert_eq!(row.verdict, Verdict::NeedsInput(field.into()), "{symbol}");
         assert!(row.safety.is_none(), "{symbol}");
     }
+    // S_F needs the fillet radius of its FE model as well as the allowable.
+    g.rating.safety.root_stress_allowable = Some(100e6);
+    let t2 = table(&g);
+    let row = t2.rows.iter().find(|r| r.symbol == "S_F").unwrap();
+    assert_eq!(
+        row.verdict,
+        Verdict::NeedsInput("rating.root_fillet_radius_mm".into())
+    );
+    assert!(row.safety.is_none());
     // Without the heat balance the sump temperature is the lubricant's input, not a result.
     assert!(matches!(verdict("S_T").verdict, Verdict::NotComputed(_)));
     assert!(verdict("S_T").safety.is_none());

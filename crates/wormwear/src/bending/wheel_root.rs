@@ -112,6 +112,11 @@ struct FlankLoads<'a> {
 }
 
 impl FlankLoads<'_> {
+    /// The sector's fillet radius, mm.
+    fn radius_mm(&self) -> f64 {
+        self.sector.settings.fillet_radius * 1e3
+    }
+
     /// The layer holding face coordinate z and the fraction across it.
     fn layer(&self, z: f64) -> (usize, f64) {
         let lz = &self.sector.layer_z;
@@ -186,15 +191,6 @@ impl FlankLoads<'_> {
             }
         }
         Ok(())
-    }
-
-    fn radius_mm(&self) -> f64 {
-        self.gear
-            .rating
-            .safety
-            .root_fillet_radius
-            .unwrap_or(f64::NAN)
-            * 1e3
     }
 }
 
