@@ -14,6 +14,10 @@ use crate::wear::{CycleWear, StepView, WearError, WearState};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
+/// A required life beyond this many times the simulated one makes S_W's extrapolation a
+/// warning.
+const EXTRAPOLATION_WARNING: f64 = 2.0;
+
 /// A stage of the pipeline a request asks for. Each runs the stages it needs before it
 /// (the loaded analysis needs the unloaded one); what is written follows what was asked
 /// ([`crate::output::write_results`]).
@@ -592,6 +596,7 @@ impl<'a> Pipeline<'a> {
             None => None,
         };
         let root_stress = self.root_stress(geo, tca, strength);
+        let sump = self.sump_temperature(geo, tca, ltca, thermal);
         let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
             gear,
             iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
@@ -601,7 +606,19 @@ impl<'a> Pipeline<'a> {
             endurance,
             worm_deflection,
             root_stress,
+            sump,
         });
+        let simulated = life.and_then(|l| l.end.records.last()).map(|r| r.cycles);
+        if let (Some(end), Some(required)) = (simulated, table.required_cycles) {
+            if required > EXTRAPOLATION_WARNING * end {
+                self.warnings.push(format!(
+                    "safety: S_W extrapolates the life's last slope from {end:.3e} to the required \
+                     {required:.3e} wheel cycles ({:.1} times the simulated life); run the life \
+                     that far (--cycles {required:.0}) for a simulated figure",
+                    required / end
+                ));
+            }
+        }
         self.warnings.extend(table.failed().map(|r| {
             format!(
                 "safety: {} = {:.2} is below its minimum {} ({})",
@@ -612,6 +629,50 @@ impl<'a> Pipeline<'a> {
             )
         }));
         Ok(Some(table))
+    }
+
+    /// The sump temperature of S_T (MODEL §9.1, §13): the run's own heat balance, or, when the
+    /// run holds the lubricant's fixed temperature and the table has a temperature limit, the
+    /// housing's heat balance at the nominal torque solved for the table alone (its `[housing]`
+    /// inputs or their defaults); an error is the row's reason.
+    fn sump_temperature(
+        &mut self,
+        geo: &Geometry,
+        tca: &Tca,
+        ltca: &Ltca,
+        thermal: Option<&crate::friction::Thermal>,
+    ) -> Option<Result<crate::safety::Sump, String>> {
+        if let Some(t) = thermal.filter(|t| t.mode == "balance") {
+            return Some(Ok(crate::safety::Sump {
+                thermal: t.clone(),
+                own: true,
+            }));
+        }
+        let gear = self.gear;
+        gear.rating.safety.oil_temperature_limit?;
+        let rating = crate::rating::rate(gear);
+        let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
+        let contacts = crate::friction::MeshContacts::new(gear, geo, tca, ltca);
+        let housing = crate::input::Housing {
+            balance: true,
+            ..gear.housing
+        };
+        let result = crate::friction::heat_balance(
+            &contacts,
+            &gear.lubricant,
+            &gear.friction,
+            &housing,
+            other,
+        )
+        .map(|thermal| crate::safety::Sump {
+            thermal,
+            own: false,
+        })
+        .map_err(|e| e.to_string());
+        if let Err(e) = &result {
+            self.warnings.push(format!("safety: S_T not computed: {e}"));
+        }
+        Some(result)
     }
 
     /// The wheel's root stresses under `ltca` (MODEL §9.1) when the safety table asks for them

@@ -90,6 +90,18 @@ pub struct SafetyInputsOf<'a> {
     /// The wheel's root stresses at K_A T (None: not asked for, i.e. no allowable or no fillet
     /// radius; an error: why they could not be computed).
     pub root_stress: Option<Result<RootStresses, String>>,
+    /// The sump temperature's heat balance (None: no balance and no temperature limit; an
+    /// error: why the balance has no solution).
+    pub sump: Option<Result<Sump, String>>,
+}
+
+/// The heat balance behind S_T.
+#[derive(Debug, Clone)]
+pub struct Sump {
+    pub thermal: Thermal,
+    /// Whether it is the run's own (lubricant.temperature = "balance"), else solved for the
+    /// table while the run held the lubricant's fixed temperature.
+    pub own: bool,
 }
 
 /// The gear with its torque times `factor` (the rating case of K_A).
@@ -426,23 +438,49 @@ fn wear_limit_rows(s: &SafetyInputsOf, records: &[StepRecord], cycles: f64) -> V
 /// against the allowed oil temperature, both in degC.
 fn temperature_row(s: &SafetyInputsOf) -> SafetyRow {
     let inputs = &s.gear.rating.safety;
-    let balance = s.thermal.filter(|t| t.mode == "balance");
-    let value = balance.map(|t| t.oil_temperature_k - 273.15);
-    let allowable = match (balance, inputs.oil_temperature_limit) {
-        (None, _) => Err(Verdict::NotComputed(
-            "needs the heat balance: [lubricant] temperature = \"balance\"".into(),
-        )),
-        (_, None) => Err(Verdict::NeedsInput("rating.oil_temperature_limit_c".into())),
-        (_, Some(t)) => Ok(t - 273.15),
+    let limit = inputs
+        .oil_temperature_limit
+        .map(|t| t - 273.15)
+        .ok_or_else(|| Verdict::NeedsInput("rating.oil_temperature_limit_c".into()));
+    let (value, source, failure) = match &s.sump {
+        Some(Ok(sump)) => (
+            Some(
+                s.records
+                    .filter(|_| sump.own)
+                    .into_iter()
+                    .flatten()
+                    .map(|r| r.friction.oil_temperature_k)
+                    .fold(sump.thermal.oil_temperature_k, f64::max)
+                    - 273.15,
+            ),
+            if sump.own {
+                "steady sump temperature of the run's heat balance at the nominal torque, the \
+                 highest over the life when it ran (MODEL §13), ratio in degC"
+                    .to_string()
+            } else {
+                format!(
+                    "steady sump temperature of the housing's heat balance at the nominal torque \
+                     (MODEL §13; [housing] or its defaults), solved for this table: the run \
+                     itself holds the lubricant's fixed {:.1} C; ratio in degC",
+                    s.gear.lubricant.temperature - 273.15
+                )
+            },
+            None,
+        ),
+        Some(Err(e)) => (None, String::new(), Some(Verdict::NotComputed(e.clone()))),
+        None => (None, "housing heat balance (MODEL §13)".into(), None),
     };
-    row(
+    let mut r = row(
         ("Oil sump temperature", "S_T", "degC"),
         value,
-        allowable,
+        limit,
         inputs.minimum[4],
-        "steady sump temperature of the housing's heat balance at the nominal torque (MODEL §13), ratio in degC"
-            .into(),
-    )
+        source,
+    );
+    if let (Some(v), true) = (failure, r.allowable.is_some()) {
+        r.verdict = v;
+    }
+    r
 }
 
 #[cfg(test)]

@@ -128,7 +128,33 @@ fn rows_without_their_input_say_which_and_never_show_a_safety() {
         Verdict::NeedsInput("rating.root_fillet_radius_mm".into())
     );
     assert!(row.safety.is_none());
-    // Without the heat balance the sump temperature is the lubricant's input, not a result.
-    assert!(matches!(verdict("S_T").verdict, Verdict::NotComputed(_)));
+    assert_eq!(
+        verdict("S_T").verdict,
+        Verdict::NeedsInput("rating.oil_temperature_limit_c".into())
+    );
     assert!(verdict("S_T").safety.is_none());
+}
+
+#[test]
+fn with_a_fixed_oil_temperature_s_t_solves_the_housing_balance_for_the_table() {
+    // The run holds the lubricant's fixed temperature; S_T solves the housing's balance at the
+    // nominal torque for the table alone: the same steady temperature as the run with the
+    // balance gives for its unworn mesh (the loaded contact does not depend on the oil).
+    let mut g = rated();
+    let request = Request::new([Stage::Ltca]);
+    let run = |g: &GearSet| {
+        wormwear::run(g, Source::default(), request.clone(), &mut |_| Ok(()))
+            .unwrap()
+            .safety
+            .unwrap()
+    };
+    let own = run(&g);
+    g.housing.balance = false;
+    let solved = run(&g);
+    let row = |t: &SafetyTable| t.rows.iter().find(|r| r.symbol == "S_T").unwrap().clone();
+    let (a, b) = (row(&own), row(&solved));
+    assert_eq!(a.value, b.value);
+    assert!(a.value.unwrap() > 20.0, "{a:?}");
+    assert!(b.source.contains("solved for this table"), "{}", b.source);
+    assert!(!a.source.contains("solved for this table"), "{}", a.source);
 }
