@@ -893,7 +893,8 @@ fn friction_and_heat_balance_inputs_are_checked_by_name() {
     // mode, a negative housing area, a cooler that cannot be a heat flow, and friction
     // constants out of range: each named with its value and range.
     let with = |lubricant: &str, housing: &str| {
-        let text = design().replace("[lubricant]\n", &format!("[lubricant]\n{lubricant}\n"));
+        let text = without_safety_inputs()
+            .replace("[lubricant]\n", &format!("[lubricant]\n{lubricant}\n"));
         format!("{text}\n[housing]\n{housing}\n")
     };
     let e = error_of(&set(
@@ -938,13 +939,34 @@ fn friction_and_heat_balance_inputs_are_checked_by_name() {
     assert!(gear.housing.area > 0.0 && gear.housing.heat_transfer > 0.0);
 }
 
+/// The design example without its safety inputs and its housing (the tests add their own).
+fn without_safety_inputs() -> String {
+    let mut text = design();
+    for key in [
+        "required_life_h",
+        "root_stress_allowable_mpa",
+        "root_fillet_radius_mm",
+        "deflection_limit_um",
+        "oil_temperature_limit_c",
+    ] {
+        text = remove(&text, "rating", key);
+    }
+    let housing = text
+        .find("\n[housing]")
+        .expect("the design example's housing");
+    text[..housing].to_string()
+}
+
 #[test]
 fn safety_table_inputs_are_checked_by_name_and_converted_to_si() {
     // Each bad value named with its field and value, all reported at once; good ones in SI.
-    let with = |lines: &str| design().replace("[rating]\n", &format!("[rating]\n{lines}\n"));
+    let with = |lines: &str| {
+        without_safety_inputs().replace("[rating]\n", &format!("[rating]\n{lines}\n"))
+    };
     let e = error_of(&with(
         "required_life_h = -5.0\napplication_factor = 0.5\ndeflection_limit_um = 0.0\n\
-         oil_temperature_limit_c = 400.0\nminimum_safety_wear = 0.0\nstarts_per_hour = -1.0",
+         oil_temperature_limit_c = 400.0\nminimum_safety_wear = 0.0\nstarts_per_hour = -1.0\n\
+         root_fillet_radius_mm = -1.0",
     ));
     assert_mentions(
         &e,
@@ -958,10 +980,12 @@ fn safety_table_inputs_are_checked_by_name_and_converted_to_si() {
             "400",
             "rating.minimum_safety_wear",
             "rating.starts_per_hour",
+            "rating.root_fillet_radius_mm",
         ],
     );
     let gear = input::load_from_str(&with(
-        "required_life_h = 2000.0\nroot_stress_allowable_mpa = 80.0\ndeflection_limit_um = 40.0\n\
+        "required_life_h = 2000.0\nroot_stress_allowable_mpa = 80.0\nroot_fillet_radius_mm = 0.8\n\
+         deflection_limit_um = 40.0\n\
          thickness_loss_limit_mm = 0.5\nmass_loss_limit_g = 30.0\noil_temperature_limit_c = 90.0\n\
          application_factor = 1.25\nminimum_safety_pitting = 1.5",
     ))
@@ -969,6 +993,7 @@ fn safety_table_inputs_are_checked_by_name_and_converted_to_si() {
     let s = gear.rating.safety;
     assert_eq!(s.required_life_hours, Some(2000.0));
     assert_eq!(s.root_stress_allowable, Some(80e6));
+    assert!((s.root_fillet_radius.unwrap() - 0.8e-3).abs() < 1e-18);
     assert!((s.deflection_limit.unwrap() - 40e-6).abs() < 1e-18);
     assert!((s.thickness_loss_limit.unwrap() - 0.5e-3).abs() < 1e-18);
     assert!((s.mass_loss_limit.unwrap() - 0.03).abs() < 1e-15);
