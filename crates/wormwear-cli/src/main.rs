@@ -10,6 +10,7 @@ use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
 mod calibrate_cmd;
+mod init_cmd;
 mod rating_cmd;
 mod rexs_cmd;
 
@@ -40,6 +41,23 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Write a new gear file: every section with its keys, units and defaults (the numbers of
+    /// the 1/40 reference gear), in the thread profile asked for; prints it without -o.
+    #[command(
+        after_help = "Example:\n  wormwear init --profile K -o my-gear.toml\n  \
+                            wormwear check my-gear.toml"
+    )]
+    Init {
+        /// Thread profile of worm and hob.
+        #[arg(long, value_enum, default_value = "a", ignore_case = true)]
+        profile: init_cmd::ProfileArg,
+        /// Gear file to write (refused if it exists, unless --force).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Replace an existing file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Validate a gear file and print derived data (lead angle, modules, radii, flank area...).
     #[command(after_help = "Example:\n  wormwear check examples/gear-1x40-design.toml --json")]
     Check {
@@ -322,7 +340,7 @@ fn restore_sigpipe() {
 /// interrupted run's temporary files were removed; exit code 2 when it cannot.
 fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, ExitCode> {
     let output = match &cli.command {
-        Command::Check { .. } | Command::Import { .. } => None,
+        Command::Check { .. } | Command::Import { .. } | Command::Init { .. } => None,
         Command::Geometry { output, .. }
         | Command::Tca { output, .. }
         | Command::Ltca { output, .. }
@@ -354,6 +372,11 @@ fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, Exi
 /// Runs the command.
 fn dispatch(cli: &Cli) -> Result<(), Failure> {
     match &cli.command {
+        Command::Init {
+            profile,
+            output,
+            force,
+        } => init_cmd::init(*profile, output.as_deref(), *force, cli.quiet),
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),

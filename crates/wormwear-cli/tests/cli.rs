@@ -1656,3 +1656,69 @@ fn a_closed_stdout_ends_the_output_without_a_panic() {
         assert_ne!(out.status.code(), Some(101), "{err}");
     }
 }
+
+#[test]
+fn init_writes_a_file_that_checks_and_runs_for_every_profile() {
+    let dir = tempfile::tempdir().unwrap();
+    for profile in ["A", "N", "I", "K", "C"] {
+        let file = dir.path().join(format!("new/gear-{profile}.toml"));
+        let init = bin()
+            .args(["init", "--profile", profile, "-o"])
+            .arg(&file)
+            .output();
+        let init = init.unwrap();
+        assert!(init.status.success(), "{init:?}");
+        let text = std::fs::read_to_string(&file).unwrap();
+        assert!(text.contains(&format!("profile = \"{profile}\"")), "{text}");
+        // Every section, with units in the key names.
+        for section in [
+            "[worm]",
+            "[hob]",
+            "[cutting]",
+            "[wheel]",
+            "[operating]",
+            "[materials.worm]",
+            "[materials.wheel]",
+            "[lubricant]",
+            "[housing]",
+            "[conditions]",
+            "[analysis]",
+            "[wear]",
+            "[rating]",
+            "[bending]",
+        ] {
+            assert!(text.contains(section), "{profile}: no {section}");
+        }
+        let out_dir = dir.path().join(format!("out-{profile}"));
+        for args in [vec!["check"], vec!["-q", "run", "--cycles", "20000"]] {
+            let mut command = bin();
+            command.args(&args).arg(&file);
+            if args.contains(&"run") {
+                command.arg("-o").arg(&out_dir);
+            }
+            let out = command.output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{profile} {args:?}: {err}");
+        }
+        assert_files(&out_dir, &["summary.json", "report.html", "wear_steps.csv"]);
+    }
+    // Without -o the file goes to stdout; an existing file or a directory is refused.
+    let out = bin().arg("init").output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("profile = \"A\""));
+    let existing = dir.path().join("new/gear-A.toml");
+    let again = bin().args(["init", "-o"]).arg(&existing).output().unwrap();
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+    let forced = bin()
+        .args(["init", "--force", "--profile", "k", "-o"])
+        .arg(&existing)
+        .output()
+        .unwrap();
+    assert!(forced.status.success());
+    assert!(std::fs::read_to_string(&existing)
+        .unwrap()
+        .contains("profile = \"K\""));
+    let to_dir = bin().args(["init", "-o"]).arg(dir.path()).output().unwrap();
+    assert_eq!(to_dir.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&to_dir.stderr).contains("is a directory"));
+}

@@ -162,13 +162,7 @@ fn profile_n_normal_section_is_straight() {
 #[test]
 fn flanks_are_invariant_under_the_screw_motion() {
     for hand in [Hand::Right, Hand::Left] {
-        for profile in [
-            ProfileType::A,
-            ProfileType::N,
-            ProfileType::I,
-            ProfileType::K,
-            ProfileType::C,
-        ] {
+        for profile in ProfileType::ALL {
             let def = thread(profile, 5.0 * MM, 3, 28.0 * MM, 20.0, hand);
             let w = ThreadSurface::new(&def).unwrap();
             let h = def.lead_per_rad();

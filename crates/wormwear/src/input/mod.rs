@@ -7,6 +7,7 @@
 
 pub mod schema;
 mod syntax;
+pub mod template;
 mod validate;
 
 use std::f64::consts::PI;
@@ -30,6 +31,17 @@ pub enum ProfileType {
     K,
     /// ZC: ground by a wheel with a circular-arc profile.
     C,
+}
+
+impl ProfileType {
+    /// Every thread profile, in the order A, N, I, K, C.
+    pub const ALL: [ProfileType; 5] = [
+        ProfileType::A,
+        ProfileType::N,
+        ProfileType::I,
+        ProfileType::K,
+        ProfileType::C,
+    ];
 }
 
 /// Hand of the thread.
