@@ -591,6 +591,31 @@ fn import_rexs(path: &str, stage: Option<u64>) -> PyResult<(String, Vec<String>)
     Ok((imported.text, imported.warnings))
 }
 
+/// Compares finished runs (`wormwear compare`): writes compare.html, compare.csv and the
+/// overlaid curves into `output`; returns the page's path, the runs' labels and the key results
+/// as (quantity, unit, value per run).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn compare(
+    dirs: Vec<String>,
+    output: &str,
+) -> PyResult<(String, Vec<String>, Vec<(String, String, Vec<Option<f64>>)>)> {
+    let dirs: Vec<std::path::PathBuf> = dirs.into_iter().map(Into::into).collect();
+    let comparison = wormwear::output::compare::compare(&dirs)
+        .map_err(|e| InputError::new_err(e.to_string()))?;
+    let page = wormwear::output::compare::write_comparison(&comparison, Path::new(output))
+        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    Ok((
+        page.display().to_string(),
+        comparison.runs.iter().map(|r| r.label.clone()).collect(),
+        comparison
+            .rows
+            .into_iter()
+            .map(|r| (r.quantity, r.unit, r.values))
+            .collect(),
+    ))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", m.py().get_type::<InputError>())?;
@@ -605,5 +630,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;
     m.add_function(wrap_pyfunction!(import_rexs, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     Ok(())
 }

@@ -119,6 +119,16 @@ def test_a_run_with_a_life_equals_the_cli(cli, design_file, tmp_path):
     assert math.isclose(np.nanmax(r.wear.depth.values), records["max_wear_m"].iloc[-1], rel_tol=1e-12)
     r.write(tmp_path / "py")
     assert_same_files(tmp_path / "cli", tmp_path / "py")
+    # The two runs side by side (wormwear compare): the same numbers, as the CLI writes them.
+    frame = wormwear.compare([tmp_path / "cli", tmp_path / "py"], tmp_path / "compare")
+    assert list(frame.columns) == ["unit", "cli", "py"]
+    assert frame.loc["Worm torque", "cli"] == pytest.approx(60.0)
+    np.testing.assert_array_equal(frame["cli"].to_numpy(float), frame["py"].to_numpy(float))
+    assert (tmp_path / "compare" / "compare.html").exists()
+    cli("-q", "compare", tmp_path / "cli", tmp_path / "py", "-o", tmp_path / "compare-cli")
+    assert (tmp_path / "compare-cli" / "compare.csv").read_text() == (
+        tmp_path / "compare" / "compare.csv"
+    ).read_text()
 
 
 def test_input_errors_raise_with_the_cli_message_and_every_problem(cli, design_file, tmp_path):

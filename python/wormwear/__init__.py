@@ -38,6 +38,7 @@ __all__ = [
     "GearSet",
     "Results",
     "FlankMap",
+    "compare",
     "InputError",
     "ComputationError",
     "load",
@@ -118,6 +119,24 @@ def load(path: "str | os.PathLike[str]") -> GearSet:
     """Reads and validates a gear file (TOML, the CLI's format). Raises :class:`InputError`
     (every problem with its field, value and range) or OSError."""
     return GearSet(_native.NativeGear.load(os.fspath(path)))
+
+
+def compare(
+    runs: Sequence["str | os.PathLike[str]"], output: "str | os.PathLike[str]"
+) -> pd.DataFrame:
+    """Compares finished runs (output directories of ``wormwear run``, ``ltca``, ``wear``,
+    ``rating`` or ``Results.write``), as ``wormwear compare`` does: writes compare.html (the
+    key results side by side with the differences to the first run, the backlash and wear
+    curves overlaid), compare.csv and the curves into ``output``, and returns the key results
+    as a DataFrame indexed by quantity, with a ``unit`` column and one column per run (labelled
+    by its directory's name)."""
+    _page, labels, rows = _native.compare([os.fspath(r) for r in runs], os.fspath(output))
+    frame = pd.DataFrame(
+        [[unit] + [np.nan if v is None else v for v in values] for _, unit, values in rows],
+        index=pd.Index([q for q, _, _ in rows], name="quantity"),
+        columns=["unit"] + list(labels),
+    )
+    return frame
 
 
 def rexs_stages(path: "str | os.PathLike[str]") -> list:

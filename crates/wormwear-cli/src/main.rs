@@ -10,6 +10,7 @@ use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
 mod calibrate_cmd;
+mod compare_cmd;
 mod init_cmd;
 mod rating_cmd;
 mod rexs_cmd;
@@ -57,6 +58,17 @@ enum Command {
         /// Replace an existing file.
         #[arg(long)]
         force: bool,
+    },
+    /// Compare finished runs: their key results side by side with the differences to the
+    /// first, the backlash and wear curves of their lives overlaid (compare.html, compare.csv).
+    #[command(after_help = "Example:\n  wormwear compare out/60nm out/90nm -o out/compare")]
+    Compare {
+        /// Output directories of `run`, `ltca`, `wear` or `rating` (two or more).
+        #[arg(required = true, num_args = 2..)]
+        runs: Vec<PathBuf>,
+        /// Directory for the comparison (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Validate a gear file and print derived data (lead angle, modules, radii, flank area...).
     #[command(after_help = "Example:\n  wormwear check examples/gear-1x40-design.toml --json")]
@@ -350,7 +362,8 @@ fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, Exi
         | Command::Calibrate { output, .. }
         | Command::Sweep { output, .. }
         | Command::ExportRexs { output, .. }
-        | Command::Validate { output, .. } => Some(output),
+        | Command::Validate { output, .. }
+        | Command::Compare { output, .. } => Some(output),
     };
     let lock = match output
         .map(|dir| wormwear::output::lock_directory(dir))
@@ -377,6 +390,7 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
             output,
             force,
         } => init_cmd::init(*profile, output.as_deref(), *force, cli.quiet),
+        Command::Compare { runs, output } => compare_cmd::compare(runs, output, cli.quiet),
         Command::Check { file, json } => check(file, *json),
         Command::Geometry { file, output } => geometry(file, output, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),

@@ -1722,3 +1722,78 @@ fn init_writes_a_file_that_checks_and_runs_for_every_profile() {
     assert_eq!(to_dir.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&to_dir.stderr).contains("is a directory"));
 }
+
+#[test]
+fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
+    let text = text.replace("model = \"fe\"", "model = \"none\"");
+    let mut runs = Vec::new();
+    for torque in ["60.0", "90.0"] {
+        let file = dir.path().join(format!("gear-{torque}.toml"));
+        let gear = text.replace(
+            "worm_torque_nm = 60.0",
+            &format!("worm_torque_nm = {torque}"),
+        );
+        std::fs::write(&file, gear).unwrap();
+        let out_dir = dir.path().join(format!("{torque}nm"));
+        let run = bin()
+            .args(["-q", "run", "--cycles", "20000", "--step-cycles", "10000"])
+            .arg(&file)
+            .arg("-o")
+            .arg(&out_dir)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{run:?}");
+        runs.push(out_dir);
+    }
+    let out = dir.path().join("compare");
+    let compared = bin()
+        .arg("compare")
+        .args(&runs)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(compared.status.success(), "{compared:?}");
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let torque = csv
+        .lines()
+        .find(|l| l.starts_with("\"Worm torque\""))
+        .unwrap();
+    let values: Vec<f64> = torque
+        .split(',')
+        .skip(2)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(
+        (values[0] - 60.0).abs() < 1e-6 && (values[1] - 90.0).abs() < 1e-6,
+        "{torque}"
+    );
+    // More torque, more wear: the life's rows and both overlaid curves are there.
+    let backlash = csv
+        .lines()
+        .find(|l| l.contains("Backlash increase"))
+        .unwrap();
+    let b: Vec<f64> = backlash
+        .split(',')
+        .skip(2)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(b[1] > b[0], "{backlash}");
+    let page = std::fs::read_to_string(out.join("compare.html")).unwrap();
+    assert_eq!(page.matches("<svg").count(), 2);
+    assert!(page.contains("(+50.0 %)"), "the torque's difference");
+    // A directory that is not a run: exit 2, named.
+    let not_a_run = bin()
+        .arg("compare")
+        .arg(&runs[0])
+        .arg(dir.path())
+        .arg("-o")
+        .arg(dir.path().join("x"))
+        .output()
+        .unwrap();
+    assert_eq!(not_a_run.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&not_a_run.stderr);
+    assert!(err.contains("no summary.json"), "{err}");
+}

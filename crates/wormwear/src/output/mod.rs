@@ -4,6 +4,7 @@
 //! never leaves a half-written file. `summary.json` is one JSON object; each command adds or
 //! replaces its own section and keeps the others.
 
+pub mod compare;
 pub mod friction;
 pub mod geometry;
 pub mod ltca;

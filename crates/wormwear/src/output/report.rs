@@ -69,7 +69,8 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
     ("Ratings (ISO/TR 14521)", "rating", &[]),
 ];
 
-fn escape(s: &str) -> String {
+/// `s` as HTML text (also inside attribute values).
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")

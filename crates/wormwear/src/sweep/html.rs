@@ -3,6 +3,7 @@
 //! combination of the other parameters' values.
 
 use super::{Row, Sweep};
+use crate::output::report::escape;
 use crate::output::OutputError;
 use crate::plot::{line_chart, Series};
 use std::fmt::Write as _;
@@ -75,13 +76,6 @@ const QUANTITIES: [Quantity; 8] = [
         file: "life_to_backlash_limit",
     },
 ];
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 /// A parameter's value in a row as text.
 fn value_text(row: &Row, name: &str) -> String {
