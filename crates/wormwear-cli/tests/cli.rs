@@ -1797,3 +1797,34 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
     let err = String::from_utf8_lossy(&not_a_run.stderr);
     assert!(err.contains("no summary.json"), "{err}");
 }
+
+#[test]
+fn the_backlash_plot_draws_the_limit_when_the_curve_nears_it_and_names_it_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
+        .unwrap()
+        .replace("model = \"fe\"", "model = \"none\"");
+    for (name, limit, expected) in [
+        ("near", "10.0", "backlash limit 10 um"),
+        ("far", "5000.0", "backlash limit 5000 um: above the scale"),
+    ] {
+        let file = dir.path().join(format!("{name}.toml"));
+        let gear = text.replace(
+            "step_wear_um = 4.0",
+            &format!("step_wear_um = 4.0\nbacklash_limit_um = {limit}"),
+        );
+        std::fs::write(&file, gear).unwrap();
+        let out = dir.path().join(name);
+        let wear = bin()
+            .args(["-q", "wear", "--cycles", "20000", "--step-cycles", "10000"])
+            .arg(&file)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(wear.status.success(), "{wear:?}");
+        let svg = std::fs::read_to_string(out.join("wear_backlash.svg")).unwrap();
+        assert!(svg.contains(expected), "{name}: no {expected:?}");
+        assert_eq!(svg.contains("above the scale"), name == "far", "{name}");
+    }
+}

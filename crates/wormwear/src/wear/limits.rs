@@ -38,10 +38,7 @@ impl WearLimits {
     /// The limits of this gear and plan.
     pub fn new(gear: &GearSet, geo: &Geometry, tca: &Tca, plan: &WearPlan) -> Self {
         let rating = crate::rating::rate(gear);
-        let per = gear.worm.normal_pressure_angle.cos() * rating.lead_angle_deg.to_radians().cos();
-        let backlash = plan
-            .backlash_limit
-            .unwrap_or(rating.wear_limit_backlash_m / per);
+        let (backlash, per) = Self::backlash_limit(gear, &rating, plan);
         Self {
             flank_loss_per_backlash: per,
             pointed_tip_flank_loss_m: rating.wear_limit_pointed_tip_m,
@@ -52,6 +49,20 @@ impl WearLimits {
             stop_at: plan.stop_at,
             node_thickness: tooth_thickness(geo, tca.loaded_flank),
         }
+    }
+
+    /// The backlash increase limit (the plan's, or the standard's (d) as a tangential
+    /// backlash), m, and the flank loss per unit of backlash increase, cos(alpha_n) cos(gamma).
+    pub fn backlash_limit(
+        gear: &GearSet,
+        rating: &crate::rating::Rating,
+        plan: &WearPlan,
+    ) -> (f64, f64) {
+        let per = gear.worm.normal_pressure_angle.cos() * rating.lead_angle_deg.to_radians().cos();
+        let backlash = plan
+            .backlash_limit
+            .unwrap_or(rating.wear_limit_backlash_m / per);
+        (backlash, per)
     }
 
     /// Thinnest tooth left with `removal` worn off the loaded flank: the thickness, m

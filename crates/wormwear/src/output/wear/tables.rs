@@ -25,7 +25,9 @@ pub(super) fn write_tables(
     position_table(tca, &state.records).write(&path)?;
     files.push(path);
     update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
-    let charts = life_charts(&state.records);
+    let (limit, _) =
+        crate::wear::WearLimits::backlash_limit(gear, &crate::rating::rate(gear), plan);
+    let charts = life_charts(&state.records, limit);
     for (name, title, y, series) in charts {
         let path = dir.join(name);
         line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
@@ -38,6 +40,7 @@ pub(super) fn write_tables(
 /// transmission error, pressure, efficiency and oil temperature charts.
 fn life_charts(
     records: &[crate::wear::StepRecord],
+    backlash_limit: f64,
 ) -> [(&'static str, &'static str, &'static str, Vec<Series>); 6] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
@@ -50,7 +53,7 @@ fn life_charts(
             "wear_backlash.svg",
             "Backlash increase (tangential at r2, mean over positions)",
             "backlash increase (um)",
-            backlash_series(records),
+            with_limit_line(backlash_series(records), records, backlash_limit),
         ),
         (
             "wear_depth.svg",
@@ -261,6 +264,43 @@ pub fn summary_value(
 
 /// The backlash increase over cycles (1e6, um): the whole curve, and its pitting phases drawn
 /// over it in orange (no wear: flat).
+/// The backlash curves with the life's backlash limit as a line across the
+/// cycles, when the curve reaches a quarter of it (else the limit would flatten the curve; the
+/// legend then gives it in words).
+fn with_limit_line(
+    mut series: Vec<Series>,
+    records: &[crate::wear::StepRecord],
+    limit: f64,
+) -> Vec<Series> {
+    let (Some(first), Some(last)) = (records.first(), records.last()) else {
+        return series;
+    };
+    let reached = records
+        .iter()
+        .map(|r| r.backlash_increase_m)
+        .fold(0.0, f64::max);
+    let label = format!("backlash limit {:.0} um", limit * UM);
+    if reached >= 0.25 * limit {
+        series.push(Series {
+            label,
+            points: vec![
+                (first.cycles * 1e-6, limit * UM),
+                (last.cycles * 1e-6, limit * UM),
+            ],
+            color: 3,
+            bold: false,
+        });
+    } else if let Some(s) = series.first_mut() {
+        let note = format!("{label}: above the scale");
+        s.label = if s.label.is_empty() {
+            format!("increase ({note})")
+        } else {
+            format!("{} ({note})", s.label)
+        };
+    }
+    series
+}
+
 pub(super) fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series> {
     let points = |rs: &[crate::wear::StepRecord]| -> Vec<(f64, f64)> {
         rs.iter()
