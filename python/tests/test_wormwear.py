@@ -369,3 +369,18 @@ def test_rexs_stage_loads_and_results_go_back_to_rexs(tmp_path):
     bad.write_text("<model version='1.4'><components>")
     with pytest.raises(wormwear.InputError, match="ends inside"):
         wormwear.load_rexs(bad)
+
+
+def test_the_readme_session_runs_as_written(tmp_path, monkeypatch):
+    # The README's notebook-style session, executed as written from a directory that has the
+    # repository's examples (its outputs go to tmp_path/out).
+    text = (ROOT / "README.md").read_text()
+    start = text.index("```python\nimport wormwear\n") + len("```python\n")
+    block = text[start : text.index("```", start)]
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
+    exec(compile(block, "README.md", "exec"), namespace)
+    assert (tmp_path / "out" / "compare" / "compare.html").exists()
+    assert (tmp_path / "out" / "zi.rexs").exists()
+    assert namespace["same"].to_dict() == namespace["gear"].to_dict()
