@@ -512,7 +512,26 @@ fn report_renders_in_a_headless_browser() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    run_design_quietly(dir.path(), "10000", "10000");
+    run_design_quietly(dir.path(), "180000", "30000");
+    // The page stays small: the maps of every state are files beside it, loaded when opened.
+    let page = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    assert!(
+        page.len() < 5_000_000,
+        "report.html is {} bytes",
+        page.len()
+    );
+    let folded: Vec<&str> = page
+        .split("<img loading=\"lazy\" src=\"")
+        .skip(1)
+        .map(|rest| &rest[..rest.find('"').unwrap()])
+        .collect();
+    assert!(folded.len() >= 20, "{} folded maps", folded.len());
+    for name in folded {
+        assert!(
+            dir.path().join(name).exists(),
+            "{name} is not beside the report"
+        );
+    }
     let url = format!("file://{}", dir.path().join("report.html").display());
     let shot = dir.path().join("report.png");
     let dom = Command::new(&browser)

@@ -435,6 +435,7 @@ pub fn flank_map(
     let (px, py) = (0.03 * (x1 - x0), 0.05 * (y1 - y0));
     let (width, height) = (1100u32, 620u32);
     let mut svg = String::new();
+    let cell_paths;
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
@@ -464,21 +465,15 @@ pub fn flank_map(
                 RGBColor(220, 220, 220)
             }
         };
+        // The cells go in after rendering, one path per colour, where this marker stands.
         chart
-            .draw_series(
-                cells
-                    .iter()
-                    .map(|c| Polygon::new(c.corners.to_vec(), cell_color(c).filled())),
-            )
+            .draw_series(std::iter::once(Text::new(
+                CELLS_MARKER,
+                (x0, y0),
+                ("sans-serif", 1),
+            )))
             .map_err(plot_err)?;
-        // Same-colour outlines hide the anti-aliasing seams between neighbouring cells.
-        chart
-            .draw_series(cells.iter().map(|c| {
-                let mut ring = c.corners.to_vec();
-                ring.push(c.corners[0]);
-                PathElement::new(ring, cell_color(c).stroke_width(1))
-            }))
-            .map_err(plot_err)?;
+        cell_paths = cell_paths_svg(cells, |p| chart.backend_coord(&p), cell_color);
         let levels = iso.map_or_else(Vec::new, |_| nice_levels(lo, hi, 6));
         if let Some(grid) = iso {
             draw_iso_lines(&mut chart, grid, &levels, (x1 - x0, y1 - y0))?;
@@ -494,7 +489,58 @@ pub fn flank_map(
         colour_bar(&bar, bar_label, (lo, span), &levels)?;
         root.present().map_err(plot_err)?;
     }
-    write_atomic(path, svg.as_bytes())
+    write_atomic(path, with_cells(&svg, &cell_paths).as_bytes())
+}
+
+/// Text drawn where the cells of a flank map go ([`with_cells`]).
+const CELLS_MARKER: &str = "wormwear-cells-here";
+
+/// The cells as SVG paths, one per colour (fill and a same-colour 1 px outline that hides the
+/// anti-aliasing seams between neighbours), in pixel coordinates from `pixel`.
+fn cell_paths_svg(
+    cells: &[MapCell],
+    pixel: impl Fn((f64, f64)) -> (i32, i32),
+    color: impl Fn(&MapCell) -> RGBColor,
+) -> String {
+    use std::fmt::Write as _;
+    let mut by_color: Vec<(RGBColor, String)> = Vec::new();
+    for c in cells {
+        let rgb = color(c);
+        let k = match by_color.iter().position(|(col, _)| *col == rgb) {
+            Some(k) => k,
+            None => {
+                by_color.push((rgb, String::new()));
+                by_color.len() - 1
+            }
+        };
+        let d = &mut by_color[k].1;
+        for (i, &p) in c.corners.iter().enumerate() {
+            let (x, y) = pixel(p);
+            let _ = write!(d, "{}{x} {y}", if i == 0 { "M" } else { "L" });
+        }
+        d.push('Z');
+    }
+    let mut out = String::new();
+    for (RGBColor(r, g, b), d) in by_color {
+        let _ = writeln!(
+            out,
+            "<path fill=\"#{r:02X}{g:02X}{b:02X}\" stroke=\"#{r:02X}{g:02X}{b:02X}\" \
+             stroke-width=\"1\" stroke-linejoin=\"round\" d=\"{d}\"/>"
+        );
+    }
+    out
+}
+
+/// `svg` with the marker's text element replaced by `cells`.
+fn with_cells(svg: &str, cells: &str) -> String {
+    let Some(at) = svg.find(CELLS_MARKER) else {
+        return svg.to_string();
+    };
+    let start = svg[..at].rfind("<text").unwrap_or(at);
+    let end = svg[at..]
+        .find("</text>")
+        .map_or(at, |k| at + k + "</text>".len());
+    format!("{}{}{}", &svg[..start], cells, &svg[end..])
 }
 
 /// Iso-lines of `grid` at `levels` over a map whose extent is `size` (x, y); pieces shorter
@@ -582,6 +628,49 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_flank_map_draws_each_cell_once_in_one_path_per_colour() {
+        // A 4 x 3 grid of unit cells in two values (two colours) and one without a value.
+        let mut cells = Vec::new();
+        for i in 0..4 {
+            for j in 0..3 {
+                let (x, y) = (i as f64, j as f64);
+                cells.push(MapCell {
+                    corners: [(x, y), (x + 1.0, y), (x + 1.0, y + 1.0), (x, y + 1.0)],
+                    value: if (i, j) == (0, 0) {
+                        f64::NAN
+                    } else {
+                        (i % 2) as f64
+                    },
+                });
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("map.svg");
+        let none: &[Series] = &[];
+        flank_map(
+            &path,
+            "t",
+            "x",
+            "y",
+            &cells,
+            (0.0, 1.0),
+            "v",
+            none,
+            &[],
+            None,
+        )
+        .unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(!svg.contains(CELLS_MARKER));
+        let paths: Vec<&str> = svg.split("<path fill=").skip(1).collect();
+        assert_eq!(paths.len(), 3, "two colours and the grey of no value");
+        let drawn: usize = paths.iter().map(|p| p.matches('M').count()).sum();
+        assert_eq!(drawn, cells.len());
+        // The cells come before the colour bar's and the axes' text, under everything else.
+        assert!(svg.find("<path").unwrap() < svg.rfind("<text").unwrap());
+    }
 
     /// Grid of `n` x `n` points on [-1, 1]^2 with values f(x, y).
     fn grid(n: usize, f: impl Fn(f64, f64) -> f64) -> IsoGrid {

@@ -475,27 +475,56 @@ fn stage_section(
         wear_states_table(h, steps);
     }
     for prefix in prefixes {
-        for path in figures(dir, prefix) {
-            let name = path
-                .file_name()
-                .and_then(|n| n.to_str())
-                .unwrap_or_default()
-                .to_string();
-            let Ok(svg) = crate::files::read_text(&path, crate::files::OWN_FILE_LIMIT) else {
-                continue;
-            };
-            let body = match svg.find("<svg") {
-                Some(k) => &svg[k..],
-                None => continue,
-            };
-            let _ = writeln!(
-                h,
-                "<figure>{body}<figcaption>{}</figcaption></figure>",
-                escape(&name)
-            );
+        let paths = figures(dir, prefix);
+        match prefix.strip_suffix('*') {
+            Some(series) if !paths.is_empty() => state_figures(h, series, &paths),
+            _ => paths.iter().for_each(|path| inline_figure(h, path)),
         }
     }
     h.push_str("</section>\n");
+}
+
+/// The file name of `path` as text.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// A figure inline (its SVG in the page).
+fn inline_figure(h: &mut String, path: &Path) {
+    let Ok(svg) = crate::files::read_text(path, crate::files::OWN_FILE_LIMIT) else {
+        return;
+    };
+    if let Some(k) = svg.find("<svg") {
+        let _ = writeln!(
+            h,
+            "<figure>{}<figcaption>{}</figcaption></figure>",
+            &svg[k..],
+            escape(&file_name(path))
+        );
+    }
+}
+
+/// A map at every state, folded: the files beside the report, loaded when opened (the page
+/// stays small; the last state's map is inline in its section).
+fn state_figures(h: &mut String, series: &str, paths: &[PathBuf]) {
+    let _ = write!(
+        h,
+        "<details><summary>{} at every map state ({} files, loaded when opened)</summary>",
+        escape(series.trim_end_matches('_')),
+        paths.len()
+    );
+    for path in paths {
+        let name = escape(&file_name(path));
+        let _ = write!(
+            h,
+            "<figure><img loading=\"lazy\" src=\"{name}\" alt=\"{name}\" \
+             style=\"max-width:100%\"><figcaption>{name}</figcaption></figure>"
+        );
+    }
+    h.push_str("</details>\n");
 }
 
 /// The wear states as a folded table.
