@@ -1847,3 +1847,38 @@ fn the_backlash_plot_draws_the_limit_when_the_curve_nears_it_and_names_it_otherw
         assert_eq!(svg.contains("above the scale"), name == "far", "{name}");
     }
 }
+
+#[test]
+fn the_te_plot_shows_the_ripple_about_its_stated_mean() {
+    // The design case's loaded TE has a mean of about -5560 urad (mostly the wheel shaft's
+    // torsion) and a ripple of about 40 urad: drawn about the mean, the axis spans the ripple.
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["-q", "ltca"])
+        .arg(example("gear-1x40-design.toml"))
+        .arg("-o")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let (mean, p2p) = (
+        summary["ltca"]["te_mean_rad"].as_f64().unwrap() * 1e6,
+        summary["ltca"]["te_p2p_rad"].as_f64().unwrap() * 1e6,
+    );
+    assert!(mean.abs() > 20.0 * p2p, "mean {mean}, p2p {p2p}");
+    let svg = std::fs::read_to_string(dir.path().join("ltca_transmission_error.svg")).unwrap();
+    let ticks: Vec<f64> = svg
+        .split("</text>")
+        .filter_map(|t| t.rsplit('>').next()?.trim().parse::<f64>().ok())
+        .collect();
+    assert!(ticks.len() > 5, "{ticks:?}");
+    let span = ticks.iter().fold(0.0f64, |a, t| a.max(t.abs()));
+    assert!(span < 2.0 * p2p, "ticks up to {span} for a ripple of {p2p}");
+    assert!(
+        svg.contains(&format!("mean {mean:.0} urad")),
+        "the mean is stated"
+    );
+}

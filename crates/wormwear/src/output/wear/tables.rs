@@ -30,7 +30,7 @@ pub(super) fn write_tables(
     let charts = life_charts(&state.records, limit);
     for (name, title, y, series) in charts {
         let path = dir.join(name);
-        line_chart(&path, title, "wheel cycles (millions)", y, &series, false)?;
+        line_chart(&path, &title, "wheel cycles (millions)", y, &series, false)?;
         files.push(path);
     }
     Ok(files)
@@ -41,23 +41,33 @@ pub(super) fn write_tables(
 fn life_charts(
     records: &[crate::wear::StepRecord],
     backlash_limit: f64,
-) -> [(&'static str, &'static str, &'static str, Vec<Series>); 6] {
+) -> [(&'static str, String, &'static str, Vec<Series>); 6] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
         points: records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
         color,
         bold: true,
     };
+    let range = |f: &dyn Fn(&crate::wear::StepRecord) -> f64| {
+        records
+            .iter()
+            .map(|r| f(r) * UM)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let (m0, m1) = range(&|r| r.te_mean_rad);
+    let te_title = format!("Loaded TE peak to peak over life (mean TE {m0:.0} to {m1:.0} urad)");
     [
         (
             "wear_backlash.svg",
-            "Backlash increase (tangential at r2, mean over positions)",
+            "Backlash increase (tangential at r2, mean over positions)".to_string(),
             "backlash increase (um)",
             with_limit_line(backlash_series(records), records, backlash_limit),
         ),
         (
             "wear_depth.svg",
-            "Wear depth",
+            "Wear depth".to_string(),
             "depth (um)",
             vec![
                 curve(&|r| r.max_wear_m * UM, "max (one node, mesh-dependent)", 1),
@@ -67,26 +77,20 @@ fn life_charts(
         ),
         (
             "wear_transmission_error.svg",
-            "Loaded transmission error over life",
-            "TE (urad, wheel)",
+            te_title,
+            "TE peak to peak (urad, wheel)",
             vec![
-                curve(&|r| r.te_mean_rad * UM, "mean", 0),
                 curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
                 curve(
-                    &|r| r.te_mean_relative_rad * UM,
-                    "mean relative to the wear's rigid lag",
-                    3,
-                ),
-                curve(
                     &|r| r.te_p2p_relative_rad * UM,
-                    "peak-to-peak relative to the lag",
+                    "peak-to-peak relative to the wear's rigid lag",
                     4,
                 ),
             ],
         ),
         (
             "wear_pressure.svg",
-            "Contact pressure over life",
+            "Contact pressure over life".to_string(),
             "pressure (MPa)",
             vec![
                 curve(&|r| r.max_pressure_pa * MPA, "P_max (raw)", 1),
@@ -100,7 +104,7 @@ fn life_charts(
         ),
         (
             "wear_efficiency.svg",
-            "Efficiency over life, from the contact's friction (MODEL §13)",
+            "Efficiency over life, from the contact's friction (MODEL §13)".to_string(),
             "efficiency (%)",
             vec![
                 curve(&|r| 100.0 * r.friction.mesh_efficiency, "mesh", 0),
@@ -109,7 +113,7 @@ fn life_charts(
         ),
         (
             "wear_oil_temperature.svg",
-            "Oil temperature over life (fixed, or the heat balance of each state)",
+            "Oil temperature over life (fixed, or the heat balance of each state)".to_string(),
             "oil temperature (C)",
             vec![curve(&|r| r.friction.oil_temperature_k - 273.15, "sump", 4)],
         ),
