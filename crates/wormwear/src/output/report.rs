@@ -3,6 +3,7 @@
 //! summary.json, the figures of each stage in order, the ratings, the warnings and links to the
 //! data files beside it (CSV tables, STL and VTK surfaces for CAD and ParaView).
 
+use super::compare::number;
 use super::{write_atomic, OutputError};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -75,6 +76,73 @@ pub(crate) fn escape(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// Units of summary.json's keys by their suffix: (suffix, unit shown, factor). The longest
+/// suffix that matches wins; SI values become the units an engineer reads (MPa, um, urad).
+const UNITS: &[(&str, &str, f64)] = &[
+    ("_nm_per_rad", "N m/rad", 1.0),
+    ("_rad_per_nm", "urad/(N m)", 1e6),
+    ("_n_per_m", "N/m", 1.0),
+    ("_w_m2", "W/m^2", 1.0),
+    ("_pa_s", "Pa s", 1.0),
+    ("_m_s", "m/s", 1.0),
+    ("_mm2", "mm^2", 1.0),
+    ("_m3", "mm^3", 1e9),
+    ("_mpa", "MPa", 1.0),
+    ("_gpa", "GPa", 1.0),
+    ("_deg", "deg", 1.0),
+    ("_rpm", "rpm", 1.0),
+    ("_mm", "mm", 1.0),
+    ("_um", "um", 1.0),
+    ("_pa", "MPa", 1e-6),
+    ("_rad", "urad", 1e6),
+    ("_nm", "N m", 1.0),
+    ("_m", "um", 1e6),
+    ("_w", "W", 1.0),
+    ("_k", "C", 1.0),
+    ("_c", "C", 1.0),
+    ("_n", "N", 1.0),
+    ("_cycles", "wheel cycles", 1.0),
+    ("_percent", "%", 1.0),
+    ("_fraction", "%", 100.0),
+    ("_share", "%", 100.0),
+];
+
+/// A summary.json key and value as a label, a unit and the value in that unit: the key's unit
+/// suffix read ([`UNITS`]), the rest in words ("max_pressure_pa", 1.86e9 -> "Max pressure",
+/// "MPa", 1860); kelvin to Celsius.
+pub(crate) fn human(key: &str, value: f64) -> (String, String, f64) {
+    let (stem, unit, x) = match UNITS.iter().find(|(suffix, ..)| key.ends_with(suffix)) {
+        Some((suffix, unit, factor)) => {
+            let stem = &key[..key.len() - suffix.len()];
+            let x = if *suffix == "_k" {
+                value - 273.15
+            } else {
+                value * factor
+            };
+            (stem.to_string(), unit.to_string(), x)
+        }
+        None => (key.to_string(), String::new(), value),
+    };
+    let words: Vec<String> = stem
+        .split('_')
+        .filter(|w| !w.is_empty())
+        .map(|w| match w {
+            "te" => "TE".to_string(),
+            "p2p" => "peak to peak".to_string(),
+            "ke" => "KE".to_string(),
+            "iso" => "ISO".to_string(),
+            "ltca" => "LTCA".to_string(),
+            "tca" => "TCA".to_string(),
+            _ => w.to_string(),
+        })
+        .collect();
+    let mut label = words.join(" ");
+    if let Some(first) = label.get(..1) {
+        label = first.to_uppercase() + &label[1..];
+    }
+    (label, unit, x)
 }
 
 /// A scalar of summary.json as table text (numbers to 6 significant digits).
@@ -164,17 +232,17 @@ fn phase_timeline(phases: &[serde_json::Value], mode: Option<&serde_json::Value>
     }
     h.push_str(
         "</div><table><tr><th>phase</th><th>from (cycles)</th><th>to (cycles)</th>\
-         <th>pitted share at the end</th></tr>",
+         <th>pitted share at the end (%)</th></tr>",
     );
     for p in phases {
         let _ = write!(
             h,
-            "<tr><td>{}</td><td class=\"n\">{:.4e}</td><td class=\"n\">{:.4e}</td>\
-             <td class=\"n\">{:.4}</td></tr>",
+            "<tr><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>\
+             <td class=\"n\">{}</td></tr>",
             escape(p["kind"].as_str().unwrap_or("")),
-            span(p, "start_cycles"),
-            span(p, "end_cycles"),
-            span(p, "pitted_share_end")
+            cycles_text(span(p, "start_cycles")),
+            cycles_text(span(p, "end_cycles")),
+            number(100.0 * span(p, "pitted_share_end"))
         );
     }
     h.push_str("</table>");
@@ -190,12 +258,13 @@ pub fn write_report(dir: &Path, title: &str, input_text: &str) -> Result<PathBuf
     let mut h = String::new();
     page_head(&mut h, title);
     contents(&mut h, &summary);
-    safety_section(&mut h, &summary);
+    let hours = hours_per_cycle(&summary, input_text);
+    safety_section(&mut h, &summary, hours);
     warnings_section(&mut h, &summary);
-    key_results(&mut h, &summary);
+    key_results(&mut h, &summary, hours);
     for (name, key, prefixes) in SECTIONS {
         if let Some(section) = summary.get(key) {
-            stage_section(&mut h, dir, (name, key, prefixes), section);
+            stage_section(&mut h, dir, (name, key, prefixes), (section, hours));
         }
     }
     files_section(&mut h, dir);
@@ -257,26 +326,27 @@ fn verdict_text(v: &serde_json::Value) -> String {
 
 /// The safety table (MODEL §9.1) at the top of the page, a row in red where its safety falls
 /// below its minimum.
-fn safety_section(h: &mut String, summary: &serde_json::Value) {
+fn safety_section(h: &mut String, summary: &serde_json::Value, hours: Option<f64>) {
     let table = &summary["rating"]["safety"];
     let Some(rows) = table["rows"].as_array() else {
         return;
     };
-    let number = |v: &serde_json::Value| match v.as_f64() {
-        Some(x) => format!("{x:.4}"),
-        None => "-".into(),
-    };
+    let value = |v: &serde_json::Value| v.as_f64().map_or("-".into(), number);
+    let safety = |v: &serde_json::Value| v.as_f64().map_or("-".into(), |x| format!("{x:.2}"));
     let failed = rows.iter().filter(|r| r["verdict"] == "fail").count();
+    let life = table["required_cycles"]
+        .as_f64()
+        .map_or("not given".into(), |n| {
+            let h = hours.map_or(String::new(), |per| format!(" ({} h)", number(n * per)));
+            format!("{} wheel cycles{h}", cycles_text(n))
+        });
     let _ = writeln!(
         h,
         "<section id=\"safety\"><h2>Safety</h2><p>From the model (MODEL §9.1): K_A {}, required \
-         life {}. {}</p><table><tr><th>quantity</th><th>symbol</th><th>value</th>\
+         life {life}. {}</p><table><tr><th>quantity</th><th>symbol</th><th>value</th>\
          <th>allowable</th><th>unit</th><th>safety</th><th>minimum</th><th>verdict</th>\
          <th>how</th></tr>",
         table["application_factor"],
-        table["required_cycles"]
-            .as_f64()
-            .map_or("not given".into(), |n| format!("{n:.4e} wheel cycles")),
         match failed {
             0 => String::new(),
             n => format!("<b class=\"fail\">{n} safety value(s) below the minimum.</b>"),
@@ -291,14 +361,15 @@ fn safety_section(h: &mut String, summary: &serde_json::Value) {
         let _ = writeln!(
             h,
             "<tr{class}><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>\
-             <td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td></tr>",
+             <td>{}</td><td class=\"n\"><b>{}</b></td><td class=\"n\">{}</td><td>{}</td>\
+             <td><details><summary>how</summary>{}</details></td></tr>",
             escape(r["quantity"].as_str().unwrap_or("")),
             escape(r["symbol"].as_str().unwrap_or("")),
-            number(&r["value"]),
-            number(&r["allowable"]),
+            value(&r["value"]),
+            value(&r["allowable"]),
             escape(r["unit"].as_str().unwrap_or("")),
-            number(&r["safety"]),
-            number(&r["minimum"]),
+            safety(&r["safety"]),
+            value(&r["minimum"]),
             escape(&verdict_text(&r["verdict"])),
             escape(r["source"].as_str().unwrap_or(""))
         );
@@ -375,10 +446,16 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 16] = [
         1.0,
         "",
     ),
-    ("Oil temperature", "friction", "oil_temperature_k", 1.0, "K"),
+    ("Oil temperature", "friction", "oil_temperature_k", 1.0, "C"),
     ("Worm torque", "rating", "worm_torque_nm", 1.0, "N m"),
-    ("Pitting life N_LI", "rating", "n_li_cycles", 1.0, "cycles"),
-    ("Life simulated", END, "cycles", 1.0, "cycles"),
+    (
+        "Pitting life N_LI",
+        "rating",
+        "n_li_cycles",
+        1.0,
+        "wheel cycles",
+    ),
+    ("Life simulated", END, "cycles", 1.0, "wheel cycles"),
     (
         "Max wear at the end (patch mean)",
         END,
@@ -413,7 +490,7 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 16] = [
 const END: &str = "";
 
 /// Key results first: what an engineer looks for before the details.
-fn key_results(h: &mut String, summary: &serde_json::Value) {
+fn key_results(h: &mut String, summary: &serde_json::Value, hours: Option<f64>) {
     let last_step = summary["wear"]["steps"]
         .as_array()
         .and_then(|s| s.last())
@@ -428,16 +505,21 @@ fn key_results(h: &mut String, summary: &serde_json::Value) {
             key.split('.').fold(&summary[section], |v, part| &v[part])
         };
         if let Some(x) = value.as_f64() {
-            let text = format!("{:.4e}", x * scale)
-                .parse::<f64>()
-                .map(|y| format!("{y}"))
-                .unwrap_or_default();
+            let (text, unit) = match (unit, hours) {
+                ("C", _) => (number(x - 273.15), unit.to_string()),
+                ("wheel cycles", Some(per)) => (
+                    cycles_text(x),
+                    format!("wheel cycles ({} h at the running speed)", number(x * per)),
+                ),
+                ("wheel cycles", None) => (cycles_text(x), unit.to_string()),
+                _ => (number(x * scale), unit.to_string()),
+            };
             let _ = write!(
                 h,
                 "<tr><th>{}</th><td class=\"n\">{}</td><td>{}</td></tr>",
                 escape(label),
                 escape(&text),
-                escape(unit)
+                escape(&unit)
             );
         }
     }
@@ -450,21 +532,30 @@ fn stage_section(
     h: &mut String,
     dir: &Path,
     (name, key, prefixes): (&str, &str, &[&str]),
-    section: &serde_json::Value,
+    (section, hours): (&serde_json::Value, Option<f64>),
 ) {
     let _ = write!(h, "<section id=\"{key}\"><h2>{}</h2>", escape(name));
     // Scalars of the section as a table; the wear steps as their own table.
     if let serde_json::Value::Object(m) = section {
-        h.push_str("<table>");
+        h.push_str("<table><tr><th>quantity</th><th>value</th><th>unit</th></tr>");
         for (k, v) in m {
-            if let Some(text) = scalar(v) {
-                let _ = write!(
-                    h,
-                    "<tr><th>{}</th><td class=\"n\">{}</td></tr>",
-                    escape(k),
-                    escape(&text)
-                );
-            }
+            let (label, value, unit) = match v.as_f64() {
+                Some(x) => {
+                    let (label, unit, x) = human(k, x);
+                    (label, number(x), unit)
+                }
+                None => match scalar(v) {
+                    Some(text) => (human(k, 0.0).0, text, String::new()),
+                    None => continue,
+                },
+            };
+            let _ = write!(
+                h,
+                "<tr><th>{}</th><td class=\"n\">{}</td><td>{}</td></tr>",
+                escape(&label),
+                escape(&value),
+                escape(&unit)
+            );
         }
         h.push_str("</table>");
     }
@@ -472,7 +563,7 @@ fn stage_section(
         h.push_str(&phase_timeline(phases, section.get("pitting")));
     }
     if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
-        wear_states_table(h, steps);
+        wear_states_table(h, steps, hours);
     }
     for prefix in prefixes {
         let paths = figures(dir, prefix);
@@ -527,8 +618,39 @@ fn state_figures(h: &mut String, series: &str, paths: &[PathBuf]) {
     h.push_str("</details>\n");
 }
 
+/// Hours per wheel cycle at the running speed: the ratio (summary's geometry) over the worm
+/// speed (the input's `conditions.worm_speed_rpm`); None when either is missing.
+fn hours_per_cycle(summary: &serde_json::Value, input_text: &str) -> Option<f64> {
+    let ratio = summary["geometry"]["ratio"].as_f64()?;
+    let input: toml::Table = input_text.parse().ok()?;
+    let rpm = input.get("conditions")?.get("worm_speed_rpm")?;
+    let rpm = rpm
+        .as_float()
+        .or_else(|| rpm.as_integer().map(|i| i as f64))?;
+    (rpm > 0.0).then(|| ratio / (rpm * 60.0))
+}
+
+/// Wheel cycles as a whole number with thin groups of three digits ("180 000").
+fn cycles_text(cycles: f64) -> String {
+    if !cycles.is_finite() {
+        return "-".into();
+    }
+    let digits = format!("{:.0}", cycles.abs());
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    if cycles < 0.0 {
+        out.insert(0, '-');
+    }
+    out
+}
+
 /// The wear states as a folded table.
-fn wear_states_table(h: &mut String, steps: &[serde_json::Value]) {
+fn wear_states_table(h: &mut String, steps: &[serde_json::Value], hours: Option<f64>) {
     let columns = [
         ("cycles", 1.0, "cycles"),
         ("phase", 1.0, "phase"),
@@ -543,18 +665,26 @@ fn wear_states_table(h: &mut String, steps: &[serde_json::Value]) {
     h.push_str("<details><summary>Wear states (table)</summary><table><tr>");
     for (_, _, label) in columns {
         let _ = write!(h, "<th>{label}</th>");
+        if label == "cycles" && hours.is_some() {
+            h.push_str("<th>hours</th>");
+        }
     }
     h.push_str("</tr>");
     for s in steps {
         h.push_str("<tr>");
         for (k, scale, _) in columns {
             let cell = match &s[k] {
-                serde_json::Value::Number(n) => {
-                    format!("{:.4}", n.as_f64().unwrap_or(f64::NAN) * scale)
+                serde_json::Value::Number(n) if k == "cycles" => {
+                    cycles_text(n.as_f64().unwrap_or(f64::NAN))
                 }
+                serde_json::Value::Number(n) => number(n.as_f64().unwrap_or(f64::NAN) * scale),
                 other => scalar(other).unwrap_or_default(),
             };
             let _ = write!(h, "<td class=\"n\">{}</td>", escape(&cell));
+            if let (Some(per), "cycles") = (hours, k) {
+                let hrs = s[k].as_f64().unwrap_or(f64::NAN) * per;
+                let _ = write!(h, "<td class=\"n\">{}</td>", number(hrs));
+            }
         }
         h.push_str("</tr>");
     }
@@ -586,4 +716,38 @@ fn files_section(h: &mut String, dir: &Path) {
         let _ = write!(h, "<li><a href=\"{f}\">{f}</a></li>", f = escape(f));
     }
     h.push_str("</ul></section>\n");
+}
+
+#[cfg(test)]
+mod human_tests {
+    use super::*;
+
+    #[test]
+    fn keys_read_as_labels_with_units() {
+        let (l, u, x) = human("max_pressure_pa", 1.862089e9);
+        assert_eq!(
+            (l.as_str(), u.as_str(), number(x).as_str()),
+            ("Max pressure", "MPa", "1862")
+        );
+        let (l, u, x) = human("te_p2p_rad", 5.025e-5);
+        assert_eq!((l.as_str(), u.as_str()), ("TE peak to peak", "urad"));
+        assert!((x - 50.25).abs() < 1e-9);
+        let (l, u, x) = human("oil_temperature_k", 333.0);
+        assert_eq!(
+            (l.as_str(), u.as_str(), number(x).as_str()),
+            ("Oil temperature", "C", "59.85")
+        );
+        let (l, u, x) = human("contact_area_fraction", 0.936);
+        assert_eq!(
+            (l.as_str(), u.as_str(), number(x).as_str()),
+            ("Contact area", "%", "93.60")
+        );
+        let (l, u, _) = human("mesh_stiffness_mean_nm_per_rad", 4.3e5);
+        assert_eq!((l.as_str(), u.as_str()), ("Mesh stiffness mean", "N m/rad"));
+        let (l, u, _) = human("states", 26.0);
+        assert_eq!((l.as_str(), u.as_str()), ("States", ""));
+        assert_eq!(cycles_text(180000.4), "180 000");
+        assert_eq!(cycles_text(1234567.0), "1 234 567");
+        assert_eq!(cycles_text(999.0), "999");
+    }
 }
