@@ -532,6 +532,14 @@ fn report_renders_in_a_headless_browser() {
             "{name} is not beside the report"
         );
     }
+    // Tables in words with a unit column, not summary.json's keys; cycles with hours.
+    assert!(
+        !page.contains("<th>max_pressure_pa</th>"),
+        "a raw key as a label"
+    );
+    assert!(page.contains("<th>Max pressure</th><td class=\"n\">"));
+    assert!(page.contains("<th>quantity</th><th>value</th><th>unit</th>"));
+    assert!(page.contains("wheel cycles (80 h at the running speed)"));
     let url = format!("file://{}", dir.path().join("report.html").display());
     let shot = dir.path().join("report.png");
     let dom = Command::new(&browser)
