@@ -210,10 +210,11 @@ pub fn line_chart_spanned(
             .y_label_area_size(70)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(plot_err)?;
+        let (dx, dy) = (tick_decimals(x1 - x0), tick_decimals(y1 - y0));
         chart
             .configure_mesh()
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
+            .x_label_formatter(&|v| tick_label_with(*v, dx))
+            .y_label_formatter(&|v| tick_label_with(*v, dy))
             .x_desc(x_label)
             .y_desc(y_label)
             .label_style(("sans-serif", 15))
@@ -264,11 +265,27 @@ pub struct MapCell {
 /// Short tick label: up to three decimals without trailing zeros ("800", "0.25"), scientific
 /// notation for very large or very small magnitudes.
 pub fn tick_label(v: f64) -> String {
+    tick_label_with(v, 3)
+}
+
+/// Decimals that tell apart the ticks of an axis spanning `span` (plotters puts about ten
+/// ticks on it): at least three, more when the ticks are closer than 0.001.
+pub fn tick_decimals(span: f64) -> usize {
+    let step = span.abs() / 10.0;
+    if step > 0.0 && step.is_finite() {
+        ((-step.log10().floor()) as i64 + 1).clamp(3, 9) as usize
+    } else {
+        3
+    }
+}
+
+/// [`tick_label`] with up to `decimals` decimals.
+pub fn tick_label_with(v: f64, decimals: usize) -> String {
     let a = v.abs();
     if a != 0.0 && !(1e-3..1e5).contains(&a) {
         return format!("{v:.2e}");
     }
-    let s = format!("{v:.3}");
+    let s = format!("{v:.decimals$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {
         "0".into()
@@ -447,6 +464,14 @@ pub fn flank_map(
             .y_label_area_size(70)
             .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
             .map_err(plot_err)?;
+        // A band much narrower than it is long is drawn stretched: say by how much.
+        let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
+        let stretch = (x1 - x0 + 2.0 * px) / (y1 - y0 + 2.0 * py) * plot_h as f64 / plot_w as f64;
+        let y_label = if stretch > 3.0 {
+            format!("{y_label}, drawn {stretch:.0} x the x scale")
+        } else {
+            y_label.to_string()
+        };
         chart
             .configure_mesh()
             .x_desc(x_label)
@@ -670,6 +695,41 @@ mod tests {
         assert_eq!(drawn, cells.len());
         // The cells come before the colour bar's and the axes' text, under everything else.
         assert!(svg.find("<path").unwrap() < svg.rfind("<text").unwrap());
+        // A 4 x 3 map is drawn near true scale: no stretch noted.
+        assert!(!svg.contains("x the x scale"));
+        // A band 40 long and 1 high is drawn stretched, and says by how much.
+        let band: Vec<MapCell> = (0..40)
+            .map(|i| MapCell {
+                corners: [
+                    (i as f64, 0.0),
+                    (i as f64 + 1.0, 0.0),
+                    (i as f64 + 1.0, 1.0),
+                    (i as f64, 1.0),
+                ],
+                value: 0.5,
+            })
+            .collect();
+        flank_map(
+            &path,
+            "t",
+            "x",
+            "y",
+            &band,
+            (0.0, 1.0),
+            "v",
+            none,
+            &[],
+            None,
+        )
+        .unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let stretch: f64 = svg
+            .split(", drawn ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .expect("the stretch stated");
+        assert!((15.0..40.0).contains(&stretch), "{stretch}");
     }
 
     /// Grid of `n` x `n` points on [-1, 1]^2 with values f(x, y).
@@ -773,6 +833,19 @@ mod tests {
             .map(|(a, b)| ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt())
             .sum();
         assert!((length - 2.0).abs() < 1e-9, "{length}");
+    }
+
+    #[test]
+    fn close_ticks_get_the_decimals_that_tell_them_apart() {
+        // The design case's stiffness axis: 0.4285 to 0.4331 MN m/rad.
+        let d = tick_decimals(0.4331 - 0.4285);
+        let ticks: Vec<String> = (0..10)
+            .map(|k| tick_label_with(0.4285 + 0.0005 * k as f64, d))
+            .collect();
+        let mut unique = ticks.clone();
+        unique.dedup();
+        assert_eq!(unique.len(), ticks.len(), "{ticks:?}");
+        assert_eq!(tick_decimals(1000.0), 3);
     }
 
     #[test]
