@@ -673,21 +673,24 @@ mod tests {
         }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("map.svg");
-        let none: &[Series] = &[];
-        flank_map(
-            &path,
-            "t",
-            "x",
-            "y",
-            &cells,
-            (0.0, 1.0),
-            "v",
-            none,
-            &[],
-            None,
-        )
-        .unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
+        let drawn_map = |cells: &[MapCell]| {
+            let none: &[Series] = &[];
+            flank_map(
+                &path,
+                "t",
+                "x",
+                "y",
+                cells,
+                (0.0, 1.0),
+                "v",
+                none,
+                &[],
+                None,
+            )
+            .unwrap();
+            std::fs::read_to_string(&path).unwrap()
+        };
+        let svg = drawn_map(&cells);
         assert!(!svg.contains(CELLS_MARKER));
         let paths: Vec<&str> = svg.split("<path fill=").skip(1).collect();
         assert_eq!(paths.len(), 3, "two colours and the grey of no value");
@@ -709,20 +712,7 @@ mod tests {
                 value: 0.5,
             })
             .collect();
-        flank_map(
-            &path,
-            "t",
-            "x",
-            "y",
-            &band,
-            (0.0, 1.0),
-            "v",
-            none,
-            &[],
-            None,
-        )
-        .unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
+        let svg = drawn_map(&band);
         let stretch: f64 = svg
             .split(", drawn ")
             .nth(1)
