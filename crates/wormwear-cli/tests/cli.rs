@@ -1498,10 +1498,18 @@ fn sweep_runs_a_grid_writes_its_table_and_page_and_resumes() {
         "{csv}"
     );
     let html = std::fs::read_to_string(out_dir.join("sweep.html")).unwrap();
-    assert!(html.contains("plots/max_pressure_vs_conditions_worm_torque_nm.svg"));
-    assert!(out_dir
-        .join("plots/max_pressure_vs_conditions_worm_torque_nm.svg")
-        .is_file());
+    assert!(html.contains("plots/s0_vs_conditions_worm_torque_nm.svg"));
+    let chart =
+        std::fs::read_to_string(out_dir.join("plots/s0_vs_conditions_worm_torque_nm.svg")).unwrap();
+    // Axis titles in words with units, each computed case marked.
+    assert!(chart.contains("Worm torque (N m)"));
+    assert!(chart.matches("<circle").count() >= 3, "no markers");
+    // Only what varies: the pressure sits at the flow pressure in every variant (a sentence,
+    // no chart), and the loaded contact does not depend on the roughness (no chart against it).
+    assert!(html.contains("The same in every variant"));
+    assert!(!html.contains("plots/max_pressure_vs_"));
+    assert!(!html.contains("plots/s0_vs_lubricant_composite_roughness_um.svg"));
+    assert!(html.contains("overflow-x:auto"));
     assert!(out_dir.join("variants/v6/ltca_positions.csv").is_file());
     let again = sweep();
     assert!(again.status.success());

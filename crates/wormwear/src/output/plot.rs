@@ -26,6 +26,44 @@ pub struct Series {
     pub bold: bool,
 }
 
+/// Markers at the points of the `k`-th series: shapes and sizes differ from series to series,
+/// the earlier ones larger, so that curves lying on each other stay visible.
+fn draw_markers<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    points: &[(f64, f64)],
+    k: usize,
+    color: RGBColor,
+) -> Result<(), OutputError>
+where
+    DB::ErrorType: 'static,
+{
+    let size = 7 - (k % 4) as u32;
+    let result = match k % 3 {
+        0 => chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, size, color.filled())))
+            .map(|_| ()),
+        1 => chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| TriangleMarker::new(p, size + 1, color.filled())),
+            )
+            .map(|_| ()),
+        _ => chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| Cross::new(p, size, color.stroke_width(2))),
+            )
+            .map(|_| ()),
+    };
+    result.map_err(plot_err)
+}
+
 /// Draws the series as lines and, if any has a label, the legend at `position`.
 fn draw_series_with_legend<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<
@@ -34,17 +72,19 @@ fn draw_series_with_legend<'a, DB: DrawingBackend + 'a>(
         Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
     >,
     series: &[Series],
-    position: SeriesLabelPosition,
+    (position, markers): (SeriesLabelPosition, bool),
 ) -> Result<(), OutputError>
 where
     DB::ErrorType: 'static,
 {
     let mut labelled = false;
-    for s in series {
+    for (k, s) in series.iter().enumerate() {
         let color = COLORS[s.color % COLORS.len()];
         let style = color.stroke_width(if s.bold { 3 } else { 2 });
-        // A single point draws no line: mark it.
-        if s.points.len() == 1 {
+        if markers {
+            draw_markers(chart, &s.points, k, color)?;
+        } else if s.points.len() == 1 {
+            // A single point draws no line: mark it.
             chart
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, color.filled())))
                 .map_err(plot_err)?;
@@ -54,8 +94,15 @@ where
             .map_err(plot_err)?;
         if !s.label.is_empty() {
             labelled = true;
+            let dot = if markers {
+                color.filled()
+            } else {
+                color.mix(0.0).filled()
+            };
             anno.label(s.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (20, 0)], color.stroke_width(3))
+                    + Circle::new((10, 0), 4, dot)
             });
         }
     }
@@ -164,6 +211,32 @@ pub fn line_chart_spanned(
     equal_aspect: bool,
     min_y_span: f64,
 ) -> Result<(), OutputError> {
+    chart_with(
+        path,
+        (title, x_label, y_label),
+        series,
+        (equal_aspect, min_y_span, false),
+    )
+}
+
+/// As [`line_chart`], each series also marked at its points, in shapes and sizes that differ
+/// from series to series (curves lying on each other stay visible): few points, each one a
+/// computed case (a design study).
+pub fn line_chart_marked(
+    path: &Path,
+    (title, x_label, y_label): (&str, &str, &str),
+    series: &[Series],
+) -> Result<(), OutputError> {
+    chart_with(path, (title, x_label, y_label), series, (false, 0.0, true))
+}
+
+/// The line chart of [`line_chart_spanned`] and [`line_chart_marked`].
+fn chart_with(
+    path: &Path,
+    (title, x_label, y_label): (&str, &str, &str),
+    series: &[Series],
+    (equal_aspect, min_y_span, markers): (bool, f64, bool),
+) -> Result<(), OutputError> {
     let (mut x0, mut x1, mut y0, mut y1) =
         bounds(series.iter().flat_map(|s| s.points.iter().copied()));
     if y1 - y0 < min_y_span {
@@ -222,7 +295,7 @@ pub fn line_chart_spanned(
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(plot_err)?;
-        draw_series_with_legend(&mut chart, series, corner)?;
+        draw_series_with_legend(&mut chart, series, (corner, markers))?;
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, svg.as_bytes())
@@ -510,7 +583,11 @@ pub fn flank_map(
                     .map(|&(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))),
             )
             .map_err(plot_err)?;
-        draw_series_with_legend(&mut chart, overlays, SeriesLabelPosition::UpperMiddle)?;
+        draw_series_with_legend(
+            &mut chart,
+            overlays,
+            (SeriesLabelPosition::UpperMiddle, false),
+        )?;
         colour_bar(&bar, bar_label, (lo, span), &levels)?;
         root.present().map_err(plot_err)?;
     }

@@ -5,7 +5,7 @@
 use super::{Row, Sweep};
 use crate::output::report::escape;
 use crate::output::OutputError;
-use crate::plot::{line_chart, Series};
+use crate::plot::{line_chart_marked, Series};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -108,7 +108,12 @@ fn parameter_charts(
             };
             let label: Vec<String> = others
                 .iter()
-                .map(|o| format!("{} = {}", short(o), value_text(row, o)))
+                .map(|o| {
+                    let (label, unit, _) = crate::output::report::human(short(o), 0.0);
+                    format!("{label} = {} {unit}", value_text(row, o))
+                        .trim_end()
+                        .to_string()
+                })
                 .collect();
             let label = label.join(", ");
             match groups.iter_mut().find(|g| g.0 == label) {
@@ -116,7 +121,13 @@ fn parameter_charts(
                 None => groups.push((label, vec![(x, y * q.scale)])),
             }
         }
-        if groups.is_empty() {
+        // Nothing to see where the result does not change along this parameter.
+        let flat = groups.iter().all(|(_, points)| {
+            points
+                .iter()
+                .all(|p| (p.1 - points[0].1).abs() <= 1e-9 * points[0].1.abs().max(1e-300))
+        });
+        if groups.is_empty() || !varies(rows, q) || flat {
             continue;
         }
         let series: Vec<Series> = groups
@@ -133,17 +144,36 @@ fn parameter_charts(
             })
             .collect();
         let file = PathBuf::from("plots").join(format!("{}_vs_{}.svg", q.file, slug(name)));
-        line_chart(
+        let axis = axis_title(name);
+        line_chart_marked(
             &dir.join(&file),
-            &format!("{} against {}", q.title, short(name)),
-            name,
-            q.unit,
+            (&format!("{} against {}", q.title, axis), &axis, q.unit),
             &series,
-            false,
         )?;
         charts.push((q.title.to_string(), file));
     }
     Ok(charts)
+}
+
+/// A parameter's axis title: its last part in words with its unit, from the unit in its name
+/// ("conditions.worm_torque_nm" -> "Worm torque (N m)"); the values stay in the file's units.
+fn axis_title(name: &str) -> String {
+    let (label, unit, _) = crate::output::report::human(short(name), 0.0);
+    if unit.is_empty() {
+        label
+    } else {
+        format!("{label} ({unit})")
+    }
+}
+
+/// Whether a quantity takes more than one value over the finished variants (a result that
+/// does not change is neither charted nor tabled).
+fn varies(rows: &[Row], q: &Quantity) -> bool {
+    let mut values = rows.iter().filter(|r| r.ok).filter_map(|r| (q.value)(r));
+    match values.next() {
+        Some(first) => values.any(|v| (v - first).abs() > 1e-9 * first.abs().max(1e-300)),
+        None => false,
+    }
 }
 
 /// The last part of a dotted name.
@@ -195,7 +225,12 @@ pub fn write_html(dir: &Path, sweep: &Sweep, rows: &[Row]) -> Result<PathBuf, Ou
         if charts.is_empty() {
             continue;
         }
-        let _ = writeln!(h, "<h2>Against {}</h2>", escape(name));
+        let _ = writeln!(
+            h,
+            "<h2>Against {} <small>({})</small></h2>",
+            escape(&axis_title(name)),
+            escape(name)
+        );
         for (title, file) in charts {
             let _ = writeln!(
                 h,
@@ -214,11 +249,17 @@ pub fn write_html(dir: &Path, sweep: &Sweep, rows: &[Row]) -> Result<PathBuf, Ou
 /// The table of variants: name (a link to its report when there is one), parameters, key
 /// results, error.
 fn write_table(h: &mut String, sweep: &Sweep, rows: &[Row]) {
-    h.push_str("<table><tr><th>variant</th>");
+    let shown: Vec<&Quantity> = QUANTITIES.iter().filter(|q| varies(rows, q)).collect();
+    h.push_str("<div style=\"overflow-x:auto\"><table><tr><th>variant</th>");
     for p in &sweep.parameters {
-        let _ = write!(h, "<th>{}</th>", escape(p));
+        let _ = write!(
+            h,
+            "<th title=\"{}\">{}</th>",
+            escape(p),
+            escape(&axis_title(p))
+        );
     }
-    for q in &QUANTITIES {
+    for q in &shown {
         let _ = write!(h, "<th>{}</th>", escape(q.unit));
     }
     h.push_str("<th>error</th></tr>\n");
@@ -237,8 +278,10 @@ fn write_table(h: &mut String, sweep: &Sweep, rows: &[Row]) {
         for p in &sweep.parameters {
             let _ = write!(h, "<td class=\"n\">{}</td>", escape(&value_text(row, p)));
         }
-        for q in &QUANTITIES {
-            let text = (q.value)(row).map_or(String::new(), |v| format!("{:.4}", v * q.scale));
+        for q in &shown {
+            let text = (q.value)(row).map_or(String::new(), |v| {
+                crate::output::compare::number(v * q.scale)
+            });
             let _ = write!(h, "<td class=\"n\">{text}</td>");
         }
         let _ = writeln!(
@@ -247,5 +290,18 @@ fn write_table(h: &mut String, sweep: &Sweep, rows: &[Row]) {
             escape(row.error.as_deref().unwrap_or(""))
         );
     }
-    h.push_str("</table>\n");
+    h.push_str("</table></div>\n");
+    let constant: Vec<&str> = QUANTITIES
+        .iter()
+        .filter(|q| !varies(rows, q))
+        .map(|q| q.title)
+        .collect();
+    if !constant.is_empty() {
+        let _ = writeln!(
+            h,
+            "<p>The same in every variant (or not computed), so neither tabled nor charted: {} \
+             (their values are in sweep.csv).</p>",
+            escape(&constant.join("; "))
+        );
+    }
 }
