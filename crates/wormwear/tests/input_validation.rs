@@ -86,7 +86,7 @@ fn unknown_key_is_rejected() {
 #[test]
 fn missing_field_is_named() {
     let text = remove(&design(), "wheel", "teeth");
-    assert_mentions(&error_of(&text), &["missing field `teeth`"]);
+    assert_mentions(&error_of(&text), &["[wheel] is missing the key `teeth`"]);
 }
 
 #[test]
@@ -1017,8 +1017,57 @@ fn unknown_keys_are_all_reported_at_once_with_their_lines() {
             &format!("line {}", line_of("worm_torqe_nm")),
             "unknown field `face_widht_mm`",
             &format!("line {}", line_of("face_widht_mm")),
-            "missing field `face_width_mm`",
+            "[wheel] is missing the key `face_width_mm`",
         ],
     );
+    assert!(input::load_from_str(&design()).is_ok());
+}
+
+#[test]
+fn missing_keys_and_tables_are_all_reported_at_once_with_their_tables_lines() {
+    // Two keys left out of [worm] and [hob], two of [wheel], and the whole [cutting] table:
+    // every one named in one error, with the line of its table's header.
+    let mut text = design();
+    for (table, key) in [
+        ("worm", "reference_radius_mm"),
+        ("hob", "reference_radius_mm"),
+        ("wheel", "teeth"),
+        ("wheel", "face_width_mm"),
+        ("cutting", "centre_distance_mm"),
+        ("cutting", "offset_mm"),
+        ("cutting", "inclination_deg"),
+    ] {
+        text = remove(&text, table, key);
+    }
+    let text = text.replace("[cutting]\n", "\n");
+    let line_of = |header: &str| {
+        text.lines()
+            .position(|l| l.starts_with(header))
+            .map(|k| k + 1)
+            .unwrap()
+    };
+    let e = error_of(&text);
+    for expected in [
+        format!(
+            "line {}: [worm] is missing the key `reference_radius_mm`",
+            line_of("[worm]")
+        ),
+        format!(
+            "line {}: [hob] is missing the key `reference_radius_mm`",
+            line_of("[hob]")
+        ),
+        format!(
+            "line {}: [wheel] is missing the key `teeth`",
+            line_of("[wheel]")
+        ),
+        format!(
+            "line {}: [wheel] is missing the key `face_width_mm`",
+            line_of("[wheel]")
+        ),
+        "the file has no [cutting] table".to_string(),
+    ] {
+        assert!(e.contains(&expected), "no {expected:?} in:\n{e}");
+    }
+    // A complete file is unaffected.
     assert!(input::load_from_str(&design()).is_ok());
 }

@@ -1,5 +1,5 @@
-//! Reading a gear file's TOML text: every unknown key at once, parse errors with their long
-//! lines cut and, for a nesting too deep to place, its line.
+//! Reading a gear file's TOML text: every unknown key and every missing key or table at once,
+//! parse errors with their long lines cut and, for a nesting too deep to place, its line.
 
 use super::{GearFile, InputError};
 
@@ -45,7 +45,111 @@ pub(super) fn parse_gear_file(text: &str) -> Result<GearFile, InputError> {
             }
         }
     }
+    if current.message().starts_with("missing field") {
+        let missing = missing_keys(&lines.join("\n"));
+        if !missing.is_empty() {
+            errors.pop();
+            errors.extend(missing);
+        }
+    }
     Err(InputError::Syntax(errors.join("\n")))
+}
+
+/// The required tables of a gear file and the type each is read as.
+type TableCheck = fn(toml::Value) -> Result<(), toml::de::Error>;
+
+fn table_check<T: serde::de::DeserializeOwned>(v: toml::Value) -> Result<(), toml::de::Error> {
+    T::deserialize(v).map(|_| ())
+}
+
+const REQUIRED_TABLES: &[(&str, bool, TableCheck)] = &[
+    ("worm", true, table_check::<super::schema::ThreadSpec>),
+    ("hob", true, table_check::<super::schema::ThreadSpec>),
+    ("cutting", true, table_check::<super::schema::SettingSpec>),
+    ("wheel", true, table_check::<super::schema::WheelSpec>),
+    (
+        "operating",
+        true,
+        table_check::<super::schema::OperatingSpec>,
+    ),
+    (
+        "conditions",
+        true,
+        table_check::<super::schema::ConditionsSpec>,
+    ),
+    (
+        "materials.worm",
+        false,
+        table_check::<super::schema::MaterialSpec>,
+    ),
+    (
+        "materials.wheel",
+        false,
+        table_check::<super::schema::MaterialSpec>,
+    ),
+    ("wear", false, table_check::<super::schema::WearSpec>),
+];
+
+/// Every required key and table the gear file's text leaves out, each with the line of its
+/// table's header: each table read alone, a missing key given a stand-in value (of the first
+/// type it takes) and the table read again, until nothing more is missing. Empty when the text
+/// is not TOML or a key is missing from a table inside a table (the reader's message then).
+fn missing_keys(text: &str) -> Vec<String> {
+    let Ok(root) = text.parse::<toml::Table>() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for &(path, required, check) in REQUIRED_TABLES {
+        let table = path
+            .split('.')
+            .try_fold(&root, |t, part| t.get(part)?.as_table());
+        let Some(table) = table else {
+            if required {
+                out.push(format!("the file has no [{path}] table"));
+            }
+            continue;
+        };
+        let line = text
+            .lines()
+            .position(|l| l.trim_start().starts_with(&format!("[{path}]")))
+            .map_or(String::new(), |k| format!("line {}: ", k + 1));
+        let mut table = table.clone();
+        while let Err(e) = check(toml::Value::Table(table.clone())) {
+            let Some(key) = e
+                .message()
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split('`').next())
+                .map(String::from)
+            else {
+                break;
+            };
+            out.push(format!("{line}[{path}] is missing the key `{key}`"));
+            let stand_in = [
+                toml::Value::Float(1.0),
+                toml::Value::Integer(1),
+                toml::Value::String(String::new()),
+                toml::Value::Array(Vec::new()),
+            ]
+            .into_iter()
+            .find(|v| {
+                let mut t = table.clone();
+                t.insert(key.clone(), v.clone());
+                check(toml::Value::Table(t)).err().is_none_or(|e| {
+                    !e.message().contains(&format!("`{key}`"))
+                        && !e.message().starts_with("invalid type")
+                })
+            });
+            match stand_in {
+                Some(v) if !table.contains_key(&key) => {
+                    table.insert(key, v);
+                }
+                // Not a key of this table itself but of a table inside it: the reader's own
+                // message, which shows the place, says it better.
+                _ => return Vec::new(),
+            }
+        }
+    }
+    out
 }
 
 /// A parse error of `text` as an input error, its long lines cut.
