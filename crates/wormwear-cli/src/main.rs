@@ -32,8 +32,9 @@ struct Cli {
     /// Print only errors.
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
-    /// Print progress as lines on stderr (one per wear state), also when stderr is not a
-    /// terminal (CI logs, pipes), where the progress bar stays hidden.
+    /// Print progress as lines on stderr, also when stderr is not a terminal (CI logs, pipes),
+    /// where the progress bar stays hidden: one line per wear state of a life (wear, run,
+    /// rating, calibrate, export-rexs); the other commands have no progress to print.
     #[arg(short, long, global = true)]
     verbose: bool,
     #[command(subcommand)]

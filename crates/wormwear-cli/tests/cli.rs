@@ -561,6 +561,42 @@ fn report_renders_in_a_headless_browser() {
         dom.matches("<svg").count() >= 20,
         "figures missing from the rendered page"
     );
+    // No horizontal overflow at 1280 px: a copy of the page reports its scroll width.
+    let check = dir.path().join("overflow-check.html");
+    std::fs::write(
+        &check,
+        page.replace(
+            "</body>",
+            "<script>document.body.setAttribute('data-width', \
+             document.documentElement.scrollWidth + ' ' + window.innerWidth);</script></body>",
+        ),
+    )
+    .unwrap();
+    let dom = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--window-size=1280,1000",
+        ])
+        .arg("--dump-dom")
+        .arg(format!("file://{}", check.display()))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    let widths: Vec<f64> = dom
+        .split("data-width=\"")
+        .nth(1)
+        .and_then(|t| t.split('"').next())
+        .map(|t| t.split(' ').filter_map(|w| w.parse().ok()).collect())
+        .unwrap_or_default();
+    assert_eq!(widths.len(), 2, "no width reported");
+    assert!(
+        widths[0] <= widths[1],
+        "the page is {} px wide at {} px",
+        widths[0],
+        widths[1]
+    );
     let status = Command::new(&browser)
         .args([
             "--headless",
@@ -1897,4 +1933,18 @@ fn the_te_plot_shows_the_ripple_about_its_stated_mean() {
         svg.contains(&format!("mean {mean:.0} urad")),
         "the mean is stated"
     );
+}
+
+#[test]
+fn every_command_says_what_verbose_does_for_it() {
+    for command in ["check", "ltca", "wear", "run", "sweep", "compare", "init"] {
+        let out = bin().args([command, "--help"]).output().unwrap();
+        let help = String::from_utf8_lossy(&out.stdout);
+        let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(help.contains("--verbose"), "{command}: {help}");
+        assert!(
+            help.contains("one line per wear state of a life (wear, run"),
+            "{command}: {help}"
+        );
+    }
 }
