@@ -689,13 +689,17 @@ impl<'a> Pipeline<'a> {
             return None;
         };
         let level = crate::bending::wheel_root::ROOT_LEVEL;
-        let result = crate::bending::wheel_root::root_stress(
+        let result = crate::bending::wheel_root::root_stress_cached(
             self.gear,
             geo,
             ltca,
-            tca.loaded_flank,
-            (level, radius),
+            (tca.loaded_flank, level, radius),
+            Some(&crate::bending::model::cache_dir()),
         )
+        .map(|(stresses, warnings)| {
+            self.warnings.extend(warnings);
+            stresses
+        })
         .map_err(|e| e.to_string());
         match &result {
             Err(e) => self.warnings.push(format!("safety: S_F not computed: {e}")),

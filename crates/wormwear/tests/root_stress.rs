@@ -7,7 +7,9 @@ mod common;
 use wormwear::bending::fe::element_stiffness;
 use wormwear::bending::fe::Elastic;
 use wormwear::bending::root_mesh::fillet_sector_mesh;
-use wormwear::bending::wheel_root::{root_mesh_settings, root_stress, RootStressError};
+use wormwear::bending::wheel_root::{
+    root_mesh_settings, root_stress, root_stress_cached, RootStressError,
+};
 use wormwear::geometry::Geometry;
 use wormwear::input::{BendingKind, GearSet, Torque};
 use wormwear::ltca::Ltca;
@@ -81,6 +83,34 @@ fn a_fillet_reaching_above_the_lowest_contact_is_refused_naming_the_input() {
     );
     let text = err.to_string();
     assert!(text.contains("rating.root_fillet_radius_mm = 3"), "{text}");
+}
+
+#[test]
+fn the_root_stress_is_cached_checked_and_recomputed_when_its_entry_is_damaged() {
+    let (g, geo, flank, ltca) = loaded(60.0);
+    let dir = tempfile::tempdir().unwrap();
+    let args = (flank, 1, FILLET);
+    let (first, w) = root_stress_cached(&g, &geo, &ltca, args, Some(dir.path())).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let entries: Vec<_> = std::fs::read_dir(dir.path()).unwrap().flatten().collect();
+    assert_eq!(entries.len(), 1);
+    let (again, w) = root_stress_cached(&g, &geo, &ltca, args, Some(dir.path())).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(again, first);
+    // Another fillet radius is another entry, not this one's value.
+    let other = (flank, 1, 0.8e-3);
+    let (smaller, _) = root_stress_cached(&g, &geo, &ltca, other, Some(dir.path())).unwrap();
+    assert_ne!(smaller.interior.stress, first.interior.stress);
+    // A damaged entry fails its checksum: recomputed, with a warning, to the same value.
+    let path = entries[0].path();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let digit = text.find("\"stress\":").unwrap() + 10;
+    let mut bytes = text.into_bytes();
+    bytes[digit] = if bytes[digit] == b'1' { b'2' } else { b'1' };
+    std::fs::write(&path, bytes).unwrap();
+    let (fixed, w) = root_stress_cached(&g, &geo, &ltca, args, Some(dir.path())).unwrap();
+    assert_eq!(fixed, first);
+    assert!(w.iter().any(|m| m.contains("not used")), "{w:?}");
 }
 
 /// Refinement study (heavy: level 4 takes ~40 s and 6 GB): the root stress inside the face

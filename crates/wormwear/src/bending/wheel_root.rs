@@ -69,7 +69,7 @@ pub enum RootStressError {
 }
 
 /// The largest root stress and where it is.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RootStress {
     /// Linearised root stress sigma_m + |sigma_b| (the larger extreme fibre), Pa.
     pub stress: f64,
@@ -282,7 +282,7 @@ impl LoadedSector {
 
 /// The root stress readings of the loaded sector (MODEL §9.1), each the largest over every
 /// position and tooth in the middle.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RootStresses {
     /// Over the sections from one module inside each face end: the root stress of the safety
     /// table.
@@ -305,6 +305,47 @@ pub fn root_stress(
 ) -> Result<RootStresses, RootStressError> {
     let loaded = LoadedSector::solve(gear, geo, ltca, (flank, level, fillet_radius))?;
     Ok(loaded.root_stresses(gear.worm.axial_pitch / std::f64::consts::PI)?)
+}
+
+/// Version of the root stress's cache entries: raise it when the sector, its loads or its
+/// reading change.
+const CACHE_VERSION: u32 = 1;
+
+/// [`root_stress`] from the cache directory `dir` when an entry of the same key is there (the
+/// whole gear, K_A and the safety inputs with it, the flank, level and fillet radius), else
+/// computed and cached; checksummed like the bending models. Cache problems never fail the
+/// run: they come back as warnings.
+pub fn root_stress_cached(
+    gear: &GearSet,
+    geo: &Geometry,
+    ltca: &Ltca,
+    (flank, level, fillet_radius): (Flank, usize, f64),
+    dir: Option<&std::path::Path>,
+) -> Result<(RootStresses, Vec<String>), RootStressError> {
+    let key = serde_json::json!({
+        "version": CACHE_VERSION,
+        "gear": gear,
+        "flank": format!("{flank:?}"),
+        "level": level,
+        "fillet_radius": fillet_radius,
+    })
+    .to_string();
+    let path = dir.map(|d| super::model::cache_path(d, "root-stress", &key));
+    let mut warnings = Vec::new();
+    match path.as_deref().map(|p| super::model::read_cache(p, &key)) {
+        Some(Ok(Some(cached))) => return Ok((cached, warnings)),
+        Some(Err(reason)) => warnings.push(format!(
+            "root stress cache entry not used ({reason}): recomputed"
+        )),
+        _ => {}
+    }
+    let stresses = root_stress(gear, geo, ltca, flank, (level, fillet_radius))?;
+    if let Some(p) = &path {
+        if let Err(e) = super::model::write_cache(p, &key, &stresses) {
+            warnings.push(format!("root stress not cached in {}: {e}", p.display()));
+        }
+    }
+    Ok((stresses, warnings))
 }
 
 /// A root section at one face station: Gauss points along the chord between the central
