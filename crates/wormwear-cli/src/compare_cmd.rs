@@ -20,7 +20,7 @@ pub fn compare(dirs: &[PathBuf], output: &Path, quiet: bool) -> Result<(), Failu
             let values: Vec<String> = row
                 .values
                 .iter()
-                .map(|v| v.map_or("-".into(), wormwear::output::compare::number))
+                .map(|v| v.map_or("-".into(), wormwear::output::text::number))
                 .collect();
             println!(
                 "{:<40} {:<12} {}",

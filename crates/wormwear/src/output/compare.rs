@@ -3,7 +3,7 @@
 //! from each run's summary.json and wear_steps.csv.
 
 use super::plot::{line_chart, Series};
-use super::report::escape;
+use super::text::{escape, number};
 use super::{write_atomic, OutputError};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -274,18 +274,6 @@ fn safety_rows(summaries: &[Value]) -> Vec<KeyResult> {
                 .collect(),
         })
         .collect()
-}
-
-/// A number for the table: four significant digits, integers as integers.
-pub fn number(v: f64) -> String {
-    if (v - v.round()).abs() <= 1e-9 * v.abs().max(1.0) && v.abs() < 1e9 {
-        format!("{v:.0}")
-    } else if v.abs() >= 1e5 || v.abs() < 1e-3 {
-        format!("{v:.3e}")
-    } else {
-        let digits = (3 - v.abs().log10().floor() as i32).max(0) as usize;
-        format!("{v:.digits$}")
-    }
 }
 
 /// The difference of `v` to the first run's `first`: absolute and in % of it.

@@ -12,6 +12,7 @@ pub mod plot;
 pub mod report;
 pub mod safety;
 pub mod tca;
+pub mod text;
 pub mod vtk;
 pub mod wear;
 

@@ -537,14 +537,11 @@ pub fn flank_map(
             .y_label_area_size(70)
             .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
             .map_err(plot_err)?;
-        // A band much narrower than it is long is drawn stretched: say by how much.
-        let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
-        let stretch = (x1 - x0 + 2.0 * px) / (y1 - y0 + 2.0 * py) * plot_h as f64 / plot_w as f64;
-        let y_label = if stretch > 3.0 {
-            format!("{y_label}, drawn {stretch:.0} x the x scale")
-        } else {
-            y_label.to_string()
-        };
+        let y_label = stretched(
+            y_label,
+            (x1 - x0 + 2.0 * px, y1 - y0 + 2.0 * py),
+            chart.plotting_area().dim_in_pixel(),
+        );
         chart
             .configure_mesh()
             .x_desc(x_label)
@@ -556,13 +553,7 @@ pub fn flank_map(
             .map_err(plot_err)?;
         let (lo, hi) = range;
         let span = if hi > lo { hi - lo } else { 1.0 };
-        let cell_color = |c: &MapCell| {
-            if c.value.is_finite() {
-                scale_color((c.value - lo) / span)
-            } else {
-                RGBColor(220, 220, 220)
-            }
-        };
+        let cell_color = |c: &MapCell| cell_colour(c.value, (lo, span));
         // The cells go in after rendering, one path per colour, where this marker stands.
         chart
             .draw_series(std::iter::once(Text::new(
@@ -592,6 +583,26 @@ pub fn flank_map(
         root.present().map_err(plot_err)?;
     }
     write_atomic(path, with_cells(&svg, &cell_paths).as_bytes())
+}
+
+/// A map cell's colour: the scale at its value within (lo, lo + span), grey without a value.
+fn cell_colour(value: f64, (lo, span): (f64, f64)) -> RGBColor {
+    if value.is_finite() {
+        scale_color((value - lo) / span)
+    } else {
+        RGBColor(220, 220, 220)
+    }
+}
+
+/// The y label of a map of extent `size` (x, y) drawn on `pixels` (width, height): a band much
+/// narrower than it is long is drawn stretched, and the label says by how much.
+fn stretched(y_label: &str, size: (f64, f64), pixels: (u32, u32)) -> String {
+    let stretch = size.0 / size.1 * pixels.1 as f64 / pixels.0 as f64;
+    if stretch > 3.0 {
+        format!("{y_label}, drawn {stretch:.0} x the x scale")
+    } else {
+        y_label.to_string()
+    }
 }
 
 /// Text drawn where the cells of a flank map go ([`with_cells`]).

@@ -3,7 +3,7 @@
 //! summary.json, the figures of each stage in order, the ratings, the warnings and links to the
 //! data files beside it (CSV tables, STL and VTK surfaces for CAD and ParaView).
 
-use super::compare::number;
+use super::text::{cycles_text, escape, human, number};
 use super::{write_atomic, OutputError};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -69,81 +69,6 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
     ),
     ("Ratings (ISO/TR 14521)", "rating", &[]),
 ];
-
-/// `s` as HTML text (also inside attribute values).
-pub(crate) fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
-/// Units of summary.json's keys by their suffix: (suffix, unit shown, factor). The longest
-/// suffix that matches wins; SI values become the units an engineer reads (MPa, um, urad).
-const UNITS: &[(&str, &str, f64)] = &[
-    ("_nm_per_rad", "N m/rad", 1.0),
-    ("_rad_per_nm", "urad/(N m)", 1e6),
-    ("_n_per_m", "N/m", 1.0),
-    ("_w_m2", "W/m^2", 1.0),
-    ("_pa_s", "Pa s", 1.0),
-    ("_m_s", "m/s", 1.0),
-    ("_mm2", "mm^2", 1.0),
-    ("_m3", "mm^3", 1e9),
-    ("_mpa", "MPa", 1.0),
-    ("_gpa", "GPa", 1.0),
-    ("_deg", "deg", 1.0),
-    ("_rpm", "rpm", 1.0),
-    ("_mm", "mm", 1.0),
-    ("_um", "um", 1.0),
-    ("_pa", "MPa", 1e-6),
-    ("_rad", "urad", 1e6),
-    ("_nm", "N m", 1.0),
-    ("_m", "um", 1e6),
-    ("_w", "W", 1.0),
-    ("_k", "C", 1.0),
-    ("_c", "C", 1.0),
-    ("_n", "N", 1.0),
-    ("_cycles", "wheel cycles", 1.0),
-    ("_percent", "%", 1.0),
-    ("_fraction", "%", 100.0),
-    ("_share", "%", 100.0),
-];
-
-/// A summary.json key and value as a label, a unit and the value in that unit: the key's unit
-/// suffix read ([`UNITS`]), the rest in words ("max_pressure_pa", 1.86e9 -> "Max pressure",
-/// "MPa", 1860); kelvin to Celsius.
-pub(crate) fn human(key: &str, value: f64) -> (String, String, f64) {
-    let (stem, unit, x) = match UNITS.iter().find(|(suffix, ..)| key.ends_with(suffix)) {
-        Some((suffix, unit, factor)) => {
-            let stem = &key[..key.len() - suffix.len()];
-            let x = if *suffix == "_k" {
-                value - 273.15
-            } else {
-                value * factor
-            };
-            (stem.to_string(), unit.to_string(), x)
-        }
-        None => (key.to_string(), String::new(), value),
-    };
-    let words: Vec<String> = stem
-        .split('_')
-        .filter(|w| !w.is_empty())
-        .map(|w| match w {
-            "te" => "TE".to_string(),
-            "p2p" => "peak to peak".to_string(),
-            "ke" => "KE".to_string(),
-            "iso" => "ISO".to_string(),
-            "ltca" => "LTCA".to_string(),
-            "tca" => "TCA".to_string(),
-            _ => w.to_string(),
-        })
-        .collect();
-    let mut label = words.join(" ");
-    if let Some(first) = label.get(..1) {
-        label = first.to_uppercase() + &label[1..];
-    }
-    (label, unit, x)
-}
 
 /// A scalar of summary.json as table text (numbers to 6 significant digits).
 fn scalar(v: &serde_json::Value) -> Option<String> {
@@ -628,25 +553,6 @@ fn hours_per_cycle(summary: &serde_json::Value, input_text: &str) -> Option<f64>
         .as_float()
         .or_else(|| rpm.as_integer().map(|i| i as f64))?;
     (rpm > 0.0).then(|| ratio / (rpm * 60.0))
-}
-
-/// Wheel cycles as a whole number with thin groups of three digits ("180 000").
-fn cycles_text(cycles: f64) -> String {
-    if !cycles.is_finite() {
-        return "-".into();
-    }
-    let digits = format!("{:.0}", cycles.abs());
-    let mut out = String::new();
-    for (k, c) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k) % 3 == 0 {
-            out.push(' ');
-        }
-        out.push(c);
-    }
-    if cycles < 0.0 {
-        out.insert(0, '-');
-    }
-    out
 }
 
 /// The wear states as a folded table.

@@ -3,7 +3,7 @@
 //! combination of the other parameters' values.
 
 use super::{Row, Sweep};
-use crate::output::report::escape;
+use crate::output::text::{escape, human, number};
 use crate::output::OutputError;
 use crate::plot::{line_chart_marked, Series};
 use std::fmt::Write as _;
@@ -109,7 +109,7 @@ fn parameter_charts(
             let label: Vec<String> = others
                 .iter()
                 .map(|o| {
-                    let (label, unit, _) = crate::output::report::human(short(o), 0.0);
+                    let (label, unit, _) = human(short(o), 0.0);
                     format!("{label} = {} {unit}", value_text(row, o))
                         .trim_end()
                         .to_string()
@@ -158,7 +158,7 @@ fn parameter_charts(
 /// A parameter's axis title: its last part in words with its unit, from the unit in its name
 /// ("conditions.worm_torque_nm" -> "Worm torque (N m)"); the values stay in the file's units.
 fn axis_title(name: &str) -> String {
-    let (label, unit, _) = crate::output::report::human(short(name), 0.0);
+    let (label, unit, _) = human(short(name), 0.0);
     if unit.is_empty() {
         label
     } else {
@@ -279,9 +279,7 @@ fn write_table(h: &mut String, sweep: &Sweep, rows: &[Row]) {
             let _ = write!(h, "<td class=\"n\">{}</td>", escape(&value_text(row, p)));
         }
         for q in &shown {
-            let text = (q.value)(row).map_or(String::new(), |v| {
-                crate::output::compare::number(v * q.scale)
-            });
+            let text = (q.value)(row).map_or(String::new(), |v| number(v * q.scale));
             let _ = write!(h, "<td class=\"n\">{text}</td>");
         }
         let _ = writeln!(

@@ -36,6 +36,17 @@ pub(super) fn write_tables(
     Ok(files)
 }
 
+/// The title of the TE-over-life chart: the range of the mean TE it leaves out, urad.
+fn te_title(records: &[crate::wear::StepRecord]) -> String {
+    let (m0, m1) = records
+        .iter()
+        .map(|r| r.te_mean_rad * UM)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    format!("Loaded TE peak to peak over life (mean TE {m0:.0} to {m1:.0} urad)")
+}
+
 /// The curves over cycles: (file, title, y label, series) of the backlash, wear depth,
 /// transmission error, pressure, efficiency and oil temperature charts.
 fn life_charts(
@@ -48,16 +59,7 @@ fn life_charts(
         color,
         bold: true,
     };
-    let range = |f: &dyn Fn(&crate::wear::StepRecord) -> f64| {
-        records
-            .iter()
-            .map(|r| f(r) * UM)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            })
-    };
-    let (m0, m1) = range(&|r| r.te_mean_rad);
-    let te_title = format!("Loaded TE peak to peak over life (mean TE {m0:.0} to {m1:.0} urad)");
+    let te_title = te_title(records);
     [
         (
             "wear_backlash.svg",
