@@ -244,6 +244,36 @@ pub(crate) fn read_cache<T: serde::de::DeserializeOwned>(
     Ok((file.key == key).then_some(file.model))
 }
 
+/// The value of `key` from the cache directory `dir` (entry `{prefix}-{hash}.json`) when an
+/// entry of that key is there and its checksum holds, else `compute`d and written there.
+/// Cache problems never fail the run: they come back as warnings naming `what`.
+pub(crate) fn cached<T, E>(
+    dir: Option<&Path>,
+    (prefix, what): (&str, &str),
+    key: &str,
+    compute: impl FnOnce() -> Result<T, E>,
+) -> Result<(T, Vec<String>), E>
+where
+    T: serde::Serialize + serde::de::DeserializeOwned,
+{
+    let path = dir.map(|d| cache_path(d, prefix, key));
+    let mut warnings = Vec::new();
+    match path.as_deref().map(|p| read_cache(p, key)) {
+        Some(Ok(Some(value))) => return Ok((value, warnings)),
+        Some(Err(reason)) => warnings.push(format!(
+            "{what} cache entry not used ({reason}): recomputed"
+        )),
+        _ => {}
+    }
+    let value = compute()?;
+    if let Some(p) = &path {
+        if let Err(e) = write_cache(p, key, &value) {
+            warnings.push(format!("{what} not cached in {}: {e}", p.display()));
+        }
+    }
+    Ok((value, warnings))
+}
+
 /// Writes a cache entry atomically (temporary file, then rename), sealed with its checksum.
 pub(crate) fn write_cache<T: serde::Serialize>(
     path: &Path,

@@ -330,22 +330,9 @@ pub fn root_stress_cached(
         "fillet_radius": fillet_radius,
     })
     .to_string();
-    let path = dir.map(|d| super::model::cache_path(d, "root-stress", &key));
-    let mut warnings = Vec::new();
-    match path.as_deref().map(|p| super::model::read_cache(p, &key)) {
-        Some(Ok(Some(cached))) => return Ok((cached, warnings)),
-        Some(Err(reason)) => warnings.push(format!(
-            "root stress cache entry not used ({reason}): recomputed"
-        )),
-        _ => {}
-    }
-    let stresses = root_stress(gear, geo, ltca, flank, (level, fillet_radius))?;
-    if let Some(p) = &path {
-        if let Err(e) = super::model::write_cache(p, &key, &stresses) {
-            warnings.push(format!("root stress not cached in {}: {e}", p.display()));
-        }
-    }
-    Ok((stresses, warnings))
+    super::model::cached(dir, ("root-stress", "root stress"), &key, || {
+        root_stress(gear, geo, ltca, flank, (level, fillet_radius))
+    })
 }
 
 /// A root section at one face station: Gauss points along the chord between the central

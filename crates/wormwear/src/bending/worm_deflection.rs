@@ -127,24 +127,8 @@ pub fn compliance_in(
         "bending": super::model::cache_key(gear),
     })
     .to_string();
-    let path = dir.map(|d| super::model::cache_path(d, "worm-deflection", &key));
-    let mut warnings = Vec::new();
-    match path.as_deref().map(|p| super::model::read_cache(p, &key)) {
-        Some(Ok(Some(c))) => return Ok((c, warnings)),
-        Some(Err(reason)) => warnings.push(format!(
-            "worm deflection cache entry not used ({reason}): recomputed"
-        )),
-        _ => {}
-    }
     let refinement = gear.bending.mesh_refinement;
-    let c = compute(gear, geo).map_err(|e| BendingError::of("worm", refinement, e))?;
-    if let Some(p) = &path {
-        if let Err(e) = super::model::write_cache(p, &key, &c) {
-            warnings.push(format!(
-                "worm deflection not cached in {}: {e}",
-                p.display()
-            ));
-        }
-    }
-    Ok((c, warnings))
+    super::model::cached(dir, ("worm-deflection", "worm deflection"), &key, || {
+        compute(gear, geo).map_err(|e| BendingError::of("worm", refinement, e))
+    })
 }

@@ -88,21 +88,12 @@ pub fn human(key: &str, value: f64) -> (String, String, f64) {
     (label, unit, x)
 }
 
-/// Wheel cycles as a whole number with thin groups of three digits ("180 000").
+/// Wheel cycles as a whole number with thin groups of three digits ("180 000"; "-" when not
+/// finite).
 pub fn cycles_text(cycles: f64) -> String {
-    if !cycles.is_finite() {
-        return "-".into();
+    if cycles.is_finite() {
+        crate::wear::grouped(cycles)
+    } else {
+        "-".into()
     }
-    let digits = format!("{:.0}", cycles.abs());
-    let mut out = String::new();
-    for (k, c) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k) % 3 == 0 {
-            out.push(' ');
-        }
-        out.push(c);
-    }
-    if cycles < 0.0 {
-        out.insert(0, '-');
-    }
-    out
 }

@@ -44,7 +44,12 @@ pub fn cycles_label(cycles: f64) -> String {
         let s = s.trim_end_matches('0').trim_end_matches('.');
         return format!("{s} million");
     }
-    let digits = format!("{}", cycles.round().abs() as u64);
+    grouped(cycles)
+}
+
+/// A finite number rounded to a whole one, in groups of three digits ("1 117 629").
+pub fn grouped(value: f64) -> String {
+    let digits = format!("{}", value.round().abs() as u64);
     let mut out = String::new();
     for (k, ch) in digits.chars().enumerate() {
         if k > 0 && (digits.len() - k) % 3 == 0 {
@@ -52,7 +57,7 @@ pub fn cycles_label(cycles: f64) -> String {
         }
         out.push(ch);
     }
-    if cycles < 0.0 {
+    if value < 0.0 {
         out.insert(0, '-');
     }
     out
