@@ -19,6 +19,7 @@
 //! [`validation`] runs the study behind VALIDATION.md.
 
 pub mod bending;
+pub mod cad;
 pub mod calibration;
 pub mod contact;
 pub mod files;
