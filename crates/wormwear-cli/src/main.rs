@@ -3,12 +3,14 @@
 //! Exit codes: 0 success, 1 computation or output error, 2 invalid input (bad file or arguments).
 
 use anyhow::Context;
+use args::{CadArgs, LifeArgs};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use wormwear::geometry::{Geometry, GeometrySummary};
 use wormwear::input::{self, GearSet, InputError};
 
+mod args;
 mod calibrate_cmd;
 mod compare_cmd;
 mod init_cmd;
@@ -90,6 +92,8 @@ enum Command {
         /// Output directory (created if needed).
         #[arg(short, long)]
         output: PathBuf,
+        #[command(flatten)]
+        cad: CadArgs,
     },
     /// Loaded tooth contact analysis: load sharing, pressures, transmission error, stiffness.
     #[command(
@@ -120,6 +124,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         life: LifeArgs,
+        #[command(flatten)]
+        cad: CadArgs,
     },
     /// The safety table from the model (MODEL §9.1): tooth root, worm deflection, pitting,
     /// wear at the required life, oil temperature, against the [rating] table's allowables and
@@ -151,6 +157,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         life: LifeArgs,
+        #[command(flatten)]
+        cad: CadArgs,
     },
     /// Archard coefficient K (MODEL §10) from wear tests (least squares on V = (K/H) W_asp L)
     /// or from a measured backlash-increase curve (inverse problem through the life
@@ -276,40 +284,8 @@ enum Command {
     },
 }
 
-/// Overrides of the file's [wear] section.
-#[derive(clap::Args, Debug, Clone, Default)]
-struct LifeArgs {
-    /// Wheel cycles to simulate (overrides wear.life_cycles).
-    #[arg(long)]
-    cycles: Option<f64>,
-    /// Fixed steps of this many wheel cycles (overrides the file's step).
-    #[arg(long, conflicts_with = "step_wear_um")]
-    step_cycles: Option<f64>,
-    /// Adaptive steps removing at most this depth, um (overrides the file's step).
-    #[arg(long)]
-    step_wear_um: Option<f64>,
-    /// Ignore the pitting phases of the schedule (wear all along).
-    #[arg(long)]
-    no_pitting: bool,
-    /// Continue from the checkpoint in the output directory.
-    #[arg(long)]
-    resume: bool,
-}
-
-impl LifeArgs {
-    /// The library's form of the overrides.
-    fn overrides(&self) -> wormwear::runner::LifeOverrides {
-        wormwear::runner::LifeOverrides {
-            cycles: self.cycles,
-            step_cycles: self.step_cycles,
-            step_wear_um: self.step_wear_um,
-            no_pitting: self.no_pitting,
-        }
-    }
-}
-
 /// Error classes mapped to exit codes.
-enum Failure {
+pub(crate) enum Failure {
     Input(anyhow::Error),
     Run(anyhow::Error),
 }
@@ -393,15 +369,25 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
         } => init_cmd::init(*profile, output.as_deref(), *force, cli.quiet),
         Command::Compare { runs, output } => compare_cmd::compare(runs, output, cli.quiet),
         Command::Check { file, json } => check(file, *json),
-        Command::Geometry { file, output } => geometry(file, output, cli.quiet),
+        Command::Geometry { file, output, cad } => geometry(file, output, cad, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),
         Command::Ltca {
             file,
             output,
             map_position,
         } => ltca(file, output, *map_position, cli.quiet),
-        Command::Wear { file, output, life } => wear(file, output, life, cli.quiet, cli.verbose),
-        Command::Run { file, output, life } => run(file, output, life, cli.quiet, cli.verbose),
+        Command::Wear {
+            file,
+            output,
+            life,
+            cad,
+        } => wear(file, output, (life, cad), cli.quiet, cli.verbose),
+        Command::Run {
+            file,
+            output,
+            life,
+            cad,
+        } => run(file, output, (life, cad), cli.quiet, cli.verbose),
         Command::Rating { file, output, life } => {
             rating_cmd::rating(file, output, life, cli.quiet, cli.verbose)
         }
@@ -612,9 +598,10 @@ fn print_files(files: &[PathBuf]) {
     }
 }
 
-fn geometry(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
+fn geometry(file: &Path, dir: &Path, cad: &CadArgs, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
-    let request = wormwear::Request::new([wormwear::Stage::Geometry]);
+    let mut request = wormwear::Request::new([wormwear::Stage::Geometry]);
+    request.cad = cad.request(dir)?;
     let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
     if !quiet {
         print_files(&files);
@@ -754,12 +741,13 @@ fn life_request(
 fn wear(
     file: &Path,
     dir: &Path,
-    args: &LifeArgs,
+    (args, cad): (&LifeArgs, &CadArgs),
     quiet: bool,
     verbose: bool,
 ) -> Result<(), Failure> {
     let gear = load(file)?;
-    let request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
+    let mut request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
+    request.cad = cad.request(dir)?;
     let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
     finish_life(&results, dir, quiet);
     Ok(())
@@ -841,14 +829,15 @@ fn planned_request(
 fn run(
     file: &Path,
     dir: &Path,
-    args: &LifeArgs,
+    (args, cad): (&LifeArgs, &CadArgs),
     quiet: bool,
     verbose: bool,
 ) -> Result<(), Failure> {
     use wormwear::Stage;
     let gear = load(file)?;
     let without_life = [Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report];
-    let request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
+    let mut request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
+    request.cad = cad.request(dir)?;
     let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
     if !quiet {
         print_geometry(&results, dir);

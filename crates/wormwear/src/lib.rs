@@ -63,5 +63,6 @@ pub fn run(
     let life = pipeline.life(&geometry, tca.as_ref(), &bending)?;
     let analyses = (ltca.as_ref(), thermal.as_ref(), life.as_ref());
     let safety = pipeline.safety(&geometry, tca.as_ref(), &bending, analyses)?;
-    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal, safety), life))
+    let cad = pipeline.cad(&geometry, tca.as_ref(), life.as_ref())?;
+    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal, safety), life, cad))
 }

@@ -98,6 +98,8 @@ pub struct Request {
     pub resume: Option<WearState>,
     /// Position whose pressure maps are drawn, 0-based (below `analysis.positions`).
     pub map_position: usize,
+    /// The CAD solids (STEP) to build, None: none.
+    pub cad: Option<crate::cad::CadRequest>,
 }
 
 impl Request {
@@ -108,6 +110,7 @@ impl Request {
             life: None,
             resume: None,
             map_position: 0,
+            cad: None,
         }
     }
 
@@ -131,6 +134,16 @@ impl Request {
         if self.needs_bending() {
             if let Some(problem) = crate::rating::implausible_load(gear) {
                 return Err(RunError::Request(problem));
+            }
+        }
+        if let Some(cad) = &self.cad {
+            cad.check(gear.wheel.teeth).map_err(RunError::Cad)?;
+            if cad.state.is_some() && self.life.is_none() {
+                return Err(RunError::Request(
+                    "a worn wheel's STEP file (its wear state) needs a life: give the cycles or \
+                     a [wear] section"
+                        .into(),
+                ));
             }
         }
         let positions = gear.analysis.positions;
@@ -380,6 +393,8 @@ pub struct Results {
     pub thermal: Option<crate::friction::Thermal>,
     /// The safety table from the model (MODEL §9.1), with a loaded analysis.
     pub safety: Option<crate::safety::SafetyTable>,
+    /// The CAD solids, when asked for.
+    pub cad: Option<crate::cad::CadSolids>,
     /// Warnings of the stages, each with its stage's prefix where the CLI prints one.
     pub warnings: Vec<String>,
 }
@@ -404,6 +419,8 @@ pub enum RunError {
     Friction(#[source] crate::friction::FrictionError),
     #[error("{}", wear_context(.0))]
     Wear(#[source] WearError),
+    #[error("CAD solids")]
+    Cad(#[source] crate::cad::CadError),
     /// The caller's event handler stopped the run (an interrupt, a file that cannot be
     /// written).
     #[error("{0}")]
@@ -425,6 +442,7 @@ impl RunError {
         matches!(
             self,
             RunError::Request(_)
+                | RunError::Cad(crate::cad::CadError::Request(_))
                 | RunError::Geometry(_)
                 | RunError::Friction(_)
                 | RunError::Bending(crate::bending::model::BendingError::TooLarge { .. })
@@ -741,6 +759,7 @@ impl<'a> Pipeline<'a> {
             Option<crate::safety::SafetyTable>,
         ),
         life: Option<Life>,
+        cad: Option<crate::cad::CadSolids>,
     ) -> Results {
         Results {
             thermal,
@@ -758,7 +777,59 @@ impl<'a> Pipeline<'a> {
             bending: bending.info,
             ltca,
             life,
+            cad,
             warnings: self.warnings,
+        }
+    }
+
+    /// The CAD solids the request asks for (issue 37): worm and wheel, and after a life the
+    /// wheel worn as at the asked map state (its wear step) or the last state.
+    pub(crate) fn cad(
+        &mut self,
+        geo: &Geometry,
+        tca: Option<&Tca>,
+        life: Option<&Life>,
+    ) -> Result<Option<crate::cad::CadSolids>, RunError> {
+        let Some(request) = self.request.cad else {
+            return Ok(None);
+        };
+        let state = match (life, tca) {
+            (Some(life), Some(tca)) => {
+                Some((self.worn_state(life, request.state), tca.loaded_flank))
+            }
+            _ => None,
+        };
+        let change = state.map(|(s, flank)| (s, flank, s.flank_change()));
+        let worn = change.as_ref().map(|(s, flank, change)| {
+            let from = crate::cad::WornFrom {
+                step: s.step,
+                cycles: s.cycles,
+            };
+            (from, *flank, change)
+        });
+        crate::cad::solids(self.gear, geo, request, worn)
+            .map(Some)
+            .map_err(RunError::Cad)
+    }
+
+    /// The life's state whose worn wheel is written: the map state of wear step `asked`, or
+    /// the last (with a warning when no map state has that step).
+    fn worn_state<'l>(&mut self, life: &'l Life, asked: Option<usize>) -> &'l WearState {
+        let last = life.maps.last().map_or(&life.end, |m| &m.state);
+        let Some(step) = asked else { return last };
+        match life.maps.iter().find(|m| m.state.step == step) {
+            Some(m) => &m.state,
+            None => {
+                let kept: Vec<String> =
+                    life.maps.iter().map(|m| m.state.step.to_string()).collect();
+                self.warnings.push(format!(
+                    "cad: no map state at wear step {step} (the life kept steps {}); the worn \
+                     wheel is the last state's, step {}",
+                    kept.join(", "),
+                    last.step
+                ));
+                last
+            }
         }
     }
 }

@@ -44,7 +44,7 @@ pub struct FitCheck {
 /// A part ready to write: the solid, the checks of its flank fit and its volume computed
 /// from the sections (worm: the section's area times the length; wheel: the sections' areas
 /// integrated across the face width), mm^3.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct CadPart {
     pub built: SweptSolid,
     pub checks: Vec<FitCheck>,
@@ -56,6 +56,8 @@ pub struct CadPart {
 pub struct FaceSummary {
     pub kind: FaceKind,
     pub index: usize,
+    /// Band between the splits along the sweep ([`section_solid::SectionSweep::breaks`]).
+    pub band: usize,
     pub area_mm2: f64,
     pub centroid_mm: [f64; 3],
 }
@@ -116,6 +118,7 @@ impl CadPart {
                 FaceSummary {
                     kind: f.kind,
                     index: f.index,
+                    band: f.band,
                     area_mm2,
                     centroid_mm,
                 }
@@ -215,4 +218,74 @@ impl CadPart {
         }
         Ok(lines.join("\n") + "\n")
     }
+}
+
+/// The CAD solids a run asks for: the wheel's tooth count (None: all) and, after a life, the
+/// wear step of the map state whose worn wheel is written (None: the last state).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CadRequest {
+    pub teeth: Option<usize>,
+    pub state: Option<usize>,
+}
+
+impl CadRequest {
+    /// Checks the tooth count against the wheel's `teeth` before any work.
+    pub fn check(&self, teeth: u32) -> Result<(), CadError> {
+        match self.teeth {
+            Some(n) if n == 0 || n > teeth as usize => Err(CadError::Request(format!(
+                "the wheel's tooth count for the STEP file is {n}, allowed 1 to {teeth} (the \
+                 wheel's teeth)"
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The worn state a worn wheel shows: its wear step and wheel cycles.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WornFrom {
+    pub step: usize,
+    pub cycles: f64,
+}
+
+/// The solids of a run: worm and wheel as built, and the worn wheel after a life.
+#[derive(Debug, Clone)]
+pub struct CadSolids {
+    pub worm: CadPart,
+    pub wheel: CadPart,
+    pub worn: Option<(WornFrom, CadPart)>,
+}
+
+/// Builds the solids of `request`; `worn` is the life's state to show: which state, the loaded
+/// flank and its change on the flank grid (wear, pits and plastic set, normal depth, m).
+pub fn solids(
+    gear: &crate::input::GearSet,
+    geo: &crate::geometry::Geometry,
+    request: CadRequest,
+    worn: Option<(
+        WornFrom,
+        crate::geometry::Flank,
+        &crate::geometry::FlankField,
+    )>,
+) -> Result<CadSolids, CadError> {
+    request.check(geo.teeth)?;
+    let teeth = request.teeth;
+    let worm = worm::worm_part(gear, geo)?;
+    let wheel = wheel::wheel_part(
+        gear,
+        geo,
+        wheel::WheelRequest {
+            teeth,
+            change: None,
+        },
+    )?;
+    let worn = match worn {
+        Some((from, flank, change)) => {
+            let change = Some((flank, change));
+            let part = wheel::wheel_part(gear, geo, wheel::WheelRequest { teeth, change })?;
+            Some((from, part))
+        }
+        None => None,
+    };
+    Ok(CadSolids { worm, wheel, worn })
 }

@@ -25,14 +25,48 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 use truck_modeling::{Point3, Vector3};
 
-/// Points along each flank of a section.
+/// Points along each flank of a section of the new wheel.
 const FLANK_POINTS: usize = 17;
 /// Points along each fillet.
 const FILLET_POINTS: usize = 9;
 /// Largest angle between two points of an arc, rad.
 const ARC_STEP: f64 = 0.02;
-/// Largest station spacing along the face width, m.
+/// Largest station spacing along the face width of the new wheel, m.
 const STATION_STEP: f64 = 1.0e-3;
+
+/// How finely the sections sample the flanks: points per flank of sides [A, B] and the
+/// largest station spacing (m). The new flank is smooth: 17 points and 1 mm keep the fit
+/// within 1 um on the reference gears. A flank change lives on the flank grid's nodes, linear
+/// between them: the changed flank is sampled on the grid's rows (the same radii: evenly
+/// spaced between r_low and the top) and the stations are as far apart as its columns.
+#[derive(Debug, Clone, Copy)]
+struct Resolution {
+    flank_points: [usize; 2],
+    station_step: f64,
+}
+
+impl Resolution {
+    fn of(geo: &Geometry, request: &WheelRequest, sides: [Flank; 2]) -> Self {
+        match request.change {
+            None => Self {
+                flank_points: [FLANK_POINTS; 2],
+                station_step: STATION_STEP,
+            },
+            Some((flank, _)) => {
+                let wf = geo.wheel_flank(flank);
+                let column = geo.blank.face_width / wf.cells_face as f64;
+                let points = |side: Flank| match side == flank {
+                    true => wf.cells_height + 1,
+                    false => FLANK_POINTS,
+                };
+                Self {
+                    flank_points: [points(sides[0]), points(sides[1])],
+                    station_step: STATION_STEP.min(column),
+                }
+            }
+        }
+    }
+}
 
 /// What to build: the tooth count (None: all) and a change of one flank (normal depth into
 /// the material, m, on the flank grid's nodes).
@@ -61,33 +95,16 @@ pub fn wheel_part(
     request: WheelRequest,
 ) -> Result<CadPart, CadError> {
     let z2 = geo.teeth as usize;
-    if let Some(n) = request.teeth {
-        if n == 0 || n > z2 {
-            return Err(CadError::Request(format!(
-                "the wheel's tooth count for CAD is {n}, allowed 1 to {z2} (the wheel's teeth)"
-            )));
-        }
-    }
+    check_request(geo, &request)?;
     let hobbing = geo.hobbing(gear);
     let sides = sides(geo, &hobbing)?;
-    let (zs, bounds) = stations(&geo.blank);
+    let resolution = Resolution::of(geo, &request, sides);
+    let (zs, bounds) = stations(&geo.blank, resolution.station_step);
     let sections: Vec<SpaceSection> = zs
         .par_iter()
-        .map(|&z| space_section(geo, &hobbing, sides, z, request))
+        .map(|&z| space_section(geo, &hobbing, (sides, resolution.flank_points), z, request))
         .collect::<Result<_, _>>()?;
-    let bore = gear.wheel_body().rim_inner_radius();
-    let lowest_root = sections
-        .iter()
-        .map(|s| s.root)
-        .fold(f64::INFINITY, f64::min);
-    if bore <= 0.0 || bore >= lowest_root {
-        return Err(CadError::Build(format!(
-            "the rim's inner radius {:.3} mm is not between 0 and the root radius {:.3} mm \
-             ([bending] rim_thickness_mm)",
-            bore * 1e3,
-            lowest_root * 1e3
-        )));
-    }
+    let bore = bore_radius(gear, &sections)?;
     let layout = Layout {
         zs: &zs,
         sections: &sections,
@@ -103,21 +120,7 @@ pub fn wheel_part(
         let q = gear.operating.wheel_to_worm(&p) * 1e3;
         Point3::new(q.x, q.y, q.z)
     };
-    let place = |pieces: Vec<Piece>| -> Vec<SweptFace> {
-        pieces
-            .into_iter()
-            .map(|p| SweptFace {
-                kind: p.kind,
-                index: p.index,
-                rows: p
-                    .rows
-                    .into_iter()
-                    .map(|r| r.into_iter().map(to_worm).collect())
-                    .collect(),
-            })
-            .collect()
-    };
-    let (outer, inner) = (place(outer), place(inner));
+    let (outer, inner) = (place(outer, &to_worm), place(inner, &to_worm));
     let first = match request.teeth {
         Some(n) if n < z2 => -(n as i64) / 2,
         _ => 0,
@@ -125,7 +128,7 @@ pub fn wheel_part(
     let checks = fit_checks(
         geo,
         &hobbing,
-        (sides, &zs, &bounds),
+        (sides, &zs, &bounds, resolution.flank_points),
         &outer,
         (first, layout.tau),
         request,
@@ -147,24 +150,74 @@ pub fn wheel_part(
     })
 }
 
+/// Checks the tooth count and that a flank change lies on the flank grid.
+fn check_request(geo: &Geometry, request: &WheelRequest) -> Result<(), CadError> {
+    let teeth = super::CadRequest {
+        teeth: request.teeth,
+        state: None,
+    };
+    teeth.check(geo.teeth)?;
+    match request.change {
+        Some((flank, field)) if !field.fits(geo.wheel_flank(flank)) => Err(CadError::Request(
+            "the flank change does not lie on the wheel's flank grid".into(),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The rim's inner radius (`[bending]` rim thickness below the root), checked to lie between
+/// the axis and the lowest root radius of the sections, m.
+fn bore_radius(gear: &GearSet, sections: &[SpaceSection]) -> Result<f64, CadError> {
+    let bore = gear.wheel_body().rim_inner_radius();
+    let lowest_root = sections
+        .iter()
+        .map(|s| s.root)
+        .fold(f64::INFINITY, f64::min);
+    if bore <= 0.0 || bore >= lowest_root {
+        return Err(CadError::Build(format!(
+            "the rim's inner radius {:.3} mm is not between 0 and the root radius {:.3} mm \
+             ([bending] rim_thickness_mm)",
+            bore * 1e3,
+            lowest_root * 1e3
+        )));
+    }
+    Ok(bore)
+}
+
+/// The pieces placed in the worm frame (mm).
+fn place(pieces: Vec<Piece>, to_worm: &impl Fn(V3<f64>) -> Point3) -> Vec<SweptFace> {
+    pieces
+        .into_iter()
+        .map(|p| SweptFace {
+            kind: p.kind,
+            index: p.index,
+            rows: p
+                .rows
+                .into_iter()
+                .map(|r| r.into_iter().map(to_worm).collect())
+                .collect(),
+        })
+        .collect()
+}
+
 /// The stations across the face width and the indices of the band bounds: the blank top
 /// (outer cylinder clipped by the throat torus) has a kink where the two meet, |z| =
 /// sqrt(r_g^2 - (a - r_e2)^2); the faces are split there, stations evenly spaced at most
-/// [`STATION_STEP`] apart in each band. m.
-fn stations(blank: &crate::geometry::BlankLimits) -> (Vec<f64>, Vec<usize>) {
+/// `step` apart in each band. m.
+fn stations(blank: &crate::geometry::BlankLimits, step: f64) -> (Vec<f64>, Vec<usize>) {
     let half = 0.5 * blank.face_width;
     let depth = blank.centre_distance - blank.outer_radius;
     let mut edges = vec![-half];
     if depth > 0.0 && depth < blank.gorge_radius {
         let kink = (blank.gorge_radius.powi(2) - depth * depth).sqrt();
-        if kink < half - 0.5 * STATION_STEP {
+        if kink < half - 0.5 * step {
             edges.extend([-kink, kink]);
         }
     }
     edges.push(half);
     let (mut zs, mut bounds) = (vec![-half], vec![0]);
     for w in edges.windows(2) {
-        let n = ((w[1] - w[0]) / STATION_STEP).ceil().max(2.0) as usize;
+        let n = ((w[1] - w[0]) / step).ceil().max(2.0) as usize;
         zs.extend((1..=n).map(|i| w[0] + (w[1] - w[0]) * i as f64 / n as f64));
         bounds.push(zs.len() - 1);
     }
@@ -188,7 +241,7 @@ fn sides(geo: &Geometry, hobbing: &Hobbing) -> Result<[Flank; 2], CadError> {
 fn space_section(
     geo: &Geometry,
     hobbing: &Hobbing,
-    sides: [Flank; 2],
+    (sides, points): ([Flank; 2], [usize; 2]),
     z: f64,
     request: WheelRequest,
 ) -> Result<SpaceSection, CadError> {
@@ -198,10 +251,11 @@ fn space_section(
     let mut root = f64::INFINITY;
     for (s, &side) in sides.iter().enumerate() {
         let (low, _) = hobbing.radial_limits(side, z, top)?;
-        flank[s] = (0..FLANK_POINTS)
+        let n = points[s];
+        flank[s] = (0..n)
             .map(|i| {
-                let r = low + (top - low) * i as f64 / (FLANK_POINTS - 1) as f64;
-                flank_point(geo, hobbing, side, r, z, request)
+                let r = low + (top - low) * i as f64 / (n - 1) as f64;
+                flank_point(geo, hobbing, (side, i == n - 1), r, z, request)
             })
             .collect::<Result<_, _>>()?;
         let r_root = root_radius(hobbing, side, z, low)?;
@@ -240,11 +294,16 @@ fn space_section(
     })
 }
 
-/// A flank point at (r, z) in the body frame, moved by the flank change along its normal.
+/// A flank point at (r, z) in the body frame, moved by the flank change (depth d normal to
+/// the flank) within its transverse plane: by d n_t / |n_t|^2 (n_t the normal without its
+/// axial part), which is a normal depth d to first order and keeps the face ends plane. At the
+/// blank top (`on_top`) the point slides along the top circle instead, to where the moved
+/// flank meets it: the tip land narrows, and no wedge is cut between the moved corner and the
+/// tip arc's next point.
 fn flank_point(
     geo: &Geometry,
     hobbing: &Hobbing,
-    side: Flank,
+    (side, on_top): (Flank, bool),
     r: f64,
     z: f64,
     request: WheelRequest,
@@ -254,7 +313,17 @@ fn flank_point(
         Some((flank, field)) if flank == side => field.at(geo.wheel_flank(side), r, z),
         _ => 0.0,
     };
-    Ok(p.position() - p.normal_vec() * depth)
+    let mut n = p.normal_vec();
+    n.z = 0.0;
+    let shift = n * (depth / n.norm_squared());
+    if !on_top || depth == 0.0 {
+        return Ok(p.position() - shift);
+    }
+    // Along the circle, e_theta = (-sin, -cos, 0) in the wheel_point convention: the arc s
+    // with s e_theta . shift = -|shift|^2 puts the point on the moved flank (to first order).
+    let e_theta = V3::new(-p.theta.sin(), -p.theta.cos(), 0.0);
+    let s = -shift.norm_squared() / e_theta.dot(&shift);
+    Ok(polar(r, p.theta + s / r, z))
 }
 
 /// Root radius at z: the lowest radius the hob's tip reaches, by bisection below r_low. m.
@@ -307,6 +376,11 @@ fn polar(r: f64, theta: f64, z: f64) -> V3<f64> {
 fn turned(p: V3<f64>, delta: f64) -> V3<f64> {
     let (s, c) = delta.sin_cos();
     V3::new(c * p.x + s * p.y, -s * p.x + c * p.y, p.z)
+}
+
+/// The top point of a flank's section.
+fn top_of(flank: &[V3<f64>]) -> V3<f64> {
+    *flank.last().expect("flank points")
 }
 
 /// Angles from t0 to t1 at most [`ARC_STEP`] apart (the same count at every station: the
@@ -409,16 +483,12 @@ impl Layout<'_> {
     fn tip(&self, space: i64, index: usize) -> Piece {
         let d = space as f64 * self.tau;
         let angle = |p: V3<f64>| (-p.y).atan2(p.x);
-        let span = |s: &SpaceSection| {
-            angle(s.flank[0][FLANK_POINTS - 1]) + self.tau - angle(s.flank[1][FLANK_POINTS - 1])
-        };
+        let span =
+            |s: &SpaceSection| angle(top_of(&s.flank[0])) + self.tau - angle(top_of(&s.flank[1]));
         let n = arc_count(self.sections.iter().map(span));
         self.piece(FaceKind::Tip, index, |k| {
             let s = &self.sections[k];
-            let (b, a) = (
-                s.flank[1][FLANK_POINTS - 1],
-                turned(s.flank[0][FLANK_POINTS - 1], self.tau),
-            );
+            let (b, a) = (top_of(&s.flank[1]), turned(top_of(&s.flank[0]), self.tau));
             let (t0, t1) = (angle(b), angle(b) + span(s));
             let mut row: Vec<_> = (0..n)
                 .map(|i| {
@@ -518,7 +588,7 @@ impl Layout<'_> {
 fn fit_checks(
     geo: &Geometry,
     hobbing: &Hobbing,
-    (sides, zs, bounds): ([Flank; 2], &[f64], &[usize]),
+    (sides, zs, bounds, all_points): ([Flank; 2], &[f64], &[usize], [usize; 2]),
     outer: &[SweptFace],
     (first, tau): (i64, f64),
     request: WheelRequest,
@@ -538,6 +608,7 @@ fn fit_checks(
             .expect("a flank piece");
         let u = mean_chord_params(&outer[face].rows);
         let turn = (first + outer[face].index as i64) as f64 * tau;
+        let points = all_points[s];
         for (band, w) in bounds.windows(2).enumerate() {
             let rows: Vec<Vec<(Point3, (f64, f64))>> = (w[0]..w[1])
                 .into_par_iter()
@@ -546,12 +617,12 @@ fn fit_checks(
                     let v = ((k - w[0]) as f64 + 0.5) / (w[1] - w[0]) as f64;
                     let top = geo.blank.top(z);
                     let (low, _) = hobbing.radial_limits(side, z, top)?;
-                    (0..FLANK_POINTS - 1)
+                    (0..points - 1)
                         .map(|i| {
-                            let r =
-                                low + (top - low) * (i as f64 + 0.5) / (FLANK_POINTS - 1) as f64;
-                            let p = turned(flank_point(geo, hobbing, side, r, z, request)?, turn);
-                            let ui = if s == 0 { FLANK_POINTS - 2 - i } else { i };
+                            let r = low + (top - low) * (i as f64 + 0.5) / (points - 1) as f64;
+                            let p = flank_point(geo, hobbing, (side, false), r, z, request)?;
+                            let p = turned(p, turn);
+                            let ui = if s == 0 { points - 2 - i } else { i };
                             Ok((to_worm(p), (0.5 * (u[ui] + u[ui + 1]), v)))
                         })
                         .collect()

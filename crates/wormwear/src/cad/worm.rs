@@ -33,54 +33,13 @@ pub fn worm_part(gear: &GearSet, geo: &Geometry) -> Result<CadPart, CadError> {
     let length = gear.bending.worm_body_length;
     let angle = |flank: Flank, rho: f64| -worm.axial_profile(flank, rho).0 / screw;
     // The flank at the smaller polar angle comes first counter-clockwise.
-    let (a, b) = if angle(Flank::Left, rf) < angle(Flank::Right, rf) {
-        (Flank::Left, Flank::Right)
+    let sides = if angle(Flank::Left, rf) < angle(Flank::Right, rf) {
+        [Flank::Left, Flank::Right]
     } else {
-        (Flank::Right, Flank::Left)
+        [Flank::Right, Flank::Left]
     };
     let starts = worm.starts() as usize;
-    let pitch_angle = 2.0 * PI / starts as f64;
-    let tip_width = angle(b, ra) - angle(a, ra);
-    let root_width = angle(a, rf) + pitch_angle - angle(b, rf);
-    if tip_width <= 0.0 || root_width <= 0.0 {
-        return Err(CadError::Build(format!(
-            "the worm's section does not close: thread {:.4} rad wide at the tip, root gap \
-             {:.4} rad",
-            tip_width, root_width
-        )));
-    }
-    let radii = |from: f64, to: f64| -> Vec<f64> {
-        (0..FLANK_POINTS)
-            .map(|i| from + (to - from) * i as f64 / (FLANK_POINTS - 1) as f64)
-            .collect()
-    };
-    let arc = |r: f64, t0: f64, t1: f64| -> Vec<Polar> {
-        let n = (((t1 - t0).abs() / ARC_STEP).ceil() as usize).max(2) + 1;
-        (0..n)
-            .map(|i| (r, t0 + (t1 - t0) * i as f64 / (n - 1) as f64))
-            .collect()
-    };
-    let mut pieces: Vec<(FaceKind, usize, Vec<Polar>)> = Vec::new();
-    for thread in 0..starts {
-        let turn = thread as f64 * pitch_angle;
-        let flank_up: Vec<Polar> = radii(rf, ra)
-            .into_iter()
-            .map(|r| (r, angle(a, r) + turn))
-            .collect();
-        let flank_down: Vec<Polar> = radii(ra, rf)
-            .into_iter()
-            .map(|r| (r, angle(b, r) + turn))
-            .collect();
-        pieces.push((kind(a), thread, flank_up));
-        pieces.push((
-            FaceKind::Tip,
-            thread,
-            arc(ra, angle(a, ra) + turn, angle(b, ra) + turn),
-        ));
-        pieces.push((kind(b), thread, flank_down));
-        let next = angle(a, rf) + turn + pitch_angle;
-        pieces.push((FaceKind::Root, thread, arc(rf, angle(b, rf) + turn, next)));
-    }
+    let pieces = section_pieces((rf, ra), starts, sides, &angle)?;
     let turns = length / (2.0 * PI * screw.abs());
     let stations = ((turns * STATIONS_PER_TURN).ceil() as usize).max(8) + 1;
     let xs: Vec<f64> = uniform_params(stations)
@@ -110,12 +69,56 @@ pub fn worm_part(gear: &GearSet, geo: &Geometry) -> Result<CadPart, CadError> {
         breaks: Vec::new(),
     })?;
     let checks = checks.into_iter().map(|c| built.map_check(c)).collect();
-    let section = section_area(rf, ra, starts, pitch_angle, angle, [a, b]);
+    let pitch_angle = 2.0 * PI / starts as f64;
+    let section = section_area(rf, ra, starts, pitch_angle, angle, sides);
     Ok(CadPart {
         built,
         checks,
         volume_mm3: section * length * 1e9,
     })
+}
+
+/// The pieces of the section at x = 0, counter-clockwise: per thread, flank A up from the root
+/// radius, the tip arc, flank B down, the root arc to the next thread (`angle`: the flanks'
+/// polar angle at a radius, rad).
+fn section_pieces(
+    (rf, ra): (f64, f64),
+    starts: usize,
+    [a, b]: [Flank; 2],
+    angle: &impl Fn(Flank, f64) -> f64,
+) -> Result<Vec<(FaceKind, usize, Vec<Polar>)>, CadError> {
+    let pitch_angle = 2.0 * PI / starts as f64;
+    let tip_width = angle(b, ra) - angle(a, ra);
+    let root_width = angle(a, rf) + pitch_angle - angle(b, rf);
+    if tip_width <= 0.0 || root_width <= 0.0 {
+        return Err(CadError::Build(format!(
+            "the worm's section does not close: thread {tip_width:.4} rad wide at the tip, \
+             root gap {root_width:.4} rad"
+        )));
+    }
+    let flank = |side: Flank, from: f64, to: f64, turn: f64| -> Vec<Polar> {
+        (0..FLANK_POINTS)
+            .map(|i| from + (to - from) * i as f64 / (FLANK_POINTS - 1) as f64)
+            .map(|r| (r, angle(side, r) + turn))
+            .collect()
+    };
+    let arc = |r: f64, t0: f64, t1: f64| -> Vec<Polar> {
+        let n = (((t1 - t0).abs() / ARC_STEP).ceil() as usize).max(2) + 1;
+        (0..n)
+            .map(|i| (r, t0 + (t1 - t0) * i as f64 / (n - 1) as f64))
+            .collect()
+    };
+    let mut pieces = Vec::new();
+    for thread in 0..starts {
+        let turn = thread as f64 * pitch_angle;
+        let tip = arc(ra, angle(a, ra) + turn, angle(b, ra) + turn);
+        let next = angle(a, rf) + turn + pitch_angle;
+        pieces.push((kind(a), thread, flank(a, rf, ra, turn)));
+        pieces.push((FaceKind::Tip, thread, tip));
+        pieces.push((kind(b), thread, flank(b, ra, rf, turn)));
+        pieces.push((FaceKind::Root, thread, arc(rf, angle(b, rf) + turn, next)));
+    }
+    Ok(pieces)
 }
 
 /// Area of the worm's transverse section (the same at every x: a screw motion keeps areas), m^2:

@@ -4,6 +4,7 @@
 //! never leaves a half-written file. `summary.json` is one JSON object; each command adds or
 //! replaces its own section and keeps the others.
 
+pub mod cad;
 pub mod compare;
 pub mod friction;
 pub mod geometry;
@@ -33,6 +34,8 @@ pub enum OutputError {
     Encode { what: String, message: String },
     #[error("cannot read {path}: {message}")]
     Read { path: PathBuf, message: String },
+    #[error("cannot write {path}: it is a directory, and {what} needs a file there")]
+    IsDirectory { path: PathBuf, what: &'static str },
     /// A drawing of the geometry (a section) could not be computed.
     #[error("geometry drawing")]
     Geometry(#[source] crate::geometry::GeometryError),
@@ -243,6 +246,9 @@ pub fn write_results(
             _ => {}
         }
     }
+    if let Some(solids) = results.cad.as_ref() {
+        files.extend(cad::write_cad(solids, dir)?);
+    }
     if results.stages.contains(&Stage::Report) {
         let title = results.source.title(gear);
         files.push(report::write_report(dir, &title, &results.source.text)?);
@@ -262,6 +268,9 @@ pub fn summary_sections(
     let (input, geometry) = geometry::summary_values(gear, geo, Path::new(&results.source.file))?;
     map.insert("input".into(), input);
     map.insert("geometry".into(), geometry);
+    if let Some(solids) = results.cad.as_ref() {
+        map.insert("cad".into(), cad::summary_value(solids)?);
+    }
     let Some(t) = results.tca.as_ref() else {
         return Ok(map);
     };

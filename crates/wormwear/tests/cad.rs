@@ -1,0 +1,318 @@
+//! CAD solids (issue 37): the worm and the wheel as closed B-spline solids, checked against
+//! truths they were not built from: envelope points between the fitted ones, the flank grid's
+//! own area, the wheel's rotational symmetry (a sector of n teeth is n pitches of the whole),
+//! the worn wheel's lost volume against the integral of the flank change, and OpenCASCADE
+//! (gmsh's Python package) reading the STEP files: one solid, our volume, our face areas, and
+//! the flank grid's envelope points on its surfaces.
+
+mod common;
+
+use common::{example, skipped};
+use wormwear::cad::section_solid::FaceKind;
+use wormwear::cad::wheel::{wheel_part, WheelRequest};
+use wormwear::cad::worm::worm_part;
+use wormwear::cad::{CadPart, CadRequest};
+use wormwear::geometry::{Flank, FlankField, Geometry, GeometrySummary};
+use wormwear::input::{BendingKind, GearSet};
+
+fn built(name: &str) -> (GearSet, Geometry) {
+    let g = example(name);
+    let geo = Geometry::build(&g).unwrap();
+    (g, geo)
+}
+
+fn full_wheel(g: &GearSet, geo: &Geometry) -> CadPart {
+    wheel_part(g, geo, WheelRequest::default()).unwrap()
+}
+
+#[test]
+fn new_flanks_fit_within_a_micrometre_and_the_wheel_flank_has_the_grids_area() {
+    for name in ["gear-1x40-design.toml", "gear-k-2x25.toml"] {
+        let (g, geo) = built(name);
+        let worm = worm_part(&g, &geo).unwrap();
+        let wheel = full_wheel(&g, &geo);
+        for (part, what) in [(&worm, "worm"), (&wheel, "wheel")] {
+            let s = part.summary("x");
+            assert!(
+                s.fit_check_points > 500,
+                "{name} {what}: {}",
+                s.fit_check_points
+            );
+            assert!(
+                s.max_fit_deviation_um < 1.0,
+                "{name} {what}: {} um",
+                s.max_fit_deviation_um
+            );
+        }
+        // The flank grid's cells (areas of the curved surface, summed) against the B-spline
+        // flanks integrated by Gauss: two discretisations of one surface.
+        let grid = GeometrySummary::new(&g, &geo);
+        let s = wheel.summary("wheel.step");
+        let z2 = geo.teeth as f64;
+        for (ours, theirs) in [
+            (s.flank_area_left_mm2 / z2, grid.active_flank_area_left_mm2),
+            (
+                s.flank_area_right_mm2 / z2,
+                grid.active_flank_area_right_mm2,
+            ),
+        ] {
+            assert!(
+                (ours / theirs - 1.0).abs() < 1e-3,
+                "{name}: {ours} vs {theirs} mm^2"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_sector_of_n_teeth_is_n_pitches_of_the_whole_wheel() {
+    let (g, geo) = built("gear-1x40-design.toml");
+    let whole = full_wheel(&g, &geo).volume_mm3;
+    for n in [1, 3] {
+        let sector = wheel_part(
+            &g,
+            &geo,
+            WheelRequest {
+                teeth: Some(n),
+                change: None,
+            },
+        )
+        .unwrap();
+        let share = whole * n as f64 / geo.teeth as f64;
+        assert!(
+            (sector.volume_mm3 / share - 1.0).abs() < 1e-6,
+            "{n} teeth: {} vs {share} mm^3",
+            sector.volume_mm3
+        );
+        // Per band (3: the blank top's kink splits the faces): 5 pieces per tooth, the two
+        // sides and the bore arc; then the two end faces.
+        assert_eq!(sector.built.solid.face_iter().count(), 3 * (5 * n + 3) + 2);
+    }
+}
+
+#[test]
+fn the_worn_wheel_loses_the_volume_of_its_flank_change() {
+    let mut g = example("gear-1x40-design.toml");
+    g.bending.kind = BendingKind::None;
+    let plan = wormwear::input::WearPlan::with_life(20_000.0);
+    let mut request = wormwear::Request::new([wormwear::Stage::Wear]).with_life(plan);
+    request.cad = Some(CadRequest {
+        teeth: Some(3),
+        state: None,
+    });
+    let results = wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
+    let (geo, life) = (&results.geometry, results.life.as_ref().unwrap());
+    let flank = results.tca.as_ref().unwrap().loaded_flank;
+    let change = life.end.flank_change();
+    let wf = geo.wheel_flank(flank);
+    let removed = 3.0 * change.integral(wf) * 1e9;
+    assert!(removed > 1.0, "{removed} mm^3");
+    // The same sampling without the change: the difference is the change alone.
+    let zero = FlankField::zeros(wf);
+    let request = |field| WheelRequest {
+        teeth: Some(3),
+        change: Some((flank, field)),
+    };
+    let new = wheel_part(&g, geo, request(&zero)).unwrap().volume_mm3;
+    let worn = results.cad.as_ref().unwrap().worn.as_ref().unwrap();
+    assert_eq!(worn.0.step, life.end.step);
+    let lost = new - worn.1.volume_mm3;
+    eprintln!("lost {lost} mm^3, flank change integral {removed} mm^3");
+    assert!(
+        (lost / removed - 1.0).abs() < 5e-3,
+        "lost {lost} vs worn {removed} mm^3"
+    );
+}
+
+#[test]
+fn the_step_text_is_one_named_closed_solid_the_same_every_time() {
+    let (g, geo) = built("gear-1x40-design.toml");
+    let worm = worm_part(&g, &geo).unwrap();
+    let text = worm.step_text("worm").unwrap();
+    assert!(text.starts_with("ISO-10303-21;"));
+    assert!(text.contains("FILE_NAME('worm.step', '2000-01-01T00:00:00', (''), (''),"));
+    assert!(text.contains("#7 = PRODUCT('worm','worm','', (#8));"));
+    assert_eq!(text.matches("MANIFOLD_SOLID_BREP").count(), 1);
+    assert_eq!(text.matches("CLOSED_SHELL").count(), 1);
+    assert!(text.contains("SI_UNIT(.MILLI.,.METRE.)"));
+    assert_eq!(
+        text,
+        worm_part(&g, &geo).unwrap().step_text("worm").unwrap()
+    );
+}
+
+#[test]
+fn tooth_counts_outside_the_wheel_are_refused() {
+    let (g, geo) = built("gear-1x40-design.toml");
+    for n in [0, 41] {
+        let err = wheel_part(
+            &g,
+            &geo,
+            WheelRequest {
+                teeth: Some(n),
+                change: None,
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains(&format!("is {n}, allowed 1 to 40")), "{err}");
+        let request = wormwear::Request {
+            cad: Some(CadRequest {
+                teeth: Some(n),
+                state: None,
+            }),
+            ..wormwear::Request::new([wormwear::Stage::Geometry])
+        };
+        assert!(request.check(&g).unwrap_err().is_input());
+    }
+}
+
+/// Our faces of `kinds` with their centroids and areas, for the reader.
+fn faces_of(
+    part: &CadPart,
+    keep: impl Fn(FaceKind, usize) -> bool,
+) -> Vec<(FaceKind, [f64; 3], f64)> {
+    part.face_summaries()
+        .into_iter()
+        .filter(|f| keep(f.kind, f.index))
+        .map(|f| (f.kind, f.centroid_mm, f.area_mm2))
+        .collect()
+}
+
+/// The reader's answer for `part` written as STEP, with the faces and the points (each with the
+/// indices of the faces it may lie on). None when gmsh is absent.
+fn read_back(
+    part: &CadPart,
+    faces: &[(FaceKind, [f64; 3], f64)],
+    points: &[([f64; 3], Vec<usize>)],
+) -> Option<serde_json::Value> {
+    let dir = tempfile::tempdir().unwrap();
+    let step = dir.path().join("part.step");
+    std::fs::write(&step, part.step_text("part").unwrap()).unwrap();
+    let request = serde_json::json!({
+        "faces": faces.iter().map(|f| serde_json::json!({"centroid": f.1, "area": f.2})).collect::<Vec<_>>(),
+        "points": points.iter().map(|p| p.0).collect::<Vec<_>>(),
+        "point_faces": points.iter().map(|p| p.1.clone()).collect::<Vec<_>>(),
+    });
+    let request_path = dir.path().join("request.json");
+    std::fs::write(&request_path, request.to_string()).unwrap();
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/step_reader.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(&step)
+        .arg(&request_path)
+        .output()
+        .ok()?;
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(serde_json::from_slice(&out.stdout).unwrap())
+}
+
+fn gmsh_present() -> bool {
+    std::process::Command::new("python3")
+        .args(["-c", "import gmsh"])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Checks the reader's answer: one solid of our volume, our face areas, points on the faces.
+fn check_answer(
+    what: &str,
+    part: &CadPart,
+    faces: &[(FaceKind, [f64; 3], f64)],
+    answer: &serde_json::Value,
+) {
+    assert_eq!(answer["solids"], 1, "{what}");
+    let volume = answer["volume"].as_f64().unwrap();
+    assert!(
+        (volume / part.volume_mm3 - 1.0).abs() < 1e-4,
+        "{what}: {volume} vs {} mm^3",
+        part.volume_mm3
+    );
+    for (i, f) in faces.iter().enumerate() {
+        let area = answer["areas"][i].as_f64().unwrap();
+        assert!(
+            (area / f.2 - 1.0).abs() < 1e-5,
+            "{what} {:?}: {area} vs {} mm^2",
+            f.0,
+            f.2
+        );
+        assert!(
+            answer["centroid_gaps"][i].as_f64().unwrap() < 1e-3,
+            "{what}: face {i} not found"
+        );
+    }
+    let worst = answer["distances"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d.as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-3,
+        "{what}: a flank point is {worst} mm off the read surface"
+    );
+    eprintln!(
+        "{what}: OpenCASCADE volume {volume:.3} mm^3 (ours {:.3}), worst flank point {:.4} um",
+        part.volume_mm3,
+        worst * 1e3
+    );
+}
+
+#[test]
+fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
+    if !gmsh_present() {
+        skipped(
+            "cad::opencascade_reads_one_solid",
+            "gmsh's Python package (OpenCASCADE) is absent",
+        );
+        return;
+    }
+    for name in ["gear-1x40-design.toml", "gear-k-2x25.toml"] {
+        let (g, geo) = built(name);
+        let wheel = full_wheel(&g, &geo);
+        // The reference space's flanks (tooth 0) and the grid's cell centres: envelope points
+        // of the analysis grid, which the CAD sections did not sample.
+        let faces = faces_of(&wheel, |k, i| k.is_flank() && i == 0);
+        let mut points = Vec::new();
+        for (flank, kind) in [
+            (Flank::Left, FaceKind::FlankLeft),
+            (Flank::Right, FaceKind::FlankRight),
+        ] {
+            let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
+            for c in geo.wheel_flank(flank).cells.iter().step_by(7) {
+                let p = g.operating.wheel_to_worm(&c.position()) * 1e3;
+                points.push(([p.x, p.y, p.z], on.clone()));
+            }
+        }
+        let answer = read_back(&wheel, &faces, &points).unwrap();
+        check_answer(&format!("{name} wheel"), &wheel, &faces, &answer);
+        // The worm: its flank faces and points of its helicoids over the body.
+        let worm = worm_part(&g, &geo).unwrap();
+        let faces = faces_of(&worm, |k, i| k.is_flank() && i == 0);
+        let (rf, ra) = (g.worm.root_radius, g.worm.tip_radius);
+        let half = 0.45 * g.bending.worm_body_length;
+        let mut points = Vec::new();
+        for (flank, kind) in [
+            (Flank::Left, FaceKind::FlankLeft),
+            (Flank::Right, FaceKind::FlankRight),
+        ] {
+            let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
+            for a in 0..13 {
+                let rho = rf + (ra - rf) * (a as f64 + 0.37) / 13.0;
+                for b in 0..40 {
+                    let p = geo.worm.flank_point(flank, rho, 0.0, 0);
+                    let x = -half + 2.0 * half * (b as f64 + 0.29) / 40.0;
+                    let phi = (x - p.x) / (geo.worm.hand_sign() * geo.worm.lead_per_rad());
+                    let q = geo.worm.flank_point(flank, rho, phi, 0) * 1e3;
+                    points.push(([q.x, q.y, q.z], on.clone()));
+                }
+            }
+        }
+        let answer = read_back(&worm, &faces, &points).unwrap();
+        check_answer(&format!("{name} worm"), &worm, &faces, &answer);
+    }
+}
