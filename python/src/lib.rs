@@ -227,7 +227,7 @@ fn stages(names: Option<Vec<String>>, has_life: bool) -> PyResult<Vec<Stage>> {
 
 /// Runs the pipeline (see `wormwear.run`).
 #[pyfunction]
-#[pyo3(signature = (gear, stages=None, cycles=None, step_cycles=None, step_wear_um=None, no_pitting=false, map_position=0, progress=None))]
+#[pyo3(signature = (gear, stages=None, cycles=None, step_cycles=None, step_wear_um=None, no_pitting=false, map_position=0, progress=None, step=None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -239,6 +239,7 @@ fn run(
     no_pitting: bool,
     map_position: usize,
     progress: Option<Py<PyAny>>,
+    step: Option<(Option<usize>, Option<usize>)>,
 ) -> PyResult<NativeResults> {
     let overrides = LifeOverrides {
         cycles,
@@ -249,6 +250,7 @@ fn run(
     let has_life = gear.gear.wear.is_some() || overrides.asks_for_life();
     let mut request = Request::new(self::stages(stages, has_life)?);
     request.map_position = map_position;
+    request.cad = step.map(|(teeth, state)| wormwear::cad::CadRequest { teeth, state });
     if request.has(Stage::Wear) {
         let plan = overrides
             .plan(&gear.gear, OverrideNames::Python)

@@ -384,3 +384,22 @@ def test_the_readme_session_runs_as_written(tmp_path, monkeypatch):
     assert (tmp_path / "out" / "compare" / "compare.html").exists()
     assert (tmp_path / "out" / "zi.rexs").exists()
     assert namespace["same"].to_dict() == namespace["gear"].to_dict()
+
+
+def test_step_solids_equal_the_cli_and_bad_requests_raise(cli, design_file, tmp_path):
+    # The CLI's --step and the Python run's step=True write the same STEP files.
+    cli("-q", "geometry", design_file, "-o", tmp_path / "cli", "--step", "--step-teeth", "3")
+    gear = wormwear.load(str(design_file))
+    r = wormwear.run(gear, stages=["geometry"], step=True, step_teeth=3)
+    r.write(tmp_path / "py")
+    for name in ("worm.step", "wheel.step", "cad_faces.csv"):
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes(), name
+    cad = r.summary["cad"]
+    assert cad["length_unit"] == "mm" and cad["max_flank_fit_deviation_um"] < 1.0
+    assert cad["wheel_worn"] is None
+    faces = pd.read_csv(tmp_path / "py" / "cad_faces.csv")
+    assert set(faces["part"]) == {"worm", "wheel"}
+    with pytest.raises(wormwear.InputError, match="allowed 1 to 40"):
+        wormwear.run(gear, stages=["geometry"], step=True, step_teeth=0)
+    with pytest.raises(wormwear.InputError, match="needs a life"):
+        wormwear.run(gear, stages=["geometry"], step=True, step_state=2)

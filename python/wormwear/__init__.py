@@ -308,7 +308,8 @@ class Results:
 
     def write(self, directory: "str | os.PathLike[str]") -> list:
         """Writes the files the CLI writes for the same stages (summary.json, CSV, SVG, VTK,
-        report.html) into ``directory`` (created); returns their paths."""
+        report.html, and the STEP solids of ``run(..., step=True)``) into ``directory``
+        (created); returns their paths."""
         path = os.fspath(directory)
         os.makedirs(path, exist_ok=True)
         return self._native.write(path)
@@ -327,13 +328,19 @@ def run(
     no_pitting: bool = False,
     map_position: int = 0,
     progress: Optional[Callable[[str, dict], None]] = None,
+    step: bool = False,
+    step_teeth: Optional[int] = None,
+    step_state: Optional[int] = None,
 ) -> Results:
     """Runs the pipeline on ``gear``: ``stages`` from :data:`STAGES` (default: all that
     ``wormwear run`` runs; ``wear`` needs the gear's ``[wear]`` section or ``cycles``). Life
     overrides as the CLI's flags: ``cycles`` (wheel cycles), ``step_cycles`` (fixed steps,
     wheel cycles), ``step_wear_um`` (adaptive steps, um), ``no_pitting``. ``map_position``:
     the position (0-based) whose pressure maps ``write`` draws. ``progress(event, details)``
-    is called at each stage and wear state.
+    is called at each stage and wear state. ``step``: also build the CAD solids that ``write``
+    writes as STEP (worm.step, wheel.step, and wheel_worn.step after a life), as the CLI's
+    ``--step``; ``step_teeth``: the wheel's tooth count (default all), ``step_state``: the wear
+    step of the map state the worn wheel shows (default the last).
 
     The GIL is released while it computes; Ctrl-C raises KeyboardInterrupt at the next stage or
     wear state. Raises :class:`InputError` for an input problem, :class:`ComputationError`
@@ -351,6 +358,7 @@ def run(
         no_pitting,
         map_position,
         callback,
+        (step_teeth, step_state) if step else None,
     )
     return Results(native)
 

@@ -67,6 +67,9 @@ def run(
     no_pitting: bool = False,
     map_position: int = 0,
     progress: Optional[Callable[[str, dict], None]] = None,
+    step: bool = False,
+    step_teeth: Optional[int] = None,
+    step_state: Optional[int] = None,
 ) -> Results: ...
 def sweep(
     base: GearSet,

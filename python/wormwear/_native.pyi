@@ -42,6 +42,7 @@ def run(
     no_pitting: bool = False,
     map_position: int = 0,
     progress: Optional[Callable[[str, str], None]] = None,
+    step: Optional[tuple[Optional[int], Optional[int]]] = None,
 ) -> NativeResults: ...
 def expand_grid(grid_json: str) -> tuple[list[str], str]: ...
 def sweep(

@@ -1948,3 +1948,56 @@ fn every_command_says_what_verbose_does_for_it() {
         );
     }
 }
+
+#[test]
+fn step_output_writes_solids_and_refuses_bad_requests_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let run = |extra: &[&str]| {
+        bin()
+            .args(["geometry", "--quiet"])
+            .arg(example("gear-1x40-design.toml"))
+            .arg("-o")
+            .arg(&out_dir)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--step", "--step-teeth", "2"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_files(&out_dir, &["worm.step", "wheel.step", "cad_faces.csv"]);
+    let step = std::fs::read_to_string(out_dir.join("wheel.step")).unwrap();
+    assert!(step.starts_with("ISO-10303-21;") && step.contains("PRODUCT('wheel'"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert!(
+        summary["cad"]["max_flank_fit_deviation_um"]
+            .as_f64()
+            .unwrap()
+            < 1.0
+    );
+    // Without a life there is no worn wheel; a tooth count of 0 and a directory where a STEP
+    // file goes are input errors (exit 2) with the reason.
+    for (extra, expected) in [
+        (&["--step", "--step-state", "3"][..], "needs a life"),
+        (&["--step", "--step-teeth", "0"][..], "allowed 1 to 40"),
+    ] {
+        let out = run(extra);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(expected), "{err}");
+    }
+    std::fs::remove_file(out_dir.join("worm.step")).unwrap();
+    std::fs::create_dir(out_dir.join("worm.step")).unwrap();
+    let out = run(&["--step"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("worm.step: it is a directory"), "{err}");
+    // --step-teeth alone asks for nothing: clap refuses it.
+    assert_eq!(run(&["--step-teeth", "2"]).status.code(), Some(2));
+}

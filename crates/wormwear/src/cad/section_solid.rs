@@ -486,6 +486,23 @@ mod tests {
     }
 
     #[test]
+    fn simpson_integrates_cubics_exactly_with_even_and_odd_interval_counts() {
+        let f = |x: f64| 2.0 * x * x * x - x * x + 3.0;
+        let exact = |x: f64| 0.5 * x.powi(4) - x.powi(3) / 3.0 + 3.0 * x;
+        for n in [2usize, 3, 4, 5, 8, 9] {
+            let h = 1.7 / n as f64;
+            let samples: Vec<f64> = (0..=n).map(|i| f(h * i as f64)).collect();
+            let expected = exact(1.7) - exact(0.0);
+            assert!(
+                (simpson(&samples, h) - expected).abs() < 1e-12,
+                "{n} intervals"
+            );
+        }
+        // One interval: the trapezoid, exact for a line.
+        assert!((simpson(&[1.0, 3.0], 0.5) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
     fn a_loop_that_does_not_close_is_refused() {
         let mut sweep = twisted_square(0.0, 3, 3);
         sweep.outer[2].rows[1][0].x += 1e-3;
