@@ -122,6 +122,12 @@ fn the_worn_wheel_loses_the_volume_of_its_flank_change() {
         (lost / removed - 1.0).abs() < 5e-3,
         "lost {lost} vs worn {removed} mm^3"
     );
+    // The worn solid is one valid solid for OpenCASCADE too, of our volume.
+    if gmsh_present() {
+        let faces = faces_of(&worn.1, |k, i| k.is_flank() && i == 1);
+        let answer = read_back(&worn.1, &faces, &[]).unwrap();
+        check_answer("worn wheel, 3 teeth", &worn.1, &faces, &answer);
+    }
 }
 
 #[test]
@@ -226,6 +232,12 @@ fn check_answer(
     answer: &serde_json::Value,
 ) {
     assert_eq!(answer["solids"], 1, "{what}");
+    // OpenCASCADE's mesher fills the solid with tetrahedra: its boundary is closed and valid.
+    assert!(
+        answer["tetrahedra"].as_u64().unwrap() > 1000,
+        "{what}: {}",
+        answer["tetrahedra"]
+    );
     let volume = answer["volume"].as_f64().unwrap();
     assert!(
         (volume / part.volume_mm3 - 1.0).abs() < 1e-4,
@@ -256,9 +268,11 @@ fn check_answer(
         "{what}: a flank point is {worst} mm off the read surface"
     );
     eprintln!(
-        "{what}: OpenCASCADE volume {volume:.3} mm^3 (ours {:.3}), worst flank point {:.4} um",
+        "{what}: OpenCASCADE volume {volume:.3} mm^3 (ours {:.3}), worst flank point {:.4} um, \
+         {} tetrahedra",
         part.volume_mm3,
-        worst * 1e3
+        worst * 1e3,
+        answer["tetrahedra"]
     );
 }
 
@@ -315,4 +329,42 @@ fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
         let answer = read_back(&worm, &faces, &points).unwrap();
         check_answer(&format!("{name} worm"), &worm, &faces, &answer);
     }
+}
+
+#[test]
+fn the_worn_wheel_shows_the_asked_map_state_or_the_last_with_a_warning() {
+    let mut g = example("gear-1x40-design.toml");
+    g.bending.kind = BendingKind::None;
+    let run = |state| {
+        let plan = wormwear::input::WearPlan::with_life(20_000.0);
+        let mut request = wormwear::Request::new([wormwear::Stage::Wear]).with_life(plan);
+        request.cad = Some(CadRequest {
+            teeth: Some(1),
+            state,
+        });
+        wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap()
+    };
+    let asked = run(Some(2));
+    let (from, _) = asked.cad.as_ref().unwrap().worn.as_ref().unwrap();
+    let map = asked
+        .life
+        .as_ref()
+        .unwrap()
+        .maps
+        .iter()
+        .find(|m| m.state.step == 2)
+        .unwrap();
+    assert_eq!((from.step, from.cycles), (2, map.state.cycles));
+    assert!(from.cycles < asked.life.as_ref().unwrap().end.cycles);
+    let missing = run(Some(999));
+    let (from, _) = missing.cad.as_ref().unwrap().worn.as_ref().unwrap();
+    assert_eq!(from.step, missing.life.as_ref().unwrap().end.step);
+    assert!(
+        missing
+            .warnings
+            .iter()
+            .any(|w| w.contains("no map state at wear step 999")),
+        "{:?}",
+        missing.warnings
+    );
 }

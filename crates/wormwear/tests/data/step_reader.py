@@ -6,6 +6,8 @@ REQUEST: {"faces": [{"centroid": [x, y, z], "area": a}, ...],   (mm, mm^2: our f
           "points": [[x, y, z], ...],                               (mm: points to project)
           "point_faces": [[i, j, ...], ...]}                        (indices into faces, per point)
 ANSWER:  {"solids": n, "volume": V, "areas": [OCC area of each requested face],
+          "tetrahedra": number of tetrahedra gmsh fills the solid with (a closed, valid
+                        boundary is needed for that; 0 if meshing failed),
           "centroid_gaps": [distance from our centroid to the matched OCC face's],
           "distances": [distance from each point to the nearest of its faces]}
 The faces are matched by their centres of mass, which OpenCASCADE computes itself.
@@ -44,10 +46,20 @@ def main():
             closest, _ = gmsh.model.getClosestPoint(2, matched[i], point)
             best = min(best, math.dist(closest, point))
         distances.append(best)
+    tetrahedra = 0
+    try:
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 1.0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 6.0)
+        gmsh.model.mesh.generate(3)
+        _, elements, _ = gmsh.model.mesh.getElements(3)
+        tetrahedra = sum(len(e) for e in elements)
+    except Exception as e:  # noqa: BLE001 (any failure is the answer 0)
+        print(f"meshing failed: {e}", file=sys.stderr)
     gmsh.finalize()
     json.dump(
         {
             "solids": len(solids),
+            "tetrahedra": tetrahedra,
             "volume": volume,
             "areas": areas,
             "centroid_gaps": gaps,
