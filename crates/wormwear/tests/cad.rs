@@ -38,8 +38,9 @@ fn new_flanks_fit_within_a_micrometre_and_the_wheel_flank_has_the_grids_area() {
                 "{name} {what}: {}",
                 s.fit_check_points
             );
+            // The bound is 1 um; the wheel refines its sampling to half of it.
             assert!(
-                s.max_fit_deviation_um < 1.0,
+                s.max_fit_deviation_um < if what == "wheel" { 0.5 } else { 1.0 },
                 "{name} {what}: {} um",
                 s.max_fit_deviation_um
             );

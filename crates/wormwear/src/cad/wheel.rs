@@ -34,11 +34,20 @@ const ARC_STEP: f64 = 0.02;
 /// Largest station spacing along the face width of the new wheel, m.
 const STATION_STEP: f64 = 1.0e-3;
 
+/// The new wheel's flank fit aimed at, mm (half the 1 um the issue asks for: a margin for
+/// gears other than the references).
+const FIT_TARGET_MM: f64 = 0.5e-3;
+
+/// Refinements of the new wheel's sampling at most (each: 1.4 times the points, 1/1.4 the
+/// station spacing).
+const REFINEMENTS: usize = 3;
+
 /// How finely the sections sample the flanks: points per flank of sides [A, B] and the
-/// largest station spacing (m). The new flank is smooth: 17 points and 1 mm keep the fit
-/// within 1 um on the reference gears. A flank change lives on the flank grid's nodes, linear
-/// between them: the changed flank is sampled on the grid's rows (the same radii: evenly
-/// spaced between r_low and the top) and the stations are as far apart as its columns.
+/// largest station spacing (m). The new flank is smooth: 17 points and 1 mm give 0.44 um on
+/// the design case, and [`wheel_part`] refines until the fit is within [`FIT_TARGET_MM`]. A
+/// flank change lives on the flank grid's nodes, linear between them: the changed flank is
+/// sampled on the grid's rows (the same radii: evenly spaced between r_low and the top) and
+/// the stations are as far apart as its columns.
 #[derive(Debug, Clone, Copy)]
 struct Resolution {
     flank_points: [usize; 2],
@@ -88,21 +97,47 @@ struct SpaceSection {
     mid: f64,
 }
 
-/// The wheel's solid and the checks of its flank fit (the flanks of one tooth space).
+/// The wheel's solid and the checks of its flank fit (the flanks of one tooth space). A new
+/// wheel whose fit misses [`FIT_TARGET_MM`] is sampled again more finely (up to
+/// [`REFINEMENTS`] times; the last is kept whatever its fit, which the summary reports).
 pub fn wheel_part(
     gear: &GearSet,
     geo: &Geometry,
     request: WheelRequest,
 ) -> Result<CadPart, CadError> {
-    let z2 = geo.teeth as usize;
     check_request(geo, &request)?;
     let hobbing = geo.hobbing(gear);
     let sides = sides(geo, &hobbing)?;
-    let resolution = Resolution::of(geo, &request, sides);
+    let mut resolution = Resolution::of(geo, &request, sides);
+    let mut part = sampled_part(gear, geo, (&hobbing, sides), request, resolution)?;
+    for _ in 0..REFINEMENTS {
+        if request.change.is_some() || part.max_fit_deviation_mm() <= FIT_TARGET_MM {
+            break;
+        }
+        resolution = Resolution {
+            flank_points: resolution
+                .flank_points
+                .map(|n| (n as f64 * 1.4).ceil() as usize),
+            station_step: resolution.station_step / 1.4,
+        };
+        part = sampled_part(gear, geo, (&hobbing, sides), request, resolution)?;
+    }
+    Ok(part)
+}
+
+/// The wheel's solid sampled at `resolution`.
+fn sampled_part(
+    gear: &GearSet,
+    geo: &Geometry,
+    (hobbing, sides): (&Hobbing, [Flank; 2]),
+    request: WheelRequest,
+    resolution: Resolution,
+) -> Result<CadPart, CadError> {
+    let z2 = geo.teeth as usize;
     let (zs, bounds) = stations(&geo.blank, resolution.station_step);
     let sections: Vec<SpaceSection> = zs
         .par_iter()
-        .map(|&z| space_section(geo, &hobbing, (sides, resolution.flank_points), z, request))
+        .map(|&z| space_section(geo, hobbing, (sides, resolution.flank_points), z, request))
         .collect::<Result<_, _>>()?;
     let bore = bore_radius(gear, &sections)?;
     let layout = Layout {
@@ -127,7 +162,7 @@ pub fn wheel_part(
     };
     let checks = fit_checks(
         geo,
-        &hobbing,
+        hobbing,
         (sides, &zs, &bounds, resolution.flank_points),
         &outer,
         (first, layout.tau),
