@@ -1,7 +1,8 @@
 //! `report.html`: one self-contained page (inline SVG, inline CSS, no network) gathering what a
 //! run wrote into its output directory: the input file, the derived data of every stage from
 //! summary.json, the figures of each stage in order, the ratings, the warnings and links to the
-//! data files beside it (CSV tables, STL and VTK surfaces for CAD and ParaView).
+//! data files beside it (CSV tables, STL and VTK surfaces for viewing and ParaView, STEP solids
+//! for CAD).
 
 use super::text::{cycles_text, escape, human, number};
 use super::{write_atomic, OutputError};
@@ -605,7 +606,7 @@ fn files_section(h: &mut String, dir: &Path) {
             rd.filter_map(|e| e.ok())
                 .filter_map(|e| e.file_name().to_str().map(String::from))
                 .filter(|n| {
-                    [".vtp", ".stl", ".csv", ".json"]
+                    [".vtp", ".stl", ".step", ".csv", ".json"]
                         .iter()
                         .any(|x| n.ends_with(x))
                 })
@@ -616,7 +617,9 @@ fn files_section(h: &mut String, dir: &Path) {
     h.push_str(
         "<section id=\"files\"><h2>Files</h2><p>Beside this page: <code>.vtp</code> surfaces \
          with their results for ParaView (File > Open; colour by an array, e.g. \
-         <code>wear_um</code>), STL for CAD, CSV tables, <code>summary.json</code>.</p><ul>",
+         <code>wear_um</code>), STL for viewing, with <code>--step</code> the STEP solids for \
+         CAD (mm, worm frame: worm and wheel assemble at the centre distance), CSV tables, \
+         <code>summary.json</code>.</p><ul>",
     );
     for f in &files {
         let _ = write!(h, "<li><a href=\"{f}\">{f}</a></li>", f = escape(f));
