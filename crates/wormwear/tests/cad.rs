@@ -369,3 +369,60 @@ fn the_worn_wheel_shows_the_asked_map_state_or_the_last_with_a_warning() {
         missing.warnings
     );
 }
+
+/// Heavy (about a minute: OpenCASCADE's boolean intersection of B-spline solids): run with
+/// `cargo test -p wormwear --test cad -- --ignored`.
+#[test]
+#[ignore]
+fn the_worm_and_the_wheel_assemble_touching_without_overlap() {
+    if !gmsh_present() {
+        skipped(
+            "cad::assemble",
+            "gmsh's Python package (OpenCASCADE) is absent",
+        );
+        return;
+    }
+    // At rotation 0 the unloaded mesh touches on the contact line (conjugate flanks) and
+    // nowhere overlaps: the placement in the worm frame is the gear set's.
+    let (g, geo) = built("gear-1x40-design.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let worm = dir.path().join("worm.step");
+    let wheel = dir.path().join("wheel.step");
+    std::fs::write(
+        &worm,
+        worm_part(&g, &geo).unwrap().step_text("worm").unwrap(),
+    )
+    .unwrap();
+    let sector = wheel_part(
+        &g,
+        &geo,
+        WheelRequest {
+            teeth: Some(3),
+            change: None,
+        },
+    )
+    .unwrap();
+    std::fs::write(&wheel, sector.step_text("wheel").unwrap()).unwrap();
+    let script =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/step_assembly.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(&worm)
+        .arg(&wheel)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (common, distance) = (
+        answer["intersection"].as_f64().unwrap(),
+        answer["distance"].as_f64().unwrap(),
+    );
+    eprintln!("common volume {common:.2e} mm^3, distance {distance:.2e} mm");
+    // A 1 um interference over the contact line would be ~1e-2 mm^3.
+    assert!(common.abs() < 1e-3, "the parts overlap by {common} mm^3");
+    assert!(distance < 1e-3, "the parts are {distance} mm apart");
+}
