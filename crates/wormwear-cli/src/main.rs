@@ -82,9 +82,11 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Generate worm and wheel geometry: sections (CSV, SVG), flank grids (CSV), STL, summary.json.
+    /// Generate worm and wheel geometry: sections (CSV, SVG), flank grids (CSV), STL, summary.json;
+    /// with --step the worm and the wheel as STEP solids for CAD.
     #[command(
-        after_help = "Example:\n  wormwear geometry examples/gear-1x40-design.toml -o out/1x40"
+        after_help = "Examples:\n  wormwear geometry examples/gear-1x40-design.toml -o out/1x40\n  \
+                      wormwear geometry examples/gear-1x40-design.toml -o out/1x40 --step --step-teeth 3"
     )]
     Geometry {
         /// Gear file (TOML).
