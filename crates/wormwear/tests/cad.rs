@@ -21,6 +21,43 @@ fn built(name: &str) -> (GearSet, Geometry) {
     (g, geo)
 }
 
+/// The request of a new wheel of `n` teeth.
+fn teeth(n: usize) -> WheelRequest<'static> {
+    WheelRequest {
+        teeth: Some(n),
+        change: None,
+    }
+}
+
+/// A life of `cycles` on the design case without bending, asking for the CAD solids.
+fn life_with_cad(cycles: f64, cad: CadRequest) -> wormwear::Results {
+    let mut g = example("gear-1x40-design.toml");
+    g.bending.kind = BendingKind::None;
+    let plan = wormwear::input::WearPlan::with_life(cycles);
+    let mut request = wormwear::Request::new([wormwear::Stage::Wear]).with_life(plan);
+    request.cad = Some(cad);
+    wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap()
+}
+
+/// Runs `python3 tests/data/SCRIPT ARGS...` and parses the JSON it prints; None when
+/// python3 cannot be started.
+fn python_json(script: &str, args: &[&std::path::Path]) -> Option<serde_json::Value> {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(script);
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .args(args)
+        .output()
+        .ok()?;
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(serde_json::from_slice(&out.stdout).unwrap())
+}
+
 fn full_wheel(g: &GearSet, geo: &Geometry) -> CadPart {
     wheel_part(g, geo, WheelRequest::default()).unwrap()
 }
@@ -70,15 +107,7 @@ fn a_sector_of_n_teeth_is_n_pitches_of_the_whole_wheel() {
     let (g, geo) = built("gear-1x40-design.toml");
     let whole = full_wheel(&g, &geo).volume_mm3;
     for n in [1, 3] {
-        let sector = wheel_part(
-            &g,
-            &geo,
-            WheelRequest {
-                teeth: Some(n),
-                change: None,
-            },
-        )
-        .unwrap();
+        let sector = wheel_part(&g, &geo, teeth(n)).unwrap();
         let share = whole * n as f64 / geo.teeth as f64;
         assert!(
             (sector.volume_mm3 / share - 1.0).abs() < 1e-6,
@@ -93,16 +122,18 @@ fn a_sector_of_n_teeth_is_n_pitches_of_the_whole_wheel() {
 
 #[test]
 fn the_worn_wheel_loses_the_volume_of_its_flank_change() {
-    let mut g = example("gear-1x40-design.toml");
-    g.bending.kind = BendingKind::None;
-    let plan = wormwear::input::WearPlan::with_life(20_000.0);
-    let mut request = wormwear::Request::new([wormwear::Stage::Wear]).with_life(plan);
-    request.cad = Some(CadRequest {
-        teeth: Some(3),
-        state: None,
-    });
-    let results = wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
-    let (geo, life) = (&results.geometry, results.life.as_ref().unwrap());
+    let results = life_with_cad(
+        20_000.0,
+        CadRequest {
+            teeth: Some(3),
+            state: None,
+        },
+    );
+    let (g, geo, life) = (
+        &results.gear,
+        &results.geometry,
+        results.life.as_ref().unwrap(),
+    );
     let flank = results.tca.as_ref().unwrap().loaded_flank;
     let change = life.end.flank_change();
     let wf = geo.wheel_flank(flank);
@@ -114,7 +145,7 @@ fn the_worn_wheel_loses_the_volume_of_its_flank_change() {
         teeth: Some(3),
         change: Some((flank, field)),
     };
-    let new = wheel_part(&g, geo, request(&zero)).unwrap().volume_mm3;
+    let new = wheel_part(g, geo, request(&zero)).unwrap().volume_mm3;
     let worn = results.cad.as_ref().unwrap().worn.as_ref().unwrap();
     assert_eq!(worn.0.step, life.end.step);
     let lost = new - worn.1.volume_mm3;
@@ -152,16 +183,7 @@ fn the_step_text_is_one_named_closed_solid_the_same_every_time() {
 fn tooth_counts_outside_the_wheel_are_refused() {
     let (g, geo) = built("gear-1x40-design.toml");
     for n in [0, 41] {
-        let err = wheel_part(
-            &g,
-            &geo,
-            WheelRequest {
-                teeth: Some(n),
-                change: None,
-            },
-        )
-        .unwrap_err()
-        .to_string();
+        let err = wheel_part(&g, &geo, teeth(n)).unwrap_err().to_string();
         assert!(err.contains(&format!("is {n}, allowed 1 to 40")), "{err}");
         let request = wormwear::Request {
             cad: Some(CadRequest {
@@ -203,19 +225,7 @@ fn read_back(
     });
     let request_path = dir.path().join("request.json");
     std::fs::write(&request_path, request.to_string()).unwrap();
-    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/step_reader.py");
-    let out = std::process::Command::new("python3")
-        .arg(script)
-        .arg(&step)
-        .arg(&request_path)
-        .output()
-        .ok()?;
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    Some(serde_json::from_slice(&out.stdout).unwrap())
+    python_json("step_reader.py", &[&step, &request_path])
 }
 
 fn gmsh_present() -> bool {
@@ -334,16 +344,14 @@ fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
 
 #[test]
 fn the_worn_wheel_shows_the_asked_map_state_or_the_last_with_a_warning() {
-    let mut g = example("gear-1x40-design.toml");
-    g.bending.kind = BendingKind::None;
     let run = |state| {
-        let plan = wormwear::input::WearPlan::with_life(20_000.0);
-        let mut request = wormwear::Request::new([wormwear::Stage::Wear]).with_life(plan);
-        request.cad = Some(CadRequest {
-            teeth: Some(1),
-            state,
-        });
-        wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap()
+        life_with_cad(
+            20_000.0,
+            CadRequest {
+                teeth: Some(1),
+                state,
+            },
+        )
     };
     let asked = run(Some(2));
     let (from, _) = asked.cad.as_ref().unwrap().worn.as_ref().unwrap();
@@ -393,30 +401,9 @@ fn the_worm_and_the_wheel_assemble_touching_without_overlap() {
         worm_part(&g, &geo).unwrap().step_text("worm").unwrap(),
     )
     .unwrap();
-    let sector = wheel_part(
-        &g,
-        &geo,
-        WheelRequest {
-            teeth: Some(3),
-            change: None,
-        },
-    )
-    .unwrap();
+    let sector = wheel_part(&g, &geo, teeth(3)).unwrap();
     std::fs::write(&wheel, sector.step_text("wheel").unwrap()).unwrap();
-    let script =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/step_assembly.py");
-    let out = std::process::Command::new("python3")
-        .arg(script)
-        .arg(&worm)
-        .arg(&wheel)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let answer: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let answer = python_json("step_assembly.py", &[&worm, &wheel]).unwrap();
     let (common, distance) = (
         answer["intersection"].as_f64().unwrap(),
         answer["distance"].as_f64().unwrap(),

@@ -75,6 +75,9 @@ pub struct PartSummary {
     /// Largest distance from a computed flank point (not interpolated) to the flank surface, um.
     pub max_fit_deviation_um: f64,
     pub fit_check_points: usize,
+    /// Every lateral face (for `cad_faces.csv`; not in summary.json).
+    #[serde(skip)]
+    pub face_list: Vec<FaceSummary>,
 }
 
 /// Gauss-Legendre nodes and weights on [0, 1], two per knot span in each direction.
@@ -175,6 +178,7 @@ impl CadPart {
             flank_area_right_mm2: area(FaceKind::FlankRight),
             max_fit_deviation_um: self.max_fit_deviation_mm() * 1e3,
             fit_check_points: self.checks.iter().map(|c| c.points.len()).sum(),
+            face_list: faces,
         }
     }
 

@@ -55,11 +55,16 @@ struct WornSection {
 
 /// The `cad` section of summary.json.
 pub fn summary_value(solids: &CadSolids) -> Result<serde_json::Value, OutputError> {
+    to_json("cad", &section(solids))
+}
+
+/// The section's content: each part's summary (its faces integrated and its fit measured once).
+fn section(solids: &CadSolids) -> CadSection {
     let (worm, wheel) = (
         solids.worm.summary(WORM_FILE),
         solids.wheel.summary(WHEEL_FILE),
     );
-    let section = CadSection {
+    CadSection {
         frame: "worm frame of MODEL §1: x along the worm axis, the wheel centre at y = a; \
                 worm and wheel at rotation 0",
         length_unit: "mm",
@@ -70,23 +75,23 @@ pub fn summary_value(solids: &CadSolids) -> Result<serde_json::Value, OutputErro
             from: *from,
             part: part.summary(WORN_FILE),
         }),
-    };
-    to_json("cad", &section)
+    }
 }
 
 /// Writes the STEP files, the faces' table and the `cad` section into `dir`.
 pub fn write_cad(solids: &CadSolids, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
     check_targets(dir)?;
-    let mut parts: Vec<(&str, &str, &CadPart)> = vec![
-        (WORM_FILE, "worm", &solids.worm),
-        (WHEEL_FILE, "wheel", &solids.wheel),
+    let section = section(solids);
+    let mut parts: Vec<(&str, &str, &CadPart, &PartSummary)> = vec![
+        (WORM_FILE, "worm", &solids.worm, &section.worm),
+        (WHEEL_FILE, "wheel", &solids.wheel, &section.wheel),
     ];
-    if let Some((_, part)) = &solids.worn {
-        parts.push((WORN_FILE, "wheel_worn", part));
+    if let (Some((_, part)), Some(worn)) = (&solids.worn, &section.wheel_worn) {
+        parts.push((WORN_FILE, "wheel_worn", part, &worn.part));
     }
     let mut files = Vec::new();
     let mut faces = String::from("part,kind,tooth,band,area_mm2,x_mm,y_mm,z_mm\n");
-    for (file, name, part) in parts {
+    for (file, name, part, summary) in parts {
         let text = part.step_text(name).map_err(|e| OutputError::Encode {
             what: file.into(),
             message: e.to_string(),
@@ -94,7 +99,7 @@ pub fn write_cad(solids: &CadSolids, dir: &Path) -> Result<Vec<PathBuf>, OutputE
         let path = dir.join(file);
         write_atomic(&path, text.as_bytes())?;
         files.push(path);
-        for f in part.face_summaries() {
+        for f in &summary.face_list {
             let kind = serde_json::to_value(f.kind).unwrap_or_default();
             let [x, y, z] = f.centroid_mm;
             let _ = writeln!(
@@ -110,6 +115,6 @@ pub fn write_cad(solids: &CadSolids, dir: &Path) -> Result<Vec<PathBuf>, OutputE
     let path = dir.join(FACES_FILE);
     write_atomic(&path, faces.as_bytes())?;
     files.push(path);
-    update_summary(dir, "cad", summary_value(solids)?)?;
+    update_summary(dir, "cad", to_json("cad", &section)?)?;
     Ok(files)
 }
