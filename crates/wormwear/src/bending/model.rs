@@ -22,7 +22,7 @@ use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 
 /// Version of the FE models and their fit: bump when a change alters the coefficients.
-const MODEL_VERSION: &str = "fe-bending-3";
+const MODEL_VERSION: &str = "fe-bending-4";
 
 /// Why the bending stage failed.
 #[derive(Debug, thiserror::Error)]

@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 
 /// Version of the compliance's computation: bump when a change alters it.
-const VERSION: &str = "worm-deflection-1";
+const VERSION: &str = "worm-deflection-2";
 
 /// Compliance of the worm's axis at the mesh plane (x1 = 0): column j the displacement (worm
 /// frame x, y, z; m) of the axis under a unit force (N) along worm-frame axis j spread evenly

@@ -5,15 +5,16 @@
 //! size limits, and the solves a model calls; `system` the assembled system and its
 //! factorisation; `checks` boxes, CalculiX decks and element measures for the tests.
 
-use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
 mod checks;
+mod ordering;
 mod system;
 
 pub use checks::*;
+use ordering::*;
 use system::*;
 
 /// Natural coordinates of the 20 nodes: 8 corners, then the 12 edge midpoints.

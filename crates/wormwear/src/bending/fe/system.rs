@@ -18,6 +18,11 @@ impl SizeLimits {
         unknowns: MAX_UNKNOWNS,
         factor_nonzeros: MAX_FACTOR_NONZEROS,
     };
+    /// No limits (the solves of the checks and the ratings, whose meshes the models bound).
+    pub(super) const NONE: Self = Self {
+        unknowns: usize::MAX,
+        factor_nonzeros: usize::MAX,
+    };
 }
 
 /// The text of [`FeError::TooLarge`].
@@ -113,12 +118,18 @@ pub(super) fn solve_assembled(
     loads: &[Vec<Load>],
 ) -> Result<Solution, FeError> {
     let system = assemble(mesh, elements, fixed, springs, loads);
-    let llt = system
-        .matrix
-        .sp_cholesky(Side::Lower)
-        .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
+    let free = system.matrix.nrows();
+    let node = free_dof_nodes(&system.map, free);
+    let factor = BlockedLast::ordered(
+        system.matrix.symbolic(),
+        &node,
+        &vec![false; free],
+        SizeLimits::NONE,
+    )?;
     Ok(Solution {
-        x: llt.solve(&system.rhs),
+        x: factor
+            .factorize(system.matrix, system.rhs.ncols())?
+            .solve(system.rhs, false),
         map: system.map,
         prescribed: system.prescribed,
     })
@@ -295,7 +306,10 @@ pub(super) fn solve_free_minus_blocked(
     let elements = element_stiffnesses(mesh, material)?;
     let system = fill(mesh, &elements, springs, loads, dofs, pattern);
     drop(elements);
-    let x = factor.difference(system.matrix, system.rhs)?;
+    let cases = system.rhs.ncols();
+    let x = factor
+        .factorize(system.matrix, cases)?
+        .solve(system.rhs, true);
     let mut prescribed = system.prescribed;
     for p in prescribed.iter_mut().flatten() {
         *p = 0.0;
@@ -319,16 +333,14 @@ pub(super) struct BlockedLast {
 }
 
 impl BlockedLast {
-    /// Orders and analyses `pattern`; refuses a factor above `limits.factor_nonzeros`.
+    /// Orders and analyses `pattern` with the `blocked` nodes' free DOFs last; refuses a
+    /// factor above `limits.factor_nonzeros`.
     pub(super) fn analyse(
         pattern: &LowerPattern,
         dofs: &Dofs,
         blocked: &[usize],
         limits: SizeLimits,
     ) -> Result<Self, FeError> {
-        use faer::sparse::linalg::cholesky::{
-            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
-        };
         let free = dofs.free;
         let mut is_blocked = vec![false; free];
         for &n in blocked {
@@ -339,11 +351,26 @@ impl BlockedLast {
                 }
             }
         }
-        let (forward, inverse, unblocked) =
-            order_blocked_last(pattern.symbolic(free), &is_blocked)?;
+        let node = free_dof_nodes(&dofs.map, free);
+        Self::ordered(pattern.symbolic(free), &node, &is_blocked, limits)
+    }
+
+    /// Orders the lower-triangle pattern `lower` ([`order_blocked_last`]: `node` the mesh node
+    /// of every unknown, the `last` ones at the end) and analyses it.
+    pub(super) fn ordered(
+        lower: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+        node: &[usize],
+        last: &[bool],
+        limits: SizeLimits,
+    ) -> Result<Self, FeError> {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let free = last.len();
+        let (forward, inverse, unblocked) = order_blocked_last(lower, node, last)?;
         let perm = faer::perm::PermRef::new_checked(&forward, &inverse, free);
         let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(free),
+            lower,
             Side::Lower,
             SymmetricOrdering::Custom(perm),
             CholeskySymbolicParams::default(),
@@ -363,16 +390,15 @@ impl BlockedLast {
         })
     }
 
-    /// Factorises `matrix` and returns the free run minus the blocked run of every case of
-    /// `rhs` (free-DOF numbering): L^-T [0; y_B] with y = L^-1 f.
-    pub(super) fn difference(
+    /// The numeric factor L of `matrix` on this order, with a work buffer large enough for
+    /// the solves of up to `cases` right-hand sides at once.
+    pub(super) fn factorize(
         &self,
         matrix: SparseColMat<usize, f64>,
-        rhs: Mat<f64>,
-    ) -> Result<Mat<f64>, FeError> {
+        cases: usize,
+    ) -> Result<Factor<'_>, FeError> {
         use faer::dyn_stack::{MemBuffer, MemStack};
         let symbolic = &self.symbolic;
-        let (free, cases) = (rhs.nrows(), rhs.ncols());
         let par = faer::get_global_parallelism();
         let mut values = vec![0.0; symbolic.len_val()];
         let mut mem = MemBuffer::new(
@@ -391,64 +417,58 @@ impl BlockedLast {
                 Default::default(),
             )
             .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
-        drop(matrix);
-        let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(self.forward[i], c)]);
-        drop(rhs);
-        lower_solve(symbolic, &values, y.as_mut(), false, par, &mut mem);
-        for c in 0..cases {
-            for i in 0..self.unblocked {
-                y[(i, c)] = 0.0;
-            }
-        }
-        lower_solve(symbolic, &values, y.as_mut(), true, par, &mut mem);
-        Ok(Mat::<f64>::from_fn(free, cases, |i, c| {
-            y[(self.inverse[i], c)]
-        }))
+        Ok(Factor {
+            order: self,
+            values,
+            mem,
+        })
     }
 }
 
-/// Fill-reducing order with the `last` unknowns at the end: AMD on the matrix without them,
-/// then them in their own order. Returns (forward: new -> old, inverse: old -> new, the number
-/// of unknowns before the last ones).
+/// The numeric Cholesky factor of a [`BlockedLast`] order.
+pub(super) struct Factor<'a> {
+    order: &'a BlockedLast,
+    values: Vec<f64>,
+    mem: faer::dyn_stack::MemBuffer,
+}
+
+impl Factor<'_> {
+    /// The solution of every case of `rhs` (free-DOF numbering, at most the `cases` of
+    /// [`BlockedLast::factorize`]): K^-1 f, or with `difference` the free run minus the
+    /// blocked run, L^-T [0; y_B] with y = L^-1 f.
+    pub(super) fn solve(&mut self, rhs: Mat<f64>, difference: bool) -> Mat<f64> {
+        let (free, cases) = (rhs.nrows(), rhs.ncols());
+        let order = self.order;
+        let (symbolic, values) = (&order.symbolic, &self.values);
+        let par = faer::get_global_parallelism();
+        let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(order.forward[i], c)]);
+        drop(rhs);
+        lower_solve(symbolic, values, y.as_mut(), false, par, &mut self.mem);
+        if difference {
+            for c in 0..cases {
+                for i in 0..order.unblocked {
+                    y[(i, c)] = 0.0;
+                }
+            }
+        }
+        lower_solve(symbolic, values, y.as_mut(), true, par, &mut self.mem);
+        Mat::<f64>::from_fn(free, cases, |i, c| y[(order.inverse[i], c)])
+    }
+}
+
+/// Fill-reducing order with the `last` unknowns at the end: nested dissection of the matrix
+/// without them ([`nested_dissection`], `node` the mesh node of every unknown), then them in
+/// their own order. Returns (forward: new -> old, inverse: old -> new, the number of unknowns
+/// before the last ones).
 pub(super) fn order_blocked_last(
     matrix: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    node: &[usize],
     last: &[bool],
 ) -> Result<(Vec<usize>, Vec<usize>, usize), FeError> {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::sparse::linalg::amd;
     let n = last.len();
-    let mut local = vec![usize::MAX; n];
-    let kept: Vec<usize> = (0..n).filter(|&i| !last[i]).collect();
-    for (k, &i) in kept.iter().enumerate() {
-        local[i] = k;
-    }
-    let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
-    let mut ptr = Vec::with_capacity(kept.len() + 1);
-    let mut rows = Vec::new();
-    ptr.push(0);
-    for &c in &kept {
-        rows.extend(
-            row_idx[col_ptr[c]..col_ptr[c + 1]]
-                .iter()
-                .filter(|&&r| !last[r])
-                .map(|&r| local[r]),
-        );
-        ptr.push(rows.len());
-    }
-    let m = kept.len();
-    let nnz = rows.len();
-    let pattern = SymbolicSparseColMat::new_checked(m, m, ptr, None, rows);
-    let (mut fwd, mut inv) = (vec![0usize; m], vec![0usize; m]);
-    let mut mem = MemBuffer::new(amd::order_scratch::<usize>(m, nnz));
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        pattern.as_ref(),
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .map_err(|e| FeError::Factorisation(format!("{e:?}")))?;
-    let mut forward: Vec<usize> = fwd.iter().map(|&k| kept[k]).collect();
+    let keep: Vec<bool> = last.iter().map(|&l| !l).collect();
+    let mut forward = nested_dissection(matrix, node, &keep)?;
+    let m = forward.len();
     forward.extend((0..n).filter(|&i| last[i]));
     let mut inverse = vec![0; n];
     for (new, &old) in forward.iter().enumerate() {
@@ -570,5 +590,59 @@ mod tests {
             }) => assert_eq!(unknowns, dofs.free),
             other => panic!("expected TooLarge on the unknowns, got {other:?}"),
         }
+    }
+
+    /// The nested dissection order of a clamped cube's stiffness pattern: a permutation of the
+    /// unknowns with each node's unknowns consecutive, the same on every call, and a factor no
+    /// fuller than faer's approximate minimum degree gives (the reason for it).
+    #[test]
+    fn nested_dissection_keeps_nodes_together_and_fills_less_than_minimum_degree() {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let (mesh, lattice) = box_mesh((0.01, 0.01, 0.01), (8, 8, 8), |p| p);
+        let fixed: Vec<Fixed> = lattice
+            .iter()
+            .enumerate()
+            .filter(|(_, ijk)| ijk[2] == 0)
+            .flat_map(|(k, _)| (0..3).map(move |d| (k, d, 0.0)))
+            .collect();
+        let dofs = Dofs::new(&mesh, &fixed);
+        let pattern = LowerPattern::new(&mesh, &[], &dofs.map, dofs.free);
+        let node = free_dof_nodes(&dofs.map, dofs.free);
+        let keep = vec![true; dofs.free];
+        let order = nested_dissection(pattern.symbolic(dofs.free), &node, &keep).unwrap();
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..dofs.free).collect::<Vec<_>>());
+        for pair in order.windows(2) {
+            if node[pair[0]] == node[pair[1]] {
+                assert_eq!(pair[1], pair[0] + 1, "a node's unknowns in their own order");
+            }
+        }
+        let runs = order.windows(2).filter(|p| node[p[0]] != node[p[1]]).count() + 1;
+        let nodes = node.iter().collect::<std::collections::HashSet<_>>().len();
+        assert_eq!(runs, nodes, "each node's unknowns together");
+        let again = nested_dissection(pattern.symbolic(dofs.free), &node, &keep).unwrap();
+        assert_eq!(order, again);
+        let nonzeros = |ordering| {
+            factorize_symbolic_cholesky(
+                pattern.symbolic(dofs.free),
+                Side::Lower,
+                ordering,
+                CholeskySymbolicParams::default(),
+            )
+            .unwrap()
+            .len_val()
+        };
+        let (forward, inverse, _) =
+            order_blocked_last(pattern.symbolic(dofs.free), &node, &vec![false; dofs.free])
+                .unwrap();
+        let perm = faer::perm::PermRef::new_checked(&forward, &inverse, dofs.free);
+        let (nd, amd) = (
+            nonzeros(SymmetricOrdering::Custom(perm)),
+            nonzeros(SymmetricOrdering::Amd),
+        );
+        assert!(nd < amd, "nested dissection {nd} nonzeros, minimum degree {amd}");
     }
 }
