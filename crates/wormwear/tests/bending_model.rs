@@ -5,6 +5,7 @@
 mod common;
 use common::example;
 use wormwear::bending::model::{build_in, cache_key, Origin};
+use wormwear::bending::worm_deflection::compliance_in;
 use wormwear::geometry::Geometry;
 use wormwear::input::{BendingKind, GearSet};
 use wormwear::ltca::{self, BendingModel, Ltca, LtcaSettings};
@@ -84,6 +85,39 @@ fn fe_bending_is_cached_reused_and_makes_the_mesh_more_compliant() {
                 assert_eq!(a[(i, j)].to_bits(), b[(i, j)].to_bits());
             }
         }
+    }
+    // The cold build cached the worm's deflection compliance (MODEL §9.1) from the worm
+    // model's own factorisation (free-run solves beside the free-minus-blocked ones, nested
+    // dissection with the blocked DOFs last). It is read back from that entry, and agrees with
+    // the deflection's own model, factorised separately in another order.
+    let entries = |prefix: &str| {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter(|e| {
+                let name = e.as_ref().unwrap().file_name();
+                name.to_string_lossy().starts_with(prefix)
+            })
+            .count()
+    };
+    assert_eq!(entries("worm-deflection-"), 1);
+    let (shared, warnings) = compliance_in(&g, &geo, Some(dir.path())).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let alone = wormwear::bending::worm_deflection::compute(&g, &geo).unwrap();
+    let largest = alone
+        .columns
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for (a, b) in shared
+        .columns
+        .iter()
+        .flatten()
+        .zip(alone.columns.iter().flatten())
+    {
+        assert!(
+            (a - b).abs() < 1e-9 * largest,
+            "deflection compliance {a:e} from the bending's factor, {b:e} alone"
+        );
     }
     // Never stale: every input the coefficients depend on is in the key.
     let key = cache_key(&g);

@@ -293,8 +293,15 @@ fn free_minus_blocked_from_one_factorisation_equals_two_solves() {
         })
         .collect();
     assert!(loads.len() >= 5 && blocked.len() >= 10);
-    let got =
-        free_minus_blocked(&mesh, &STEEL, &fixed, &springs, &blocked, &loads, &observed).unwrap();
+    let got = free_minus_blocked(
+        &mesh,
+        &STEEL,
+        (&fixed, &springs),
+        &blocked,
+        &loads,
+        &observed,
+    )
+    .unwrap();
     let cases: Vec<Vec<Load>> = loads
         .iter()
         .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())

@@ -15,7 +15,7 @@ use super::wheel_mesh::{SectorMeshSettings, WebSettings};
 use super::wheel_model::WheelBending;
 use super::wheel_shaft::WheelShaft;
 use super::worm_mesh::{WormBody, WormMeshSettings};
-use super::worm_model::{FeBending, WormBending};
+use super::worm_model::{FeBending, MeshPointCompliance, WormBending};
 use crate::geometry::Geometry;
 use crate::input::{BendingKind, GearSet};
 use std::hash::{Hash, Hasher};
@@ -23,6 +23,21 @@ use std::path::{Path, PathBuf};
 
 /// Version of the FE models and their fit: bump when a change alters the coefficients.
 const MODEL_VERSION: &str = "fe-bending-4";
+
+/// Version of the worm deflection's compliance (MODEL §9.1): bump when a change alters it.
+const DEFLECTION_VERSION: &str = "worm-deflection-2";
+
+/// The deflection compliance's cache file prefix and its name in warnings.
+pub(crate) const DEFLECTION_CACHE: (&str, &str) = ("worm-deflection", "worm deflection");
+
+/// The cache key of the worm deflection's compliance: its version and the bending's key.
+pub fn deflection_cache_key(gear: &GearSet) -> String {
+    serde_json::json!({
+        "version": DEFLECTION_VERSION,
+        "bending": cache_key(gear),
+    })
+    .to_string()
+}
 
 /// Why the bending stage failed.
 #[derive(Debug, thiserror::Error)]
@@ -150,6 +165,15 @@ pub fn worm_body(gear: &GearSet) -> WormBody {
 
 /// Builds both members' bending models (no cache).
 pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<FeBending, BendingError> {
+    compute_with_deflection(gear, geo).map(|(model, _)| model)
+}
+
+/// [`compute`] and the worm's deflection compliance (MODEL §9.1) from the worm model's own
+/// factorisation (None when its mesh has no flank node in the mesh zone or no bore node).
+pub fn compute_with_deflection(
+    gear: &GearSet,
+    geo: &Geometry,
+) -> Result<(FeBending, Option<MeshPointCompliance>), BendingError> {
     let b = &gear.bending;
     let wheel_settings = wheel_mesh_settings(gear, b.mesh_refinement, b.width_points);
     let worm_settings = worm_mesh_settings(b.mesh_refinement);
@@ -167,21 +191,24 @@ pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<FeBending, BendingError
             )
         },
         || {
-            WormBending::build(
+            WormBending::build_with_deflection(
                 gear,
                 geo,
                 &body,
                 &worm_settings,
-                b.height_points,
-                b.worm_width_points,
+                (b.height_points, b.worm_width_points),
             )
         },
     );
     let refinement = b.mesh_refinement;
-    Ok(FeBending {
-        wheel: wheel.map_err(|e| BendingError::of("wheel", refinement, e))?,
-        worm: worm.map_err(|e| BendingError::of("worm", refinement, e))?,
-    })
+    let (worm, deflection) = worm.map_err(|e| BendingError::of("worm", refinement, e))?;
+    Ok((
+        FeBending {
+            wheel: wheel.map_err(|e| BendingError::of("wheel", refinement, e))?,
+            worm,
+        },
+        deflection,
+    ))
 }
 
 /// The cache key: everything the coefficients depend on, as JSON text.
@@ -339,11 +366,24 @@ pub fn build_in(
             Vec::new(),
         ));
     }
-    let model = compute(gear, geo)?;
+    let (model, deflection) = compute_with_deflection(gear, geo)?;
     if let Some(p) = &path {
         if let Err(e) = write_cache(p, &key, &model) {
             warnings.push(format!(
                 "bending coefficients not cached in {}: {e}",
+                p.display()
+            ));
+        }
+    }
+    // The deflection came from the same factorisation: cached for the ratings, which would
+    // otherwise factor the worm model again.
+    if let (Some(d), Some(compliance)) = (dir, deflection) {
+        let key = deflection_cache_key(gear);
+        let p = cache_path(d, DEFLECTION_CACHE.0, &key);
+        if let Err(e) = write_cache(&p, &key, &compliance) {
+            warnings.push(format!(
+                "{} not cached in {}: {e}",
+                DEFLECTION_CACHE.1,
                 p.display()
             ));
         }

@@ -220,7 +220,7 @@ pub fn bending_displacements(
         .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
         .collect();
     let blocked: Vec<usize> = m.right_flank[1].iter().map(|f| f.2).collect();
-    free_minus_blocked(&m.mesh, material, &fixed, &[], &blocked, loads, observed)
+    free_minus_blocked(&m.mesh, material, (&fixed, &[]), &blocked, loads, observed)
 }
 
 impl BendingModel for WheelBending {

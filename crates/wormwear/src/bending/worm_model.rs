@@ -11,7 +11,10 @@
 //! fixed, stiff tangential springs).
 
 use super::basis::{Basis, WidthFunctions};
-use super::fe::{free_minus_blocked, solve_with_springs, Elastic, FeError, Fixed, Load, Spring};
+use super::fe::{
+    free_minus_blocked_and_free, solve_with_springs, CaseDisplacements, Elastic, FeError, Fixed,
+    Load, Spring,
+};
 use super::relation::{cached_core, relation_low_rank, relation_rows, CoreCache};
 use super::worm_mesh::{worm_mesh_on, WormBody, WormLattice, WormMesh, WormMeshSettings};
 use crate::geometry::{Flank, Geometry};
@@ -19,7 +22,7 @@ use crate::input::GearSet;
 use crate::ltca::solver::LowRank;
 use crate::ltca::{BendingModel, LocalCell};
 use faer::Mat;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Worm bending model (coefficients in m/N).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -135,6 +138,19 @@ impl WormBending {
         height: usize,
         width: usize,
     ) -> Result<Self, FeError> {
+        Self::build_with_deflection(gear, geo, body, settings, (height, width)).map(|(m, _)| m)
+    }
+
+    /// [`WormBending::build`] and, from the same factorisation, the worm's deflection
+    /// compliance at the mesh point (MODEL §9.1; None when the mesh has no flank node in the
+    /// mesh zone or no bore node).
+    pub fn build_with_deflection(
+        gear: &GearSet,
+        geo: &Geometry,
+        body: &WormBody,
+        settings: &WormMeshSettings,
+        (height, width): (usize, usize),
+    ) -> Result<(Self, Option<MeshPointCompliance>), FeError> {
         let flank = crate::kinematics::loaded_flank(gear);
         let theta_m = zone_half_angle(gear);
         let lattice = WormLattice::aligned(settings, theta_m, height, width);
@@ -175,7 +191,11 @@ impl WormBending {
             .collect();
         // Observed: the data points on the three threads (ids[t][l] is observed[t * n + l]).
         let observed: Vec<usize> = ids.iter().flatten().copied().collect();
-        let bending = worm_bending_displacements(&m, body, &material, &loads, &observed)?;
+        let deflection = deflection_cases(&m, theta_m).ok();
+        let plain = deflection.as_ref().map_or(&[][..], |(cases, _)| &cases[..]);
+        let (bending, free) =
+            worm_bending_and_free(&m, body, &material, (&loads, &observed), plain)?;
+        let compliance = deflection.map(|(_, axis)| compliance_of(&free, &axis));
         let n = data.len();
         let relation = |t: usize| {
             Mat::from_fn(n, n, |l, c| {
@@ -186,7 +206,7 @@ impl WormBending {
         };
         let coords: Vec<(f64, f64)> = data.iter().map(|d| d.2).collect();
         let profile = axial_profile_table(geo, flank, (rf, ra));
-        Ok(Self {
+        let model = Self {
             basis,
             same: basis.fit_least_squares(&coords, &relation(1)),
             before: basis.fit_least_squares(&coords, &relation(0)),
@@ -199,7 +219,8 @@ impl WormBending {
                 / (2.0 * std::f64::consts::PI),
             profile,
             cores: CoreCache::default(),
-        })
+        };
+        Ok((model, compliance))
     }
 
     /// Basis coordinates (r~, theta~) of a worm-frame point: r~ = (rho - r_f1)/(r_a1 - r_f1),
@@ -255,6 +276,95 @@ fn ring_weights(m: &WormMesh, ring: &[usize]) -> Vec<(f64, f64)> {
             (phi[i], 0.5 * span)
         })
         .collect()
+}
+
+/// Compliance of the worm's axis at the mesh plane (x1 = 0): column j the displacement (worm
+/// frame x, y, z; m) of the axis under a unit force (N) along worm-frame axis j spread evenly
+/// over the loaded flank's nodes of the central thread in the mesh zone.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeshPointCompliance {
+    pub columns: [[f64; 3]; 3],
+}
+
+impl MeshPointCompliance {
+    /// Lateral deflection of the axis (perpendicular to x1) under the force `f` (worm frame,
+    /// N), m.
+    pub fn lateral_deflection(&self, f: &Vector3<f64>) -> f64 {
+        let c = Matrix3::from_fn(|i, j| self.columns[j][i]);
+        let d = c * f;
+        d.y.hypot(d.z)
+    }
+}
+
+/// The nodes the mesh force is spread over: the central thread's loaded flank within the mesh
+/// zone (|phi| <= theta_m about y1, towards the wheel) on the middle half of the thread height.
+fn zone_nodes(m: &WormMesh, theta_m: f64) -> Vec<usize> {
+    let half = m.height_steps as f64;
+    m.loaded[1]
+        .iter()
+        .filter(|&&(_, h, n)| {
+            let x = m.mesh.nodes[n];
+            let phi = x[2].atan2(x[1]);
+            let t = h as f64 / half;
+            phi.abs() <= theta_m && (0.25..=0.75).contains(&t)
+        })
+        .map(|f| f.2)
+        .collect()
+}
+
+/// The bore's nodes nearest the mesh plane x1 = 0, one per half-layer (the axis's
+/// displacement there is their mean).
+fn axis_nodes(m: &WormMesh) -> Vec<usize> {
+    let bore = m
+        .mesh
+        .nodes
+        .iter()
+        .map(|x| x[1].hypot(x[2]))
+        .fold(f64::INFINITY, f64::min);
+    let mut best: Vec<Option<(f64, usize)>> = vec![None; m.half_layers];
+    for (i, x) in m.mesh.nodes.iter().enumerate() {
+        if (x[1].hypot(x[2]) - bore).abs() > 1e-9 * bore.max(1e-3) {
+            continue;
+        }
+        let phi = x[2].atan2(x[1]);
+        let tau = 2.0 * std::f64::consts::PI;
+        let li =
+            (((phi + 0.5 * tau) / tau * m.half_layers as f64).round() as usize) % m.half_layers;
+        if best[li].is_none_or(|(d, _)| x[0].abs() < d) {
+            best[li] = Some((x[0].abs(), i));
+        }
+    }
+    best.into_iter().flatten().map(|(_, i)| i).collect()
+}
+
+/// The deflection's load cases (MODEL §9.1): a unit force along each worm-frame axis spread
+/// evenly over [`zone_nodes`]; with the bore nodes whose mean displacement is the axis's
+/// ([`axis_nodes`]). Err when either set is empty.
+pub(super) fn deflection_cases(
+    m: &WormMesh,
+    theta_m: f64,
+) -> Result<(Vec<Vec<Load>>, Vec<usize>), FeError> {
+    let zone = zone_nodes(m, theta_m);
+    let axis = axis_nodes(m);
+    if zone.is_empty() || axis.is_empty() {
+        return Err(FeError::Factorisation(
+            "the worm mesh has no flank node in the mesh zone or no bore node".into(),
+        ));
+    }
+    let share = 1.0 / zone.len() as f64;
+    let cases = (0..3)
+        .map(|d| zone.iter().map(|&n| (n, d, share)).collect())
+        .collect();
+    Ok((cases, axis))
+}
+
+/// The compliance from the displacements of the three [`deflection_cases`], [case][node] in m:
+/// the mean over the `axis` nodes.
+pub(super) fn compliance_of(u: &[Vec<[f64; 3]>], axis: &[usize]) -> MeshPointCompliance {
+    let columns = std::array::from_fn(|j| {
+        std::array::from_fn(|i| axis.iter().map(|&n| u[j][n][i]).sum::<f64>() / axis.len() as f64)
+    });
+    MeshPointCompliance { columns }
 }
 
 /// Supports of the worm model (see the module doc). Bearings: stiff springs on the ring's
@@ -317,10 +427,28 @@ pub fn worm_bending_displacements(
     loads: &[(usize, Vector3<f64>)],
     observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
+    worm_bending_and_free(m, body, material, (loads, observed), &[]).map(|(bending, _)| bending)
+}
+
+/// [`worm_bending_displacements`] and, from the same factorisation, the worm model's
+/// displacements with its supports alone (as [`worm_displacements`]) under the load cases
+/// `plain`, [case][node] in m.
+pub fn worm_bending_and_free(
+    m: &WormMesh,
+    body: &WormBody,
+    material: &Elastic,
+    bending: (&[(usize, Vector3<f64>)], &[usize]),
+    plain: &[Vec<Load>],
+) -> Result<(CaseDisplacements, CaseDisplacements), FeError> {
     let (fixed, springs) = supports(m, body, material);
     let blocked: Vec<usize> = m.opposite[1].iter().map(|f| f.2).collect();
-    free_minus_blocked(
-        &m.mesh, material, &fixed, &springs, &blocked, loads, observed,
+    free_minus_blocked_and_free(
+        &m.mesh,
+        material,
+        (&fixed, &springs),
+        &blocked,
+        bending,
+        plain,
     )
 }
 

@@ -387,26 +387,57 @@ pub fn element_stiffnesses(mesh: &Mesh, material: &Elastic) -> Result<Vec<Vec<f6
 pub fn free_minus_blocked(
     mesh: &Mesh,
     material: &Elastic,
-    fixed: &[Fixed],
-    springs: &[Spring],
+    supports: (&[Fixed], &[Spring]),
     blocked: &[usize],
     loads: &[(usize, nalgebra::Vector3<f64>)],
     observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
-    let cases: Vec<Vec<Load>> = loads
+    let no_plain: &[Vec<Load>] = &[];
+    free_minus_blocked_and_free(
+        mesh,
+        material,
+        supports,
+        blocked,
+        (loads, observed),
+        no_plain,
+    )
+    .map(|(bending, _)| bending)
+}
+
+/// Displacements of several load cases at a set of nodes, [case][node], m (or m/N).
+pub type CaseDisplacements = Vec<Vec<[f64; 3]>>;
+
+/// [`free_minus_blocked`] and, from the same factorisation, the free run alone (the supports
+/// only, nothing blocked) under the load cases `plain`: the displacement of every node,
+/// [case][node], m. The worm's bending model and its deflection share one factorisation so.
+pub fn free_minus_blocked_and_free(
+    mesh: &Mesh,
+    material: &Elastic,
+    (fixed, springs): (&[Fixed], &[Spring]),
+    blocked: &[usize],
+    (loads, observed): (&[(usize, nalgebra::Vector3<f64>)], &[usize]),
+    plain: &[Vec<Load>],
+) -> Result<(CaseDisplacements, CaseDisplacements), FeError> {
+    let mut cases: Vec<Vec<Load>> = loads
         .iter()
         .map(|(n, nrm)| (0..3).map(|d| (*n, d, -nrm[d])).collect())
         .collect();
-    let difference = solve_free_minus_blocked(
+    let bending_cases = cases.len();
+    cases.extend_from_slice(plain);
+    let solution = solve_free_minus_blocked(
         mesh,
         material,
         fixed,
         springs,
         blocked,
-        &cases,
+        (&cases, bending_cases),
         SizeLimits::MODEL,
     )?;
-    Ok((0..cases.len())
-        .map(|c| observed.iter().map(|&n| difference.at(c, n)).collect())
-        .collect())
+    let bending = (0..bending_cases)
+        .map(|c| observed.iter().map(|&n| solution.at(c, n)).collect())
+        .collect();
+    let free = (bending_cases..cases.len())
+        .map(|c| (0..mesh.nodes.len()).map(|n| solution.at(c, n)).collect())
+        .collect();
+    Ok((bending, free))
 }

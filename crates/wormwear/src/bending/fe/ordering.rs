@@ -103,10 +103,7 @@ impl NodeGraph {
             adjncy.extend_from_slice(list);
             xadj.push(metis::idx_t::try_from(adjncy.len()).map_err(|_| too_large("edges"))?);
         }
-        let weight = members
-            .iter()
-            .map(|m| m.len() as metis::idx_t)
-            .collect();
+        let weight = members.iter().map(|m| m.len() as metis::idx_t).collect();
         if metis::idx_t::try_from(members.len()).is_err() {
             return Err(too_large("nodes"));
         }

@@ -129,9 +129,10 @@ pub(super) fn solve_assembled(
     Ok(Solution {
         x: factor
             .factorize(system.matrix, system.rhs.ncols())?
-            .solve(system.rhs, false),
+            .solve(system.rhs, 0),
         map: system.map,
         prescribed: system.prescribed,
+        difference_cases: 0,
     })
 }
 
@@ -274,13 +275,15 @@ pub(super) fn fill(
 
 /// The free run (`fixed` only) minus the blocked run (also the `blocked` nodes held at zero)
 /// of the same mesh and loads, from ONE Cholesky factorisation (MODEL §5.5 step 2). The
-/// blocked DOFs B are ordered last (AMD order for the others, R), so with A = L L^T the leading
+/// blocked DOFs B are ordered last (nested dissection for the others, R), so with A = L L^T the leading
 /// block L_RR of L is the Cholesky factor of the blocked run's matrix A_RR. Forward
 /// substitution y = L^-1 f serves both runs (its R part does not see f_B); the free run is
 /// L^-T y and the blocked run L^-T [y_R; 0] (x_R = A_RR^-1 f_R, x_B = 0, its loads on blocked
 /// nodes vanishing as they do for prescribed DOFs), so their difference is L^-T [0; y_B]: one
 /// factorisation and two triangular solves instead of two factorisations and four. The
 /// prescribed displacements are the same in both runs, so the difference is zero there.
+/// Of the load cases `loads`, the first `difference_cases` get this difference; the others the
+/// free run alone, K^-1 f, from the same factor (the worm's deflection, MODEL §9.1).
 ///
 /// The size is checked before anything large is computed: the unknowns against
 /// [`MAX_UNKNOWNS`], then the factor's nonzeros from the symbolic analysis against
@@ -291,7 +294,7 @@ pub(super) fn solve_free_minus_blocked(
     fixed: &[Fixed],
     springs: &[Spring],
     blocked: &[usize],
-    loads: &[Vec<Load>],
+    (loads, difference_cases): (&[Vec<Load>], usize),
     limits: SizeLimits,
 ) -> Result<Solution, FeError> {
     let dofs = Dofs::new(mesh, fixed);
@@ -309,15 +312,12 @@ pub(super) fn solve_free_minus_blocked(
     let cases = system.rhs.ncols();
     let x = factor
         .factorize(system.matrix, cases)?
-        .solve(system.rhs, true);
-    let mut prescribed = system.prescribed;
-    for p in prescribed.iter_mut().flatten() {
-        *p = 0.0;
-    }
+        .solve(system.rhs, difference_cases);
     Ok(Solution {
         x,
         map: system.map,
-        prescribed,
+        prescribed: system.prescribed,
+        difference_cases,
     })
 }
 
@@ -434,9 +434,9 @@ pub(super) struct Factor<'a> {
 
 impl Factor<'_> {
     /// The solution of every case of `rhs` (free-DOF numbering, at most the `cases` of
-    /// [`BlockedLast::factorize`]): K^-1 f, or with `difference` the free run minus the
-    /// blocked run, L^-T [0; y_B] with y = L^-1 f.
-    pub(super) fn solve(&mut self, rhs: Mat<f64>, difference: bool) -> Mat<f64> {
+    /// [`BlockedLast::factorize`]): for the first `difference_cases` the free run minus the
+    /// blocked run, L^-T [0; y_B] with y = L^-1 f; for the others K^-1 f.
+    pub(super) fn solve(&mut self, rhs: Mat<f64>, difference_cases: usize) -> Mat<f64> {
         let (free, cases) = (rhs.nrows(), rhs.ncols());
         let order = self.order;
         let (symbolic, values) = (&order.symbolic, &self.values);
@@ -444,11 +444,9 @@ impl Factor<'_> {
         let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(order.forward[i], c)]);
         drop(rhs);
         lower_solve(symbolic, values, y.as_mut(), false, par, &mut self.mem);
-        if difference {
-            for c in 0..cases {
-                for i in 0..order.unblocked {
-                    y[(i, c)] = 0.0;
-                }
+        for c in 0..difference_cases.min(cases) {
+            for i in 0..order.unblocked {
+                y[(i, c)] = 0.0;
             }
         }
         lower_solve(symbolic, values, y.as_mut(), true, par, &mut self.mem);
@@ -517,6 +515,8 @@ pub(super) struct Solution {
     pub(super) x: Mat<f64>,
     pub(super) map: Vec<usize>,
     pub(super) prescribed: Vec<Option<f64>>,
+    /// The first cases are free-minus-blocked differences, zero where prescribed.
+    pub(super) difference_cases: usize,
 }
 
 impl Solution {
@@ -526,6 +526,7 @@ impl Solution {
         for (d, ud) in u.iter_mut().enumerate() {
             let g = 3 * n + d;
             *ud = match self.prescribed[g] {
+                Some(_) if c < self.difference_cases => 0.0,
                 Some(v) => v,
                 None => self.x[(self.map[g], c)],
             };
@@ -564,7 +565,7 @@ mod tests {
             factor_nonzeros: usize::MAX,
         };
         let solve =
-            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], &loads, limits);
+            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], (&loads, 1), limits);
         assert!(solve(unlimited).is_ok());
         // The factor holds more nonzeros than the lower triangle of the matrix.
         let dofs = Dofs::new(&mesh, &fixed);
@@ -620,7 +621,11 @@ mod tests {
                 assert_eq!(pair[1], pair[0] + 1, "a node's unknowns in their own order");
             }
         }
-        let runs = order.windows(2).filter(|p| node[p[0]] != node[p[1]]).count() + 1;
+        let runs = order
+            .windows(2)
+            .filter(|p| node[p[0]] != node[p[1]])
+            .count()
+            + 1;
         let nodes = node.iter().collect::<std::collections::HashSet<_>>().len();
         assert_eq!(runs, nodes, "each node's unknowns together");
         let again = nested_dissection(pattern.symbolic(dofs.free), &node, &keep).unwrap();
@@ -643,6 +648,9 @@ mod tests {
             nonzeros(SymmetricOrdering::Custom(perm)),
             nonzeros(SymmetricOrdering::Amd),
         );
-        assert!(nd < amd, "nested dissection {nd} nonzeros, minimum degree {amd}");
+        assert!(
+            nd < amd,
+            "nested dissection {nd} nonzeros, minimum degree {amd}"
+        );
     }
 }
