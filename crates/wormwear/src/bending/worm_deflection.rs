@@ -32,7 +32,11 @@ pub fn compute(gear: &GearSet, geo: &Geometry) -> Result<MeshPointCompliance, Fe
         poisson_ratio: gear.worm_material.poisson_ratio,
     };
     let u = worm_displacements(&m, &body, &material, &cases)?;
-    Ok(compliance_of(&u, &axis))
+    let at_axis: Vec<Vec<[f64; 3]>> = u
+        .iter()
+        .map(|case| axis.iter().map(|&n| case[n]).collect())
+        .collect();
+    Ok(compliance_of(&at_axis))
 }
 
 /// The compliance for the gear: from the cache directory when an entry of the same key is

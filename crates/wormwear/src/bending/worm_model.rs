@@ -192,10 +192,12 @@ impl WormBending {
         // Observed: the data points on the three threads (ids[t][l] is observed[t * n + l]).
         let observed: Vec<usize> = ids.iter().flatten().copied().collect();
         let deflection = deflection_cases(&m, theta_m).ok();
-        let plain = deflection.as_ref().map_or(&[][..], |(cases, _)| &cases[..]);
+        let plain = deflection
+            .as_ref()
+            .map_or((&[][..], &[][..]), |(cases, axis)| (&cases[..], &axis[..]));
         let (bending, free) =
             worm_bending_and_free(&m, body, &material, (&loads, &observed), plain)?;
-        let compliance = deflection.map(|(_, axis)| compliance_of(&free, &axis));
+        let compliance = deflection.map(|_| compliance_of(&free));
         let n = data.len();
         let relation = |t: usize| {
             Mat::from_fn(n, n, |l, c| {
@@ -358,11 +360,11 @@ pub(super) fn deflection_cases(
     Ok((cases, axis))
 }
 
-/// The compliance from the displacements of the three [`deflection_cases`], [case][node] in m:
-/// the mean over the `axis` nodes.
-pub(super) fn compliance_of(u: &[Vec<[f64; 3]>], axis: &[usize]) -> MeshPointCompliance {
+/// The compliance from the displacements of the axis nodes under the three
+/// [`deflection_cases`], [case][axis node] in m: their mean.
+pub(super) fn compliance_of(u: &[Vec<[f64; 3]>]) -> MeshPointCompliance {
     let columns = std::array::from_fn(|j| {
-        std::array::from_fn(|i| axis.iter().map(|&n| u[j][n][i]).sum::<f64>() / axis.len() as f64)
+        std::array::from_fn(|i| u[j].iter().map(|x| x[i]).sum::<f64>() / u[j].len() as f64)
     });
     MeshPointCompliance { columns }
 }
@@ -427,18 +429,19 @@ pub fn worm_bending_displacements(
     loads: &[(usize, Vector3<f64>)],
     observed: &[usize],
 ) -> Result<Vec<Vec<[f64; 3]>>, FeError> {
-    worm_bending_and_free(m, body, material, (loads, observed), &[]).map(|(bending, _)| bending)
+    worm_bending_and_free(m, body, material, (loads, observed), (&[], &[]))
+        .map(|(bending, _)| bending)
 }
 
 /// [`worm_bending_displacements`] and, from the same factorisation, the worm model's
 /// displacements with its supports alone (as [`worm_displacements`]) under the load cases
-/// `plain`, [case][node] in m.
+/// `plain.0` at the nodes `plain.1`, [case][k] in m.
 pub fn worm_bending_and_free(
     m: &WormMesh,
     body: &WormBody,
     material: &Elastic,
     bending: (&[(usize, Vector3<f64>)], &[usize]),
-    plain: &[Vec<Load>],
+    plain: (&[Vec<Load>], &[usize]),
 ) -> Result<(CaseDisplacements, CaseDisplacements), FeError> {
     let (fixed, springs) = supports(m, body, material);
     let blocked: Vec<usize> = m.opposite[1].iter().map(|f| f.2).collect();

@@ -399,7 +399,7 @@ pub fn free_minus_blocked(
         supports,
         blocked,
         (loads, observed),
-        no_plain,
+        (no_plain, &[]),
     )
     .map(|(bending, _)| bending)
 }
@@ -408,15 +408,16 @@ pub fn free_minus_blocked(
 pub type CaseDisplacements = Vec<Vec<[f64; 3]>>;
 
 /// [`free_minus_blocked`] and, from the same factorisation, the free run alone (the supports
-/// only, nothing blocked) under the load cases `plain`: the displacement of every node,
-/// [case][node], m. The worm's bending model and its deflection share one factorisation so.
+/// only, nothing blocked) under the load cases `plain`, at the nodes `plain_observed`:
+/// [case][k], m. The worm's bending model and its deflection share one factorisation so. Only
+/// the observed nodes are solved for (the backward substitution skips what they do not need).
 pub fn free_minus_blocked_and_free(
     mesh: &Mesh,
     material: &Elastic,
     (fixed, springs): (&[Fixed], &[Spring]),
     blocked: &[usize],
     (loads, observed): (&[(usize, nalgebra::Vector3<f64>)], &[usize]),
-    plain: &[Vec<Load>],
+    (plain, plain_observed): (&[Vec<Load>], &[usize]),
 ) -> Result<(CaseDisplacements, CaseDisplacements), FeError> {
     let mut cases: Vec<Vec<Load>> = loads
         .iter()
@@ -424,20 +425,24 @@ pub fn free_minus_blocked_and_free(
         .collect();
     let bending_cases = cases.len();
     cases.extend_from_slice(plain);
+    let wanted: Vec<usize> = observed.iter().chain(plain_observed).copied().collect();
     let solution = solve_free_minus_blocked(
         mesh,
         material,
         fixed,
         springs,
         blocked,
-        (&cases, bending_cases),
+        Cases {
+            loads: &cases,
+            difference: bending_cases,
+            observed: Some(&wanted),
+        },
         SizeLimits::MODEL,
     )?;
-    let bending = (0..bending_cases)
-        .map(|c| observed.iter().map(|&n| solution.at(c, n)).collect())
-        .collect();
+    let at = |c: usize, nodes: &[usize]| nodes.iter().map(|&n| solution.at(c, n)).collect();
+    let bending = (0..bending_cases).map(|c| at(c, observed)).collect();
     let free = (bending_cases..cases.len())
-        .map(|c| (0..mesh.nodes.len()).map(|n| solution.at(c, n)).collect())
+        .map(|c| at(c, plain_observed))
         .collect();
     Ok((bending, free))
 }

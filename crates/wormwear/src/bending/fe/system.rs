@@ -129,7 +129,7 @@ pub(super) fn solve_assembled(
     Ok(Solution {
         x: factor
             .factorize(system.matrix, system.rhs.ncols())?
-            .solve(system.rhs, 0),
+            .solve(system.rhs, 0, None),
         map: system.map,
         prescribed: system.prescribed,
         difference_cases: 0,
@@ -282,8 +282,8 @@ pub(super) fn fill(
 /// nodes vanishing as they do for prescribed DOFs), so their difference is L^-T [0; y_B]: one
 /// factorisation and two triangular solves instead of two factorisations and four. The
 /// prescribed displacements are the same in both runs, so the difference is zero there.
-/// Of the load cases `loads`, the first `difference_cases` get this difference; the others the
-/// free run alone, K^-1 f, from the same factor (the worm's deflection, MODEL §9.1).
+/// Of the load cases ([`Cases`]), the first get this difference, the others the free run
+/// alone, K^-1 f, from the same factor (the worm's deflection, MODEL §9.1).
 ///
 /// The size is checked before anything large is computed: the unknowns against
 /// [`MAX_UNKNOWNS`], then the factor's nonzeros from the symbolic analysis against
@@ -294,7 +294,7 @@ pub(super) fn solve_free_minus_blocked(
     fixed: &[Fixed],
     springs: &[Spring],
     blocked: &[usize],
-    (loads, difference_cases): (&[Vec<Load>], usize),
+    cases: Cases<'_>,
     limits: SizeLimits,
 ) -> Result<Solution, FeError> {
     let dofs = Dofs::new(mesh, fixed);
@@ -307,18 +307,37 @@ pub(super) fn solve_free_minus_blocked(
     let pattern = LowerPattern::new(mesh, springs, &dofs.map, dofs.free);
     let factor = BlockedLast::analyse(&pattern, &dofs, blocked, limits)?;
     let elements = element_stiffnesses(mesh, material)?;
-    let system = fill(mesh, &elements, springs, loads, dofs, pattern);
+    let map = &dofs.map;
+    let wanted: Option<Vec<usize>> = cases.observed.map(|nodes| {
+        nodes
+            .iter()
+            .flat_map(|&n| (0..3).map(move |d| map[3 * n + d]))
+            .filter(|&i| i != usize::MAX)
+            .collect()
+    });
+    let system = fill(mesh, &elements, springs, cases.loads, dofs, pattern);
     drop(elements);
-    let cases = system.rhs.ncols();
-    let x = factor
-        .factorize(system.matrix, cases)?
-        .solve(system.rhs, difference_cases);
+    let count = system.rhs.ncols();
+    let x = factor.factorize(system.matrix, count)?.solve(
+        system.rhs,
+        cases.difference,
+        wanted.as_deref(),
+    );
     Ok(Solution {
         x,
         map: system.map,
         prescribed: system.prescribed,
-        difference_cases,
+        difference_cases: cases.difference,
     })
+}
+
+/// The load cases of [`solve_free_minus_blocked`]: the first `difference` of `loads` get the
+/// free-minus-blocked difference, the others the free run alone; with `observed` (nodes) only
+/// those nodes' displacements are computed exactly (the others are NaN).
+pub(super) struct Cases<'a> {
+    pub(super) loads: &'a [Vec<Load>],
+    pub(super) difference: usize,
+    pub(super) observed: Option<&'a [usize]>,
 }
 
 /// The symbolic Cholesky factor of a run's free-free stiffness with the blocked DOFs ordered
@@ -435,21 +454,42 @@ pub(super) struct Factor<'a> {
 impl Factor<'_> {
     /// The solution of every case of `rhs` (free-DOF numbering, at most the `cases` of
     /// [`BlockedLast::factorize`]): for the first `difference_cases` the free run minus the
-    /// blocked run, L^-T [0; y_B] with y = L^-1 f; for the others K^-1 f.
-    pub(super) fn solve(&mut self, rhs: Mat<f64>, difference_cases: usize) -> Mat<f64> {
+    /// blocked run, L^-T [0; y_B] with y = L^-1 f; for the others K^-1 f. With `wanted` (free
+    /// DOFs) only those are exact, the backward substitution skipping the supernodes they do
+    /// not depend on, and the skipped rows are NaN.
+    pub(super) fn solve(
+        &mut self,
+        rhs: Mat<f64>,
+        difference_cases: usize,
+        wanted: Option<&[usize]>,
+    ) -> Mat<f64> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
         let (free, cases) = (rhs.nrows(), rhs.ncols());
         let order = self.order;
         let (symbolic, values) = (&order.symbolic, &self.values);
         let par = faer::get_global_parallelism();
         let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(order.forward[i], c)]);
         drop(rhs);
-        lower_solve(symbolic, values, y.as_mut(), false, par, &mut self.mem);
+        let supernodal = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some((s, SupernodalLltRef::new(s, values))),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
+        match supernodal {
+            Some((_, l)) => forward_sparse(l, y.as_mut(), par),
+            None => lower_solve(symbolic, values, y.as_mut(), false, par, &mut self.mem),
+        }
         for c in 0..difference_cases.min(cases) {
             for i in 0..order.unblocked {
                 y[(i, c)] = 0.0;
             }
         }
-        lower_solve(symbolic, values, y.as_mut(), true, par, &mut self.mem);
+        match (supernodal, wanted) {
+            (Some((s, l)), Some(rows)) => {
+                let needed = supernodes_on_paths(s, rows.iter().map(|&i| order.inverse[i]));
+                backward_on(l, y.as_mut(), &needed, par);
+            }
+            _ => lower_solve(symbolic, values, y.as_mut(), true, par, &mut self.mem),
+        }
         Mat::<f64>::from_fn(free, cases, |i, c| y[(order.inverse[i], c)])
     }
 }
@@ -505,6 +545,144 @@ pub(super) fn lower_solve(
                 l.l_solve_with_conj(Conj::No, rhs, par, stack);
             }
         }
+    }
+}
+
+/// A work matrix for the updates of `k` cases by any supernode of `l` (its longest pattern).
+fn update_buffer(
+    l: faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef<'_, usize, f64>,
+    k: usize,
+) -> Mat<f64> {
+    let longest = (0..l.symbolic().n_supernodes())
+        .map(|s| l.supernode(s).pattern().len())
+        .max()
+        .unwrap_or(0);
+    Mat::<f64>::zeros(longest, k)
+}
+
+/// Forward substitution rhs <- L^-1 rhs on a supernodal factor that skips the supernodes where
+/// every case is still zero (their updates are zero): a load case on one node only touches
+/// the supernodes on its path to the root of the elimination tree. The same operations as
+/// faer's `l_solve_with_conj` on the others, so the same numbers.
+fn forward_sparse(
+    l: faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef<'_, usize, f64>,
+    mut x: faer::MatMut<'_, f64>,
+    par: faer::Par,
+) {
+    use faer::linalg::{matmul::matmul_with_conj, triangular_solve};
+    use faer::reborrow::{Reborrow, ReborrowMut};
+    use faer::{Accum, Conj};
+    let k = x.ncols();
+    let symbolic = l.symbolic();
+    let mut buffer = update_buffer(l, k);
+    for s in 0..symbolic.n_supernodes() {
+        let node = l.supernode(s);
+        let size = node.val().ncols();
+        let start = node.start();
+        let zero = (0..k).all(|j| (start..start + size).all(|i| x[(i, j)] == 0.0));
+        if zero {
+            continue;
+        }
+        let (top, bottom) = node.val().split_at_row(size);
+        let mut x_top = x.rb_mut().subrows_mut(start, size);
+        triangular_solve::solve_lower_triangular_in_place_with_conj(
+            top,
+            Conj::No,
+            x_top.rb_mut(),
+            par,
+        );
+        let pattern = node.pattern();
+        let mut tmp = buffer.as_mut().subrows_mut(0, pattern.len());
+        matmul_with_conj(
+            tmp.rb_mut(),
+            Accum::Replace,
+            bottom,
+            Conj::No,
+            x_top.rb(),
+            Conj::No,
+            1.0,
+            par,
+        );
+        for j in 0..k {
+            for (idx, &i) in pattern.iter().enumerate() {
+                x[(i, j)] -= tmp[(idx, j)];
+            }
+        }
+    }
+}
+
+/// The supernodes a backward substitution must compute for the rows `rows` (permuted
+/// numbering) to be exact: theirs and every ancestor's (a supernode's rows below its diagonal
+/// block belong to its ancestors; the parent holds the first of them).
+fn supernodes_on_paths(
+    symbolic: &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+    rows: impl Iterator<Item = usize>,
+) -> Vec<bool> {
+    let n = symbolic.n_supernodes();
+    let begin = symbolic.supernode_begin();
+    let of_row = |r: usize| begin[..n].partition_point(|&b| b <= r) - 1;
+    let mut needed = vec![false; n];
+    for r in rows {
+        needed[of_row(r)] = true;
+    }
+    for s in 0..n {
+        if needed[s] {
+            if let Some(&first) = symbolic.supernode(s).pattern().first() {
+                needed[of_row(first)] = true;
+            }
+        }
+    }
+    needed
+}
+
+/// Backward substitution rhs <- L^-T rhs on the `needed` supernodes only
+/// ([`supernodes_on_paths`]); the others' rows are set to NaN. The same operations as faer's
+/// `l_transpose_solve_with_conj` on the needed ones, so the same numbers there.
+fn backward_on(
+    l: faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef<'_, usize, f64>,
+    mut x: faer::MatMut<'_, f64>,
+    needed: &[bool],
+    par: faer::Par,
+) {
+    use faer::linalg::{matmul::matmul_with_conj, triangular_solve};
+    use faer::reborrow::{Reborrow, ReborrowMut};
+    use faer::{Accum, Conj};
+    let k = x.ncols();
+    let symbolic = l.symbolic();
+    let mut buffer = update_buffer(l, k);
+    for s in (0..symbolic.n_supernodes()).rev() {
+        let node = l.supernode(s);
+        let size = node.val().ncols();
+        let start = node.start();
+        if !needed[s] {
+            x.rb_mut().subrows_mut(start, size).fill(f64::NAN);
+            continue;
+        }
+        let (top, bottom) = node.val().split_at_row(size);
+        let pattern = node.pattern();
+        let mut tmp = buffer.as_mut().subrows_mut(0, pattern.len());
+        for j in 0..k {
+            for (idx, &i) in pattern.iter().enumerate() {
+                tmp[(idx, j)] = x[(i, j)];
+            }
+        }
+        let mut x_top = x.rb_mut().subrows_mut(start, size);
+        matmul_with_conj(
+            x_top.rb_mut(),
+            Accum::Add,
+            bottom.transpose(),
+            Conj::No,
+            tmp.rb(),
+            Conj::No,
+            -1.0,
+            par,
+        );
+        triangular_solve::solve_upper_triangular_in_place_with_conj(
+            top.transpose(),
+            Conj::No,
+            x_top.rb_mut(),
+            par,
+        );
     }
 }
 
@@ -564,8 +742,13 @@ mod tests {
             unknowns: usize::MAX,
             factor_nonzeros: usize::MAX,
         };
+        let cases = || Cases {
+            loads: &loads,
+            difference: 1,
+            observed: None,
+        };
         let solve =
-            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], (&loads, 1), limits);
+            |limits| solve_free_minus_blocked(&mesh, &STEEL, &fixed, &[], &[], cases(), limits);
         assert!(solve(unlimited).is_ok());
         // The factor holds more nonzeros than the lower triangle of the matrix.
         let dofs = Dofs::new(&mesh, &fixed);
@@ -652,5 +835,85 @@ mod tests {
             nd < amd,
             "nested dissection {nd} nonzeros, minimum degree {amd}"
         );
+    }
+
+    /// The solves that skip supernodes: the forward substitution that skips all-zero
+    /// supernodes gives faer's numbers bit for bit, and a backward substitution restricted to
+    /// the supernodes some wanted rows depend on gives the full solve's numbers there, bit for
+    /// bit, and NaN elsewhere (never a silent wrong value).
+    #[test]
+    fn solves_on_the_elimination_tree_paths_equal_the_full_solves_where_wanted() {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        let (mesh, lattice) = box_mesh((0.04, 0.01, 0.01), (16, 4, 4), |p| p);
+        let fixed: Vec<Fixed> = lattice
+            .iter()
+            .enumerate()
+            .filter(|(_, ijk)| ijk[0] == 0)
+            .flat_map(|(k, _)| (0..3).map(move |d| (k, d, 0.0)))
+            .collect();
+        let at_x = |i: usize| -> Vec<usize> {
+            (0..lattice.len())
+                .filter(|&k| lattice[k][0] == i && lattice[k][1] == 0)
+                .collect()
+        };
+        let blocked = at_x(16);
+        // Single-node loads near the blocked face (difference cases) and one spread load (a
+        // plain case); observed nodes at the tip and halfway.
+        let mut loads: Vec<Vec<Load>> = at_x(30).iter().map(|&n| vec![(n, 1, -1.0)]).collect();
+        let difference = loads.len();
+        loads.push(at_x(20).iter().map(|&n| (n, 2, 0.5)).collect());
+        let observed: Vec<usize> = at_x(32).into_iter().chain(at_x(8)).collect();
+        let dofs = Dofs::new(&mesh, &fixed);
+        let pattern = LowerPattern::new(&mesh, &[], &dofs.map, dofs.free);
+        let factor = BlockedLast::analyse(&pattern, &dofs, &blocked, SizeLimits::NONE).unwrap();
+        let elements = element_stiffnesses(&mesh, &STEEL).unwrap();
+        let map = &dofs.map.clone();
+        let system = fill(&mesh, &elements, &[], &loads, dofs, pattern);
+        let wanted: Vec<usize> = observed
+            .iter()
+            .flat_map(|&n| (0..3).map(move |d| map[3 * n + d]))
+            .filter(|&i| i != usize::MAX)
+            .collect();
+        let mut numeric = factor
+            .factorize(system.matrix.clone(), loads.len())
+            .unwrap();
+        let full = numeric.solve(system.rhs.clone(), difference, None);
+        let some = numeric.solve(system.rhs.clone(), difference, Some(&wanted));
+        let mut skipped = 0;
+        for c in 0..loads.len() {
+            for i in 0..full.nrows() {
+                if wanted.contains(&i) {
+                    assert_eq!(some[(i, c)].to_bits(), full[(i, c)].to_bits());
+                    assert!(full[(i, c)] != 0.0);
+                } else if some[(i, c)].is_nan() {
+                    skipped += 1;
+                }
+            }
+        }
+        assert!(skipped > 0, "the restricted solve skipped no supernode");
+        // The forward substitution against faer's.
+        let SymbolicCholeskyRaw::Supernodal(symbolic) = factor.symbolic.raw() else {
+            panic!("a supernodal factor expected on this size");
+        };
+        let l = SupernodalLltRef::new(symbolic, &numeric.values);
+        let par = faer::Par::Seq;
+        let mut ours = Mat::<f64>::from_fn(full.nrows(), loads.len(), |i, c| {
+            system.rhs[(factor.forward[i], c)]
+        });
+        let mut theirs = ours.clone();
+        forward_sparse(l, ours.as_mut(), par);
+        lower_solve(
+            &factor.symbolic,
+            &numeric.values,
+            theirs.as_mut(),
+            false,
+            par,
+            &mut numeric.mem,
+        );
+        for c in 0..loads.len() {
+            for i in 0..full.nrows() {
+                assert_eq!(ours[(i, c)].to_bits(), theirs[(i, c)].to_bits());
+            }
+        }
     }
 }
