@@ -201,14 +201,10 @@ pub fn compute_with_deflection(
         },
     );
     let refinement = b.mesh_refinement;
+    // The wheel's error first when both fail, as before the deflection came along.
+    let wheel = wheel.map_err(|e| BendingError::of("wheel", refinement, e))?;
     let (worm, deflection) = worm.map_err(|e| BendingError::of("worm", refinement, e))?;
-    Ok((
-        FeBending {
-            wheel: wheel.map_err(|e| BendingError::of("wheel", refinement, e))?,
-            worm,
-        },
-        deflection,
-    ))
+    Ok((FeBending { wheel, worm }, deflection))
 }
 
 /// The cache key: everything the coefficients depend on, as JSON text.
