@@ -10,6 +10,9 @@ use nalgebra::Vector3;
 use std::f64::consts::PI;
 use std::mem::MaybeUninit;
 
+mod grid;
+pub use grid::{lattice, GridInfluence};
+
 /// Elastic constants of the pair used by the half-space coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ElasticPair {
@@ -73,16 +76,26 @@ pub fn love_rectangle(x: f64, y: f64, a: f64, b: f64) -> f64 {
     v
 }
 
-/// Love's integral with a far-field expansion beyond `FAR` times the larger half side: the
-/// rectangle's monopole and quadrupole terms,
+/// Squared in-plane distance from a rectangle of half sides (a, b) beyond which Love's
+/// integral takes its far-field expansion: six times the larger half side, m^2. The radius is
+/// widened by 1e-9 so that centres exactly six half sides apart (abutting equal cells three
+/// apart) take the closed form whatever the round-off of their difference: every such pair of
+/// a lattice then gets the same number (the two forms differ by up to 2e-4 there).
+#[inline]
+fn far_field_radius2(a: f64, b: f64) -> f64 {
+    const FAR: f64 = 6.0;
+    let m = FAR * a.max(b);
+    m * m * (1.0 + 1e-9)
+}
+
+/// Love's integral with a far-field expansion beyond six times the larger half side
+/// ([`far_field_radius2`]): the rectangle's monopole and quadrupole terms,
 /// 4ab [1/d + (a^2 (2x^2 - y^2) + b^2 (2y^2 - x^2)) / (6 d^5)], relative error O((a/d)^4)
 /// (below 1e-4 there), exact closed form nearer.
 #[inline]
 pub fn love_rectangle_fast(x: f64, y: f64, a: f64, b: f64) -> f64 {
-    const FAR: f64 = 6.0;
     let d2 = x * x + y * y;
-    let m = a.max(b);
-    if d2 > FAR * FAR * m * m {
+    if d2 > far_field_radius2(a, b) {
         let d = d2.sqrt();
         let d5 = d2 * d2 * d;
         4.0 * a
@@ -522,12 +535,11 @@ impl InfluenceRows {
 }
 
 /// Squared in-plane radius around each source cell inside which its coefficients take Love's
-/// closed form (six times the larger half side; the far-field expansion beyond), m^2.
+/// closed form ([`far_field_radius2`]; the far-field expansion beyond), m^2.
 fn near_radii2(cells: &[ContactCell]) -> Vec<f64> {
-    const FAR: f64 = 6.0;
     cells
         .iter()
-        .map(|c| (FAR * c.half_nu.max(c.half_zeta)).powi(2))
+        .map(|c| far_field_radius2(c.half_nu, c.half_zeta))
         .collect()
 }
 
