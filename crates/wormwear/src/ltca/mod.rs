@@ -25,7 +25,7 @@ use mesh::*;
 pub use pattern::*;
 use position::*;
 
-use crate::contact::{hertz_half_width, ContactCell, ElasticPair, InfluenceRows};
+use crate::contact::{hertz_half_width, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::{GearSet, Torque};
@@ -34,7 +34,7 @@ use crate::subsurface::{Criterion, Equivalent, SubsurfaceSettings};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use solver::{
-    Block, BlockMatrix, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings,
+    Block, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings,
 };
 use std::f64::consts::PI;
 

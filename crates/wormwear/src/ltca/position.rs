@@ -121,11 +121,7 @@ fn contact_problem(
             let group = &cells[start..start + size];
             let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
             let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
-            Block {
-                start,
-                size,
-                matrix: BlockMatrix::Lazy(Box::new(InfluenceRows::new(pair, &contact, &levers))),
-            }
+            Block::influence(start, pair, &contact, &levers)
         })
         .collect();
     let low_rank = bending.map(|b| {

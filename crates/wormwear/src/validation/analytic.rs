@@ -3,7 +3,7 @@
 //! the tests named in [`Check::test`] assert the same computations against the same bounds,
 //! so the table in VALIDATION.md is what the suite checks, with today's numbers.
 
-use crate::contact::{coefficient, ContactCell, ElasticPair};
+use crate::contact::{ContactCell, ElasticPair};
 use crate::ltca::solver::{solve, Block, Problem, SolverKind, SolverSettings};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
@@ -45,7 +45,8 @@ pub fn flat_cells(nx: usize, ny: usize, hx: f64, hy: f64) -> Vec<ContactCell> {
     cells
 }
 
-/// Contact problem in forces on flat cells: K_ij = C_ij / S_j (displacement per unit force),
+/// Contact problem in forces on flat cells: K_ij = C_ij / S_j (displacement per unit force;
+/// [`Block::influence`]: by FFT on a lattice of many cells),
 /// separations from `gap` at the cell centres, total load `load` (N).
 pub fn flat_problem(
     cells: &[ContactCell],
@@ -54,14 +55,8 @@ pub fn flat_problem(
 ) -> Problem {
     let n = cells.len();
     let p = steel_on_bronze();
-    let mut matrix = vec![0.0; n * n];
-    for i in 0..n {
-        for j in 0..n {
-            matrix[i * n + j] = coefficient(&p, &cells[i], &cells[j]) / cells[j].area();
-        }
-    }
     Problem {
-        blocks: vec![Block::dense(0, n, matrix)],
+        blocks: vec![Block::influence(0, &p, cells, &vec![1.0; n])],
         low_rank: None,
         separation: cells.iter().map(|c| gap(&c.centre)).collect(),
         load,

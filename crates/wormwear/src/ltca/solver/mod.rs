@@ -351,6 +351,10 @@ fn wide_kernels() -> bool {
 /// non-zero entries of x only, four columns at a time (one pass over ys per four), gathered as
 /// they come (no allocation per product); `wide`: the AVX2 kernel.
 fn block_product(b: &Block, x: &[f64], ys: &mut [f64], wide: bool) {
+    if let BlockMatrix::Grid(grid) = &b.matrix {
+        grid.product(&x[b.start..b.start + b.size], ys);
+        return;
+    }
     ys.iter_mut().for_each(|v| *v = 0.0);
     let column = |j: usize| b.row(j);
     let flush = |ys: &mut [f64], coef: [f64; 4], cols: [&[f64]; 4]| {

@@ -36,7 +36,14 @@ pub enum BlockMatrix {
     Dense(std::sync::Arc<Vec<f64>>),
     /// Rows and sub-blocks on demand, the same numbers as the dense block.
     Lazy(Box<crate::contact::InfluenceRows>),
+    /// Cells on a regular lattice: products by FFT, entries from the kernel (the same
+    /// numbers as the dense block to round-off).
+    Grid(Box<crate::contact::GridInfluence>),
 }
+
+/// Cells from which a lattice's block is applied by FFT rather than assembled: below, the
+/// assembled block is as fast (measured on the Hertz grids, BENCHMARKS.md session 27).
+pub const GRID_CELLS: usize = 400;
 
 impl Block {
     /// A dense block (row-major size x size).
@@ -49,12 +56,40 @@ impl Block {
         }
     }
 
+    /// The influence block of a group of cells (one tooth contact) with their levers (m),
+    /// entries those of [`crate::contact::symmetric_block`] (MODEL §5.5): applied by FFT when
+    /// the cells form a lattice of at least [`GRID_CELLS`] (flat contacts; a gear flank's
+    /// cells never do), else assembled as the solvers read it.
+    pub fn influence(
+        start: usize,
+        pair: &crate::contact::ElasticPair,
+        cells: &[crate::contact::ContactCell],
+        levers: &[f64],
+    ) -> Self {
+        let size = cells.len();
+        let grid = (size >= GRID_CELLS)
+            .then(|| crate::contact::GridInfluence::new(pair, cells, levers))
+            .flatten();
+        let matrix = match grid {
+            Some(grid) => BlockMatrix::Grid(Box::new(grid)),
+            None => BlockMatrix::Lazy(Box::new(crate::contact::InfluenceRows::new(
+                pair, cells, levers,
+            ))),
+        };
+        Self {
+            start,
+            size,
+            matrix,
+        }
+    }
+
     /// Row j of the block (= column j: symmetric), local index.
     #[inline]
     pub fn row(&self, j: usize) -> &[f64] {
         match &self.matrix {
             BlockMatrix::Dense(m) => &m[j * self.size..(j + 1) * self.size],
             BlockMatrix::Lazy(rows) => rows.row(j),
+            BlockMatrix::Grid(grid) => grid.row(j),
         }
     }
 
@@ -70,6 +105,7 @@ impl Block {
                 std::sync::Arc::new(matrix)
             }
             BlockMatrix::Lazy(rows) => rows.sub_block(inside),
+            BlockMatrix::Grid(grid) => std::sync::Arc::new(grid.sub_block(inside)),
         }
     }
 }
