@@ -173,7 +173,10 @@ fn the_fft_operator_gives_the_assembled_blocks_solution() {
     fft.apply(&by_blocks.q, &mut u);
     assembled.apply(&by_blocks.q, &mut v);
     let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    assert!(u.iter().zip(&v).all(|(x, y)| (x - y).abs() <= 1e-13 * scale));
+    assert!(u
+        .iter()
+        .zip(&v)
+        .all(|(x, y)| (x - y).abs() <= 1e-13 * scale));
 }
 
 #[test]
@@ -188,7 +191,10 @@ fn the_sphere_converges_to_hertz_on_grids_only_the_fft_operator_can_hold() {
         let sol = solve(&problem, &SolverSettings::default(), None).unwrap();
         let p_max = sol.q.iter().copied().fold(0.0, f64::max) / cells[0].area();
         let approach = sol.approach / (a * a / 10e-3);
-        eprintln!("{n} x {n}: p_max / p0 {:.6}, approach / (a^2/R) {approach:.6}", p_max / p0);
+        eprintln!(
+            "{n} x {n}: p_max / p0 {:.6}, approach / (a^2/R) {approach:.6}",
+            p_max / p0
+        );
         errors.push(((p_max / p0 - 1.0).abs(), (approach - 1.0).abs()));
     }
     for w in errors.windows(2) {

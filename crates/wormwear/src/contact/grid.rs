@@ -143,7 +143,10 @@ impl GridInfluence {
         assert_eq!(levers.len(), cells.len());
         let (nx, ny) = lattice(cells)?;
         let kernel = lattice_kernel(pair, cells, nx, ny);
-        let (px, py) = (transform_size(2 * nx - 1, true), transform_size(2 * ny - 1, false));
+        let (px, py) = (
+            transform_size(2 * nx - 1, true),
+            transform_size(2 * ny - 1, false),
+        );
         let mut real_planner = RealFftPlanner::<f64>::new();
         let mut planner = rustfft::FftPlanner::<f64>::new();
         let mut grid = Self {
@@ -455,7 +458,10 @@ mod tests {
             }
             // Round-off of the centres' differences (the lattice tolerance allows 1e-10).
             assert!(worst <= 1e-12, "{nx} x {ny}: entries differ by {worst:e}");
-            assert_eq!(grid.row(5), &(0..n).map(|k| grid.entry(k, 5)).collect::<Vec<_>>()[..]);
+            assert_eq!(
+                grid.row(5),
+                &(0..n).map(|k| grid.entry(k, 5)).collect::<Vec<_>>()[..]
+            );
             let inside = [1, 4, 5, n - 1];
             let sub = grid.sub_block(&inside);
             assert_eq!(sub[4 + 2], grid.entry(4, 5));
@@ -492,7 +498,13 @@ mod tests {
         turned[3].normal = (turned[3].normal + Vector3::new(0.0, 1e-3, 0.0)).normalize();
         let mut larger = cells.clone();
         larger[7].half_nu *= 1.001;
-        for bad in [moved, turned, larger, cells[..29].to_vec(), cells[..1].to_vec()] {
+        for bad in [
+            moved,
+            turned,
+            larger,
+            cells[..29].to_vec(),
+            cells[..1].to_vec(),
+        ] {
             assert_eq!(lattice(&bad), None);
         }
     }

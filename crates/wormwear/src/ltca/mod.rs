@@ -33,9 +33,7 @@ use crate::kinematics::{GapEvaluator, Tca};
 use crate::subsurface::{Criterion, Equivalent, SubsurfaceSettings};
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use solver::{
-    Block, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings,
-};
+use solver::{Block, LowRank, Problem, Residuals, SolverError, SolverKind, SolverSettings};
 use std::f64::consts::PI;
 
 /// Bending influence coefficients (worm and wheel), supplied by the bending stage.
