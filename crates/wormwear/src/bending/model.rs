@@ -22,10 +22,10 @@ use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 
 /// Version of the FE models and their fit: bump when a change alters the coefficients.
-const MODEL_VERSION: &str = "fe-bending-4";
+const MODEL_VERSION: &str = "fe-bending-5";
 
 /// Version of the worm deflection's compliance (MODEL §9.1): bump when a change alters it.
-const DEFLECTION_VERSION: &str = "worm-deflection-2";
+const DEFLECTION_VERSION: &str = "worm-deflection-3";
 
 /// The deflection compliance's cache file prefix and its name in warnings.
 pub(crate) const DEFLECTION_CACHE: (&str, &str) = ("worm-deflection", "worm deflection");

@@ -313,7 +313,7 @@ pub fn root_stress(
 
 /// Version of the root stress's cache entries: raise it when the sector, its loads or its
 /// reading change.
-const CACHE_VERSION: u32 = 2;
+const CACHE_VERSION: u32 = 3;
 
 /// [`root_stress`] from the cache directory `dir` when an entry of the same key is there (the
 /// whole gear, K_A and the safety inputs with it, the flank, level and fillet radius), else

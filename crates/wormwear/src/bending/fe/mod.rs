@@ -10,10 +10,12 @@ use faer::{Mat, Side};
 use rayon::prelude::*;
 
 mod checks;
+mod congruence;
 mod ordering;
 mod system;
 
 pub use checks::*;
+pub use congruence::{element_stiffnesses, ElementStiffnesses};
 use ordering::*;
 use system::*;
 
@@ -369,14 +371,6 @@ pub fn solve_with_springs(
     Ok((0..loads.len())
         .map(|c| (0..mesh.nodes.len()).map(|n| solution.at(c, n)).collect())
         .collect())
-}
-
-/// Stiffness matrices of all elements (row-major 60 x 60 each), computed in parallel.
-pub fn element_stiffnesses(mesh: &Mesh, material: &Elastic) -> Result<Vec<Vec<f64>>, FeError> {
-    (0..mesh.elements.len())
-        .into_par_iter()
-        .map(|e| element_stiffness(mesh, e, material))
-        .collect()
 }
 
 /// Bending displacements by the free / blocked technique (MODEL §5.5 step 2): for each load

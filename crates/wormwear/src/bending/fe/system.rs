@@ -112,7 +112,7 @@ impl LowerPattern {
 /// Solves with element stiffnesses already computed (shared by runs on the same mesh).
 pub(super) fn solve_assembled(
     mesh: &Mesh,
-    elements: &[Vec<f64>],
+    elements: &ElementStiffnesses,
     fixed: &[Fixed],
     springs: &[Spring],
     loads: &[Vec<Load>],
@@ -150,7 +150,7 @@ pub(super) struct System {
 /// right-hand sides) and the springs added.
 pub(super) fn assemble(
     mesh: &Mesh,
-    elements: &[Vec<f64>],
+    elements: &ElementStiffnesses,
     fixed: &[Fixed],
     springs: &[Spring],
     loads: &[Vec<Load>],
@@ -191,10 +191,24 @@ impl Dofs {
     }
 }
 
+/// The load cases' right-hand sides on the free DOFs (N; loads on prescribed DOFs dropped).
+fn load_vectors(loads: &[Vec<Load>], map: &[usize], free: usize) -> Mat<f64> {
+    let mut rhs = Mat::<f64>::zeros(free, loads.len());
+    for (c, case) in loads.iter().enumerate() {
+        for &(n, d, v) in case {
+            let g = 3 * n + d;
+            if map[g] != usize::MAX {
+                rhs[(map[g], c)] += v;
+            }
+        }
+    }
+    rhs
+}
+
 /// The stiffness values on `pattern` and the right-hand sides (see [`assemble`]).
 pub(super) fn fill(
     mesh: &Mesh,
-    elements: &[Vec<f64>],
+    elements: &ElementStiffnesses,
     springs: &[Spring],
     loads: &[Vec<Load>],
     dofs: Dofs,
@@ -207,15 +221,7 @@ pub(super) fn fill(
     } = dofs;
     let mut values = vec![0.0; pattern.row_idx.len()];
     let ncase = loads.len();
-    let mut rhs = Mat::<f64>::zeros(free, ncase);
-    for (c, case) in loads.iter().enumerate() {
-        for &(n, d, v) in case {
-            let g = 3 * n + d;
-            if map[g] != usize::MAX {
-                rhs[(map[g], c)] += v;
-            }
-        }
-    }
+    let mut rhs = load_vectors(loads, &map, free);
     // Stiffness entry (free row fr, global column gc): into the matrix (lower triangle) when
     // the column is free, onto the right-hand sides when it is prescribed.
     let mut scatter = |fr: usize, gc: usize, v: f64| match prescribed[gc] {
@@ -231,7 +237,9 @@ pub(super) fn fill(
             }
         }
     };
-    for (e, k) in mesh.elements.iter().zip(elements) {
+    let mut buffer = Vec::new();
+    for (index, e) in mesh.elements.iter().enumerate() {
+        let k = elements.matrix(index, &mut buffer);
         let dofs: Vec<usize> = e
             .iter()
             .flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2])
