@@ -1,24 +1,24 @@
 //! Stage 5a — friction, mesh power loss, efficiency and oil temperature (MODEL §13).
 //!
-//! Mixed lubrication at every loaded cell of every position of the loaded analysis: the
-//! asperities carry the share f_a of the local pressure (MODEL §10's Greenwood–Williamson
-//! form), the fluid film the rest with Eyring's shear stress bounded by the limiting shear
-//! stress; the local friction coefficient is mu = f_a mu_b + (1 - f_a) tau_f / p. The mesh
-//! loss is the cycle mean of sum mu p |v_g| S over the cells; with the no-load, bearing and
-//! seal losses of MODEL §9 it gives the efficiency, and with the housing's heat transfer the
-//! steady oil temperature: the fixed point temperature -> viscosity -> film -> friction ->
-//! loss ([`heat_balance`]).
+//! Mixed lubrication at every loaded cell of every position of the loaded analysis
+//! ([`crate::traction`]: Greenwood & Tripp's asperity share at the central film, Eyring's film
+//! shear bounded by the limiting shear, boundary friction on the asperities). The mesh loss is
+//! the cycle mean of sum mu p |v_g| S over the cells; with the no-load, bearing and seal losses
+//! of MODEL §9 it gives the efficiency, and with the housing's heat transfer the steady oil
+//! temperature: the fixed point temperature -> viscosity -> film -> friction -> loss
+//! ([`heat_balance`]).
 //!
-//! The loaded analysis stays frictionless (MODEL §5.2, §12): friction changes the worm torque
-//! the mesh needs, not the normal pressures it carries (a first-order reading, stated in the
-//! README). SI units throughout (Pa, m, m/s, W, K).
+//! The loaded analysis carries the friction's moments (MODEL §5.2: the transmitted torque,
+//! [`crate::ltca`]); here the same local law is evaluated on its pressures at any oil
+//! temperature. SI units throughout (Pa, m, m/s, W, K).
 
 use crate::geometry::Geometry;
 use crate::input::{FrictionLaw, GearSet, Housing, Lubricant};
-use crate::kinematics::{material_velocities, Tca};
-use crate::ltca::Ltca;
-use crate::lubrication::{self, LineContact};
-use std::f64::consts::PI;
+use crate::kinematics::Tca;
+use crate::ltca::{cell_sliding, FilmGeometry, FrictionInputs, Ltca};
+use crate::lubrication::LineContact;
+pub use crate::traction::LocalFriction;
+use crate::traction::{central_film_thickness, local_friction, PointContact};
 
 /// Errors of the heat balance; each names the input that decides it.
 #[derive(Debug, thiserror::Error)]
@@ -53,104 +53,6 @@ impl FrictionError {
     }
 }
 
-/// The asperities' contact pressure W_sec / A_c = 0.2 E' sqrt(m2 / pi) (MODEL §10), Pa, with
-/// E' the reduced modulus (Pa) and m2 = Rdq^2 the mean square roughness slope (Rdq in rad).
-pub fn asperity_pressure(e_prime: f64, slope_rdq: f64) -> f64 {
-    0.2 * e_prime * (slope_rdq * slope_rdq / PI).sqrt()
-}
-
-/// Share of the local pressure `pressure` (Pa) the asperities carry (MODEL §13):
-/// f_a = min(1, (W_sec / A_c)(A_c / A_0) / p), A_c / A_0 from the film thickness
-/// h = Phi_T h_min and the composite roughness R_q (both m; MODEL §10). 1 where p <= 0.
-pub fn asperity_share(
-    pressure: f64,
-    film_thickness: f64,
-    roughness_rq: f64,
-    e_prime: f64,
-    slope_rdq: f64,
-) -> f64 {
-    if pressure <= 0.0 || pressure.is_nan() {
-        return 1.0;
-    }
-    let carried = asperity_pressure(e_prime, slope_rdq)
-        * lubrication::asperity_area_fraction(film_thickness, roughness_rq);
-    (carried / pressure).min(1.0)
-}
-
-/// Shear stress of the lubricant film, Pa, at pressure `pressure` (Pa), sliding speed
-/// `sliding_speed` (m/s) and film thickness `film_thickness` (m): Eyring's law
-/// tau = tau_0 asinh(eta(p) gamma / tau_0), gamma = v_s / h, with the Barus viscosity
-/// eta(p) = eta_0 exp(alpha p) (`viscosity` eta_0 in Pa s, `pressure_viscosity` alpha in
-/// 1/Pa), bounded by the limiting shear stress Lambda p (Bair & Winer). A film of no
-/// thickness shears at the limit.
-pub fn fluid_shear(
-    pressure: f64,
-    sliding_speed: f64,
-    film_thickness: f64,
-    viscosity: f64,
-    pressure_viscosity: f64,
-    law: &FrictionLaw,
-) -> f64 {
-    let p = pressure.max(0.0);
-    let limit = law.limiting_shear * p;
-    let speed = sliding_speed.abs();
-    if speed == 0.0 {
-        return 0.0;
-    }
-    if film_thickness.is_nan() || film_thickness <= 0.0 {
-        return limit;
-    }
-    let eta = viscosity * (pressure_viscosity * p).exp();
-    let rate = speed / film_thickness;
-    let eyring = law.eyring_stress * (eta * rate / law.eyring_stress).asinh();
-    eyring.min(limit)
-}
-
-/// The friction at one point of the contact (MODEL §13).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct LocalFriction {
-    /// mu = f_a mu_b + (1 - f_a) tau_f / p.
-    pub coefficient: f64,
-    /// f_a, the asperities' share of the pressure.
-    pub asperity_share: f64,
-    /// tau_f, the film's shear stress, Pa.
-    pub fluid_shear: f64,
-}
-
-/// Local friction at pressure `pressure` (Pa) and sliding speed (m/s) over a film of thickness
-/// `film_thickness` (Phi_T h_min, m) of `lubricant` (its viscosity at the oil temperature),
-/// with the reduced modulus `e_prime` (Pa) (MODEL §13).
-pub fn local_friction(
-    pressure: f64,
-    sliding_speed: f64,
-    film_thickness: f64,
-    lubricant: &Lubricant,
-    law: &FrictionLaw,
-    e_prime: f64,
-) -> LocalFriction {
-    let share = asperity_share(
-        pressure,
-        film_thickness,
-        lubricant.composite_roughness,
-        e_prime,
-        law.roughness_slope,
-    );
-    let tau = fluid_shear(
-        pressure,
-        sliding_speed,
-        film_thickness,
-        lubricant.viscosity,
-        lubricant.pressure_viscosity,
-        law,
-    );
-    let fluid = if pressure > 0.0 { tau / pressure } else { 0.0 };
-    LocalFriction {
-        coefficient: share * law.boundary + (1.0 - share) * fluid,
-        asperity_share: share,
-        fluid_shear: tau,
-    }
-}
-
 /// One loaded cell of one position with what its friction needs that the oil temperature does
 /// not change.
 #[derive(Debug, Clone, Copy)]
@@ -181,8 +83,12 @@ pub struct MeshContacts {
     lines: Vec<LineContact>,
     positions: usize,
     e_prime: f64,
-    /// Output power P2 = omega2 x mean wheel torque of the positions, W.
+    /// Flow pressure bounding the asperities' pressure, Pa.
+    flow_pressure: f64,
+    /// Output power P2 = omega2 x mean transmitted wheel torque of the positions, W.
     pub output_power: f64,
+    /// Input power P1 = omega1 x mean worm torque of the positions, W.
+    pub input_power: f64,
 }
 
 /// The node columns of a flank grid: their z and radial limits (m), and the cell rows.
@@ -235,38 +141,6 @@ fn flank_cells_at(wf: &FlankGrid, (r, z): (f64, f64), half_dz: f64) -> [(usize, 
     out
 }
 
-/// The end of the slice that starts at cell `start` of a position (a slice's cells are
-/// consecutive: same tooth, same node column).
-fn slice_end(pr: &crate::ltca::PositionResult, start: usize) -> usize {
-    let first = &pr.cells[start];
-    (start..pr.cells.len())
-        .find(|&k| pr.cells[k].tooth_index != first.tooth_index || pr.cells[k].slice != first.slice)
-        .unwrap_or(pr.cells.len())
-}
-
-/// The line contact of one slice's cells `slice` (MODEL §6): the curvature radius (m), the
-/// rolling velocities (u1, u2; m/s), the line load sum p x (width across the line) (N/m) and
-/// the peak pressure (Pa).
-fn slice_line(
-    pr: &crate::ltca::PositionResult,
-    slice: std::ops::Range<usize>,
-    radius: f64,
-    (u1, u2): (f64, f64),
-) -> LineContact {
-    let line_load: f64 = slice
-        .clone()
-        .map(|k| pr.pressure[k] * 2.0 * pr.cells[k].cell.half_nu)
-        .sum();
-    let peak = slice.map(|k| pr.pressure[k]).fold(0.0, f64::max);
-    LineContact {
-        radius,
-        u1,
-        u2,
-        line_load,
-        pressure: peak,
-    }
-}
-
 /// Friction over the mesh cycle (MODEL §13).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct MeshFriction {
@@ -297,78 +171,41 @@ impl MeshContacts {
     /// curvature from the TCA's contact line, the rolling velocities of the nearest flank node).
     pub fn new(gear: &GearSet, geo: &Geometry, tca: &Tca, ltca: &Ltca) -> Self {
         let wf = geo.wheel_flank(tca.loaded_flank);
-        let rolling = tca.rolling_velocities(wf);
-        let radius: std::collections::HashMap<(usize, i32, usize), f64> = tca
-            .contact_lines
-            .iter()
-            .map(|c| ((c.position, c.tooth, c.slice), c.curvature_radius))
-            .collect();
-        let ni = wf.cells_height;
+        let film = FilmGeometry::new(tca, wf);
         let grid = FlankGrid::of(wf);
-        let node = |j: usize, r: f64| {
-            let t = (r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]);
-            let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
-            j * (ni + 1) + i
-        };
         let (mut cells, mut lines) = (Vec::new(), Vec::new());
         for (n, pr) in ltca.positions.iter().enumerate() {
-            let mut start = 0;
-            while start < pr.cells.len() {
-                let first = &pr.cells[start];
-                let end = slice_end(pr, start);
-                let slice = start..end;
-                let curvature = radius
-                    .get(&(pr.position, first.tooth, first.slice))
-                    .copied()
-                    .unwrap_or(f64::NAN);
-                lines.push(slice_line(
-                    pr,
-                    slice.clone(),
-                    curvature,
-                    rolling[node(first.slice, first.r)],
-                ));
-                let line = lines.len() - 1;
-                for k in slice.filter(|&k| pr.pressure[k] > 0.0) {
-                    let c = &pr.cells[k];
-                    let v = material_velocities(
-                        &c.cell.centre,
-                        &geo.worm,
-                        &gear.operating,
-                        gear.conditions.worm_speed,
-                        gear.ratio(),
-                    );
-                    let vg = nalgebra::Vector3::from(v.sliding).norm();
-                    cells.push(CellContact {
-                        flank_cells: flank_cells_at(&grid, (c.r, c.z), c.half_dz),
-                        position: n,
-                        cell: k,
-                        pressure: pr.pressure[k],
-                        sliding_speed: vg,
-                        area: c.cell.area(),
-                        line,
-                    });
-                }
-                start = end;
+            let (slices, of_cell) = film.slice_lines(pr.position, &pr.cells, &pr.pressure);
+            let sliding = cell_sliding(gear, geo, &pr.cells);
+            let first = lines.len();
+            lines.extend(slices);
+            for k in (0..pr.cells.len()).filter(|&k| pr.pressure[k] > 0.0) {
+                let c = &pr.cells[k];
+                cells.push(CellContact {
+                    flank_cells: flank_cells_at(&grid, (c.r, c.z), c.half_dz),
+                    position: n,
+                    cell: k,
+                    pressure: pr.pressure[k],
+                    sliding_speed: sliding[k].speed,
+                    area: c.cell.area(),
+                    line: first + of_cell[k],
+                });
             }
         }
-        let torque = ltca
-            .positions
-            .iter()
-            .map(|p| p.wheel_torque.abs())
-            .sum::<f64>()
-            / ltca.positions.len().max(1) as f64;
+        let mean = |f: &dyn Fn(&crate::ltca::PositionResult) -> f64| {
+            ltca.positions.iter().map(f).sum::<f64>() / ltca.positions.len().max(1) as f64
+        };
+        let inputs = FrictionInputs::of(gear, &gear.lubricant);
         Self {
             cells,
             flank_areas: wf.cell_area.clone(),
             lines,
             positions: ltca.positions.len(),
-            e_prime: lubrication::reduced_modulus(
-                gear.worm_material.youngs_modulus,
-                gear.worm_material.poisson_ratio,
-                gear.wheel_material.youngs_modulus,
-                gear.wheel_material.poisson_ratio,
-            ),
-            output_power: torque * gear.conditions.worm_speed / gear.ratio(),
+            e_prime: inputs.e_prime,
+            flow_pressure: inputs.flow_pressure,
+            output_power: mean(&|p| p.wheel_torque.abs()) * gear.conditions.worm_speed
+                / gear.ratio(),
+            input_power: mean(&|p| p.worm_torque.abs()) * gear.conditions.worm_speed,
         }
     }
 
@@ -421,20 +258,16 @@ impl MeshContacts {
         let films: Vec<f64> = self
             .lines
             .iter()
-            .map(|line| {
-                let film = lubrication::film(lubricant, self.e_prime, line);
-                film.h_min * film.thermal_factor
-            })
+            .map(|line| central_film_thickness(lubricant, self.e_prime, line))
             .collect();
         for c in &self.cells {
-            let f = local_friction(
-                c.pressure,
-                c.sliding_speed,
-                films[c.line],
-                lubricant,
-                law,
-                self.e_prime,
-            );
+            let at = PointContact {
+                pressure: c.pressure,
+                sliding_speed: c.sliding_speed,
+                film_thickness: films[c.line],
+                roughness: lubricant.composite_roughness,
+            };
+            let f = local_friction(&at, lubricant, law, (self.e_prime, self.flow_pressure));
             let density = f.coefficient * c.pressure * c.sliding_speed;
             visit(c, f, density);
         }
@@ -606,6 +439,45 @@ pub fn heat_balance_from(
     Ok(thermal("balance", t, evaluations.get() + 1))
 }
 
+/// Largest number of loaded analyses of the oil temperature's fixed point (MODEL §13).
+const OIL_ITERATIONS: usize = 6;
+
+/// The oil temperature's fixed point between the loaded analysis' friction and the heat
+/// balance has converged when two passes differ by less than this, K.
+pub const OIL_TOLERANCE_K: f64 = 0.05;
+
+/// The loaded analysis `analyse` runs with `settings`, and with the heat balance and the
+/// transmitted torque, again at the balance's oil temperature until two temperatures differ by
+/// less than [`OIL_TOLERANCE_K`] (MODEL §13: the friction the pressures carry follows the oil;
+/// at most [`OIL_ITERATIONS`] analyses; a balance that fails ends the passes, and the
+/// friction stage reports it). `other_losses` P_V0 + P_VLP + P_VD, W.
+pub fn oil_fixed_point<E>(
+    (gear, geo, tca): (&GearSet, &Geometry, &Tca),
+    other_losses: f64,
+    mut settings: crate::ltca::LtcaSettings,
+    analyse: impl Fn(&crate::ltca::LtcaSettings) -> Result<Ltca, E>,
+) -> Result<Ltca, E> {
+    let mut result = analyse(&settings)?;
+    let coupled = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
+    if !(gear.housing.balance && coupled) {
+        return Ok(result);
+    }
+    for _ in 1..OIL_ITERATIONS {
+        let contacts = MeshContacts::new(gear, geo, tca, &result);
+        let law = (&gear.lubricant, &gear.friction, &gear.housing);
+        let start = Some(settings.oil_temperature);
+        let Ok(t) = heat_balance_from(&contacts, law, other_losses, start) else {
+            break;
+        };
+        if (t.oil_temperature_k - settings.oil_temperature).abs() < OIL_TOLERANCE_K {
+            break;
+        }
+        settings.oil_temperature = t.oil_temperature_k;
+        result = analyse(&settings)?;
+    }
+    Ok(result)
+}
+
 /// The first downward crossing of `excess` above the ambient temperature `(ambient, f)`
 /// (f > 0 there), as a bracket (lo, f(lo) > 0), (hi, f(hi) <= 0): searched from `start` down
 /// while the excess there is not positive (the first crossing is below it), then up, in steps
@@ -692,94 +564,7 @@ mod tests {
     const E_PRIME: f64 = 1.557e11;
 
     fn law() -> FrictionLaw {
-        FrictionLaw {
-            boundary: 0.094,
-            roughness_slope: 0.1,
-            eyring_stress: 5e6,
-            limiting_shear: 0.04,
-        }
-    }
-
-    #[test]
-    fn the_asperities_carry_all_without_a_film_and_nothing_under_a_thick_one() {
-        let capacity = 0.25 * asperity_pressure(E_PRIME, 0.1);
-        // Below the asperities' capacity at contact (A_c/A_0 = 1/4), all of the load.
-        assert_eq!(asperity_share(0.9 * capacity, 0.0, 1e-6, E_PRIME, 0.1), 1.0);
-        // Above it, what they can carry: (W_sec/A_c)(1/4) / p.
-        let p = 2.0 * capacity;
-        assert!((asperity_share(p, 0.0, 1e-6, E_PRIME, 0.1) - 0.5).abs() < 1e-15);
-        // A film of lambda 3, 6, 10: the share falls with erfc(lambda / sqrt 2).
-        let shares: Vec<f64> = [3.0, 6.0, 10.0]
-            .iter()
-            .map(|l| asperity_share(0.9 * capacity, l * 1e-6, 1e-6, E_PRIME, 0.1))
-            .collect();
-        let expected = 0.25 * libm::erfc(3.0 / 2f64.sqrt()) * capacity * 4.0 / (0.9 * capacity);
-        assert!((shares[0] / expected - 1.0).abs() < 1e-12, "{shares:?}");
-        assert!(shares[1] < 1e-8 && shares[2] < 1e-22, "{shares:?}");
-        // With no asperity contact left the friction is the film's alone.
-        let lub = oil();
-        let f = local_friction(0.9 * capacity, 2.0, 10e-6, &lub, &law(), E_PRIME);
-        assert!((f.coefficient - f.fluid_shear / (0.9 * capacity)).abs() < 1e-15);
-        // And with no film the boundary friction where the asperities carry all.
-        let f = local_friction(0.9 * capacity, 2.0, 0.0, &lub, &law(), E_PRIME);
-        assert_eq!(f.coefficient, law().boundary);
-    }
-
-    /// The film's traction over a smooth Hertz line contact, p = p0 sqrt(1 - (x/a)^2), by the
-    /// midpoint rule on `n` strips: F / w, the friction coefficient of the contact.
-    fn hertz_traction(
-        p0: f64,
-        speed: f64,
-        film: f64,
-        viscosity: f64,
-        alpha: f64,
-        law: &FrictionLaw,
-    ) -> f64 {
-        let n = 200_000;
-        let (mut force, mut load) = (0.0, 0.0);
-        for k in 0..n {
-            let x = -1.0 + (k as f64 + 0.5) * 2.0 / n as f64;
-            let p = p0 * (1.0 - x * x).sqrt();
-            force += fluid_shear(p, speed, film, viscosity, alpha, law);
-            load += p;
-        }
-        force / load
-    }
-
-    #[test]
-    fn a_newtonian_film_over_a_hertz_line_contact_has_its_closed_form_traction() {
-        // tau_0 and Lambda out of reach, no pressure-viscosity: tau = eta v / h everywhere,
-        // so F = eta v / h x 2a and w = pi a p0 / 2: mu = 4 eta v / (pi h p0).
-        let newtonian = FrictionLaw {
-            eyring_stress: 1e15,
-            limiting_shear: 1.0,
-            ..law()
-        };
-        let (p0, v, h, eta) = (5e8, 2.0, 1e-6, 0.227);
-        let mu = hertz_traction(p0, v, h, eta, 0.0, &newtonian);
-        let exact = 4.0 * eta * v / (PI * h * p0);
-        assert!((mu / exact - 1.0).abs() < 1e-5, "{mu} vs {exact}");
-    }
-
-    #[test]
-    fn a_saturated_eyring_film_over_a_hertz_line_contact_has_its_closed_form_traction() {
-        // Where eta(p) gamma >> tau_0, tau = tau_0 ln(2 eta0 gamma / tau_0) + tau_0 alpha p:
-        // mu = tau_0 alpha + (4 tau_0 / (pi p0)) ln(2 eta0 gamma / tau_0).
-        let eyring = FrictionLaw {
-            limiting_shear: 1.0,
-            ..law()
-        };
-        let (p0, v, h, eta, alpha) = (5e8, 10.0, 1e-6, 10.0, 9.5e-9);
-        let mu = hertz_traction(p0, v, h, eta, alpha, &eyring);
-        let tau0 = eyring.eyring_stress;
-        let exact = tau0 * alpha + 4.0 * tau0 / (PI * p0) * (2.0 * eta * v / h / tau0).ln();
-        assert!((mu / exact - 1.0).abs() < 1e-3, "{mu} vs {exact}");
-        // And the limiting shear bounds it: mu <= Lambda.
-        let limited = hertz_traction(p0, v, h, eta, alpha, &law());
-        assert!(
-            limited <= law().limiting_shear + 1e-12 && limited < mu,
-            "{limited}"
-        );
+        crate::traction::tests::law()
     }
 
     #[test]
@@ -815,7 +600,9 @@ mod tests {
             }],
             positions: 1,
             e_prime: E_PRIME,
+            flow_pressure: f64::INFINITY,
             output_power,
+            input_power: f64::NAN,
         }
     }
 
@@ -831,11 +618,12 @@ mod tests {
 
     #[test]
     fn a_temperature_independent_loss_balances_at_the_hand_solution() {
-        // Boundary friction on every asperity (Rdq 1 rad: the asperities carry all at any film
-        // of this contact), no film shear: P_Vz = mu_b p |v_g| S whatever the temperature, so
+        // Boundary friction on every asperity (summits so dense and sharp that the asperities
+        // carry all at this contact's film, lambda about 1), no film shear: P_Vz = mu_b p |v_g| S whatever the temperature, so
         // theta = theta_0 + (P_Vz + P_other - Q) / (alpha A).
         let boundary = FrictionLaw {
-            roughness_slope: 1.0,
+            summit_density_radius_roughness: 1.0,
+            summit_roughness_radius: 0.1,
             limiting_shear: 0.0,
             ..law()
         };

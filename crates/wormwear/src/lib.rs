@@ -10,7 +10,8 @@
 //! 4. [`bending`] and [`contact`] — influence coefficients; [`ltca`] — loaded contact, load
 //!    sharing, transmission error (MODEL §5);
 //! 5. [`lubrication`] — film thickness and local wear coefficient (MODEL §6); [`wear`] — Archard
-//!    wear over life, backlash, pitting phases (MODEL §7-8);
+//!    wear over life, backlash, pitting phases (MODEL §7-8); [`traction`] — the local friction of
+//!    the mixed lubrication, [`friction`] — mesh loss, efficiency and oil temperature (MODEL §13);
 //! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9).
 //!
 //! [`run`] chains them for one [`Request`] and returns one [`Results`] value; [`output`]
@@ -39,6 +40,7 @@ pub mod runner;
 pub mod safety;
 pub mod subsurface;
 pub mod sweep;
+pub mod traction;
 pub mod validation;
 pub mod wear;
 

@@ -863,7 +863,9 @@ pub(crate) fn bending_model(
     Ok((Some(model), Some(info)))
 }
 
-/// The unworn loaded analysis (MODEL §5); its warnings added to `warnings`.
+/// The unworn loaded analysis (MODEL §5); its warnings added to `warnings`. With the heat
+/// balance and the transmitted torque, the friction the pressures carry is at the balance's
+/// oil temperature ([`crate::friction::oil_fixed_point`]).
 pub(crate) fn loaded_analysis(
     gear: &GearSet,
     geo: &Geometry,
@@ -871,14 +873,14 @@ pub(crate) fn loaded_analysis(
     bending: Option<&FeBending>,
     warnings: &mut Vec<String>,
 ) -> Result<Ltca, RunError> {
-    let result = crate::ltca::analyse_with(
-        gear,
-        geo,
-        tca,
-        &LtcaSettings::from_gear(gear),
-        bending.map(|b| b as &dyn BendingModel),
-    )
-    .map_err(RunError::Ltca)?;
+    let analyse = |settings: &LtcaSettings| {
+        let model = bending.map(|b| b as &dyn BendingModel);
+        crate::ltca::analyse_with(gear, geo, tca, settings, model).map_err(RunError::Ltca)
+    };
+    let rating = crate::rating::rate(gear);
+    let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
+    let settings = LtcaSettings::from_gear(gear);
+    let result = crate::friction::oil_fixed_point((gear, geo, tca), other, settings, analyse)?;
     warnings.extend(
         result
             .warnings

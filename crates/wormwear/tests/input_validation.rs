@@ -911,15 +911,44 @@ fn friction_and_heat_balance_inputs_are_checked_by_name() {
     let e = error_of(&with("", "cooler_w = -5.0\nheat_transfer_w_m2k = 0.0"));
     assert_mentions(&e, &["housing.cooler_w", "housing.heat_transfer_w_m2k"]);
     let e = error_of(&with(
-        "boundary_friction = 1.5\nroughness_slope_rad = 0.0",
+        "boundary_friction = 1.0\nsummit_density_radius_roughness = 0.0",
         "",
     ));
     assert_mentions(
         &e,
         &[
             "lubricant.boundary_friction",
-            "lubricant.roughness_slope_rad",
+            "1",
+            "0.999",
+            "lubricant.summit_density_radius_roughness",
         ],
+    );
+    // A negative summit product, and a roughness beyond Greenwood & Tripp's summits (sigma /
+    // beta at most 0.1): each named with its value and the range.
+    let e = error_of(&with(
+        "summit_density_radius_roughness = -0.05\nsummit_roughness_radius = 0.5",
+        "",
+    ));
+    assert_mentions(
+        &e,
+        &[
+            "lubricant.summit_density_radius_roughness",
+            "-0.05",
+            "lubricant.summit_roughness_radius",
+            "0.5",
+            "0.1",
+        ],
+    );
+    // The published model's torque reading is an option; anything else is named.
+    let e = error_of(&set(
+        &design(),
+        "analysis",
+        "flank_cells_height",
+        "flank_cells_height = 40\ntorque_balance = \"frictionfree\"",
+    ));
+    assert_mentions(
+        &e,
+        &["analysis.torque_balance", "frictionfree", "transmitted"],
     );
     let e = error_of(&with(
         "eyring_stress_mpa = 0.0\nlimiting_shear_coefficient = -0.1",

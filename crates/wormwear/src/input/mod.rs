@@ -242,8 +242,11 @@ impl Lubricant {
 pub struct FrictionLaw {
     /// Boundary friction coefficient mu_b of the asperity contacts.
     pub boundary: f64,
-    /// RMS slope Rdq of the composite roughness, rad.
-    pub roughness_slope: f64,
+    /// Greenwood & Tripp's summit product eta_s beta sigma (summit density x summit radius x
+    /// composite RMS roughness), dimensionless.
+    pub summit_density_radius_roughness: f64,
+    /// Composite RMS roughness over the summit radius, sigma / beta, dimensionless.
+    pub summit_roughness_radius: f64,
     /// Eyring stress tau_0, Pa.
     pub eyring_stress: f64,
     /// Limiting shear stress over pressure, Lambda.
@@ -633,6 +636,20 @@ pub struct Analysis {
     pub solver: SolverKind,
     /// Direction of the pressure on a contact cell (MODEL §5.2's n_i).
     pub pressure_direction: PressureDirection,
+    /// Which torque the pressures carry (MODEL §5.2, §12 n).
+    pub torque_balance: TorqueBalance,
+}
+
+/// Which torque the loaded analysis' pressures carry (MODEL §5.2, §12 n).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TorqueBalance {
+    /// The torque the mesh transmits (default): equilibrium about both axes with the friction
+    /// tractions of MODEL §13; a given worm torque T1 gives the wheel u eta_z T1.
+    Transmitted,
+    /// The published reading: frictionless pressures balance the given torque (a worm torque
+    /// T1 puts u T1 on the wheel, over-loading the teeth by 1 / eta_z).
+    Frictionless,
 }
 
 /// Contact law of the wheel's surface in the loaded analysis (MODEL §5.7, §12 i).

@@ -425,9 +425,12 @@ pub struct LubricantSpec {
     /// Boundary friction coefficient mu_b of the asperity contacts (MODEL §13).
     #[serde(default)]
     pub boundary_friction: Option<f64>,
-    /// RMS slope Rdq of the composite roughness, rad (MODEL §10, §13).
+    /// Greenwood & Tripp's summit product eta_s beta sigma, dimensionless (MODEL §13).
     #[serde(default)]
-    pub roughness_slope_rad: Option<f64>,
+    pub summit_density_radius_roughness: Option<f64>,
+    /// Composite RMS roughness over the summit radius, sigma / beta (MODEL §13).
+    #[serde(default)]
+    pub summit_roughness_radius: Option<f64>,
     /// Eyring stress tau_0 of the film's shear, MPa (MODEL §13).
     #[serde(default)]
     pub eyring_stress_mpa: Option<f64>,
@@ -529,6 +532,11 @@ pub struct AnalysisSpec {
     /// "wheel-flank" (MODEL §5.2's n_i; see PressureDirection).
     #[serde(default)]
     pub pressure_direction: Option<String>,
+    /// Which torque the pressures carry: "transmitted" (default: equilibrium with the contact's
+    /// friction, MODEL §5.2) or "frictionless" (the published reading: frictionless pressures
+    /// balance the given torque).
+    #[serde(default)]
+    pub torque_balance: Option<String>,
     /// LTCA solver: "conjugate-gradient" (default) or "fixed-point" (the published scheme).
     #[serde(default = "default_solver")]
     pub solver: String,
@@ -596,6 +604,7 @@ impl Default for AnalysisSpec {
             pressure_patch_along_mm: default_patch_along(),
             solver: default_solver(),
             pressure_direction: None,
+            torque_balance: None,
         }
     }
 }

@@ -20,10 +20,15 @@ pub(crate) mod passage;
 mod pattern;
 mod position;
 pub mod solver;
+mod traction;
 
 use mesh::*;
 pub use pattern::*;
 use position::*;
+use traction::torque_weights;
+pub use traction::{
+    cell_sliding, CellSliding, ContactLineRadii, FilmGeometry, FrictionInputs, PositionFriction,
+};
 
 use crate::contact::{hertz_half_width, ContactCell, ElasticPair};
 use crate::geometry::placement::{from_wheel_body, wheel_point};
@@ -70,6 +75,11 @@ pub struct LtcaSettings {
     pub solver: SolverSettings,
     /// Direction of the pressure on a cell (MODEL §5.2's n_i).
     pub pressure_direction: crate::input::PressureDirection,
+    /// Which torque the pressures carry (MODEL §5.2).
+    pub torque_balance: crate::input::TorqueBalance,
+    /// Oil temperature of the friction the transmitted torque carries, K (the lubricant's,
+    /// or the heat balance's, MODEL §13).
+    pub oil_temperature: f64,
     /// The sub-surface stress criterion of the equivalent pressure (MODEL §8.1).
     pub subsurface: SubsurfaceSettings,
 }
@@ -89,6 +99,8 @@ impl LtcaSettings {
                 ..SolverSettings::default()
             },
             pressure_direction: a.pressure_direction,
+            torque_balance: a.torque_balance,
+            oil_temperature: gear.lubricant.temperature,
             subsurface: SubsurfaceSettings {
                 criterion: gear
                     .wear
@@ -136,9 +148,10 @@ pub struct PositionResult {
     pub position: usize,
     /// Normal force carried by each studied tooth (TCA tooth order), N.
     pub tooth_load: Vec<f64>,
-    /// Wheel torque carried, N m.
+    /// Wheel torque transmitted T2 (the moments of the pressures and, with friction, of the
+    /// friction tractions about the wheel axis), N m.
     pub wheel_torque: f64,
-    /// Worm torque balanced, N m.
+    /// Worm torque balanced T1, N m.
     pub worm_torque: f64,
     /// Rigid approach (wheel rotation against its driven sense), rad.
     pub approach: f64,
@@ -153,6 +166,12 @@ pub struct PositionResult {
     pub residuals: Residuals,
     /// Relative worm-torque balance error |sum f (M x n)_x - C_m| / C_m.
     pub torque_residual: f64,
+    /// Friction coefficient of the local cells (same order as `cells`; zeros without friction,
+    /// MODEL §5.2, §13).
+    #[serde(skip)]
+    pub friction: Vec<f64>,
+    /// The worm torque the friction consumes, P_Vz / omega1 = sum mu f |v_g| / omega1, N m.
+    pub friction_torque: f64,
     /// Pressures of the local cells, Pa (same order as `cells`).
     pub pressure: Vec<f64>,
     /// Plastic indentation of the local cells: the interference -y_i l_i of the cells at the
@@ -497,7 +516,14 @@ pub fn analyse_changed(
     );
     let ev = GapEvaluator::new(gear, geo);
     let wf = geo.wheel_flank(tca.loaded_flank);
+    // The wheel torque's estimate sizes the band: u T1, times ISO/TR 14521's mesh efficiency
+    // when the pressures carry the transmitted torque (MODEL §5.2).
+    let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
     let (worm_torque, wheel_torque_guess) = match gear.conditions.torque {
+        Torque::Worm(t) if transmitted => (
+            Some(t),
+            t * gear.ratio() * crate::rating::rate(gear).mesh_efficiency,
+        ),
         Torque::Worm(t) => (Some(t), t * gear.ratio()),
         Torque::Wheel(t) => (None, t),
     };
@@ -520,6 +546,16 @@ pub fn analyse_changed(
         );
     let changed = FlankShape::new(wf, change);
     let worn = changed.as_ref().map(|c| c.worn(change.plastic_set));
+    let oil = gear.lubricant.at_temperature(settings.oil_temperature);
+    let friction =
+        (settings.torque_balance == crate::input::TorqueBalance::Transmitted).then(|| {
+            PositionFriction {
+                gear,
+                geo,
+                film: FilmGeometry::new(tca, wf),
+                inputs: FrictionInputs::of(gear, &oil),
+            }
+        });
 
     let mut positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
@@ -538,6 +574,7 @@ pub fn analyse_changed(
                 wheel_torque_guess,
                 worn,
                 warm,
+                friction.as_ref(),
             )
         })
         .collect::<Result<_, _>>()?;

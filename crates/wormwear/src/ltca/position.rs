@@ -4,8 +4,9 @@
 
 use super::*;
 
-/// The positions' mean worm and wheel torques (N m), the frictionless power balance
-/// wheel torque / (ratio x worm torque) - 1 and its warnings, which name the face position
+/// The positions' mean worm and wheel torques (N m), the power balance
+/// (wheel torque / ratio + friction's worm torque) / worm torque - 1 (0 where the normal
+/// forces do no work) and its warnings, which name the face position
 /// (m) of the pattern's peak.
 pub(super) fn torque_balance(
     positions: &[PositionResult],
@@ -17,7 +18,14 @@ pub(super) fn torque_balance(
     let wheel_torque =
         positions.iter().map(|p| p.wheel_torque).sum::<f64>() / positions.len() as f64;
     let worm_torque = positions.iter().map(|p| p.worm_torque).sum::<f64>() / positions.len() as f64;
-    let power_balance = wheel_torque / (ratio * worm_torque) - 1.0;
+    let friction_torque =
+        positions.iter().map(|p| p.friction_torque).sum::<f64>() / positions.len() as f64;
+    // T1 omega1 = T2 omega2 + P_Vz, P_Vz / omega1 the friction's share of the worm torque.
+    let power_balance = if friction_torque == 0.0 {
+        wheel_torque / (ratio * worm_torque) - 1.0
+    } else {
+        (wheel_torque / ratio + friction_torque) / worm_torque - 1.0
+    };
     let peak = (0..pattern.len())
         .max_by(|&a, &b| pattern[a].total_cmp(&pattern[b]))
         .map_or(0.0, |k| 0.5 * (wf.z[k / ni] + wf.z[k / ni + 1]));
@@ -27,7 +35,8 @@ pub(super) fn torque_balance(
 
 /// The loaded contact at position n (MODEL §5.2-5.4): the local mesh in a band around the
 /// contact lines, the problem on it, the solve with the wheel torque updated until the worm
-/// torque balances, and the band widened (up to four times) while load reaches its edge.
+/// torque balances (with `friction`, the friction tractions' moments included: the
+/// transmitted torque), and the band widened (up to four times) while load reaches its edge.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_position(
     geo: &Geometry,
@@ -43,6 +52,7 @@ pub(super) fn solve_position(
     wheel_torque_guess: f64,
     worn: Option<Worn>,
     seed: Option<&WarmStart>,
+    friction: Option<&PositionFriction>,
 ) -> Result<PositionResult, LtcaError> {
     let mut band = band0;
     let mut widenings = 0;
@@ -64,18 +74,40 @@ pub(super) fn solve_position(
         let warm: Option<Vec<f64>> = seed
             .filter(|_| widenings == 0)
             .and_then(|s| s.for_cells(n, &cells));
-        let (mut problem, weights) =
+        let (mut problem, weights, sign) =
             contact_problem(&cells, pair, settings, bending, wheel_torque_guess)
                 .ok_or(LtcaError::TorqueSign(n))?;
-        let (sol, worm) =
-            balance_worm_torque(&mut problem, &weights, settings, worm_torque, warm, n)?;
-        if at_band_edge(&cells, &sol.q, settings.columns) && widenings < 4 {
+        let balanced = match friction {
+            None => {
+                let (sol, worm) =
+                    balance_worm_torque(&mut problem, &weights, settings, worm_torque, warm, n)?;
+                let wheel = problem.load;
+                Balanced::frictionless(sol, worm, wheel, cells.len())
+            }
+            Some(f) => {
+                let target = (worm_torque, wheel_torque_guess);
+                balance_with_friction(&mut problem, &cells, sign, (settings, f), target, warm, n)?
+            }
+        };
+        if at_band_edge(&cells, &balanced.solution.q, settings.columns) && widenings < 4 {
             band *= 1.6;
             widenings += 1;
             continue;
         }
-        let mut result = position_result(n, tca, ev, settings, cells, &sol, problem.load);
+        let mut result = position_result(
+            n,
+            tca,
+            ev,
+            settings,
+            cells,
+            &balanced.solution,
+            problem.load,
+        );
+        let worm = balanced.worm;
         result.worm_torque = worm;
+        result.wheel_torque = balanced.wheel;
+        result.friction = balanced.friction;
+        result.friction_torque = balanced.friction_torque;
         let target = worm_torque.unwrap_or(worm);
         result.torque_residual = (worm - target).abs() / target;
         result.band_widenings = widenings;
@@ -101,15 +133,15 @@ fn tooth_ranges(cells: &[LocalCell]) -> Vec<(usize, usize)> {
 
 /// The complementarity problem on the cells (MODEL §5.2, §5.3): one contact block per tooth,
 /// the bending term, the flow-pressure bounds, the separations and the wheel torque `load`;
-/// with the weights that turn the unknowns into the worm torque. None when the cells' worm
-/// moments cancel (no driving sense).
+/// with the weights that turn the unknowns into the worm torque and the driving sense of the
+/// worm moments. None when the cells' worm moments cancel (no driving sense).
 fn contact_problem(
     cells: &[LocalCell],
     pair: &ElasticPair,
     settings: &LtcaSettings,
     bending: Option<&dyn BendingModel>,
     load: f64,
-) -> Option<(Problem, Vec<f64>)> {
+) -> Option<(Problem, Vec<f64>, f64)> {
     let blocks: Vec<Block> = tooth_ranges(cells)
         .into_iter()
         .map(|(start, size)| {
@@ -154,11 +186,12 @@ fn contact_problem(
         .iter()
         .map(|c| c.worm_lever * sign / c.lever)
         .collect();
-    Some((problem, weights))
+    Some((problem, weights, sign))
 }
 
-/// Outer update of the wheel torque (`problem.load`) until the worm torque balances
-/// `worm_torque` (MODEL §5.2; None: the wheel torque is given): with the fast solver, one exact
+/// Outer update of the normal wheel torque (`problem.load`) until the torque `weights . q`
+/// (the worm torque, or with friction the transmitted wheel torque) balances `target`
+/// (MODEL §5.2; None: the load is given): with the fast solver, one exact
 /// affine step on the loaded set after the first solve; the fixed-point solver (and any change
 /// of the loaded set) iterates, by secants on the (wheel torque, worm torque) pairs: with
 /// cells at the flow pressure (MODEL §5.7) the worm torque is not proportional to the wheel
@@ -167,7 +200,7 @@ fn balance_worm_torque(
     problem: &mut Problem,
     weights: &[f64],
     settings: &LtcaSettings,
-    worm_torque: Option<f64>,
+    target: Option<f64>,
     mut warm: Option<Vec<f64>>,
     n: usize,
 ) -> Result<(solver::Solution, f64), LtcaError> {
@@ -182,7 +215,7 @@ fn balance_worm_torque(
             }
         })?;
         let worm = worm_of(&sol.q);
-        let target = match worm_torque {
+        let target = match target {
             Some(t) => t,
             None => {
                 solution = Some((sol, worm));
@@ -216,6 +249,93 @@ fn balance_worm_torque(
         solution = Some((sol, worm));
     }
     Ok(solution.expect("at least one solve"))
+}
+
+/// Largest number of friction updates of a position's torque balance (MODEL §5.2).
+const FRICTION_ITERATIONS: usize = 12;
+
+/// Relative change of the torque the balance does not set between two friction updates at
+/// which the torque balance with friction has converged.
+const FRICTION_TOLERANCE: f64 = 1e-7;
+
+/// A position's solution with its torques (N m) and the friction it carries.
+struct Balanced {
+    solution: solver::Solution,
+    /// Worm torque T1 and transmitted wheel torque T2, N m.
+    worm: f64,
+    wheel: f64,
+    /// mu of each cell (zeros without friction).
+    friction: Vec<f64>,
+    /// The worm torque the friction consumes, sum mu f |v_g| / omega1, N m.
+    friction_torque: f64,
+}
+
+impl Balanced {
+    fn frictionless(solution: solver::Solution, worm: f64, wheel: f64, cells: usize) -> Self {
+        Self {
+            solution,
+            worm,
+            wheel,
+            friction: vec![0.0; cells],
+            friction_torque: 0.0,
+        }
+    }
+}
+
+/// The torque balance with the friction tractions' moments (MODEL §5.2): with the friction
+/// coefficients of the last pressures frozen, the normal load is set so that the worm torque
+/// (worm torque given) or the transmitted wheel torque (else) meets its target
+/// ([`balance_worm_torque`] on the weights of [`torque_weights`]); the friction is then
+/// updated from the new pressures, until the torque the balance does not set (the wheel's when
+/// the worm torque is given, else the worm's) changes by less than [`FRICTION_TOLERANCE`]. `target`: the worm torque when given, and the wheel torque (used
+/// when the worm torque is not given), N m.
+fn balance_with_friction(
+    problem: &mut Problem,
+    cells: &[LocalCell],
+    sign: f64,
+    (settings, friction): (&LtcaSettings, &PositionFriction),
+    (worm_torque, wheel_torque): (Option<f64>, f64),
+    mut warm: Option<Vec<f64>>,
+    n: usize,
+) -> Result<Balanced, LtcaError> {
+    let sliding = cell_sliding(friction.gear, friction.geo, cells);
+    let mut mu = vec![0.0; cells.len()];
+    // The torque the balance does not set: the wheel's when the worm torque is given.
+    let mut last_free = f64::NAN;
+    for it in 0..FRICTION_ITERATIONS {
+        let (worm_weights, wheel_weights) = torque_weights(cells, &sliding, &mu, sign);
+        let (weights, target) = match worm_torque {
+            Some(t) => (&worm_weights, t),
+            None => (&wheel_weights, wheel_torque),
+        };
+        let (sol, _) = balance_worm_torque(problem, weights, settings, Some(target), warm, n)?;
+        let dot = |w: &[f64]| w.iter().zip(&sol.q).map(|(a, q)| a * q).sum::<f64>();
+        let (worm, wheel) = (dot(&worm_weights), dot(&wheel_weights));
+        let free = if worm_torque.is_some() { wheel } else { worm };
+        if (free - last_free).abs() <= FRICTION_TOLERANCE * free.abs()
+            || it + 1 == FRICTION_ITERATIONS
+        {
+            let friction_torque = cells
+                .iter()
+                .zip(&sol.q)
+                .zip(mu.iter().zip(&sliding))
+                .map(|((c, q), (m, s))| m * q / c.lever * s.speed)
+                .sum::<f64>()
+                / friction.gear.conditions.worm_speed;
+            return Ok(Balanced {
+                solution: sol,
+                worm,
+                wheel,
+                friction: mu,
+                friction_torque,
+            });
+        }
+        last_free = free;
+        let (_, pressure, _) = cell_loads(cells, &sol.q, &sol.gap, settings.flow_pressure);
+        mu = friction.coefficients(n, cells, &sliding, &pressure);
+        warm = Some(sol.q.clone());
+    }
+    unreachable!("the last friction update returns")
 }
 
 /// Whether load reaches the first or last of the `columns` cells across the line.
@@ -260,6 +380,8 @@ fn position_result(
         max_pressure: pressure.iter().copied().fold(0.0, f64::max),
         residuals: sol.residuals,
         torque_residual: f64::NAN,
+        friction: Vec::new(),
+        friction_torque: 0.0,
         pressure,
         plastic_depth,
         equivalent: Vec::new(),

@@ -371,25 +371,40 @@ impl<'a> LifeLoop<'a> {
     fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
         let mut local = *self.settings;
         local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
+        // The friction the pressures carry at the last state's oil temperature (MODEL §13:
+        // the heat balance's lags one state); the first state's from the fixed point.
+        let last = state.records.last().map(|r| r.friction.oil_temperature_k);
+        if let Some(t) = last.filter(|t| *t > 0.0 && self.gear.housing.balance) {
+            local.oil_temperature = t;
+        }
         let changed = |f: &FlankField| f.values.iter().any(|&h| h != 0.0);
         let change = crate::ltca::FlankChange {
             removal: Some(&state.removal).filter(|f| changed(f)),
             plastic_set: Some(&state.plastic_set).filter(|f| changed(f)),
         };
-        let l = crate::ltca::analyse_changed(
-            self.gear,
-            self.geo,
-            self.tca,
-            &local,
-            self.bending,
-            change,
-            state.warm.as_ref(),
-        )
-        .map_err(|source| WearError::Ltca {
-            step: state.step,
-            cycles: state.cycles,
-            source,
-        })?;
+        let analyse = |settings: &crate::ltca::LtcaSettings| {
+            crate::ltca::analyse_changed(
+                self.gear,
+                self.geo,
+                self.tca,
+                settings,
+                self.bending,
+                change,
+                state.warm.as_ref(),
+            )
+            .map_err(|source| WearError::Ltca {
+                step: state.step,
+                cycles: state.cycles,
+                source,
+            })
+        };
+        let l = match last {
+            Some(_) => analyse(&local)?,
+            None => {
+                let inputs = (self.gear, self.geo, self.tca);
+                crate::friction::oil_fixed_point(inputs, self.other_losses, local, analyse)?
+            }
+        };
         let widenings = l
             .positions
             .iter()

@@ -115,6 +115,14 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
             ("wheel-flank", PressureDirection::WheelFlank),
         ],
     );
+    let torque_balance = ck.choice(
+        "analysis.torque_balance",
+        a.torque_balance.as_deref().unwrap_or("transmitted"),
+        &[
+            ("transmitted", TorqueBalance::Transmitted),
+            ("frictionless", TorqueBalance::Frictionless),
+        ],
+    );
     use super::SolverKind;
     let solver = ck.choice(
         "analysis.solver",
@@ -141,6 +149,7 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
         pressure_patch_along: along? * 1e-3,
         solver: solver?,
         pressure_direction: direction?,
+        torque_balance: torque_balance?,
     })
 }
 

@@ -165,11 +165,13 @@ pub(super) fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant
 
 /// The friction law of the mixed lubrication (MODEL §13) from `[lubricant]`, with its
 /// defaults: mu_b 0.094 (the low-speed cap of MODEL §9's mu_0T for a bronze wheel with
-/// polyglycol, dip lubricated: the boundary regime); Rdq 0.1 rad (assumed, typical of ground
-/// worms and hobbed wheels; measure it); tau_0 5 MPa (Eyring stresses of a few MPa, Johnson &
-/// Tevaarwerk 1977); Lambda 0.02 (the limiting shear stress over pressure of Bair & Winer 1979;
-/// the value bounds the film's friction by MODEL §9's own level for polyglycol, whose
-/// mu_0T is 0.018 at 4 m/s of sliding; mineral oils shear higher, 0.05 and more).
+/// polyglycol, dip lubricated: the boundary regime); Greenwood & Tripp's summit statistics
+/// eta_s beta sigma 0.05 and sigma / beta 0.01 (the upper ends of the ranges Greenwood & Tripp
+/// 1970-71 give for engineering surfaces, 0.03-0.05 and 1e-4-1e-2: a hobbed bronze wheel is the
+/// rough end; measure them); tau_0 5 MPa (Eyring stresses of a few MPa, Johnson & Tevaarwerk
+/// 1977); Lambda 0.02 (the limiting shear stress over pressure of Bair & Winer 1979; polyglycols
+/// shear low, mineral oils at 0.05 and more). Greenwood & Tripp's asymptotics need sigma / beta
+/// well below 1 (summits much wider than tall): at most 0.1.
 pub(super) fn friction_law(ck: &mut Checker, l: &LubricantSpec) -> Option<FrictionLaw> {
     let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
         Some(v) => ck.range(&format!("lubricant.{f}"), v, lo, hi, unit),
@@ -180,16 +182,24 @@ pub(super) fn friction_law(ck: &mut Checker, l: &LubricantSpec) -> Option<Fricti
         l.boundary_friction,
         0.094,
         0.0,
+        0.999,
+        "",
+    );
+    let summits = get(
+        "summit_density_radius_roughness",
+        l.summit_density_radius_roughness,
+        0.05,
+        1e-6,
         1.0,
         "",
     );
-    let slope = get(
-        "roughness_slope_rad",
-        l.roughness_slope_rad,
+    let ratio = get(
+        "summit_roughness_radius",
+        l.summit_roughness_radius,
+        0.01,
+        1e-8,
         0.1,
-        1e-4,
-        1.0,
-        "rad",
+        "",
     );
     let eyring = get(
         "eyring_stress_mpa",
@@ -209,7 +219,8 @@ pub(super) fn friction_law(ck: &mut Checker, l: &LubricantSpec) -> Option<Fricti
     );
     Some(FrictionLaw {
         boundary: boundary?,
-        roughness_slope: slope?,
+        summit_density_radius_roughness: summits?,
+        summit_roughness_radius: ratio?,
         eyring_stress: eyring? * 1e6,
         limiting_shear: limiting?,
     })

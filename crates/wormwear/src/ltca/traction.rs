@@ -1,0 +1,290 @@
+//! The friction tractions of the loaded contact and their moments (MODEL §5.2, §13).
+//!
+//! At each loaded cell the friction on the wheel is mu f along -v_g / |v_g| (v_g = V2 - V1, the
+//! wheel's sliding on the worm): the worm drags the wheel. Its moments about the two axes come
+//! from the power it carries: per unit normal force, the worm torque gains mu t.V1 / omega1 and
+//! the wheel torque mu t.V2 / omega2 (t = -v_g / |v_g|), so that T1 omega1 = T2 omega2 + P_Vz
+//! with P_Vz = sum mu f |v_g| wherever the normal forces do no work (the conjugate contact).
+//! The local mu follows the pressures (the film's line load, the asperities' share,
+//! [`crate::traction`]); the position's solve iterates pressures -> friction -> torques.
+//! Also here, shared with the mesh loss of [`crate::friction`]: each slice's line contact for the
+//! film, with the curvature rule at the band's end. SI units.
+
+use super::*;
+use crate::input::{FrictionLaw, Lubricant};
+use crate::kinematics::material_velocities;
+use crate::lubrication::LineContact;
+use crate::traction::{central_film_thickness, local_friction, LocalFriction, PointContact};
+use std::collections::HashMap;
+
+/// The relative curvature radius across the contact line of every (position, tooth, slice)
+/// of a TCA, with a defined value where the TCA has none (MODEL §13): slices at the band's end
+/// (the contact line does not cross them) and slices whose gap has no curvature take the
+/// radius of the nearest slice of the same contact line (position and tooth) that has one;
+/// a contact line with none takes the median radius of the analysis.
+#[derive(Debug, Clone)]
+pub struct ContactLineRadii {
+    /// Per (position, tooth): the (slice, radius) pairs with a finite positive radius.
+    lines: HashMap<(usize, i32), Vec<(usize, f64)>>,
+    median: f64,
+}
+
+impl ContactLineRadii {
+    pub fn of(tca: &Tca) -> Self {
+        let mut lines: HashMap<(usize, i32), Vec<(usize, f64)>> = HashMap::new();
+        let mut all = Vec::new();
+        for c in &tca.contact_lines {
+            let r = c.curvature_radius;
+            if r.is_finite() && r > 0.0 {
+                lines
+                    .entry((c.position, c.tooth))
+                    .or_default()
+                    .push((c.slice, r));
+                all.push(r);
+            }
+        }
+        all.sort_by(f64::total_cmp);
+        let median = all.get(all.len() / 2).copied().unwrap_or(f64::NAN);
+        Self { lines, median }
+    }
+
+    /// The radius at slice `slice` of tooth `tooth` at position `position`, m.
+    pub fn at(&self, position: usize, tooth: i32, slice: usize) -> f64 {
+        self.lines
+            .get(&(position, tooth))
+            .and_then(|line| {
+                line.iter()
+                    .min_by_key(|(s, _)| (*s as isize - slice as isize).unsigned_abs())
+                    .map(|&(_, r)| r)
+            })
+            .unwrap_or(self.median)
+    }
+}
+
+/// What the film of a loaded analysis needs that its pressures do not change: the curvature
+/// radii and the rolling velocities of the loaded flank's nodes (MODEL §6).
+#[derive(Debug, Clone)]
+pub struct FilmGeometry {
+    pub radii: ContactLineRadii,
+    /// (u1, u2) of every node of the loaded flank, m/s ([`Tca::rolling_velocities`]).
+    rolling: Vec<(f64, f64)>,
+    r_low: Vec<f64>,
+    r_high: Vec<f64>,
+    rows: usize,
+}
+
+impl FilmGeometry {
+    pub fn new(tca: &Tca, wf: &WheelFlank) -> Self {
+        Self {
+            radii: ContactLineRadii::of(tca),
+            rolling: tca.rolling_velocities(wf),
+            r_low: wf.r_low.clone(),
+            r_high: wf.r_high.clone(),
+            rows: wf.cells_height,
+        }
+    }
+
+    /// Rolling velocities of the node of column `j` nearest radius `r` (m).
+    fn rolling_at(&self, j: usize, r: f64) -> (f64, f64) {
+        let ni = self.rows;
+        let t = (r - self.r_low[j]) / (self.r_high[j] - self.r_low[j]);
+        let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
+        self.rolling[j * (ni + 1) + i]
+    }
+
+    /// The line contact of each slice of a position's cells (a slice's cells are consecutive:
+    /// same tooth, same node column) under the pressures `pressure` (Pa): its curvature radius,
+    /// rolling velocities, line load sum p x (width across the line) (N/m) and peak pressure;
+    /// with each cell's slice index.
+    pub fn slice_lines(
+        &self,
+        position: usize,
+        cells: &[LocalCell],
+        pressure: &[f64],
+    ) -> (Vec<LineContact>, Vec<usize>) {
+        let mut lines = Vec::new();
+        let mut of_cell = Vec::with_capacity(cells.len());
+        let mut start = 0;
+        while start < cells.len() {
+            let first = &cells[start];
+            let end = (start..cells.len())
+                .find(|&k| {
+                    cells[k].tooth_index != first.tooth_index || cells[k].slice != first.slice
+                })
+                .unwrap_or(cells.len());
+            let (u1, u2) = self.rolling_at(first.slice, first.r);
+            lines.push(LineContact {
+                radius: self.radii.at(position, first.tooth, first.slice),
+                u1,
+                u2,
+                line_load: (start..end)
+                    .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
+                    .sum(),
+                pressure: (start..end).map(|k| pressure[k]).fold(0.0, f64::max),
+            });
+            of_cell.extend(std::iter::repeat(lines.len() - 1).take(end - start));
+            start = end;
+        }
+        (lines, of_cell)
+    }
+}
+
+/// The sliding of one cell at the operating speed and the moments of a unit friction force
+/// on the wheel along t = -v_g / |v_g| (MODEL §5.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellSliding {
+    /// |v_g|, m/s.
+    pub speed: f64,
+    /// t.V1 / omega1: the worm torque per newton of friction, m.
+    pub worm_arm: f64,
+    /// t.V2 / omega2: the wheel torque per newton of friction, m.
+    pub wheel_arm: f64,
+}
+
+/// The sliding of the cells `cells` (worm frame) of `gear` at its worm speed (MODEL §4.5).
+pub fn cell_sliding(gear: &GearSet, geo: &Geometry, cells: &[LocalCell]) -> Vec<CellSliding> {
+    let omega1 = gear.conditions.worm_speed;
+    let omega2 = omega1 / gear.ratio();
+    cells
+        .iter()
+        .map(|c| {
+            let v = material_velocities(
+                &c.cell.centre,
+                &geo.worm,
+                &gear.operating,
+                omega1,
+                gear.ratio(),
+            );
+            let vg = Vector3::from(v.sliding);
+            let speed = vg.norm();
+            if speed == 0.0 {
+                return CellSliding {
+                    speed,
+                    worm_arm: 0.0,
+                    wheel_arm: 0.0,
+                };
+            }
+            let t = -vg / speed;
+            CellSliding {
+                speed,
+                worm_arm: t.dot(&Vector3::from(v.worm)) / omega1,
+                wheel_arm: t.dot(&Vector3::from(v.wheel)) / omega2,
+            }
+        })
+        .collect()
+}
+
+/// The lubricant, friction law and moduli of the local friction (MODEL §13).
+#[derive(Debug, Clone, Copy)]
+pub struct FrictionInputs<'a> {
+    /// The lubricant at the oil temperature.
+    pub lubricant: &'a Lubricant,
+    pub law: &'a FrictionLaw,
+    /// Reduced modulus E' of MODEL §6, Pa.
+    pub e_prime: f64,
+    /// Flow pressure bounding the asperities' pressure (the wheel's hardness), Pa.
+    pub flow_pressure: f64,
+}
+
+impl<'a> FrictionInputs<'a> {
+    /// The friction inputs of `gear` with `lubricant` (the gear's at some oil temperature).
+    pub fn of(gear: &'a GearSet, lubricant: &'a Lubricant) -> Self {
+        Self {
+            lubricant,
+            law: &gear.friction,
+            e_prime: crate::lubrication::reduced_modulus(
+                gear.worm_material.youngs_modulus,
+                gear.worm_material.poisson_ratio,
+                gear.wheel_material.youngs_modulus,
+                gear.wheel_material.poisson_ratio,
+            ),
+            flow_pressure: gear.wheel_material.hardness,
+        }
+    }
+
+    /// The local friction of every cell with pressure `pressure` (Pa), sliding `sliding` and
+    /// the film of its slice `films[of_cell[k]]` (central thickness, m).
+    pub fn cells(
+        &self,
+        pressure: &[f64],
+        sliding: &[CellSliding],
+        (films, of_cell): (&[f64], &[usize]),
+    ) -> Vec<LocalFriction> {
+        pressure
+            .iter()
+            .zip(sliding)
+            .zip(of_cell)
+            .map(|((&p, s), &line)| {
+                let at = PointContact {
+                    pressure: p,
+                    sliding_speed: s.speed,
+                    film_thickness: films[line],
+                    roughness: self.lubricant.composite_roughness,
+                };
+                local_friction(
+                    &at,
+                    self.lubricant,
+                    self.law,
+                    (self.e_prime, self.flow_pressure),
+                )
+            })
+            .collect()
+    }
+
+    /// The central film thickness of each line contact `lines`, m.
+    pub fn films(&self, lines: &[LineContact]) -> Vec<f64> {
+        lines
+            .iter()
+            .map(|l| central_film_thickness(self.lubricant, self.e_prime, l))
+            .collect()
+    }
+}
+
+/// The friction of a loaded analysis' positions: what it needs of the gear and its TCA.
+pub struct PositionFriction<'a> {
+    pub gear: &'a GearSet,
+    pub geo: &'a Geometry,
+    pub film: FilmGeometry,
+    pub inputs: FrictionInputs<'a>,
+}
+
+impl PositionFriction<'_> {
+    /// mu of each cell of position `position` under the pressures `pressure` (Pa).
+    pub fn coefficients(
+        &self,
+        position: usize,
+        cells: &[LocalCell],
+        sliding: &[CellSliding],
+        pressure: &[f64],
+    ) -> Vec<f64> {
+        let (lines, of_cell) = self.film.slice_lines(position, cells, pressure);
+        let films = self.inputs.films(&lines);
+        self.inputs
+            .cells(pressure, sliding, (&films, &of_cell))
+            .iter()
+            .map(|f| f.coefficient)
+            .collect()
+    }
+}
+
+/// Per unknown q_i = l_i f_i (MODEL §5.2): the worm torque and the wheel torque it carries
+/// with the friction coefficients `mu` — (worm_lever_i sign + mu_i worm_arm_i) / l_i and
+/// 1 + mu_i wheel_arm_i / l_i — `sign` the driving sense of the worm moments.
+pub(super) fn torque_weights(
+    cells: &[LocalCell],
+    sliding: &[CellSliding],
+    mu: &[f64],
+    sign: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    cells
+        .iter()
+        .zip(sliding)
+        .zip(mu)
+        .map(|((c, s), &m)| {
+            (
+                (c.worm_lever * sign + m * s.worm_arm) / c.lever,
+                1.0 + m * s.wheel_arm / c.lever,
+            )
+        })
+        .unzip()
+}
