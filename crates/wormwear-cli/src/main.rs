@@ -680,9 +680,17 @@ fn print_ltca(results: &wormwear::Results) {
     let Some(result) = &results.ltca else { return };
     let (te, p2p) = result.te_stats();
     println!(
-        "ltca ({}): P_max {:.0} MPa, P_mean {:.0} MPa, S0 {:.2}, TE mean {:.3e} rad p2p {:.3e} rad, \
-         stiffness {:.3e} N m/rad, up to {} teeth loaded",
+        "ltca ({}): T1 {:.2} N m, T2 {:.1} N m ({} torque, eta_z {:.4}); P_max {:.0} MPa, P_mean \
+         {:.0} MPa, S0 {:.2}, TE mean {:.3e} rad p2p {:.3e} rad, stiffness {:.3e} N m/rad, up to \
+         {} teeth loaded",
         result.bending_model,
+        result.worm_torque,
+        result.wheel_torque,
+        match result.torque_balance {
+            wormwear::input::TorqueBalance::Transmitted => "transmitted",
+            wormwear::input::TorqueBalance::Frictionless => "frictionless",
+        },
+        result.mesh_efficiency,
         result.max_pressure / 1e6,
         result.mean_pressure / 1e6,
         result.s0,
@@ -694,7 +702,9 @@ fn print_ltca(results: &wormwear::Results) {
     if result.shaft_torsion_compliance > 0.0 {
         println!(
             "  of which the wheel shaft's torsion: TE {:.3e} rad; stiffness without it {:.3e} N m/rad",
-            -result.shaft_torsion_compliance * result.wheel_torque,
+            -result.shaft_torsion_compliance
+                * result.positions.iter().map(|p| p.normal_wheel_torque).sum::<f64>()
+                / result.positions.len().max(1) as f64,
             result.stiffness_without_shaft_torsion_mean()
         );
     }

@@ -446,18 +446,18 @@ const OIL_ITERATIONS: usize = 6;
 /// balance has converged when two passes differ by less than this, K.
 pub const OIL_TOLERANCE_K: f64 = 0.05;
 
-/// The loaded analysis `analyse` runs with `settings`, and with the heat balance and the
-/// transmitted torque, again at the balance's oil temperature until two temperatures differ by
-/// less than [`OIL_TOLERANCE_K`] (MODEL §13: the friction the pressures carry follows the oil;
-/// at most [`OIL_ITERATIONS`] analyses; a balance that fails ends the passes, and the
-/// friction stage reports it). `other_losses` P_V0 + P_VLP + P_VD, W.
+/// The loaded analysis `first` (run by `analyse` with `settings`), and with the heat balance
+/// and the transmitted torque, again at the balance's oil temperature until two temperatures
+/// differ by less than [`OIL_TOLERANCE_K`] (MODEL §13: the friction the pressures carry
+/// follows the oil; at most [`OIL_ITERATIONS`] analyses; a balance that fails ends the passes,
+/// and the friction stage reports it). `other_losses` P_V0 + P_VLP + P_VD, W.
 pub fn oil_fixed_point<E>(
     (gear, geo, tca): (&GearSet, &Geometry, &Tca),
     other_losses: f64,
-    mut settings: crate::ltca::LtcaSettings,
+    (mut settings, first): (crate::ltca::LtcaSettings, Ltca),
     analyse: impl Fn(&crate::ltca::LtcaSettings) -> Result<Ltca, E>,
 ) -> Result<Ltca, E> {
-    let mut result = analyse(&settings)?;
+    let mut result = first;
     let coupled = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
     if !(gear.housing.balance && coupled) {
         return Ok(result);

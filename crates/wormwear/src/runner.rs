@@ -614,7 +614,7 @@ impl<'a> Pipeline<'a> {
             None => None,
         };
         let root_stress = self.root_stress(geo, tca, strength);
-        let sump = self.sump_temperature(geo, tca, ltca, thermal);
+        let sump = self.sump_temperature((geo, tca, bending), ltca, thermal);
         let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
             gear,
             iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
@@ -652,11 +652,11 @@ impl<'a> Pipeline<'a> {
     /// The sump temperature of S_T (MODEL §9.1, §13): the run's own heat balance, or, when the
     /// run holds the lubricant's fixed temperature and the table has a temperature limit, the
     /// housing's heat balance at the nominal torque solved for the table alone (its `[housing]`
-    /// inputs or their defaults); an error is the row's reason.
+    /// inputs or their defaults; with the transmitted torque, the loaded analysis again at the
+    /// balance's temperature, as a run with the balance does); an error is the row's reason.
     fn sump_temperature(
         &mut self,
-        geo: &Geometry,
-        tca: &Tca,
+        (geo, tca, bending): (&Geometry, &Tca, &Bending),
         ltca: &Ltca,
         thermal: Option<&crate::friction::Thermal>,
     ) -> Option<Result<crate::safety::Sump, String>> {
@@ -670,16 +670,26 @@ impl<'a> Pipeline<'a> {
         gear.rating.safety.oil_temperature_limit?;
         let rating = crate::rating::rate(gear);
         let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
-        let contacts = crate::friction::MeshContacts::new(gear, geo, tca, ltca);
-        let housing = crate::input::Housing {
-            balance: true,
-            ..gear.housing
+        let mut balanced = gear.clone();
+        balanced.housing.balance = true;
+        let analyse = |settings: &LtcaSettings| {
+            let model = bending.model.as_ref().map(|b| b as &dyn BendingModel);
+            crate::ltca::analyse_with(&balanced, geo, tca, settings, model)
         };
+        let settings = LtcaSettings::from_gear(&balanced);
+        let inputs = (&balanced, geo, tca);
+        let at_oil =
+            crate::friction::oil_fixed_point(inputs, other, (settings, ltca.clone()), analyse);
+        let ltca = match &at_oil {
+            Ok(l) => l,
+            Err(_) => ltca,
+        };
+        let contacts = crate::friction::MeshContacts::new(gear, geo, tca, ltca);
         let result = crate::friction::heat_balance(
             &contacts,
             &gear.lubricant,
             &gear.friction,
-            &housing,
+            &balanced.housing,
             other,
         )
         .map(|thermal| crate::safety::Sump {
@@ -880,7 +890,9 @@ pub(crate) fn loaded_analysis(
     let rating = crate::rating::rate(gear);
     let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
     let settings = LtcaSettings::from_gear(gear);
-    let result = crate::friction::oil_fixed_point((gear, geo, tca), other, settings, analyse)?;
+    let first = analyse(&settings)?;
+    let result =
+        crate::friction::oil_fixed_point((gear, geo, tca), other, (settings, first), analyse)?;
     warnings.extend(
         result
             .warnings

@@ -5,8 +5,10 @@
 //! local central film thickness (the separation of the mean planes) and the summit statistics
 //! eta_s beta sigma and sigma / beta,
 //!
-//!     p_asp = min(p_Y, K_GT E' F_5/2(h / sigma)),
-//!     K_GT = (16 sqrt(2) pi / 15) (eta_s beta sigma)^2 sqrt(sigma / beta),
+//! ```text
+//! p_asp = min(p_Y, K_GT E' F_5/2(h / sigma)),
+//! K_GT = (16 sqrt(2) pi / 15) (eta_s beta sigma)^2 sqrt(sigma / beta),
+//! ```
 //!
 //! E' the reduced modulus of MODEL §6 (2 / E' = sum (1 - v^2) / E) and p_Y the wheel's flow
 //! pressure (plastic asperities). The asperities take the share f_a = min(1, p_asp / p) at

@@ -303,8 +303,11 @@ fn the_patch_pressure_converges_where_the_maximum_does_not() {
     // At the worm's sharp tip edge the local maximum grows like the square root of the
     // refinement across the line (an integrable edge singularity); the mean over the stated
     // patch (0.5 mm across by 1 mm along) does not. The elastic law: the plastic one bounds
-    // the edge (`the_plastic_limit_makes_the_peaks_mesh_converged`).
-    let g = design();
+    // the edge (`the_plastic_limit_makes_the_peaks_mesh_converged`). Frictionless pressures
+    // (the contact alone: with the transmitted torque the friction at the singular edge moves
+    // the patch by 3.7 % between 11 and 41 cells, the torque by less).
+    let mut g = design();
+    g.analysis.torque_balance = wormwear::input::TorqueBalance::Frictionless;
     let (geo, tca) = prepared(&g);
     let run = |columns: usize| {
         let mut s = LtcaSettings::from_gear(&g);

@@ -40,10 +40,13 @@ fn equilibrium_and_complementarity_hold() {
     // Sharp edges (default) and with reliefs. The meshing identity below holds at conjugate
     // points; with sharp edges the worm's tip edge touches too (not a conjugate point), so it
     // is checked on the relieved gear, where the edges are eased out of contact.
-    for (g, conjugate_only) in [
+    // Frictionless pressures (the published reading, MODEL §5.2), so that T2 = u T1; the
+    // transmitted torque's balances are tests/torque_balance.rs'.
+    for (mut g, conjugate_only) in [
         (example("gear-1x40-design.toml"), false),
         (relieved("gear-1x40-design.toml"), true),
     ] {
+        g.analysis.torque_balance = wormwear::input::TorqueBalance::Frictionless;
         let res = equilibrium_and_complementarity_of(&g, conjugate_only);
         // Frictionless power balance over the cycle: mean wheel torque = u x worm torque. (At
         // a single position it departs by up to ~1 %: band cells away from the contact line,

@@ -63,12 +63,16 @@ fn the_root_stress_is_linear_in_the_pressures_and_nearly_so_in_the_torque() {
     let ratio = twice.interior.stress / base.interior.stress;
     assert!((ratio - 2.0).abs() < 1e-9, "{ratio}");
     assert_eq!(twice.interior.position, base.interior.position);
-    // Twice the torque: the contact spreads as it is loaded (Hertz: the loaded area grows),
-    // so the stress grows by slightly less than the load; measured 1.977 at level 1.
-    let (_, _, _, heavy) = loaded(120.0);
-    let heavy = root_stress(&g, &geo, &heavy, flank, (1, FILLET)).unwrap();
-    let ratio = heavy.interior.stress / base.interior.stress;
-    assert!((1.95..2.0).contains(&ratio), "{ratio}");
+    // Twice the worm torque: the wheel torque grows a little more (the mesh efficiency rises
+    // with the load), and the contact spreads as it is loaded (Hertz: the loaded area grows),
+    // so per unit wheel torque the stress grows by slightly less than the load; measured
+    // 0.989 at level 1.
+    let (_, _, _, heavy_ltca) = loaded(120.0);
+    let heavy = root_stress(&g, &geo, &heavy_ltca, flank, (1, FILLET)).unwrap();
+    let torque_ratio = heavy_ltca.wheel_torque / ltca.wheel_torque;
+    let ratio = heavy.interior.stress / base.interior.stress / torque_ratio;
+    assert!(torque_ratio > 2.0 && torque_ratio < 2.1, "{torque_ratio}");
+    assert!((0.975..1.0).contains(&ratio), "{ratio}");
     // The tensile fibre is on the loaded flank's side (the tooth bends away from the load).
     assert!(base.interior.tension_on_loaded_side);
 }

@@ -185,13 +185,15 @@ fn a_sweep_records_failing_variants_goes_on_and_resumes_where_it_stopped() {
     };
     let flow = 1e9;
     assert!(
-        p("v1") < flow && 1.4 * p("v1") > flow,
+        p("v1") < flow && 2.0 * p("v1") > flow,
         "P_max v1 {}",
         p("v1")
     );
     assert!((p("v4") / flow - 1.0).abs() < 1e-9, "P_max v4 {}", p("v4"));
-    // The roughness does not enter the loaded analysis.
-    assert_eq!(p("v1"), p("v3"));
+    // The roughness enters the loaded analysis through the friction (MODEL §5.2, §13): the
+    // smoother flank (v1, 0.5 um) loses less, so its wheel carries a little more of the worm
+    // torque.
+    assert!(p("v1") > p("v3"), "{} vs {}", p("v1"), p("v3"));
 }
 
 fn strip_times(rows: &[Row]) -> Vec<Row> {

@@ -131,8 +131,9 @@ fn shaft_torsion_shifts_the_te_and_leaves_the_load_sharing() {
     let mut worst_p = 0.0f64;
     for (a, b) in rigid.positions.iter().zip(&twisted.positions) {
         let shift = b.transmission_error - a.transmission_error;
-        // TE is negative under load (the wheel lags): the shift is -c_t C2.
-        worst_te = worst_te.max((shift / (-c_t * a.wheel_torque) - 1.0).abs());
+        // TE is negative under load (the wheel lags): the shift is -c_t W, W the normal
+        // pressures' wheel torque (the bending model carries no friction tractions).
+        worst_te = worst_te.max((shift / (-c_t * a.normal_wheel_torque) - 1.0).abs());
         let pmax = a.pressure.iter().cloned().fold(0.0, f64::max);
         for (pa, pb) in a.pressure.iter().zip(&b.pressure) {
             worst_p = worst_p.max((pa - pb).abs() / pmax);

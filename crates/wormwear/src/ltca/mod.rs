@@ -153,12 +153,16 @@ pub struct PositionResult {
     pub wheel_torque: f64,
     /// Worm torque balanced T1, N m.
     pub worm_torque: f64,
+    /// Moment of the normal pressures alone about the wheel axis W = sum f l, N m: the load of
+    /// the contact's compliance (approach, stiffness W / approach, the shaft's torsion); T2
+    /// without the friction tractions' moments.
+    pub normal_wheel_torque: f64,
     /// Rigid approach (wheel rotation against its driven sense), rad.
     pub approach: f64,
     /// Loaded transmission error = unloaded kinematic error - approach (driven sense,
     /// negative = lag), rad.
     pub transmission_error: f64,
-    /// Angular mesh stiffness C2 / approach, N m/rad.
+    /// Angular mesh stiffness W / approach (W the normal pressures' wheel torque), N m/rad.
     pub stiffness_angular: f64,
     /// Linear mesh stiffness F / (approach x lever at the force barycentre), N/m.
     pub stiffness_linear: f64,
@@ -241,22 +245,31 @@ pub struct Ltca {
     pub equivalent_pressure_max: f64,
     /// How the equivalent pressure was evaluated (its criterion, the wheel's Poisson ratio).
     pub subsurface: SubsurfaceSettings,
+    /// Mean worm torque T1 and transmitted wheel torque T2 over the positions, N m.
     pub worm_torque: f64,
     pub wheel_torque: f64,
-    /// Frictionless power balance over the pitch: mean wheel torque over u x the mean worm
-    /// torque, less 1 (0 for a model consistent with the kinematics; beyond
+    /// Ratio u = z2 / z1.
+    pub ratio: f64,
+    /// Which torque the pressures carry (MODEL §5.2).
+    pub torque_balance: crate::input::TorqueBalance,
+    /// The mesh efficiency the torques carry, eta_z = T2 / (u T1) (1 for frictionless
+    /// pressures, to the power balance).
+    pub mesh_efficiency: f64,
+    /// Power balance over the pitch: (mean T2 / u + the friction's worm torque P_Vz /
+    /// omega1) / mean T1, less 1 (0 for a model consistent with the kinematics; beyond
     /// [`POWER_BALANCE_LIMIT`] the contact is at non-conjugate points, see `warnings`).
     pub power_balance: f64,
     /// What makes these results doubtful, with the reason.
     pub warnings: Vec<String>,
 }
 
-/// Largest departure from the frictionless power balance of a trusted loaded analysis. The
+/// Largest departure from the power balance (T2 omega2 + P_Vz = T1 omega1, MODEL §5.2) of a
+/// trusted loaded analysis. The
 /// aligned examples stay within 0.5 % (band cells off the contact line, the worm's tip edge).
 pub const POWER_BALANCE_LIMIT: f64 = 0.02;
 
-/// Warnings on a loaded analysis whose mean wheel torque departs from u x the worm torque
-/// by more than [`POWER_BALANCE_LIMIT`]: the load sits at points where the pressure direction
+/// Warnings on a loaded analysis whose power balance departs by more than
+/// [`POWER_BALANCE_LIMIT`]: the load sits at points where the pressure direction
 /// is not the contact's (with `pressure_direction = "wheel-flank"`, the wheel's face edge
 /// under a misalignment), which the small worm lever (|t| / |M| ~ tan of the lead angle) turns
 /// into large torque errors.
@@ -271,8 +284,9 @@ fn power_balance_warnings(
         return Vec::new();
     }
     vec![format!(
-        "the mean wheel torque over the pitch, {wheel:.1} N m, departs from u x the worm torque, \
-         {:.1} N m, by {:+.1} % (frictionless power balance, limit {} %): the pressure \
+        "the power balance over the pitch, T2 omega2 + P_Vz = T1 omega1 (mean wheel torque \
+         {wheel:.1} N m, u x the worm torque {:.1} N m), departs by {:+.1} % (limit {} %): the \
+         pressure \
          direction is not the contact's where the load sits (largest pressure at z = {:.2} mm; \
          with analysis.pressure_direction = \"wheel-flank\", the wheel's face edge under a \
          misalignment); torques, TE and stiffness are unreliable. The default \
@@ -293,15 +307,14 @@ impl Ltca {
     pub fn stiffness_mean(&self) -> f64 {
         stats(self.positions.iter().map(|p| p.stiffness_angular)).0
     }
-    /// Mean angular mesh stiffness without the wheel shaft's torsion: C2 / (alpha - c_t C2),
-    /// N m/rad (equal to [`Ltca::stiffness_mean`] when the model has no shaft torsion).
+    /// Mean angular mesh stiffness without the wheel shaft's torsion: W / (alpha - c_t W) with
+    /// W the normal pressures' wheel torque, N m/rad (equal to [`Ltca::stiffness_mean`] when the model has no shaft torsion).
     pub fn stiffness_without_shaft_torsion_mean(&self) -> f64 {
         let c_t = self.shaft_torsion_compliance;
-        stats(
-            self.positions
-                .iter()
-                .map(|p| p.wheel_torque / (p.approach - c_t * p.wheel_torque)),
-        )
+        stats(self.positions.iter().map(|p| {
+            let w = p.normal_wheel_torque;
+            w / (p.approach - c_t * w)
+        }))
         .0
     }
     /// Most teeth carrying load at one position.
@@ -649,6 +662,9 @@ fn over_the_cycle(
         subsurface: settings.subsurface,
         worm_torque,
         wheel_torque,
+        ratio,
+        torque_balance: settings.torque_balance,
+        mesh_efficiency: wheel_torque / (ratio * worm_torque),
         power_balance,
         warnings,
     }

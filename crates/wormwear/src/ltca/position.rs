@@ -373,6 +373,7 @@ fn position_result(
         tooth_load,
         wheel_torque,
         worm_torque: f64::NAN,
+        normal_wheel_torque: wheel_torque,
         approach,
         transmission_error: tca.positions[n].kinematic_error - approach,
         stiffness_angular: wheel_torque / approach,

@@ -27,8 +27,15 @@ pub struct LtcaSummary {
     pub bending_model: String,
     pub solver: String,
     pub worm_torque_nm: f64,
-    /// Mean over the positions.
+    /// Mean over the positions: the torque the mesh transmits (MODEL §5.2).
     pub wheel_torque_nm: f64,
+    /// Which torque the pressures carry: "transmitted" (with the contact's friction) or
+    /// "frictionless" (the published reading, T2 = u T1).
+    pub torque_balance: crate::input::TorqueBalance,
+    /// The mesh efficiency the torques carry, eta_z = T2 / (u T1).
+    pub mesh_efficiency: f64,
+    /// Mean worm torque the friction consumes, P_Vz / omega1, N m.
+    pub friction_torque_nm: f64,
     /// Largest pressure of the loaded pattern's cells (raw maximum, see
     /// `max_pressure_definition`) and where it sits on the flank (cell centre), mm.
     pub max_pressure_pa: f64,
@@ -62,7 +69,7 @@ pub struct LtcaSummary {
     pub mesh_stiffness_without_shaft_torsion_nm_per_rad: f64,
     pub mesh_stiffness_linear_mean_n_per_m: f64,
     pub max_teeth_in_contact: usize,
-    /// Frictionless power balance: mean wheel torque / (u x worm torque) - 1.
+    /// Power balance: (mean wheel torque / u + friction torque) / worm torque - 1.
     pub power_balance: f64,
     /// What makes these results doubtful (also on stderr and in report.html).
     pub warnings: Vec<String>,
@@ -106,6 +113,14 @@ impl LtcaSummary {
             solver: format!("{:?}", ltca.solver),
             worm_torque_nm: ltca.worm_torque,
             wheel_torque_nm: ltca.wheel_torque,
+            torque_balance: ltca.torque_balance,
+            mesh_efficiency: ltca.mesh_efficiency,
+            friction_torque_nm: ltca
+                .positions
+                .iter()
+                .map(|p| p.friction_torque)
+                .sum::<f64>()
+                / n,
             max_pressure_pa: ltca.max_pressure,
             max_pressure_r_mm: at_max.map_or(f64::NAN, |c| c.r * MM),
             max_pressure_z_mm: at_max.map_or(f64::NAN, |c| c.z * MM),
@@ -566,13 +581,18 @@ fn pressure_maps(
     Ok(())
 }
 
-/// The table of positions (`ltca_positions.csv`): torques, approach, TE, KE, stiffness,
-/// maximum pressure and the normal force on each tooth (units in the names).
+/// The table of positions (`ltca_positions.csv`): torques (the transmitted wheel torque, the
+/// worm's, the normal pressures' wheel torque and the friction's worm torque, MODEL §5.2), the
+/// mesh efficiency T2 / (u T1), approach, TE, KE, stiffness, maximum pressure and the normal
+/// force on each tooth (units in the names).
 pub fn positions_table(tca: &Tca, ltca: &Ltca) -> Csv {
     let mut header: Vec<String> = [
         "position",
         "wheel_torque_nm",
         "worm_torque_nm",
+        "normal_wheel_torque_nm",
+        "friction_torque_nm",
+        "mesh_efficiency",
         "approach_rad",
         "transmission_error_rad",
         "kinematic_error_rad",
@@ -590,6 +610,9 @@ pub fn positions_table(tca: &Tca, ltca: &Ltca) -> Csv {
             p.position as f64,
             p.wheel_torque,
             p.worm_torque,
+            p.normal_wheel_torque,
+            p.friction_torque,
+            p.wheel_torque / (ltca.ratio * p.worm_torque),
             p.approach,
             p.transmission_error,
             tca.positions[p.position].kinematic_error,

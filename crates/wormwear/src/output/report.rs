@@ -333,9 +333,30 @@ fn warnings_section(h: &mut String, summary: &serde_json::Value) {
 
 /// The key results: (label, where in summary.json — a stage's section, or `END` for the last
 /// wear state — key (dotted: nested), scale to the unit, unit).
-const KEY_RESULTS: [(&str, &str, &str, f64, &str); 16] = [
+const KEY_RESULTS: [(&str, &str, &str, f64, &str); 20] = [
     ("Ratio", "geometry", "ratio", 1.0, ""),
     ("Lead angle", "geometry", "lead_angle_deg", 1.0, "deg"),
+    (
+        "Worm torque T1 (loaded analysis)",
+        "ltca",
+        "worm_torque_nm",
+        1.0,
+        "N m",
+    ),
+    (
+        "Wheel torque T2 the pressures carry",
+        "ltca",
+        "wheel_torque_nm",
+        1.0,
+        "N m",
+    ),
+    (
+        "Mesh efficiency of those torques, T2 / (u T1)",
+        "ltca",
+        "mesh_efficiency",
+        1.0,
+        "",
+    ),
     (
         "Max contact pressure (unworn)",
         "ltca",
@@ -373,7 +394,20 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 16] = [
         "",
     ),
     ("Oil temperature", "friction", "oil_temperature_k", 1.0, "C"),
-    ("Worm torque", "rating", "worm_torque_nm", 1.0, "N m"),
+    (
+        "Output power (contact's friction)",
+        "friction",
+        "efficiency.output_power_w",
+        1.0,
+        "W",
+    ),
+    (
+        "Worm torque (ISO/TR 14521)",
+        "rating",
+        "worm_torque_nm",
+        1.0,
+        "N m",
+    ),
     (
         "Pitting life N_LI",
         "rating",

@@ -48,7 +48,7 @@ const QUANTITIES: [Quantity; 8] = [
         file: "efficiency",
     },
     Quantity {
-        title: "Frictionless power balance",
+        title: "Power balance",
         unit: "power balance (%)",
         scale: 100.0,
         value: |r| r.power_balance,

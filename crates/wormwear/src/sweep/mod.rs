@@ -376,7 +376,7 @@ pub struct Row {
     pub contact_area_fraction: Option<f64>,
     /// Peak-to-peak transmission error of the unworn loaded analysis, rad.
     pub te_p2p_rad: Option<f64>,
-    /// Frictionless power balance of the unworn loaded analysis (MODEL §5; 0 = exact).
+    /// Power balance of the unworn loaded analysis (MODEL §5.2; 0 = exact).
     pub power_balance: Option<f64>,
     /// Mesh efficiency, worm driving (ISO/TR 14521, MODEL §9).
     pub efficiency: Option<f64>,

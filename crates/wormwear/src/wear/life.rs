@@ -398,11 +398,13 @@ impl<'a> LifeLoop<'a> {
                 source,
             })
         };
+        let first = analyse(&local)?;
         let l = match last {
-            Some(_) => analyse(&local)?,
+            Some(_) => first,
             None => {
                 let inputs = (self.gear, self.geo, self.tca);
-                crate::friction::oil_fixed_point(inputs, self.other_losses, local, analyse)?
+                let other = self.other_losses;
+                crate::friction::oil_fixed_point(inputs, other, (local, first), &analyse)?
             }
         };
         let widenings = l

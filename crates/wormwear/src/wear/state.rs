@@ -204,7 +204,7 @@ pub struct StepRecord {
     /// ([`super::WearLimits::worn_through_loaded`]).
     #[serde(default)]
     pub worn_through_loaded: bool,
-    /// Frictionless power balance of this state's loaded analysis (`Ltca::power_balance`).
+    /// Power balance of this state's loaded analysis (`Ltca::power_balance`, MODEL §5.2).
     #[serde(default)]
     pub power_balance: f64,
     /// Largest fatigue damage of the loaded flank's nodes (1: a node's life on the
@@ -294,7 +294,7 @@ impl WearState {
             .find(|r| r.power_balance.abs() > crate::ltca::POWER_BALANCE_LIMIT);
         if let Some(r) = balance {
             w.push(format!(
-                "wear: from {} cycles the loaded analyses depart from the frictionless power \
+                "wear: from {} cycles the loaded analyses depart from the power \
                  balance by {:+.1} % (more than {} %): the load sits at non-conjugate points (the \
                  wheel's face edge under a misalignment) and the model's torques, TE and wear \
                  there are unreliable (power_balance in wear_steps.csv)",
