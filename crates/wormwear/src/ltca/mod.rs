@@ -560,15 +560,7 @@ pub fn analyse_changed(
     let changed = FlankShape::new(wf, change);
     let worn = changed.as_ref().map(|c| c.worn(change.plastic_set));
     let oil = gear.lubricant.at_temperature(settings.oil_temperature);
-    let friction =
-        (settings.torque_balance == crate::input::TorqueBalance::Transmitted).then(|| {
-            PositionFriction {
-                gear,
-                geo,
-                film: FilmGeometry::new(tca, wf),
-                inputs: FrictionInputs::of(gear, &oil),
-            }
-        });
+    let friction = position_friction((gear, geo, tca), settings, &oil);
 
     let mut positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
@@ -602,6 +594,24 @@ pub fn analyse_changed(
         bending,
         rows_per_row,
     ))
+}
+
+/// What the positions' friction needs (MODEL §5.2, §13) when the pressures carry the
+/// transmitted torque; None for the frictionless reading. `oil`: the lubricant at the
+/// analysis' oil temperature.
+fn position_friction<'a>(
+    (gear, geo, tca): (&'a GearSet, &'a Geometry, &Tca),
+    settings: &LtcaSettings,
+    oil: &'a crate::input::Lubricant,
+) -> Option<PositionFriction<'a>> {
+    let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
+    transmitted.then(|| PositionFriction {
+        gear,
+        geo,
+        film: FilmGeometry::new(tca, geo.wheel_flank(tca.loaded_flank)),
+        inputs: FrictionInputs::of(gear, oil),
+        estimate: crate::rating::base_friction(tca.pitch_sliding_speed),
+    })
 }
 
 /// The loaded analysis over the mesh cycle from its positions (MODEL §5.6, §5.7, §8.1): the

@@ -79,7 +79,7 @@ pub(super) fn solve_position(
                 .ok_or(LtcaError::TorqueSign(n))?;
         let balanced = match friction {
             None => {
-                let (sol, worm) =
+                let (sol, worm, _) =
                     balance_worm_torque(&mut problem, &weights, settings, worm_torque, warm, n)?;
                 let wheel = problem.load;
                 Balanced::frictionless(sol, worm, wheel, cells.len())
@@ -195,7 +195,9 @@ fn contact_problem(
 /// affine step on the loaded set after the first solve; the fixed-point solver (and any change
 /// of the loaded set) iterates, by secants on the (wheel torque, worm torque) pairs: with
 /// cells at the flow pressure (MODEL §5.7) the worm torque is not proportional to the wheel
-/// torque and a plain rescaling can cycle. Returns the last solution and its worm torque.
+/// torque and a plain rescaling can cycle. Returns the last solution and its worm torque,
+/// with the linear response the affine step moved along (when it did: reusable for other
+/// weights while its loaded set holds).
 fn balance_worm_torque(
     problem: &mut Problem,
     weights: &[f64],
@@ -203,7 +205,8 @@ fn balance_worm_torque(
     target: Option<f64>,
     mut warm: Option<Vec<f64>>,
     n: usize,
-) -> Result<(solver::Solution, f64), LtcaError> {
+) -> Result<(solver::Solution, f64, Option<solver::LoadResponse>), LtcaError> {
+    let mut response = None;
     let worm_of = |q: &[f64]| -> f64 { weights.iter().zip(q).map(|(w, q)| w * q).sum() };
     let mut solution = None;
     let mut previous = None;
@@ -228,9 +231,15 @@ fn balance_worm_torque(
             break;
         }
         if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
-            if let Some((updated, load)) =
-                solver::affine_load_update(problem, &sol, weights, target, &settings.solver)
-            {
+            // (solver::affine_load_update, keeping the response.)
+            let at = solver::LoadResponse::of(problem, &sol, &settings.solver);
+            let step = at.as_ref().and_then(|r| {
+                let loads = r.at_target(weights, target)?;
+                let load = loads.load;
+                Some((r.solution(problem, loads, &settings.solver)?, load))
+            });
+            if let Some((updated, load)) = step {
+                response = at;
                 problem.load = load;
                 let worm = worm_of(&updated.q);
                 let close = ((worm - target) / target).abs() < 1e-9;
@@ -248,7 +257,8 @@ fn balance_worm_torque(
         warm = Some(sol.q.clone());
         solution = Some((sol, worm));
     }
-    Ok(solution.expect("at least one solve"))
+    let (sol, worm) = solution.expect("at least one solve");
+    Ok((sol, worm, response))
 }
 
 /// Largest number of friction updates of a position's torque balance (MODEL §5.2).
@@ -284,37 +294,81 @@ impl Balanced {
 
 /// The torque balance with the friction tractions' moments (MODEL §5.2): with the friction
 /// coefficients of the last pressures frozen, the normal load is set so that the worm torque
-/// (worm torque given) or the transmitted wheel torque (else) meets its target
-/// ([`balance_worm_torque`] on the weights of [`torque_weights`]); the friction is then
-/// updated from the new pressures, until the torque the balance does not set (the wheel's when
-/// the worm torque is given, else the worm's) changes by less than [`FRICTION_TOLERANCE`]. `target`: the worm torque when given, and the wheel torque (used
-/// when the worm torque is not given), N m.
+/// (worm torque given) or the transmitted wheel torque (else) meets its target; the friction is
+/// then updated from the new pressures, until the torque the balance does not set (the wheel's
+/// when the worm torque is given, else the worm's) changes by less than [`FRICTION_TOLERANCE`].
+/// The first balance is at a uniform friction estimate ([`balance_worm_torque`]); the updates
+/// move along that
+/// solution's exact linear response to the load ([`solver::LoadResponse`]: one CG for them
+/// all) while its loaded set holds, and solve again where it does not. `target`: the worm
+/// torque when given, and the wheel torque (used when the worm torque is not given), N m.
 fn balance_with_friction(
     problem: &mut Problem,
     cells: &[LocalCell],
     sign: f64,
     (settings, friction): (&LtcaSettings, &PositionFriction),
     (worm_torque, wheel_torque): (Option<f64>, f64),
-    mut warm: Option<Vec<f64>>,
+    warm: Option<Vec<f64>>,
     n: usize,
 ) -> Result<Balanced, LtcaError> {
     let sliding = cell_sliding(friction.gear, friction.geo, cells);
-    let mut mu = vec![0.0; cells.len()];
-    // The torque the balance does not set: the wheel's when the worm torque is given.
+    let target = worm_torque.unwrap_or(wheel_torque);
+    let pick = |(worm, wheel): (Vec<f64>, Vec<f64>)| match worm_torque {
+        Some(_) => (worm.clone(), worm, wheel),
+        None => (wheel.clone(), worm, wheel),
+    };
+    // The first balance at an estimate of the friction close to the final one, so that the
+    // friction's updates keep its loaded set: the friction under the warm start's loads (the
+    // previous wear state's), else a uniform one.
+    // The warm start's normal load starts the solve (its load sum q, not the estimate from
+    // the torque given).
+    let mut mu = match &warm {
+        Some(q) if q.iter().any(|&q| q > 0.0) => {
+            problem.load = q.iter().sum();
+            let pressure = cell_pressures(cells, q, settings.flow_pressure);
+            friction.coefficients(n, cells, &sliding, &pressure)
+        }
+        _ => vec![friction.estimate; cells.len()],
+    };
+    let (weights, _, _) = pick(torque_weights(cells, &sliding, &mu, sign));
+    let (mut sol, _, mut response) =
+        balance_worm_torque(problem, &weights, settings, Some(target), warm, n)?;
+    if response.is_none() {
+        response = solver::LoadResponse::of(problem, &sol, &settings.solver);
+    }
+    // The current loads: the solution's, or those of its response at a later target (gaps
+    // and residuals computed once, at the end).
+    let mut moved: Option<solver::AffineLoads> = None;
     let mut last_free = f64::NAN;
     for it in 0..FRICTION_ITERATIONS {
-        let (worm_weights, wheel_weights) = torque_weights(cells, &sliding, &mu, sign);
-        let (weights, target) = match worm_torque {
-            Some(t) => (&worm_weights, t),
-            None => (&wheel_weights, wheel_torque),
-        };
-        let (sol, _) = balance_worm_torque(problem, weights, settings, Some(target), warm, n)?;
-        let dot = |w: &[f64]| w.iter().zip(&sol.q).map(|(a, q)| a * q).sum::<f64>();
+        let previous = moved.as_ref().map_or(&sol.q, |m| &m.q).clone();
+        let pressure = cell_pressures(cells, &previous, settings.flow_pressure);
+        mu = friction.coefficients(n, cells, &sliding, &pressure);
+        let (weights, worm_weights, wheel_weights) =
+            pick(torque_weights(cells, &sliding, &mu, sign));
+        moved = response
+            .as_ref()
+            .and_then(|r| r.at_target(&weights, target));
+        if moved.is_none() {
+            // The loaded set changes: solve again, and respond from there.
+            let warm = Some(previous);
+            (sol, _, response) =
+                balance_worm_torque(problem, &weights, settings, Some(target), warm, n)?;
+            if response.is_none() {
+                response = solver::LoadResponse::of(problem, &sol, &settings.solver);
+            }
+        }
+        let q = moved.as_ref().map_or(&sol.q, |m| &m.q);
+        let dot = |w: &[f64]| w.iter().zip(q).map(|(a, q)| a * q).sum::<f64>();
         let (worm, wheel) = (dot(&worm_weights), dot(&wheel_weights));
         let free = if worm_torque.is_some() { wheel } else { worm };
-        if (free - last_free).abs() <= FRICTION_TOLERANCE * free.abs()
-            || it + 1 == FRICTION_ITERATIONS
-        {
+        let converged = (free - last_free).abs() <= FRICTION_TOLERANCE * free.abs();
+        if converged || it + 1 == FRICTION_ITERATIONS {
+            if let Some(loads) = moved.take() {
+                let settled = (response.as_ref(), loads, weights.as_slice(), target);
+                sol = settle(problem, settled, settings, n)?;
+            }
+            let dot = |w: &[f64]| w.iter().zip(&sol.q).map(|(a, q)| a * q).sum::<f64>();
             let friction_torque = cells
                 .iter()
                 .zip(&sol.q)
@@ -323,19 +377,50 @@ fn balance_with_friction(
                 .sum::<f64>()
                 / friction.gear.conditions.worm_speed;
             return Ok(Balanced {
+                worm: dot(&worm_weights),
+                wheel: dot(&wheel_weights),
                 solution: sol,
-                worm,
-                wheel,
                 friction: mu,
                 friction_torque,
             });
         }
         last_free = free;
-        let (_, pressure, _) = cell_loads(cells, &sol.q, &sol.gap, settings.flow_pressure);
-        mu = friction.coefficients(n, cells, &sliding, &pressure);
-        warm = Some(sol.q.clone());
     }
     unreachable!("the last friction update returns")
+}
+
+/// The solution at the loads `loads` a linear response `response` moved to: its gaps and
+/// residuals where its loaded set holds, else one warm-started balance of `weights . q` on
+/// `target` from those loads (a boundary cell's state changed). Sets `problem.load`.
+fn settle(
+    problem: &mut Problem,
+    (response, loads, weights, target): (
+        Option<&solver::LoadResponse>,
+        solver::AffineLoads,
+        &[f64],
+        f64,
+    ),
+    settings: &LtcaSettings,
+    n: usize,
+) -> Result<solver::Solution, LtcaError> {
+    problem.load = loads.load;
+    let exact = response.and_then(|r| r.solution(problem, loads.clone(), &settings.solver));
+    match exact {
+        Some(s) => Ok(s),
+        None => {
+            let warm = Some(loads.q);
+            Ok(balance_worm_torque(problem, weights, settings, Some(target), warm, n)?.0)
+        }
+    }
+}
+
+/// The pressure of each cell (Pa) under the loads `q` (N m), bounded by the flow pressure.
+fn cell_pressures(cells: &[LocalCell], q: &[f64], flow_pressure: f64) -> Vec<f64> {
+    cells
+        .iter()
+        .zip(q)
+        .map(|(c, q)| (q / c.lever / c.cell.area()).min(flow_pressure))
+        .collect()
 }
 
 /// Whether load reaches the first or last of the `columns` cells across the line.

@@ -122,7 +122,7 @@ impl FilmGeometry {
                     .sum(),
                 pressure: (start..end).map(|k| pressure[k]).fold(0.0, f64::max),
             });
-            of_cell.extend(std::iter::repeat(lines.len() - 1).take(end - start));
+            of_cell.extend(std::iter::repeat_n(lines.len() - 1, end - start));
             start = end;
         }
         (lines, of_cell)
@@ -246,6 +246,9 @@ pub struct PositionFriction<'a> {
     pub geo: &'a Geometry,
     pub film: FilmGeometry,
     pub inputs: FrictionInputs<'a>,
+    /// A uniform friction coefficient to start the torque balance from (ISO/TR 14521's mu_0T
+    /// at the pitch point's sliding speed): only the start, not the result.
+    pub estimate: f64,
 }
 
 impl PositionFriction<'_> {

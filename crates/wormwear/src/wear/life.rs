@@ -404,7 +404,7 @@ impl<'a> LifeLoop<'a> {
             None => {
                 let inputs = (self.gear, self.geo, self.tca);
                 let other = self.other_losses;
-                crate::friction::oil_fixed_point(inputs, other, (local, first), &analyse)?
+                crate::friction::oil_fixed_point(inputs, other, (local, first), analyse)?
             }
         };
         let widenings = l

@@ -16,58 +16,127 @@ pub fn affine_load_update(
     target: f64,
     settings: &SolverSettings,
 ) -> Option<(Solution, f64)> {
-    // The free cells (loaded, below their cap) move with the load; capped cells stay.
-    let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
-    let active: Vec<bool> = solution
-        .q
-        .iter()
-        .enumerate()
-        .map(|(i, &q)| q > 0.0 && q < cap(i))
-        .collect();
-    let v = unit_load_response(problem, &active, settings)?;
-    let sum_v: f64 = v.iter().sum();
-    if sum_v <= 0.0 {
-        return None;
+    let response = LoadResponse::of(problem, solution, settings)?;
+    let loads = response.at_target(weights, target)?;
+    let load = loads.load;
+    Some((response.solution(problem, loads, settings)?, load))
+}
+
+/// The solution's linear response to the load while its free loaded set holds (MODEL §5.4):
+/// the base solution (q0 at the load W0, approach alpha0) and K_AA v = 1 on the free loaded
+/// set A. One conjugate-gradient solve serves any number of targets (the friction's updates
+/// of the torque weights, MODEL §5.2).
+pub struct LoadResponse {
+    active: Vec<bool>,
+    v: Vec<f64>,
+    sum_v: f64,
+    q0: Vec<f64>,
+    load0: f64,
+    approach0: f64,
+    iterations: usize,
+}
+
+/// Loads of a [`LoadResponse`] at one load: q (N m), the load W (N m) and the approach (rad).
+#[derive(Debug, Clone)]
+pub struct AffineLoads {
+    pub q: Vec<f64>,
+    pub load: f64,
+    pub approach: f64,
+}
+
+impl LoadResponse {
+    /// The response of `solution` of `problem` (at `problem.load`); None when the CG fails or
+    /// the loaded set carries nothing.
+    pub fn of(problem: &Problem, solution: &Solution, settings: &SolverSettings) -> Option<Self> {
+        // The free cells (loaded, below their cap) move with the load; capped cells stay.
+        let cap = |i: usize| problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
+        let active: Vec<bool> = solution
+            .q
+            .iter()
+            .enumerate()
+            .map(|(i, &q)| q > 0.0 && q < cap(i))
+            .collect();
+        let v = unit_load_response(problem, &active, settings)?;
+        let sum_v: f64 = v.iter().sum();
+        if sum_v <= 0.0 {
+            return None;
+        }
+        Some(Self {
+            active,
+            v,
+            sum_v,
+            q0: solution.q.clone(),
+            load0: problem.load,
+            approach0: solution.approach,
+            iterations: solution.residuals.iterations,
+        })
     }
-    let t0: f64 = weights.iter().zip(&solution.q).map(|(w, q)| w * q).sum();
-    let slope: f64 = weights.iter().zip(&v).map(|(w, x)| w * x).sum::<f64>() / sum_v;
-    if slope == 0.0 || !slope.is_finite() {
-        return None;
-    }
-    let load = problem.load + (target - t0) / slope;
-    let dw = load - problem.load;
-    let q: Vec<f64> = solution
-        .q
-        .iter()
-        .zip(&v)
-        .map(|(q, x)| q + dw * x / sum_v)
-        .collect();
-    if q.iter()
-        .zip(&active)
-        .enumerate()
-        .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
-    {
-        return None;
-    }
-    let approach = solution.approach + dw / sum_v;
-    let gap = gaps_if_the_set_holds(problem, &q, approach, &active, settings)?;
-    let residuals = residuals_at_load(
-        load,
-        &q,
-        &gap,
-        approach,
-        solution.residuals.iterations,
-        problem.upper.as_deref(),
-    );
-    Some((
-        Solution {
+
+    /// The loads at which sum(weights . q) = target, or None when a free cell would leave the
+    /// loaded set (its load turning negative or reaching its cap) or the weights do not move.
+    pub fn at_target(&self, weights: &[f64], target: f64) -> Option<AffineLoads> {
+        let t0: f64 = weights.iter().zip(&self.q0).map(|(w, q)| w * q).sum();
+        let slope: f64 = weights.iter().zip(&self.v).map(|(w, x)| w * x).sum::<f64>() / self.sum_v;
+        if slope == 0.0 || !slope.is_finite() {
+            return None;
+        }
+        let load = self.load0 + (target - t0) / slope;
+        let dw = load - self.load0;
+        let q: Vec<f64> = self
+            .q0
+            .iter()
+            .zip(&self.v)
+            .map(|(q, x)| q + dw * x / self.sum_v)
+            .collect();
+        Some(AffineLoads {
             q,
-            approach,
+            load,
+            approach: self.approach0 + dw / self.sum_v,
+        })
+        .filter(|l| self.holds(&l.q, None))
+    }
+
+    /// Whether the free cells keep their state under `q` (given the caps of `problem`).
+    fn holds(&self, q: &[f64], problem: Option<&Problem>) -> bool {
+        let cap = |i: usize| {
+            problem
+                .and_then(|p| p.upper.as_ref())
+                .map_or(f64::INFINITY, |u| u[i])
+        };
+        !q.iter()
+            .zip(&self.active)
+            .enumerate()
+            .any(|(i, (&qi, &a))| a && (qi <= 0.0 || qi >= cap(i)))
+    }
+
+    /// The solution at `loads` of `problem`: its gaps and residuals, or None when a cell
+    /// outside the free loaded set leaves its state (an unloaded one penetrates, a capped one
+    /// opens) or a free one reaches its cap.
+    pub fn solution(
+        &self,
+        problem: &Problem,
+        loads: AffineLoads,
+        settings: &SolverSettings,
+    ) -> Option<Solution> {
+        if !self.holds(&loads.q, Some(problem)) {
+            return None;
+        }
+        let gap = gaps_if_the_set_holds(problem, &loads.q, loads.approach, &self.active, settings)?;
+        let residuals = residuals_at_load(
+            loads.load,
+            &loads.q,
+            &gap,
+            loads.approach,
+            self.iterations,
+            problem.upper.as_deref(),
+        );
+        Some(Solution {
+            q: loads.q,
+            approach: loads.approach,
             gap,
             residuals,
-        },
-        load,
-    ))
+        })
+    }
 }
 
 /// Conjugate gradient on the loaded set `active` for K_AA v = 1 (v zero elsewhere),
