@@ -87,12 +87,10 @@ fn efficiency_finding(m: &mut String, results: &Results) {
     if let Some(c) = first("case-c") {
         let _ = writeln!(
             m,
-            "- Efficiency (e): the contact's friction gives case C a mesh efficiency of {:.3} (mean \
-             mu {:.4}), far below ISO/TR 14521's and the published torques' (table in (e)): with \
-             the assumed 1 um roughness the film ratio stays below 1 over most of the flank and the \
-             asperities carry most of the load at mu_b 0.094. Measured roughness and slope of the \
-             test gears would settle it; it is a finding about the roughness and friction inputs, \
-             not a tuned result.",
+            "- Efficiency (e): the contact's friction (MODEL §13: Greenwood & Tripp's asperity \
+             share at the central film, carried by the loaded analysis, MODEL §5.2) gives case C a \
+             mesh efficiency of {:.3} (mean mu {:.4}); beside ISO/TR 14521's and the published \
+             torques' in (e), with the assumed 1 um roughness: the same inputs for every case.",
             c.friction.mesh_efficiency, c.friction.friction_coefficient_mean
         );
     }
@@ -100,7 +98,7 @@ fn efficiency_finding(m: &mut String, results: &Results) {
         let start = first("c-balance").map_or(f64::NAN, |r| r.friction.oil_temperature_k);
         let _ = writeln!(
             m,
-            "- Heat balance (e): in a forced-air housing case C's oil settles at {:.1} -> {:.1} C \
+            "- Heat balance (e): in the study's housing case C's oil settles at {:.1} -> {:.1} C \
              over its life instead of the fixed 60 C; the more viscous oil's thicker film ends the \
              life at {:.0} um of backlash against {:.0} um ({:+.1} %).",
             start - 273.15,
