@@ -446,7 +446,8 @@ const OIL_ITERATIONS: usize = 6;
 /// balance has converged when two passes differ by less than this, K.
 pub const OIL_TOLERANCE_K: f64 = 0.05;
 
-/// The loaded analysis `first` (run by `analyse` with `settings`), and with the heat balance
+/// The loaded analysis `first` (run by `analyse` with `settings` and a warm start), and with
+/// the heat balance
 /// and the transmitted torque, again at the balance's oil temperature until two temperatures
 /// differ by less than [`OIL_TOLERANCE_K`] (MODEL §13: the friction the pressures carry
 /// follows the oil; at most [`OIL_ITERATIONS`] analyses; a balance that fails ends the passes,
@@ -455,7 +456,7 @@ pub fn oil_fixed_point<E>(
     (gear, geo, tca): (&GearSet, &Geometry, &Tca),
     other_losses: f64,
     (mut settings, first): (crate::ltca::LtcaSettings, Ltca),
-    analyse: impl Fn(&crate::ltca::LtcaSettings) -> Result<Ltca, E>,
+    analyse: impl Fn(&crate::ltca::LtcaSettings, Option<&crate::ltca::WarmStart>) -> Result<Ltca, E>,
 ) -> Result<Ltca, E> {
     let mut result = first;
     let coupled = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
@@ -473,7 +474,7 @@ pub fn oil_fixed_point<E>(
             break;
         }
         settings.oil_temperature = t.oil_temperature_k;
-        result = analyse(&settings)?;
+        result = analyse(&settings, Some(&result.warm_start()))?;
     }
     Ok(result)
 }

@@ -672,9 +672,9 @@ impl<'a> Pipeline<'a> {
         let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
         let mut balanced = gear.clone();
         balanced.housing.balance = true;
-        let analyse = |settings: &LtcaSettings| {
+        let analyse = |settings: &LtcaSettings, warm: Option<&crate::ltca::WarmStart>| {
             let model = bending.model.as_ref().map(|b| b as &dyn BendingModel);
-            crate::ltca::analyse_with(&balanced, geo, tca, settings, model)
+            crate::ltca::analyse_worn(&balanced, geo, tca, settings, model, None, warm)
         };
         let settings = LtcaSettings::from_gear(&balanced);
         let inputs = (&balanced, geo, tca);
@@ -883,14 +883,15 @@ pub(crate) fn loaded_analysis(
     bending: Option<&FeBending>,
     warnings: &mut Vec<String>,
 ) -> Result<Ltca, RunError> {
-    let analyse = |settings: &LtcaSettings| {
+    let analyse = |settings: &LtcaSettings, warm: Option<&crate::ltca::WarmStart>| {
         let model = bending.map(|b| b as &dyn BendingModel);
-        crate::ltca::analyse_with(gear, geo, tca, settings, model).map_err(RunError::Ltca)
+        crate::ltca::analyse_worn(gear, geo, tca, settings, model, None, warm)
+            .map_err(RunError::Ltca)
     };
     let rating = crate::rating::rate(gear);
     let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
     let settings = LtcaSettings::from_gear(gear);
-    let first = analyse(&settings)?;
+    let first = analyse(&settings, None)?;
     let result =
         crate::friction::oil_fixed_point((gear, geo, tca), other, (settings, first), analyse)?;
     warnings.extend(

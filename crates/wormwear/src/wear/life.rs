@@ -382,7 +382,8 @@ impl<'a> LifeLoop<'a> {
             removal: Some(&state.removal).filter(|f| changed(f)),
             plastic_set: Some(&state.plastic_set).filter(|f| changed(f)),
         };
-        let analyse = |settings: &crate::ltca::LtcaSettings| {
+        let analyse = |settings: &crate::ltca::LtcaSettings,
+                       warm: Option<&crate::ltca::WarmStart>| {
             crate::ltca::analyse_changed(
                 self.gear,
                 self.geo,
@@ -390,7 +391,7 @@ impl<'a> LifeLoop<'a> {
                 settings,
                 self.bending,
                 change,
-                state.warm.as_ref(),
+                warm.or(state.warm.as_ref()),
             )
             .map_err(|source| WearError::Ltca {
                 step: state.step,
@@ -398,7 +399,7 @@ impl<'a> LifeLoop<'a> {
                 source,
             })
         };
-        let first = analyse(&local)?;
+        let first = analyse(&local, None)?;
         let l = match last {
             Some(_) => first,
             None => {
