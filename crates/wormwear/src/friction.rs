@@ -18,7 +18,6 @@ use crate::kinematics::Tca;
 use crate::ltca::{cell_sliding, FilmGeometry, FrictionInputs, Ltca};
 use crate::lubrication::LineContact;
 pub use crate::traction::LocalFriction;
-use crate::traction::{central_film_thickness, local_friction, PointContact};
 
 /// Errors of the heat balance; each names the input that decides it.
 #[derive(Debug, thiserror::Error)]
@@ -87,8 +86,6 @@ pub struct MeshContacts {
     flow_pressure: f64,
     /// Output power P2 = omega2 x mean transmitted wheel torque of the positions, W.
     pub output_power: f64,
-    /// Input power P1 = omega1 x mean worm torque of the positions, W.
-    pub input_power: f64,
 }
 
 /// The node columns of a flank grid: their z and radial limits (m), and the cell rows.
@@ -205,7 +202,6 @@ impl MeshContacts {
             flow_pressure: inputs.flow_pressure,
             output_power: mean(&|p| p.wheel_torque.abs()) * gear.conditions.worm_speed
                 / gear.ratio(),
-            input_power: mean(&|p| p.worm_torque.abs()) * gear.conditions.worm_speed,
         }
     }
 
@@ -255,19 +251,15 @@ impl MeshContacts {
         law: &FrictionLaw,
         mut visit: impl FnMut(&CellContact, LocalFriction, f64),
     ) {
-        let films: Vec<f64> = self
-            .lines
-            .iter()
-            .map(|line| central_film_thickness(lubricant, self.e_prime, line))
-            .collect();
+        let inputs = FrictionInputs {
+            lubricant,
+            law,
+            e_prime: self.e_prime,
+            flow_pressure: self.flow_pressure,
+        };
+        let films = inputs.films(&self.lines);
         for c in &self.cells {
-            let at = PointContact {
-                pressure: c.pressure,
-                sliding_speed: c.sliding_speed,
-                film_thickness: films[c.line],
-                roughness: lubricant.composite_roughness,
-            };
-            let f = local_friction(&at, lubricant, law, (self.e_prime, self.flow_pressure));
+            let f = inputs.at(c.pressure, c.sliding_speed, films[c.line]);
             let density = f.coefficient * c.pressure * c.sliding_speed;
             visit(c, f, density);
         }
@@ -603,7 +595,6 @@ mod tests {
             e_prime: E_PRIME,
             flow_pressure: f64::INFINITY,
             output_power,
-            input_power: f64::NAN,
         }
     }
 

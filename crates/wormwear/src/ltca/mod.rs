@@ -529,17 +529,7 @@ pub fn analyse_changed(
     );
     let ev = GapEvaluator::new(gear, geo);
     let wf = geo.wheel_flank(tca.loaded_flank);
-    // The wheel torque's estimate sizes the band: u T1, times ISO/TR 14521's mesh efficiency
-    // when the pressures carry the transmitted torque (MODEL §5.2).
-    let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
-    let (worm_torque, wheel_torque_guess) = match gear.conditions.torque {
-        Torque::Worm(t) if transmitted => (
-            Some(t),
-            t * gear.ratio() * crate::rating::rate(gear).mesh_efficiency,
-        ),
-        Torque::Worm(t) => (Some(t), t * gear.ratio()),
-        Torque::Wheel(t) => (None, t),
-    };
+    let (worm_torque, wheel_torque_guess) = torque_targets(gear, settings);
     if let Some(problem) = bending.and_then(|b| {
         shaft_torsion_problem(
             b.rigid_rotation_compliance(),
@@ -594,6 +584,22 @@ pub fn analyse_changed(
         bending,
         rows_per_row,
     ))
+}
+
+/// The worm torque to balance (None: the wheel torque is given) and the wheel torque's
+/// estimate that sizes the band and starts the solve, N m: the given wheel torque, or u T1,
+/// times ISO/TR 14521's mesh efficiency when the pressures carry the transmitted torque
+/// (MODEL §5.2).
+fn torque_targets(gear: &GearSet, settings: &LtcaSettings) -> (Option<f64>, f64) {
+    let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
+    match gear.conditions.torque {
+        Torque::Worm(t) if transmitted => (
+            Some(t),
+            t * gear.ratio() * crate::rating::rate(gear).mesh_efficiency,
+        ),
+        Torque::Worm(t) => (Some(t), t * gear.ratio()),
+        Torque::Wheel(t) => (None, t),
+    }
 }
 
 /// What the positions' friction needs (MODEL §5.2, §13) when the pressures carry the

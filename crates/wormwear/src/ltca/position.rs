@@ -231,15 +231,10 @@ fn balance_worm_torque(
             break;
         }
         if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
-            // (solver::affine_load_update, keeping the response.)
-            let at = solver::LoadResponse::of(problem, &sol, &settings.solver);
-            let step = at.as_ref().and_then(|r| {
-                let loads = r.at_target(weights, target)?;
-                let load = loads.load;
-                Some((r.solution(problem, loads, &settings.solver)?, load))
-            });
-            if let Some((updated, load)) = step {
-                response = at;
+            if let Some((updated, load, at)) =
+                solver::affine_load_update(problem, &sol, weights, target, &settings.solver)
+            {
+                response = Some(at);
                 problem.load = load;
                 let worm = worm_of(&updated.q);
                 let close = ((worm - target) / target).abs() < 1e-9;
@@ -317,19 +312,7 @@ fn balance_with_friction(
         Some(_) => (worm.clone(), worm, wheel),
         None => (wheel.clone(), worm, wheel),
     };
-    // The first balance at an estimate of the friction close to the final one, so that the
-    // friction's updates keep its loaded set: the friction under the warm start's loads (the
-    // previous wear state's), else a uniform one.
-    // The warm start's normal load starts the solve (its load sum q, not the estimate from
-    // the torque given).
-    let mut mu = match &warm {
-        Some(q) if q.iter().any(|&q| q > 0.0) => {
-            problem.load = q.iter().sum();
-            let pressure = cell_pressures(cells, q, settings.flow_pressure);
-            friction.coefficients(n, cells, &sliding, &pressure)
-        }
-        _ => vec![friction.estimate; cells.len()],
-    };
+    let mut mu = starting_friction(problem, (cells, &sliding), (settings, friction), &warm, n);
     let (weights, _, _) = pick(torque_weights(cells, &sliding, &mu, sign));
     let (mut sol, _, mut response) =
         balance_worm_torque(problem, &weights, settings, Some(target), warm, n)?;
@@ -369,13 +352,8 @@ fn balance_with_friction(
                 sol = settle(problem, settled, settings, n)?;
             }
             let dot = |w: &[f64]| w.iter().zip(&sol.q).map(|(a, q)| a * q).sum::<f64>();
-            let friction_torque = cells
-                .iter()
-                .zip(&sol.q)
-                .zip(mu.iter().zip(&sliding))
-                .map(|((c, q), (m, s))| m * q / c.lever * s.speed)
-                .sum::<f64>()
-                / friction.gear.conditions.worm_speed;
+            let omega1 = friction.gear.conditions.worm_speed;
+            let friction_torque = friction_worm_torque(cells, &sol.q, (&mu, &sliding), omega1);
             return Ok(Balanced {
                 worm: dot(&worm_weights),
                 wheel: dot(&wheel_weights),
@@ -411,6 +389,44 @@ fn settle(
             let warm = Some(loads.q);
             Ok(balance_worm_torque(problem, weights, settings, Some(target), warm, n)?.0)
         }
+    }
+}
+
+/// The worm torque the friction consumes, sum mu f |v_g| / omega1 (N m), with the cells'
+/// loads `q` = f l (N m), coefficients `mu`, sliding and the worm speed `omega1` (rad/s).
+fn friction_worm_torque(
+    cells: &[LocalCell],
+    q: &[f64],
+    (mu, sliding): (&[f64], &[CellSliding]),
+    omega1: f64,
+) -> f64 {
+    cells
+        .iter()
+        .zip(q)
+        .zip(mu.iter().zip(sliding))
+        .map(|((c, q), (m, s))| m * q / c.lever * s.speed)
+        .sum::<f64>()
+        / omega1
+}
+
+/// The friction the first balance starts from, close to the final one so that the friction's
+/// updates keep its loaded set: under the warm start's loads `warm` (the previous wear
+/// state's; their sum then starts the solve as `problem.load`, not the estimate from the
+/// torque given), else the uniform estimate.
+fn starting_friction(
+    problem: &mut Problem,
+    (cells, sliding): (&[LocalCell], &[CellSliding]),
+    (settings, friction): (&LtcaSettings, &PositionFriction),
+    warm: &Option<Vec<f64>>,
+    n: usize,
+) -> Vec<f64> {
+    match warm {
+        Some(q) if q.iter().any(|&q| q > 0.0) => {
+            problem.load = q.iter().sum();
+            let pressure = cell_pressures(cells, q, settings.flow_pressure);
+            friction.coefficients(n, cells, sliding, &pressure)
+        }
+        _ => vec![friction.estimate; cells.len()],
     }
 }
 

@@ -202,6 +202,19 @@ impl<'a> FrictionInputs<'a> {
         }
     }
 
+    /// The local friction at pressure `pressure` (Pa), sliding speed `sliding_speed` (m/s)
+    /// over a central film `film` (m), at the lubricant's composite roughness.
+    pub fn at(&self, pressure: f64, sliding_speed: f64, film: f64) -> LocalFriction {
+        let at = PointContact {
+            pressure,
+            sliding_speed,
+            film_thickness: film,
+            roughness: self.lubricant.composite_roughness,
+        };
+        let moduli = (self.e_prime, self.flow_pressure);
+        local_friction(&at, self.lubricant, self.law, moduli)
+    }
+
     /// The local friction of every cell with pressure `pressure` (Pa), sliding `sliding` and
     /// the film of its slice `films[of_cell[k]]` (central thickness, m).
     pub fn cells(
@@ -214,20 +227,7 @@ impl<'a> FrictionInputs<'a> {
             .iter()
             .zip(sliding)
             .zip(of_cell)
-            .map(|((&p, s), &line)| {
-                let at = PointContact {
-                    pressure: p,
-                    sliding_speed: s.speed,
-                    film_thickness: films[line],
-                    roughness: self.lubricant.composite_roughness,
-                };
-                local_friction(
-                    &at,
-                    self.lubricant,
-                    self.law,
-                    (self.e_prime, self.flow_pressure),
-                )
-            })
+            .map(|((&p, s), &line)| self.at(p, s.speed, films[line]))
             .collect()
     }
 

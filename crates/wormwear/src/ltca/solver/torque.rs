@@ -7,19 +7,20 @@ use super::{residuals_at_load, Problem, Solution, SolverSettings};
 /// Exact change of the solution with the load while the loaded set stays the same
 /// (the complementarity problem is then linear): with K_AA v = 1 on the loaded set A,
 /// q(W) = q0 + (W - W0) v / sum(v) and alpha(W) = alpha0 + (W - W0) / sum(v).
-/// Finds the load at which sum(weights . q) = target and returns that solution, or None when
-/// the loaded set would change (a load turning negative or a gap closing), or CG fails.
+/// Finds the load at which sum(weights . q) = target and returns that solution and load, with
+/// the response (reusable for other weights while its loaded set holds), or None when the
+/// loaded set would change (a load turning negative or a gap closing), or CG fails.
 pub fn affine_load_update(
     problem: &Problem,
     solution: &Solution,
     weights: &[f64],
     target: f64,
     settings: &SolverSettings,
-) -> Option<(Solution, f64)> {
+) -> Option<(Solution, f64, LoadResponse)> {
     let response = LoadResponse::of(problem, solution, settings)?;
     let loads = response.at_target(weights, target)?;
     let load = loads.load;
-    Some((response.solution(problem, loads, settings)?, load))
+    Some((response.solution(problem, loads, settings)?, load, response))
 }
 
 /// The solution's linear response to the load while its free loaded set holds (MODEL §5.4):
