@@ -6,12 +6,14 @@
 //! eta_s beta sigma and sigma / beta,
 //!
 //! ```text
-//! p_asp = min(p_Y, K_GT E' F_5/2(h / sigma)),
+//! p_asp = min(p_Y, K_GT E* F_5/2(h / sigma)),
 //! K_GT = (16 sqrt(2) pi / 15) (eta_s beta sigma)^2 sqrt(sigma / beta),
 //! ```
 //!
-//! E' the reduced modulus of MODEL §6 (2 / E' = sum (1 - v^2) / E) and p_Y the wheel's flow
-//! pressure (plastic asperities). The asperities take the share f_a = min(1, p_asp / p) at
+//! E* Hertz's contact modulus in Greenwood & Tripp's own convention (1 / E* = sum (1 - v^2) / E,
+//! half MODEL §6's reduced modulus E'; the constant is that of summit pairs in Hertz contact,
+//! re-derived by quadrature in the tests) and p_Y the wheel's flow pressure (plastic
+//! asperities). The asperities take the share f_a = min(1, p_asp / p) at
 //! boundary friction mu_b, the film the rest with Eyring's shear bounded by the limiting shear:
 //! mu = f_a mu_b + (1 - f_a) tau_f / p. MODEL §10's asperity formula belongs to the protocol
 //! that calibrates K from tests ([`crate::calibration`]), not here (MODEL §12 o).
@@ -91,10 +93,12 @@ pub fn greenwood_tripp_constant(law: &FrictionLaw) -> f64 {
     16.0 * 2f64.sqrt() * PI / 15.0 * product * product * law.summit_roughness_radius.sqrt()
 }
 
-/// Mean pressure carried by the asperities, Pa (MODEL §13): K_GT E' F_5/2(h / sigma) at the
+/// Mean pressure carried by the asperities, Pa (MODEL §13): K_GT E* F_5/2(h / sigma) at the
 /// mean-plane separation `separation` h (m) over the composite RMS roughness `roughness`
-/// sigma (m), with the reduced modulus `e_prime` (Pa, MODEL §6), bounded by the flow pressure
-/// `flow_pressure` (Pa; plastic asperities).
+/// sigma (m), bounded by the flow pressure `flow_pressure` (Pa; plastic asperities). E* is
+/// Hertz's contact modulus of Greenwood & Tripp's derivation (two summits of radius beta in
+/// Hertz contact, 1 / E* = sum (1 - v^2) / E), i.e. half the reduced modulus `e_prime` of
+/// MODEL §6 (Pa) that the film formulas use.
 pub fn asperity_pressure(
     separation: f64,
     roughness: f64,
@@ -107,7 +111,8 @@ pub fn asperity_pressure(
     } else {
         TABLE_END
     };
-    (greenwood_tripp_constant(law) * e_prime * summit_integral_5_2(x)).min(flow_pressure)
+    let contact_modulus = 0.5 * e_prime;
+    (greenwood_tripp_constant(law) * contact_modulus * summit_integral_5_2(x)).min(flow_pressure)
 }
 
 /// Central film thickness of a line contact, m (MODEL §13): the Moes–Venner minimum film of
@@ -328,9 +333,10 @@ pub(crate) mod tests {
         let k = greenwood_tripp_constant(&l);
         let exact = 16.0 * 2f64.sqrt() * PI / 15.0 * 0.05 * 0.05 * 0.1;
         assert!((k / exact - 1.0).abs() < 1e-14);
-        // At contact of the mean planes: K E' F_5/2(0).
+        // At contact of the mean planes: K E* F_5/2(0), E* = E' / 2.
         let p0 = asperity_pressure(0.0, 1e-6, E_PRIME, &l, f64::INFINITY);
-        assert!((p0 / (exact * E_PRIME * summit_integral(2.5, 0.0)) - 1.0).abs() < 1e-9);
+        let e_star = 0.5 * E_PRIME;
+        assert!((p0 / (exact * e_star * summit_integral(2.5, 0.0)) - 1.0).abs() < 1e-9);
         // Bounded by the flow pressure; vanishing under a thick film.
         assert_eq!(asperity_pressure(0.0, 1e-6, E_PRIME, &l, 1e6), 1e6);
         assert!(asperity_pressure(5e-6, 1e-6, E_PRIME, &l, 1e9) < 1e-6 * p0);
@@ -338,6 +344,64 @@ pub(crate) mod tests {
             asperity_pressure(f64::INFINITY, 1e-6, E_PRIME, &l, 1e9),
             0.0
         );
+    }
+
+    /// Simpson's rule of `f` over [a, b] in `n` (even) intervals.
+    fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+        let h = (b - a) / n as f64;
+        let inner: f64 = (1..n)
+            .map(|k| f(a + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 })
+            .sum();
+        (f(a) + f(b) + inner) * h / 3.0
+    }
+
+    #[test]
+    fn the_asperity_pressure_is_the_sum_of_hertz_contacts_of_summit_pairs() {
+        // Greenwood & Tripp's model from its premises, without F_5/2 or K_GT: both surfaces
+        // carry eta summits per m^2 of radius beta, heights Gaussian with sd sigma / sqrt 2
+        // each (composite sigma). Two summits of heights z1, z2 at lateral offset r, mean
+        // planes h apart, overlap by w = z1 + z2 - h - r^2 / (4 beta) and press with Hertz's
+        // P = (4/3) E* sqrt(beta / 2) w^(3/2), 1 / E* = sum (1 - v^2) / E = 2 / E'. The
+        // nominal pressure is eta^2 times the sum over pairs, by quadrature in z1, z2 and r.
+        let l = law();
+        let sigma = 1e-6;
+        let beta = sigma / l.summit_roughness_radius;
+        let eta = l.summit_density_radius_roughness / (beta * sigma);
+        let e_star = 0.5 * E_PRIME;
+        let sd = sigma / 2f64.sqrt();
+        let gauss = |z: f64| (-0.5 * (z / sd).powi(2)).exp() / (sd * (2.0 * PI).sqrt());
+        let pair_load = |overlap: f64| {
+            // Sum over r of the pairs' Hertz loads at a total overlap `overlap` (r = 0).
+            if overlap <= 0.0 {
+                return 0.0;
+            }
+            let r_max = (4.0 * beta * overlap).sqrt();
+            let hertz = |r: f64| {
+                let w = (overlap - r * r / (4.0 * beta)).max(0.0);
+                2.0 * PI * r * 4.0 / 3.0 * e_star * (beta / 2.0).sqrt() * w.powf(1.5)
+            };
+            simpson(hertz, 0.0, r_max, 200)
+        };
+        for x in [0.0, 0.5, 1.0, 2.0] {
+            let h = x * sigma;
+            let span = 8.0 * sd;
+            let nominal = eta
+                * eta
+                * simpson(
+                    |z1| {
+                        gauss(z1)
+                            * simpson(|z2| gauss(z2) * pair_load(z1 + z2 - h), -span, span, 240)
+                    },
+                    -span,
+                    span,
+                    240,
+                );
+            let ours = asperity_pressure(h, sigma, E_PRIME, &l, f64::INFINITY);
+            assert!(
+                (ours / nominal - 1.0).abs() < 2e-3,
+                "h / sigma = {x}: {ours} Pa vs the summit pairs' {nominal} Pa"
+            );
+        }
     }
 
     #[test]

@@ -292,11 +292,13 @@ impl Balanced {
 /// (worm torque given) or the transmitted wheel torque (else) meets its target; the friction is
 /// then updated from the new pressures, until the torque the balance does not set (the wheel's
 /// when the worm torque is given, else the worm's) changes by less than [`FRICTION_TOLERANCE`].
-/// The first balance is at a uniform friction estimate ([`balance_worm_torque`]); the updates
-/// move along that
-/// solution's exact linear response to the load ([`solver::LoadResponse`]: one CG for them
-/// all) while its loaded set holds, and solve again where it does not. `target`: the worm
-/// torque when given, and the wheel torque (used when the worm torque is not given), N m.
+/// The first balance starts from the friction of the warm start's loads, else a uniform
+/// estimate ([`starting_friction`]); the updates move along that solution's exact linear
+/// response to the load ([`solver::LoadResponse`]: one CG for them all) while its loaded set
+/// holds, and solve again where it does not; converged loads whose gaps leave the set are
+/// solved there and the friction updated again, so that the torques returned are those of the
+/// friction returned. `target`: the worm torque when given, and the wheel torque (used when the
+/// worm torque is not given), N m.
 fn balance_with_friction(
     problem: &mut Problem,
     cells: &[LocalCell],
@@ -314,11 +316,7 @@ fn balance_with_friction(
     };
     let mut mu = starting_friction(problem, (cells, &sliding), (settings, friction), &warm, n);
     let (weights, _, _) = pick(torque_weights(cells, &sliding, &mu, sign));
-    let (mut sol, _, mut response) =
-        balance_worm_torque(problem, &weights, settings, Some(target), warm, n)?;
-    if response.is_none() {
-        response = solver::LoadResponse::of(problem, &sol, &settings.solver);
-    }
+    let (mut sol, mut response) = rebalance(problem, &weights, settings, (target, warm), n)?;
     // The current loads: the solution's, or those of its response at a later target (gaps
     // and residuals computed once, at the end).
     let mut moved: Option<solver::AffineLoads> = None;
@@ -329,67 +327,76 @@ fn balance_with_friction(
         mu = friction.coefficients(n, cells, &sliding, &pressure);
         let (weights, worm_weights, wheel_weights) =
             pick(torque_weights(cells, &sliding, &mu, sign));
+        let free_weights = if worm_torque.is_some() {
+            &wheel_weights
+        } else {
+            &worm_weights
+        };
         moved = response
             .as_ref()
             .and_then(|r| r.at_target(&weights, target));
         if moved.is_none() {
             // The loaded set changes: solve again, and respond from there.
             let warm = Some(previous);
-            (sol, _, response) =
-                balance_worm_torque(problem, &weights, settings, Some(target), warm, n)?;
-            if response.is_none() {
-                response = solver::LoadResponse::of(problem, &sol, &settings.solver);
-            }
+            (sol, response) = rebalance(problem, &weights, settings, (target, warm), n)?;
         }
-        let q = moved.as_ref().map_or(&sol.q, |m| &m.q);
-        let dot = |w: &[f64]| w.iter().zip(q).map(|(a, q)| a * q).sum::<f64>();
-        let (worm, wheel) = (dot(&worm_weights), dot(&wheel_weights));
-        let free = if worm_torque.is_some() { wheel } else { worm };
+        let free = torque_of(free_weights, moved.as_ref().map_or(&sol.q, |m| &m.q));
         let converged = (free - last_free).abs() <= FRICTION_TOLERANCE * free.abs();
-        if converged || it + 1 == FRICTION_ITERATIONS {
-            if let Some(loads) = moved.take() {
-                let settled = (response.as_ref(), loads, weights.as_slice(), target);
-                sol = settle(problem, settled, settings, n)?;
-            }
-            let dot = |w: &[f64]| w.iter().zip(&sol.q).map(|(a, q)| a * q).sum::<f64>();
-            let omega1 = friction.gear.conditions.worm_speed;
-            let friction_torque = friction_worm_torque(cells, &sol.q, (&mu, &sliding), omega1);
-            return Ok(Balanced {
-                worm: dot(&worm_weights),
-                wheel: dot(&wheel_weights),
-                solution: sol,
-                friction: mu,
-                friction_torque,
-            });
+        let last = it + 1 == FRICTION_ITERATIONS;
+        if !(converged || last) {
+            last_free = free;
+            continue;
         }
-        last_free = free;
+        if let Some(loads) = moved.take() {
+            problem.load = loads.load;
+            let exact = response
+                .as_ref()
+                .and_then(|r| r.solution(problem, loads.clone(), &settings.solver));
+            match exact {
+                Some(s) => sol = s,
+                None => {
+                    // The final loads leave the set: solve there, and go on updating the
+                    // friction from that solution (its torques must be its friction's).
+                    let warm = Some(loads.q);
+                    (sol, response) = rebalance(problem, &weights, settings, (target, warm), n)?;
+                    if !last {
+                        last_free = torque_of(free_weights, &sol.q);
+                        continue;
+                    }
+                }
+            }
+        }
+        let omega1 = friction.gear.conditions.worm_speed;
+        let friction_torque = friction_worm_torque(cells, &sol.q, (&mu, &sliding), omega1);
+        return Ok(Balanced {
+            worm: torque_of(&worm_weights, &sol.q),
+            wheel: torque_of(&wheel_weights, &sol.q),
+            solution: sol,
+            friction: mu,
+            friction_torque,
+        });
     }
     unreachable!("the last friction update returns")
 }
 
-/// The solution at the loads `loads` a linear response `response` moved to: its gaps and
-/// residuals where its loaded set holds, else one warm-started balance of `weights . q` on
-/// `target` from those loads (a boundary cell's state changed). Sets `problem.load`.
-fn settle(
+/// The torque sum weights . q of the loads `q` (N m) under torque weights `weights`.
+fn torque_of(weights: &[f64], q: &[f64]) -> f64 {
+    weights.iter().zip(q).map(|(w, q)| w * q).sum()
+}
+
+/// A balance of `weights . q` on `target` warm-started from the loads `warm` (sets
+/// `problem.load`), with its linear response to the load.
+fn rebalance(
     problem: &mut Problem,
-    (response, loads, weights, target): (
-        Option<&solver::LoadResponse>,
-        solver::AffineLoads,
-        &[f64],
-        f64,
-    ),
+    weights: &[f64],
     settings: &LtcaSettings,
+    (target, warm): (f64, Option<Vec<f64>>),
     n: usize,
-) -> Result<solver::Solution, LtcaError> {
-    problem.load = loads.load;
-    let exact = response.and_then(|r| r.solution(problem, loads.clone(), &settings.solver));
-    match exact {
-        Some(s) => Ok(s),
-        None => {
-            let warm = Some(loads.q);
-            Ok(balance_worm_torque(problem, weights, settings, Some(target), warm, n)?.0)
-        }
-    }
+) -> Result<(solver::Solution, Option<solver::LoadResponse>), LtcaError> {
+    let (sol, _, response) =
+        balance_worm_torque(problem, weights, settings, Some(target), warm, n)?;
+    let response = response.or_else(|| solver::LoadResponse::of(problem, &sol, &settings.solver));
+    Ok((sol, response))
 }
 
 /// The worm torque the friction consumes, sum mu f |v_g| / omega1 (N m), with the cells'

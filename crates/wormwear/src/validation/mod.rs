@@ -431,7 +431,7 @@ fn endurance_jobs(jobs: &mut Vec<Job>, [a, b, c]: [&GearSet; 3], scale: f64) {
 
 /// The housing of the study's heat balances (MODEL §13): forced air, 200 W/(m^2 K) over
 /// 1 m^2, 20 C, no cooler — strongly cooled, like the rigs that held their oil at 60 C (the
-/// examples' own fan-cooled housing, 40 W/(m^2 K), puts the design case's oil at 99 C; natural
+/// examples' own fan-cooled housing, 40 W/(m^2 K), puts the design case's oil at 90 C; natural
 /// convection over the default area rejects none of these losses below 200 C).
 pub fn study_housing() -> input::Housing {
     input::Housing {
