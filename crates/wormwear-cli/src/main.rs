@@ -196,7 +196,7 @@ enum Command {
     /// Resumable: finished jobs are kept in DIR/runs and reused when their inputs are the same.
     #[command(
         after_help = "Example (from the repository root; about two hours on 2 cores):\n  \
-                      wormwear validate -o out/validation && cp out/validation/VALIDATION.md .\n  \
+                      wormwear validate -o out/validation && cp -r out/validation/VALIDATION.md out/validation/validation-figures .\n  \
                       wormwear validate -o out/smoke --quick      # a minute: the machinery only"
     )]
     Validate {

@@ -1284,8 +1284,18 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
         "### Speed study",
         "## (c) Sensitivity",
         "## (d) Our refinements against the default",
+        "## (e) Friction, efficiency and oil temperature from the contact",
+        "**Against ISO/TR 14521's rig-fitted mu_0T over sliding speeds**",
     ] {
         assert!(text.contains(heading), "{heading} missing");
+    }
+    for chart in [
+        "friction_over_sliding_speed.svg",
+        "mesh_efficiency_over_sliding_speed.svg",
+    ] {
+        let path = out.join("validation-figures").join(chart);
+        assert!(std::fs::read_to_string(&path).unwrap().contains("<svg"));
+        assert!(text.contains(&format!("(validation-figures/{chart})")));
     }
     let runs = std::fs::read_dir(out.join("runs")).unwrap().count();
     assert_eq!(runs, first.matches(" done in ").count());

@@ -236,47 +236,28 @@ fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
 #[test]
 #[ignore]
 fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
-    println!("| gear | worm speed (rpm) | v_g (m/s) | mu contact | asperity share | eta_z contact | mu_0T ISO | eta_z ISO (mu_0T) | difference (points) |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    for (name, speeds) in [
-        (
-            "gear-1x40-design.toml",
-            [110.0, 250.0, 500.0, 900.0, 1500.0, 2200.0, 2900.0],
-        ),
-        (
-            "gear-k-2x25.toml",
-            [80.0, 180.0, 360.0, 650.0, 1100.0, 1600.0, 2100.0],
-        ),
-    ] {
-        let mut last = (f64::INFINITY, f64::INFINITY);
-        for rpm in speeds {
-            let mut g = common::example(name);
-            g.bending.kind = BendingKind::None;
-            g.conditions.worm_speed = rpm * std::f64::consts::PI / 30.0;
-            let geo = Geometry::build(&g).unwrap();
-            let tca = kinematics::analyse(&g, &geo).unwrap();
-            let l = ltca::analyse(&g, &geo, &tca).unwrap();
-            let contacts = MeshContacts::new(&g, &geo, &tca, &l);
-            let f = contacts.friction(&g.lubricant, &g.friction);
-            let eta = contacts.output_power / (contacts.output_power + f.mesh_loss_w);
-            let iso = wormwear::rating::rate(&g);
-            let mu0 = wormwear::rating::base_friction(iso.sliding_speed_m_s);
-            let gamma = g.worm.lead_angle();
-            let eta_iso = gamma.tan() / (gamma + mu0.atan()).tan();
-            println!(
-                "| {} | {rpm:.0} | {:.2} | {:.4} | {:.3} | {eta:.3} | {mu0:.4} | {eta_iso:.3} | {:+.1} |",
-                name.trim_end_matches(".toml"),
-                iso.sliding_speed_m_s,
-                f.mean_coefficient,
-                f.asperity_share,
-                100.0 * (eta - eta_iso)
-            );
+    use wormwear::validation::{self, friction};
+    let settings = validation::Settings {
+        examples: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples"),
+        quick: false,
+    };
+    let points = friction::over_speeds(&settings).unwrap();
+    print!("{}", friction::table(&points));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(validation::FIGURES);
+    friction::charts(&points, &dir).unwrap();
+    println!("charts in {}", dir.display());
+    for gear in points.chunks(friction::SPEED_STUDY[0].1.len()) {
+        for pair in gear.windows(2) {
+            // The friction and the asperities' share fall with the sliding speed.
+            assert!(pair[1].friction < pair[0].friction, "{pair:?}");
+            assert!(pair[1].asperity_share < pair[0].asperity_share, "{pair:?}");
+        }
+        for p in gear {
+            // The torques the loaded analysis carries are the contact's own efficiency.
             assert!(
-                f.mean_coefficient < last.0 && f.asperity_share < last.1,
-                "{rpm} rpm"
+                (p.torque_efficiency / p.mesh_efficiency - 1.0).abs() < 0.005,
+                "{p:?}"
             );
-            assert!((l.mesh_efficiency / eta - 1.0).abs() < 0.005, "{rpm} rpm");
-            last = (f.mean_coefficient, f.asperity_share);
         }
     }
 }

@@ -9,6 +9,7 @@
 //! the results ([`report`]).
 
 pub mod analytic;
+pub mod friction;
 pub mod report;
 
 use crate::geometry::Geometry;
@@ -111,8 +112,9 @@ pub fn example(settings: &Settings, name: &str) -> Result<GearSet, ValidationErr
     Ok(g)
 }
 
-/// Runs every job not already in `dir/runs` (same key) and writes the report; returns the
-/// path of `dir/VALIDATION.md`. `progress` receives a line per job.
+/// Runs every job not already in `dir/runs` (same key) and the friction study over sliding
+/// speeds ([`friction`]), and writes the report and its figures (`dir/validation-figures`);
+/// returns the path of `dir/VALIDATION.md`. `progress` receives a line per job.
 pub fn run(
     settings: &Settings,
     dir: &Path,
@@ -166,10 +168,13 @@ pub fn run(
         results.insert(job.id.clone(), result);
     }
     let analytic = analytic::checks(&example(settings, "gear-1x40-design.toml")?);
-    let markdown = report::markdown(settings, &results, &analytic);
+    progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
+    let speeds = friction::over_speeds(settings)?;
+    friction::charts(&speeds, &dir.join(FIGURES))?;
+    let markdown = report::markdown(settings, &results, &analytic, &speeds);
     let path = dir.join("VALIDATION.md");
     crate::output::write_atomic(&path, markdown.as_bytes())?;
-    let json = serde_json::json!({ "analytic": analytic, "jobs": results });
+    let json = serde_json::json!({ "analytic": analytic, "jobs": results, "friction_over_speeds": speeds });
     crate::output::write_atomic(
         &dir.join("validation.json"),
         serde_json::to_string_pretty(&json)
@@ -178,6 +183,9 @@ pub fn run(
     )?;
     Ok(path)
 }
+
+/// The folder beside `VALIDATION.md` that holds its figures (copied with it).
+pub const FIGURES: &str = "validation-figures";
 
 fn run_path(dir: &Path, id: &str) -> PathBuf {
     dir.join("runs").join(format!("{id}.json"))

@@ -12,14 +12,19 @@ const MPA: f64 = 1e-6;
 const MM: f64 = 1e3;
 
 /// The whole document.
-pub fn markdown(settings: &Settings, results: &Results, analytic: &[Check]) -> String {
+pub fn markdown(
+    settings: &Settings,
+    results: &Results,
+    analytic: &[Check],
+    speeds: &[super::friction::SpeedPoint],
+) -> String {
     let mut m = String::new();
     header(&mut m, settings, results);
     findings(&mut m, results, analytic);
     section_a(&mut m, analytic);
     section_b(&mut m, results);
     section_c_d(&mut m, results);
-    section_e(&mut m, settings, results);
+    section_e(&mut m, settings, results, speeds);
     failures(&mut m, results);
     run_times(&mut m, results);
     m
@@ -800,17 +805,46 @@ fn variant_table(m: &mut String, results: &Results, base: &StepRecord, rows: &[(
     m.push('\n');
 }
 
-/// (e) Friction, efficiency and oil temperature from the contact (MODEL §13).
-fn section_e(m: &mut String, settings: &Settings, results: &Results) {
+/// (e) Friction, efficiency and oil temperature from the contact (MODEL §13): the speed study
+/// against ISO/TR 14521's mu_0T, the reference cases, and lives with the heat balance.
+fn section_e(
+    m: &mut String,
+    settings: &Settings,
+    results: &Results,
+    speeds: &[super::friction::SpeedPoint],
+) {
     let _ = writeln!(
         m,
         "## (e) Friction, efficiency and oil temperature from the contact\n\n\
-         The contact's friction (MODEL §13: asperities at mu_b = 0.094 on MODEL §10's share, \
-         Eyring film shear bounded at 0.02 p) on every loaded cell of the unworn gear's loaded \
-         analysis, against ISO/TR 14521's formula (MODEL §9) and the published torques \
-         (wheel torque / (u x worm torque); REFERENCE_GEARS.md derived them with that same \
-         formula). The reference gears' roughness (1 um) is assumed.\n"
+         The contact's friction (MODEL §13: Greenwood & Tripp's asperity pressure at the central \
+         film with Hertz's contact modulus, bounded by the wheel's hardness, at boundary friction \
+         mu_b; Eyring's film shear bounded by Lambda p; the summit statistics, mu_b, tau_0 and \
+         Lambda the examples' defaults; the reference gears' roughness, 1 um, assumed) on every \
+         loaded cell; the loaded analysis carries it (MODEL §5.2).\n\n\
+         **Against ISO/TR 14521's rig-fitted mu_0T over sliding speeds** (MODEL §13 validation \
+         (1)): the 1/40 design gear and the K 2/25 gear at 60 N m on the worm, unworn, no \
+         bending, oil at 60 C; ISO's eta_z = tan(gamma) / tan(gamma + atan(mu_0T)) with its \
+         factors Y at 1. One set of inputs for every speed and both gears.\n"
     );
+    m.push_str(&super::friction::table(speeds));
+    let _ = writeln!(
+        m,
+        "\n![mean friction over the sliding speed]({dir}/{f})\n\n\
+         ![mesh efficiency over the sliding speed]({dir}/{e})\n\n\
+         **The reference cases** (unworn, FE bending, oil at 60 C) against ISO/TR 14521 with the \
+         examples' factors Y and the published torques (wheel torque / (u x worm torque); \
+         REFERENCE_GEARS.md derived them with ISO's total efficiency):\n",
+        dir = super::FIGURES,
+        f = super::friction::FRICTION_CHART,
+        e = super::friction::EFFICIENCY_CHART,
+    );
+    reference_cases_table(m, settings, results);
+    thermal_life_table(m, results);
+}
+
+/// The reference cases' unworn friction and efficiencies beside ISO/TR 14521 and the published
+/// torques.
+fn reference_cases_table(m: &mut String, settings: &Settings, results: &Results) {
     let _ = writeln!(
         m,
         "| case | mesh efficiency, contact | ISO/TR 14521 | total, contact | ISO/TR 14521 | published torques | mu contact | mu ISO |"
@@ -866,7 +900,6 @@ fn section_e(m: &mut String, settings: &Settings, results: &Results) {
             iso.friction_coefficient
         );
     }
-    thermal_life_table(m, results);
 }
 
 /// Case C and the speed study with the heat balance against the fixed 60 C: oil temperature
