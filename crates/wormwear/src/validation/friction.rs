@@ -144,22 +144,26 @@ pub fn charts(points: &[SpeedPoint], dir: &Path) -> Result<(), crate::output::Ou
         }
         all
     };
-    plot::line_chart_marked(
-        &dir.join(FRICTION_CHART),
+    type Value = fn(&SpeedPoint) -> f64;
+    let charts: [(&str, &str, &str, Value, Value); 2] = [
         (
+            FRICTION_CHART,
             "Mean mesh friction over the sliding speed (unworn, 60 C)",
-            "sliding speed v_g (m/s)",
             "mean friction coefficient",
+            |p| p.friction,
+            |p| p.iso_friction,
         ),
-        &series(|p| p.friction, |p| p.iso_friction),
-    )?;
-    plot::line_chart_marked(
-        &dir.join(EFFICIENCY_CHART),
         (
+            EFFICIENCY_CHART,
             "Mesh efficiency over the sliding speed (unworn, 60 C)",
-            "sliding speed v_g (m/s)",
             "mesh efficiency eta_z",
+            |p| p.mesh_efficiency,
+            |p| p.iso_efficiency,
         ),
-        &series(|p| p.mesh_efficiency, |p| p.iso_efficiency),
-    )
+    ];
+    for (file, title, y_label, value, iso) in charts {
+        let labels = (title, "sliding speed v_g (m/s)", y_label);
+        plot::line_chart_marked(&dir.join(file), labels, &series(value, iso))?;
+    }
+    Ok(())
 }
