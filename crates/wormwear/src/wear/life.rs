@@ -67,6 +67,10 @@ pub fn simulate(
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
+    // A resumed run recomputes the state its checkpoint holds: its analysis must see the
+    // records the uninterrupted run saw then (the heat balance starts from the last one), not
+    // the state's own record, which it writes again.
+    state.records.retain(|r| r.step < state.step);
     let mut stalled = 0;
     loop {
         let (l, band) = life_loop.analyse(&state)?;

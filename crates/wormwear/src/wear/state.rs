@@ -50,13 +50,15 @@ pub struct WearState {
 }
 
 impl WearState {
+    /// The last record before this state's step: the previous state's. (A resumed life
+    /// recomputes the state its checkpoint holds, whose own record is then already there.)
+    pub(crate) fn previous_record(&self) -> Option<&StepRecord> {
+        self.records.iter().rev().find(|r| r.step < self.step)
+    }
+
     /// The loaded analyses counted up to the last record before this state's step.
     pub(crate) fn loaded_analyses_before(&self) -> usize {
-        self.records
-            .iter()
-            .rev()
-            .find(|r| r.step < self.step)
-            .map_or(0, |r| r.loaded_analyses)
+        self.previous_record().map_or(0, |r| r.loaded_analyses)
     }
 
     /// Unworn start.
