@@ -341,6 +341,27 @@ fn the_patch_pressure_converges_where_the_maximum_does_not() {
 }
 
 #[test]
+fn the_patch_pressure_is_never_above_the_flow_pressure_it_averages() {
+    // Issue 58: at 200 N m the plastic band's cells (at the flow pressure, 1 GPa) differ in
+    // width from column to column; placed at column x own width across the line they overlapped,
+    // and a patch mean reached 1.0022 GPa with no cell above 1 GPa.
+    let mut g = design();
+    g.conditions.torque = wormwear::input::Torque::Worm(200.0);
+    let (geo, tca) = prepared(&g);
+    let l = ltca::analyse(&g, &geo, &tca).unwrap();
+    let largest = l.positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
+    let flow = g.wheel_material.hardness;
+    assert_eq!(largest, flow, "the flow pressure binds at 200 N m");
+    assert!(
+        l.pressure_patch_max <= largest,
+        "{} Pa over cells of at most {largest} Pa",
+        l.pressure_patch_max
+    );
+    // The band at the flow pressure is wider than the patch: its mean is the flow pressure.
+    assert!(l.pressure_patch_max > (1.0 - 1e-9) * flow, "{}", l.pressure_patch_max);
+}
+
+#[test]
 fn map_cycles_stop_the_life_there_and_mark_the_states() {
     let g = design();
     let (geo, tca) = prepared(&g);

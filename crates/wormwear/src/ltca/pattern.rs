@@ -322,15 +322,15 @@ pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64)
         .par_iter()
         .map(|p| {
             // (across lo, across hi, z lo, z hi, pressure) of the loaded cells, per tooth.
+            let across_start = across_starts(&p.cells);
             let mut teeth: std::collections::BTreeMap<usize, Vec<[f64; 5]>> = Default::default();
-            for (c, &pr) in p.cells.iter().zip(&p.pressure) {
+            for ((c, &pr), &x) in p.cells.iter().zip(&p.pressure).zip(&across_start) {
                 if pr <= 0.0 {
                     continue;
                 }
-                let w = 2.0 * c.cell.half_nu;
                 teeth.entry(c.tooth_index).or_default().push([
-                    c.column as f64 * w,
-                    (c.column + 1) as f64 * w,
+                    x,
+                    x + 2.0 * c.cell.half_nu,
                     c.z - c.half_dz,
                     c.z + c.half_dz,
                     pr,
@@ -342,6 +342,29 @@ pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64)
                 .fold(0.0, f64::max)
         })
         .reduce(|| 0.0, f64::max)
+}
+
+/// Where each cell starts across the contact line, m: the widths 2 half_nu of the cells before
+/// it in its slice (same tooth and slice, lower columns), so that the cells of a slice tile the
+/// band without overlap even where their widths differ from column to column.
+fn across_starts(cells: &[LocalCell]) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_by_key(|&k| (cells[k].tooth_index, cells[k].slice, cells[k].column));
+    let mut start = vec![0.0; cells.len()];
+    let mut x = 0.0;
+    for (n, &k) in order.iter().enumerate() {
+        let same_slice = n > 0 && {
+            let previous = &cells[order[n - 1]];
+            (previous.tooth_index, previous.slice) == (cells[k].tooth_index, cells[k].slice)
+        };
+        x = if same_slice {
+            x + 2.0 * cells[order[n - 1]].cell.half_nu
+        } else {
+            0.0
+        };
+        start[k] = x;
+    }
+    start
 }
 
 /// [`max_patch_pressure`] over one tooth's loaded cells.
@@ -369,5 +392,7 @@ pub(super) fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64
             }
         }
     }
-    best
+    // A mean is never above the largest value it averages (the cells tile the band without
+    // overlap: this only removes the sum's rounding).
+    best.min(cells.iter().map(|c| c[4]).fold(0.0, f64::max))
 }
