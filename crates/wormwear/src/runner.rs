@@ -10,6 +10,7 @@ use crate::input::{GearSet, Phase, StepControl, WearPlan};
 use crate::kinematics::Tca;
 use crate::ltca::{BendingModel, Ltca, LtcaSettings};
 use crate::rating::Rating;
+use crate::safety::Verdict;
 use crate::wear::{CycleWear, StepView, WearError, WearState};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -626,6 +627,17 @@ impl<'a> Pipeline<'a> {
             root_stress,
             sump,
         });
+        if let Some(required) = table.required_cycles {
+            let (low, high) = endurance.data_span();
+            if required < low || required > high {
+                self.warnings.push(format!(
+                    "safety: S_H reads the pressure–life curve at the required {required:.3e} \
+                     wheel cycles (rating.required_life_h), outside the {low:.2e} to \
+                     {high:.2e} cycles its data span (MODEL §8): its allowable there is an \
+                     extrapolation"
+                ));
+            }
+        }
         let simulated = life.and_then(|l| l.end.records.last()).map(|r| r.cycles);
         if let (Some(end), Some(required)) = (simulated, table.required_cycles) {
             if required > EXTRAPOLATION_WARNING * end {
@@ -637,6 +649,13 @@ impl<'a> Pipeline<'a> {
                 ));
             }
         }
+        self.warnings
+            .extend(table.rows.iter().filter_map(|r| match &r.verdict {
+                Verdict::NotComputed(why) if r.value.is_some() && r.allowable.is_some() => Some(
+                    format!("safety: {} not computed: {why} ({})", r.symbol, r.quantity),
+                ),
+                _ => None,
+            }));
         self.warnings.extend(table.failed().map(|r| {
             format!(
                 "safety: {} = {:.2} is below its minimum {} ({})",

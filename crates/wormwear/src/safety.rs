@@ -150,15 +150,20 @@ fn row(
         (None, Ok(a)) => (Some(a), None),
         (Some(_), Ok(a)) => (Some(a), None),
     };
-    let safety = match (value, allowable) {
-        (Some(v), Some(a)) if v > 0.0 => Some(a / v),
-        (Some(_), Some(_)) => Some(f64::INFINITY),
-        _ => None,
+    // The safety is the ratio allowable / value of two positive, finite figures; any other
+    // ratio (a value of 0, below 0 as a temperature below 0 C, or infinite) is no safety.
+    let ratio = match (value, allowable) {
+        (Some(v), Some(a)) if v > 0.0 && v.is_finite() && a.is_finite() => Ok(a / v),
+        (Some(v), Some(_)) => Err(Verdict::NotComputed(format!(
+            "the value {v:.4} {unit} gives no ratio (it must be above 0 and finite)"
+        ))),
+        _ => Err(Verdict::NotComputed("no value".into())),
     };
-    let verdict = verdict.unwrap_or_else(|| match safety {
-        Some(x) if x >= minimum => Verdict::Pass,
-        Some(_) => Verdict::Fail,
-        None => Verdict::NotComputed("no value".into()),
+    let safety = ratio.as_ref().ok().copied();
+    let verdict = verdict.unwrap_or_else(|| match ratio {
+        Ok(x) if x >= minimum => Verdict::Pass,
+        Ok(_) => Verdict::Fail,
+        Err(v) => v,
     });
     SafetyRow {
         quantity: quantity.into(),
@@ -561,5 +566,16 @@ mod tests {
             (missing.safety, missing.verdict),
             (None, Verdict::NeedsInput("x".into()))
         );
+        // A value of 0, below 0 (an oil temperature below 0 C in degC) or infinite gives no
+        // ratio: not computed, never an infinite or negative safety that passes.
+        for value in [0.0, -32.09, f64::INFINITY, f64::NAN] {
+            let r = r(value);
+            assert_eq!(r.safety, None, "{value}");
+            assert!(
+                matches!(&r.verdict, Verdict::NotComputed(why) if why.contains("no ratio")),
+                "{value}: {:?}",
+                r.verdict
+            );
+        }
     }
 }

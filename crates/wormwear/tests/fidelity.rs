@@ -349,7 +349,11 @@ fn the_patch_pressure_is_never_above_the_flow_pressure_it_averages() {
     g.conditions.torque = wormwear::input::Torque::Worm(200.0);
     let (geo, tca) = prepared(&g);
     let l = ltca::analyse(&g, &geo, &tca).unwrap();
-    let largest = l.positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
+    let largest = l
+        .positions
+        .iter()
+        .map(|p| p.max_pressure)
+        .fold(0.0, f64::max);
     let flow = g.wheel_material.hardness;
     assert_eq!(largest, flow, "the flow pressure binds at 200 N m");
     assert!(
@@ -358,7 +362,11 @@ fn the_patch_pressure_is_never_above_the_flow_pressure_it_averages() {
         l.pressure_patch_max
     );
     // The band at the flow pressure is wider than the patch: its mean is the flow pressure.
-    assert!(l.pressure_patch_max > (1.0 - 1e-9) * flow, "{}", l.pressure_patch_max);
+    assert!(
+        l.pressure_patch_max > (1.0 - 1e-9) * flow,
+        "{}",
+        l.pressure_patch_max
+    );
 }
 
 #[test]

@@ -160,3 +160,36 @@ fn with_a_fixed_oil_temperature_s_t_solves_the_housing_balance_for_the_table() {
     assert!(b.source.contains("solved for this table"), "{}", b.source);
     assert!(!a.source.contains("solved for this table"), "{}", a.source);
 }
+
+#[test]
+fn a_ratio_outside_its_range_is_not_a_pass_and_a_curve_read_outside_its_data_is_warned() {
+    // Issue 58: an oil at -32 C (a housing in -50 C air) gave S_T = 90 / -32 = "inf, pass",
+    // and a required life of 1e-9 h read the pressure–life curve at 2e-6 cycles (an
+    // allowable of 72 GPa, S_H 65 "pass") without a word.
+    let mut g = rated();
+    g.rating.safety.required_life_hours = Some(1e-9);
+    g.housing.ambient = 273.15 - 50.0;
+    let results = wormwear::run(
+        &g,
+        Source::default(),
+        Request::new([Stage::Ltca]),
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    let table = results.safety.as_ref().unwrap();
+    let temperature = table.rows.iter().find(|r| r.symbol == "S_T").unwrap();
+    assert!(temperature.value.unwrap() < 0.0, "{temperature:?}");
+    assert_eq!(temperature.safety, None);
+    assert!(
+        matches!(&temperature.verdict, Verdict::NotComputed(why) if why.contains("no ratio")),
+        "{:?}",
+        temperature.verdict
+    );
+    let warned = |what: &str| results.warnings.iter().any(|w| w.contains(what));
+    assert!(warned("S_T not computed"), "{:?}", results.warnings);
+    assert!(
+        warned("pressure–life curve") && warned("rating.required_life_h"),
+        "{:?}",
+        results.warnings
+    );
+}

@@ -323,6 +323,14 @@ impl Endurance {
         life_factor: 1.0,
     };
 
+    /// The lives the curve rests on, cycles: the CuSn12 fit's points span 0.6e6 to 11e6 cycles
+    /// (MODEL §8), the same span relative to the reference for a curve given as an input, on
+    /// the life axis moved by the life factor. Outside it p_lim is an extrapolation.
+    pub fn data_span(&self) -> (f64, f64) {
+        let reference = self.life_factor * self.reference_cycles;
+        (reference * 0.6e6 / 11e6, reference)
+    }
+
     /// Endurance pressure for a life of n cycles, Pa.
     pub fn pressure(&self, n: f64) -> f64 {
         self.reference_pressure
