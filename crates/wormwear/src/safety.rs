@@ -160,7 +160,7 @@ fn row(
         _ => Err(Verdict::NotComputed("no value".into())),
     };
     let safety = ratio.as_ref().ok().copied();
-    let verdict = verdict.unwrap_or_else(|| match ratio {
+    let verdict = verdict.unwrap_or(match ratio {
         Ok(x) if x >= minimum => Verdict::Pass,
         Ok(_) => Verdict::Fail,
         Err(v) => v,
