@@ -51,7 +51,14 @@ pub fn init(
             path.display()
         )));
     }
-    if path.exists() && !force {
+    if let Some(kind) = wormwear::output::not_a_regular_file(path) {
+        return Err(Failure::Input(anyhow!(
+            "-o {}: it is {kind}, not a regular file; give the gear file's name",
+            path.display()
+        )));
+    }
+    // A link (even one to nothing) is there: replaced only with --force.
+    if path.symlink_metadata().is_ok() && !force {
         return Err(Failure::Input(anyhow!(
             "-o {}: the file exists; give another name or --force to replace it",
             path.display()

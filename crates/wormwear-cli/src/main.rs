@@ -304,11 +304,11 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", wormwear::runner::error_chain(e.as_ref()));
             ExitCode::from(2)
         }
         Err(Failure::Run(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", wormwear::runner::error_chain(e.as_ref()));
             ExitCode::from(1)
         }
     }

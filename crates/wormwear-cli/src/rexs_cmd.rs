@@ -9,6 +9,12 @@ use wormwear::rexs;
 /// Reads a REXS file, writes the gear file of its worm stage, then validates it as `check`
 /// would. An invalid result is kept (for editing) and reported with exit code 2.
 pub fn import(file: &Path, output: &Path, stage: Option<u64>, quiet: bool) -> Result<(), Failure> {
+    if let Some(kind) = wormwear::output::not_a_regular_file(output) {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "-o {}: it is {kind}, not a regular file; give the gear file's name",
+            output.display()
+        )));
+    }
     let model = rexs::read(file).map_err(|e| Failure::Input(e.into()))?;
     let imported =
         rexs::import::import(&model, stage, &file.display().to_string()).map_err(|e| {

@@ -1865,10 +1865,7 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
         .unwrap();
     assert!(compared.status.success(), "{compared:?}");
     let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
-    let torque = csv
-        .lines()
-        .find(|l| l.starts_with("\"Worm torque\""))
-        .unwrap();
+    let torque = csv.lines().find(|l| l.starts_with("Worm torque,")).unwrap();
     let values: Vec<f64> = torque
         .split(',')
         .skip(2)
@@ -1904,6 +1901,30 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
     assert_eq!(not_a_run.status.code(), Some(2));
     let err = String::from_utf8_lossy(&not_a_run.stderr);
     assert!(err.contains("no summary.json"), "{err}");
+    // Issue 58: runs in directories named like spreadsheet formulas head compare.csv's
+    // columns as text, not as formulas.
+    let formulas = [
+        dir.path().join("=HYPERLINK(\"http:x\",\"y\")"),
+        dir.path().join("+cmd|calc!A1"),
+    ];
+    for (run, named) in runs.iter().zip(&formulas) {
+        std::fs::rename(run, named).unwrap();
+    }
+    let out = dir.path().join("compare-formulas");
+    let compared = bin()
+        .arg("compare")
+        .args(&formulas)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(compared.status.success(), "{compared:?}");
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "quantity,unit,\"'=HYPERLINK(\"\"http:x\"\",\"\"y\"\")\",'+cmd|calc!A1"
+    );
 }
 
 #[test]
@@ -2039,4 +2060,74 @@ fn step_output_writes_solids_and_refuses_bad_requests_before_any_work() {
     assert!(err.contains("worm.step: it is a directory"), "{err}");
     // --step-teeth alone asks for nothing: clap refuses it.
     assert_eq!(run(&["--step-teeth", "2"]).status.code(), Some(2));
+}
+
+#[test]
+fn outputs_never_replace_devices_fifos_or_links_without_force() {
+    // Issue 58: `init --force -o /dev/null` and `import -o /dev/null` replaced the character
+    // device with a file, `init --force -o FIFO` the FIFO, `init -o dangling-link` the link.
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let link = dir.path().join("link.toml");
+    std::os::unix::fs::symlink(dir.path().join("nothing"), &link).unwrap();
+    let rexs = example("gear-1x40-design.toml")
+        .parent()
+        .unwrap()
+        .join("rexs/worm-stage-zi-2x41.rexs");
+    let null = Path::new("/dev/null");
+    for (args, what) in [
+        (
+            vec!["init", "--force", "-o", "/dev/null"],
+            "character device",
+        ),
+        (
+            vec!["import", rexs.to_str().unwrap(), "-o", "/dev/null"],
+            "character device",
+        ),
+        (
+            vec!["init", "--force", "-o", fifo.to_str().unwrap()],
+            "FIFO",
+        ),
+        (vec!["init", "-o", link.to_str().unwrap()], "--force"),
+    ] {
+        let o = bin().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(what) && err.contains("-o"), "{args:?}: {err}");
+    }
+    assert!(std::fs::metadata(null)
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    // A file that cannot be written: named (not a temporary), the cause said once.
+    let o = bin()
+        .args(["init", "--force", "-o", "/proc/self/status"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write /proc/self/status: "), "{err}");
+    assert!(
+        !err.contains(".tmp") && err.matches("os error").count() == 1,
+        "{err}"
+    );
+    // With --force the link is replaced by the file.
+    let o = bin()
+        .args(["init", "--force", "-o"])
+        .arg(&link)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{o:?}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_file());
 }

@@ -977,13 +977,17 @@ pub(crate) fn life(
     }
 }
 
-/// An error and its sources on one line, `error: source: source...`.
+/// An error and its sources on one line, `error: source: source...`, each said once.
 pub fn error_chain(e: &dyn std::error::Error) -> String {
     let mut text = e.to_string();
     let mut source = e.source();
     while let Some(s) = source {
-        text.push_str(": ");
-        text.push_str(&s.to_string());
+        // A source its error already quotes is said once.
+        let said = s.to_string();
+        if !text.ends_with(&said) {
+            text.push_str(": ");
+            text.push_str(&said);
+        }
         source = s.source();
     }
     text

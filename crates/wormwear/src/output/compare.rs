@@ -297,11 +297,13 @@ pub fn write_comparison(c: &Comparison, out: &Path) -> Result<PathBuf, OutputErr
     std::fs::create_dir_all(out).map_err(io(out))?;
     let mut csv = String::from("quantity,unit");
     for r in &c.runs {
-        csv.push_str(&format!(",\"{}\"", r.label.replace('"', "'")));
+        csv.push(',');
+        csv.push_str(&super::csv_text(&r.label));
     }
     csv.push('\n');
     for row in &c.rows {
-        csv.push_str(&format!("\"{}\",{}", row.quantity, row.unit));
+        let (quantity, unit) = (super::csv_text(&row.quantity), super::csv_text(&row.unit));
+        csv.push_str(&format!("{quantity},{unit}"));
         for v in &row.values {
             csv.push(',');
             if let Some(v) = v {

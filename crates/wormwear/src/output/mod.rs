@@ -36,6 +36,8 @@ pub enum OutputError {
     Read { path: PathBuf, message: String },
     #[error("cannot write {path}: it is a directory, and {what} needs a file there")]
     IsDirectory { path: PathBuf, what: &'static str },
+    #[error("cannot write {path}: it is {kind}, not a regular file; give the name of a file")]
+    NotRegularFile { path: PathBuf, kind: &'static str },
     /// A drawing of the geometry (a section) could not be computed.
     #[error("geometry drawing")]
     Geometry(#[source] crate::geometry::GeometryError),
@@ -107,8 +109,54 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
 
 pub use crate::wear::cycles_label;
 
+/// A CSV field, quoted when it holds a comma, a quote or a line break. A text (`number`
+/// false) that starts like a spreadsheet formula (= + - @, a tab or a carriage return) is
+/// prefixed with an apostrophe, so that a spreadsheet shows it instead of evaluating it.
+pub fn csv_cell(text: &str, number: bool) -> String {
+    let formula = text.starts_with(['=', '+', '-', '@', '\t', '\r']) && !number;
+    let text = if formula {
+        format!("'{text}")
+    } else {
+        text.to_string()
+    };
+    match text.contains([',', '"', '\n', '\r']) {
+        true => format!("\"{}\"", text.replace('"', "\"\"")),
+        false => text,
+    }
+}
+
+/// A CSV field of a text (never read as a number: "+1" is a name): [`csv_cell`].
+pub fn csv_text(text: &str) -> String {
+    csv_cell(text, false)
+}
+
+/// What is at `path` when it is neither absent nor a regular file (nor a link to one): a
+/// directory, a device, a FIFO, a socket; a dangling link is replaced like a missing file.
+pub fn not_a_regular_file(path: &Path) -> Option<&'static str> {
+    use std::os::unix::fs::FileTypeExt;
+    let meta = std::fs::metadata(path).ok()?;
+    let t = meta.file_type();
+    match () {
+        _ if t.is_file() => None,
+        _ if t.is_dir() => Some("a directory"),
+        _ if t.is_char_device() => Some("a character device"),
+        _ if t.is_block_device() => Some("a block device"),
+        _ if t.is_fifo() => Some("a FIFO"),
+        _ if t.is_socket() => Some("a socket"),
+        _ => Some("not a file"),
+    }
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+/// Refused where `path` is (or links to) something other than a regular file: a device, a
+/// FIFO or a directory is never replaced by a file. Errors name `path`, not the temporary.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    if let Some(kind) = not_a_regular_file(path) {
+        return Err(OutputError::NotRegularFile {
+            path: path.to_path_buf(),
+            kind,
+        });
+    }
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -120,9 +168,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     let written = (|| {
-        let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp))?;
-        f.write_all(bytes).map_err(io_err(&tmp))?;
-        f.sync_all().map_err(io_err(&tmp))?;
+        let mut f = std::fs::File::create(&tmp).map_err(io_err(path))?;
+        f.write_all(bytes).map_err(io_err(path))?;
+        f.sync_all().map_err(io_err(path))?;
         drop(f);
         std::fs::rename(&tmp, path).map_err(io_err(path))
     })();

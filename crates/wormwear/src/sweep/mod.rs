@@ -551,30 +551,14 @@ pub fn toml_to_json(value: &toml::Value) -> serde_json::Value {
     serde_json::to_value(value).unwrap_or_else(|_| serde_json::Value::String(value.to_string()))
 }
 
-/// A CSV field, quoted when it holds a comma, a quote or a line break. A text (not a number)
-/// that starts like a spreadsheet formula (= + - @, a tab or a carriage return) is prefixed
-/// with an apostrophe, so a spreadsheet shows it instead of evaluating it.
+/// A CSV field of a text or a number ([`crate::output::csv_cell`]).
 fn csv_field(text: &str) -> String {
-    csv_cell(text, text.parse::<f64>().is_ok())
+    crate::output::csv_cell(text, text.parse::<f64>().is_ok())
 }
 
-/// A CSV field of a text value (a TOML string: "+1" is a name, not a number), prefixed with an
-/// apostrophe whenever it starts like a formula.
+/// A CSV field of a text value (a TOML string: "+1" is a name, not a number).
 fn csv_text(text: &str) -> String {
-    csv_cell(text, false)
-}
-
-fn csv_cell(text: &str, number: bool) -> String {
-    let formula = text.starts_with(['=', '+', '-', '@', '\t', '\r']) && !number;
-    let text = if formula {
-        format!("'{text}")
-    } else {
-        text.to_string()
-    };
-    match text.contains([',', '"', '\n', '\r']) {
-        true => format!("\"{}\"", text.replace('"', "\"\"")),
-        false => text,
-    }
+    crate::output::csv_text(text)
 }
 
 /// The gear document of a variant: the base with the variant's values.
