@@ -1900,7 +1900,7 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
         .unwrap();
     assert_eq!(not_a_run.status.code(), Some(2));
     let err = String::from_utf8_lossy(&not_a_run.stderr);
-    assert!(err.contains("no summary.json"), "{err}");
+    assert!(err.contains("no readable summary.json"), "{err}");
     // Issue 58: runs in directories named like spreadsheet formulas head compare.csv's
     // columns as text, not as formulas.
     let formulas = [
@@ -2130,4 +2130,47 @@ fn outputs_never_replace_devices_fifos_or_links_without_force() {
         .unwrap();
     assert!(o.status.success(), "{o:?}");
     assert!(std::fs::symlink_metadata(&link).unwrap().is_file());
+}
+
+#[test]
+fn compare_refuses_what_is_not_a_run_summary_and_never_blocks_on_it() {
+    // Issue 58: `[1,2,3]` or `{}` as summary.json gave exit 0 with blank columns; a FIFO
+    // blocked forever; a link to /dev/zero read until 8 GB.
+    let dir = tempfile::tempdir().unwrap();
+    let (good, bad) = (dir.path().join("good"), dir.path().join("bad"));
+    std::fs::create_dir_all(&good).unwrap();
+    std::fs::create_dir_all(&bad).unwrap();
+    let summary = r#"{"input":{"program_version":"0.1.0","title":"x","file":"g.toml"},"ltca":{"worm_torque_nm":60.0}}"#;
+    std::fs::write(good.join("summary.json"), summary).unwrap();
+    let target = bad.join("summary.json");
+    let compare = || {
+        bin()
+            .arg("compare")
+            .args([&good, &bad])
+            .arg("-o")
+            .arg(dir.path().join("out"))
+            .output()
+            .unwrap()
+    };
+    for text in ["[1,2,3]", "{}", "{\"input\":{}}"] {
+        std::fs::write(&target, text).unwrap();
+        let o = compare();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{text}: {err}");
+        assert!(err.contains("not a wormwear summary"), "{text}: {err}");
+    }
+    std::fs::remove_file(&target).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(&target)
+        .status()
+        .unwrap()
+        .success());
+    let o = compare();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("FIFO"));
+    std::fs::remove_file(&target).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &target).unwrap();
+    let o = compare();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("device"));
 }

@@ -52,6 +52,16 @@ pub fn read_text(path: &Path, limit: u64) -> std::io::Result<String> {
         .map_err(|e| Error::new(ErrorKind::InvalidData, format!("not UTF-8 text ({e})")))
 }
 
+/// What is at `path` when it is neither absent nor a regular file (nor a link to one), in
+/// words: a directory, a device, a FIFO, a socket. A dangling link reads as absent.
+pub fn not_a_regular_file(path: &Path) -> Option<&'static str> {
+    let meta = std::fs::metadata(path).ok()?;
+    (!meta.file_type().is_file()).then(|| kind_of(&meta))
+}
+
+/// A run's results read back (summary.json, its tables), bytes.
+pub const RESULT_LIMIT: u64 = 256 << 20;
+
 /// What a non-regular file is, in words.
 fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     #[cfg(unix)]

@@ -37,7 +37,7 @@ pub struct Comparison {
 /// Why runs could not be compared.
 #[derive(Debug, thiserror::Error)]
 pub enum CompareError {
-    #[error("{dir}: not a wormwear output directory (no summary.json): {message}")]
+    #[error("{dir}: not a wormwear output directory (no readable summary.json): {message}")]
     NotARun { dir: String, message: String },
     #[error("{dir}/summary.json: {message}")]
     Summary { dir: String, message: String },
@@ -128,7 +128,8 @@ fn value_at(summary: &Value, path: &str, factor: f64) -> Option<f64> {
     let v = path
         .split('/')
         .try_fold(summary, |v, key| v.get(key))?
-        .as_f64()?;
+        .as_f64()
+        .filter(|v| v.is_finite())?;
     Some(if path.ends_with("_k") {
         v - 273.15
     } else {
@@ -139,7 +140,8 @@ fn value_at(summary: &Value, path: &str, factor: f64) -> Option<f64> {
 /// The life of a run from its wear_steps.csv: (cycles, backlash increase um, patch-mean
 /// largest flank loss um); empty without a life.
 fn life_of(dir: &Path) -> Vec<(f64, f64, f64)> {
-    let Ok(text) = std::fs::read_to_string(dir.join("wear_steps.csv")) else {
+    let Ok(text) = crate::files::read_text(&dir.join("wear_steps.csv"), crate::files::RESULT_LIMIT)
+    else {
         return Vec::new();
     };
     let mut lines = text.lines();
@@ -152,13 +154,22 @@ fn life_of(dir: &Path) -> Vec<(f64, f64, f64)> {
     ) else {
         return Vec::new();
     };
-    lines
+    let life: Vec<(f64, f64, f64)> = lines
         .filter_map(|line| {
             let f: Vec<&str> = line.split(',').collect();
-            let get = |i: usize| f.get(i).and_then(|s| s.parse::<f64>().ok());
+            let get = |i: usize| {
+                f.get(i)
+                    .and_then(|s| s.parse::<f64>().ok())
+                    .filter(|v| v.is_finite())
+            };
             Some((get(c)?, get(b)? * 1e6, get(w)? * 1e6))
         })
-        .collect()
+        .collect();
+    // A life's cycles rise from state to state; a table where they do not is no life.
+    if life.windows(2).any(|p| p[1].0 <= p[0].0) {
+        return Vec::new();
+    }
+    life
 }
 
 /// Reads the runs of `dirs` and gathers their key results: the table's rows, the life's end
@@ -171,16 +182,24 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
     let mut runs = Vec::new();
     for (k, dir) in dirs.iter().enumerate() {
         let shown = dir.display().to_string();
-        let text = std::fs::read_to_string(dir.join("summary.json")).map_err(|e| {
-            CompareError::NotARun {
-                dir: shown.clone(),
-                message: e.to_string(),
-            }
-        })?;
+        let summary_path = dir.join("summary.json");
+        let text =
+            crate::files::read_text(&summary_path, crate::files::RESULT_LIMIT).map_err(|e| {
+                CompareError::NotARun {
+                    dir: shown.clone(),
+                    message: e.to_string(),
+                }
+            })?;
         let summary: Value = serde_json::from_str(&text).map_err(|e| CompareError::Summary {
             dir: shown.clone(),
             message: e.to_string(),
         })?;
+        if !summary["input"]["program_version"].is_string() {
+            return Err(CompareError::Summary {
+                dir: shown.clone(),
+                message: "not a wormwear summary (it has no input.program_version)".into(),
+            });
+        }
         let name = dir
             .file_name()
             .map_or(shown.clone(), |n| n.to_string_lossy().into_owned());
@@ -279,6 +298,7 @@ fn safety_rows(summaries: &[Value]) -> Vec<KeyResult> {
 /// The difference of `v` to the first run's `first`: absolute and in % of it.
 fn difference(first: Option<f64>, v: Option<f64>) -> String {
     match (first, v) {
+        (Some(a), Some(b)) if !(b - a).is_finite() => "-".into(),
         (Some(a), Some(b)) if a != 0.0 => {
             format!("{} ({:+.1} %)", number(b - a), 100.0 * (b - a) / a.abs())
         }

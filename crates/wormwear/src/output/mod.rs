@@ -130,22 +130,7 @@ pub fn csv_text(text: &str) -> String {
     csv_cell(text, false)
 }
 
-/// What is at `path` when it is neither absent nor a regular file (nor a link to one): a
-/// directory, a device, a FIFO, a socket; a dangling link is replaced like a missing file.
-pub fn not_a_regular_file(path: &Path) -> Option<&'static str> {
-    use std::os::unix::fs::FileTypeExt;
-    let meta = std::fs::metadata(path).ok()?;
-    let t = meta.file_type();
-    match () {
-        _ if t.is_file() => None,
-        _ if t.is_dir() => Some("a directory"),
-        _ if t.is_char_device() => Some("a character device"),
-        _ if t.is_block_device() => Some("a block device"),
-        _ if t.is_fifo() => Some("a FIFO"),
-        _ if t.is_socket() => Some("a socket"),
-        _ => Some("not a file"),
-    }
-}
+pub use crate::files::not_a_regular_file;
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
 /// Refused where `path` is (or links to) something other than a regular file: a device, a
