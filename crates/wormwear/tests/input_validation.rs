@@ -1100,3 +1100,22 @@ fn missing_keys_and_tables_are_all_reported_at_once_with_their_tables_lines() {
     // A complete file is unaffected.
     assert!(input::load_from_str(&design()).is_ok());
 }
+
+#[test]
+fn an_oil_temperature_outside_the_viscosity_data_is_warned() {
+    // Issue 58: 250 C and -30 C passed without a word.
+    for (t, warned) in [("250.0", true), ("-30.0", true), ("59.85", false)] {
+        let text = set(
+            &design(),
+            "lubricant",
+            "temperature_c",
+            &format!("temperature_c = {t}"),
+        );
+        let g = input::load_from_str(&text).unwrap();
+        let warning = g
+            .warnings
+            .iter()
+            .find(|w| w.contains("lubricant.temperature_c"));
+        assert_eq!(warning.is_some(), warned, "{t}: {:?}", g.warnings);
+    }
+}
