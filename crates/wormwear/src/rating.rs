@@ -156,13 +156,17 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
     let limit = gear.wheel_material.pitting_limit * 1e-6;
     let ratio = r.sigma_hm_mpa / limit;
     let (field, torque) = torque_field(gear);
-    if r.sigma_hm_mpa < UNDERLOAD_REFUSAL_MPA {
-        let needed = torque * (UNDERLOAD_REFUSAL_MPA / r.sigma_hm_mpa).powi(2);
+    if !(r.sigma_hm_mpa >= UNDERLOAD_REFUSAL_MPA) {
+        let needed = match smallest_torque(gear) {
+            Some(t) => format!("give at least about {t:.3e} N m"),
+            None => "give a larger torque".into(),
+        };
         return Some(format!(
             "{field} = {torque:e}: the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL \
              §9) would be {:.3e} N/mm^2, below the {UNDERLOAD_REFUSAL_MPA} N/mm^2 a loaded \
-             analysis resolves: give at least about {needed:.3e} N m",
-            r.sigma_hm_mpa
+             analysis resolves (at small torques the no-load, bearing and seal losses take most \
+             of the input): {needed}",
+            r.sigma_hm_mpa.max(0.0)
         ));
     }
     // (A NaN ratio, from a p_m* outside its formula, is no refusal.)
@@ -179,6 +183,38 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
          the gear's beyond): give at most about {allowed:.3e} N m, or check the pitting limit",
         r.sigma_hm_mpa
     ))
+}
+
+/// The smallest torque of the gear's kind (worm or wheel, N m) at which sigma_Hm reaches
+/// [`UNDERLOAD_REFUSAL_MPA`], to 1 %: doubled from the given torque until it does, then
+/// bisected (the no-load losses make T2 no power of T1). None beyond 1e9 N m.
+fn smallest_torque(gear: &GearSet) -> Option<f64> {
+    let at = |t: f64| {
+        let mut g = gear.clone();
+        g.conditions.torque = match gear.conditions.torque {
+            Torque::Worm(_) => Torque::Worm(t),
+            Torque::Wheel(_) => Torque::Wheel(t),
+        };
+        rate(&g).sigma_hm_mpa >= UNDERLOAD_REFUSAL_MPA
+    };
+    let (_, given) = torque_field(gear);
+    let mut hi = given.abs().max(1e-9);
+    while !at(hi) {
+        hi *= 2.0;
+        if hi > 1e9 {
+            return None;
+        }
+    }
+    let mut lo = hi / 2.0;
+    while hi - lo > 0.01 * hi {
+        let mid = 0.5 * (lo + hi);
+        if at(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
 }
 
 /// The worm and wheel torques (N m) of the operating case: the given one, and the other

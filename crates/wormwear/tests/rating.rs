@@ -145,3 +145,30 @@ fn ratings_outside_their_formulas_ranges_are_null_with_a_reason() {
         );
     }
 }
+
+#[test]
+fn a_vanishing_torque_is_refused_naming_the_smallest_torque_that_is_not() {
+    // Issue 58: 1e-6 N m on the worm asked for "at least about inf N m", 1 N m for 1.2e15: the
+    // no-load losses take most of a small input, so the wheel torque is no power of the worm's.
+    let g = example("gear-1x40-design.toml");
+    let with = |t: f64| {
+        let mut g = g.clone();
+        g.conditions.torque = Torque::Worm(t);
+        g
+    };
+    for t in [1e-6, 1.0] {
+        let message = rating::implausible_load(&with(t)).expect("refused");
+        let named: f64 = message
+            .split("give at least about ")
+            .nth(1)
+            .and_then(|rest| rest.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{message}"));
+        assert!(named.is_finite() && named > t, "{message}");
+        assert!(rating::implausible_load(&with(named)).is_none(), "{named}");
+        assert!(
+            rating::implausible_load(&with(0.97 * named)).is_some(),
+            "{named}"
+        );
+    }
+}
