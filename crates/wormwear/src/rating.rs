@@ -156,7 +156,7 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
     let limit = gear.wheel_material.pitting_limit * 1e-6;
     let ratio = r.sigma_hm_mpa / limit;
     let (field, torque) = torque_field(gear);
-    if !(r.sigma_hm_mpa >= UNDERLOAD_REFUSAL_MPA) {
+    if r.sigma_hm_mpa.is_nan() || r.sigma_hm_mpa < UNDERLOAD_REFUSAL_MPA {
         let needed = match smallest_torque(gear) {
             Some(t) => format!("give at least about {t:.3e} N m"),
             None => "give a larger torque".into(),

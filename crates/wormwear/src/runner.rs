@@ -10,14 +10,9 @@ use crate::input::{GearSet, Phase, StepControl, WearPlan};
 use crate::kinematics::Tca;
 use crate::ltca::{BendingModel, Ltca, LtcaSettings};
 use crate::rating::Rating;
-use crate::safety::Verdict;
 use crate::wear::{CycleWear, StepView, WearError, WearState};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
-
-/// A required life beyond this many times the simulated one makes S_W's extrapolation a
-/// warning.
-const EXTRAPOLATION_WARNING: f64 = 2.0;
 
 /// A stage of the pipeline a request asks for. Each runs the stages it needs before it
 /// (the loaded analysis needs the unloaded one); what is written follows what was asked
@@ -627,44 +622,9 @@ impl<'a> Pipeline<'a> {
             root_stress,
             sump,
         });
-        if let Some(required) = table.required_cycles {
-            let (low, high) = endurance.data_span();
-            if required < low || required > high {
-                self.warnings.push(format!(
-                    "safety: S_H reads the pressure–life curve at the required {required:.3e} \
-                     wheel cycles (rating.required_life_h), outside the {low:.2e} to \
-                     {high:.2e} cycles its data span (MODEL §8): its allowable there is an \
-                     extrapolation"
-                ));
-            }
-        }
         let simulated = life.and_then(|l| l.end.records.last()).map(|r| r.cycles);
-        if let (Some(end), Some(required)) = (simulated, table.required_cycles) {
-            if required > EXTRAPOLATION_WARNING * end {
-                self.warnings.push(format!(
-                    "safety: S_W extrapolates the life's last slope from {end:.3e} to the required \
-                     {required:.3e} wheel cycles ({:.1} times the simulated life); run the life \
-                     that far (--cycles {required:.0}) for a simulated figure",
-                    required / end
-                ));
-            }
-        }
         self.warnings
-            .extend(table.rows.iter().filter_map(|r| match &r.verdict {
-                Verdict::NotComputed(why) if r.value.is_some() && r.allowable.is_some() => Some(
-                    format!("safety: {} not computed: {why} ({})", r.symbol, r.quantity),
-                ),
-                _ => None,
-            }));
-        self.warnings.extend(table.failed().map(|r| {
-            format!(
-                "safety: {} = {:.2} is below its minimum {} ({})",
-                r.symbol,
-                r.safety.unwrap_or(f64::NAN),
-                r.minimum,
-                r.quantity
-            )
-        }));
+            .extend(crate::safety::warnings(&table, endurance, simulated));
         Ok(Some(table))
     }
 

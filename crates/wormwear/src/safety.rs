@@ -137,6 +137,52 @@ pub fn safety_table(s: &SafetyInputsOf) -> SafetyTable {
     }
 }
 
+/// S_W's extrapolation beyond the simulated life that is warned: the required cycles more than
+/// this many times the life's last state.
+const EXTRAPOLATION_WARNING: f64 = 2.0;
+
+/// The warnings of a safety table: a required life outside the pressure–life curve's data
+/// (MODEL §8), S_W extrapolated far beyond the simulated life (`simulated`: its last state's
+/// wheel cycles), rows not computed for their value, rows below their minimum.
+pub fn warnings(table: &SafetyTable, endurance: Endurance, simulated: Option<f64>) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if let Some(required) = table.required_cycles {
+        let (low, high) = endurance.data_span();
+        if required < low || required > high {
+            warnings.push(format!(
+                "safety: S_H reads the pressure–life curve at the required {required:.3e} wheel \
+                 cycles (rating.required_life_h), outside the {low:.2e} to {high:.2e} cycles its \
+                 data span (MODEL §8): its allowable there is an extrapolation"
+            ));
+        }
+        if let Some(end) = simulated.filter(|&end| required > EXTRAPOLATION_WARNING * end) {
+            warnings.push(format!(
+                "safety: S_W extrapolates the life's last slope from {end:.3e} to the required \
+                 {required:.3e} wheel cycles ({:.1} times the simulated life); run the life that \
+                 far (--cycles {required:.0}) for a simulated figure",
+                required / end
+            ));
+        }
+    }
+    warnings.extend(table.rows.iter().filter_map(|r| match &r.verdict {
+        Verdict::NotComputed(why) if r.value.is_some() && r.allowable.is_some() => Some(format!(
+            "safety: {} not computed: {why} ({})",
+            r.symbol, r.quantity
+        )),
+        _ => None,
+    }));
+    warnings.extend(table.failed().map(|r| {
+        format!(
+            "safety: {} = {:.2} is below its minimum {} ({})",
+            r.symbol,
+            r.safety.unwrap_or(f64::NAN),
+            r.minimum,
+            r.quantity
+        )
+    }));
+    warnings
+}
+
 /// A row from its value and allowable: the safety allowable / value against `minimum`.
 fn row(
     (quantity, symbol, unit): (&str, &str, &str),

@@ -168,6 +168,19 @@ fn oil_parts(ck: &mut Checker, f: &GearFile) -> Option<(Lubricant, FrictionLaw, 
 /// its data (MODEL §6: viscosity grades measured at 40 and 100 C, a margin either side).
 const OIL_DATA_C: (f64, f64) = (0.0, 150.0);
 
+/// The warning for an oil temperature outside [`OIL_DATA_C`].
+fn oil_temperature_warning(lubricant: &Lubricant) -> Option<String> {
+    let oil_c = lubricant.temperature - 273.15;
+    (!(OIL_DATA_C.0..=OIL_DATA_C.1).contains(&oil_c)).then(|| {
+        format!(
+            "lubricant.temperature_c = {oil_c} degC lies outside {} to {} degC, where an oil's \
+             viscosity law rests on its data (grades are measured at 40 and 100 C): the \
+             viscosity, film and friction there are extrapolations",
+            OIL_DATA_C.0, OIL_DATA_C.1
+        )
+    })
+}
+
 pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let mut ck = Checker::default();
     let mut warnings = Vec::new();
@@ -207,15 +220,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         unreachable_input()?
     };
     let (lubricant, friction, housing) = oil;
-    let oil_c = lubricant.temperature - 273.15;
-    if !(OIL_DATA_C.0..=OIL_DATA_C.1).contains(&oil_c) {
-        warnings.push(format!(
-            "lubricant.temperature_c = {oil_c} degC lies outside {} to {} degC, where an oil's \
-             viscosity law rests on its data (grades are measured at 40 and 100 C): the \
-             viscosity, film and friction there are extrapolations",
-            OIL_DATA_C.0, OIL_DATA_C.1
-        ));
-    }
+    warnings.extend(oil_temperature_warning(&lubricant));
     let (Some(wheel), Some(mut analysis), Some(bending)) = (wheel.blank(), analysis, bending)
     else {
         unreachable_input()?
