@@ -2084,11 +2084,11 @@ fn outputs_never_replace_devices_fifos_or_links_without_force() {
     for (args, what) in [
         (
             vec!["init", "--force", "-o", "/dev/null"],
-            "character device",
+            "a device",
         ),
         (
             vec!["import", rexs.to_str().unwrap(), "-o", "/dev/null"],
-            "character device",
+            "a device",
         ),
         (
             vec!["init", "--force", "-o", fifo.to_str().unwrap()],

@@ -725,3 +725,36 @@ fn a_zip_member_larger_than_a_rexs_file_may_be_is_not_inflated() {
         "{err}"
     );
 }
+
+#[test]
+fn a_count_outside_its_range_is_named_with_its_value_not_called_missing() {
+    // Issue 58: number_of_teeth -41 or 0 read "missing: the number of starts z1 is needed",
+    // 1e308 became worm.starts = 9223372036854775807.
+    let worm = "<attribute id=\"number_of_teeth\" unit=\"none\">2</attribute>";
+    let wheel = "<attribute id=\"number_of_teeth\" unit=\"none\">41</attribute>";
+    for (from, to, expected) in [
+        (
+            worm,
+            "-41",
+            "-41: the number of starts z1 must be from 1 to 10",
+        ),
+        (worm, "0", "0: the number of starts z1 must be from 1 to 10"),
+        (worm, "1e308", "too large for a count"),
+        (
+            wheel,
+            "0",
+            "0: the number of wheel teeth z2 must be from 1 to 500",
+        ),
+    ] {
+        let e = error_of(|t| {
+            let with = from
+                .replace(">2<", &format!(">{to}<"))
+                .replace(">41<", &format!(">{to}<"));
+            t.replacen(from, &with, 1)
+        });
+        assert!(
+            e.contains("number_of_teeth") && e.contains(expected),
+            "{to}: {e}"
+        );
+    }
+}

@@ -497,10 +497,36 @@ impl<'m> Reader<'m> {
         }
     }
 
+    /// A count the gear file needs (`what`, e.g. "the number of starts z1"): present and from 1
+    /// to `max`, else an error naming the attribute, its value and the range.
+    fn count(&self, c: &Component, id: &str, what: &str, max: i64) -> Result<i64, RexsError> {
+        match self.integer(c, id)? {
+            None => Err(RexsError::attribute(
+                c,
+                id,
+                format!("missing: {what} is needed"),
+            )),
+            Some(z) if (1..=max).contains(&z) => Ok(z),
+            Some(z) => Err(RexsError::attribute(
+                c,
+                id,
+                format!("{z}: {what} must be from 1 to {max}"),
+            )),
+        }
+    }
+
     fn integer(&self, c: &Component, id: &str) -> Result<Option<i64>, RexsError> {
         match self.number(c, id, Quantity::Ratio)? {
             None => Ok(None),
-            Some(v) if v.fract() == 0.0 => Ok(Some(v as i64)),
+            // Exact as an integer up to 2^53 (beyond it, no count of teeth).
+            Some(v) if v.fract() == 0.0 && v.abs() <= 9.007_199_254_740_992e15 => {
+                Ok(Some(v as i64))
+            }
+            Some(v) if v.fract() == 0.0 => Err(RexsError::attribute(
+                c,
+                id,
+                format!("{v:e} is too large for a count"),
+            )),
             Some(v) => Err(RexsError::attribute(
                 c,
                 id,

@@ -18,16 +18,7 @@ pub(super) fn wheel_blank(
     out: &mut GearText,
 ) -> Result<Wheel, RexsError> {
     let c = parts.wheel;
-    let z2 = reader
-        .integer(c, "number_of_teeth")?
-        .filter(|z| *z > 0)
-        .ok_or_else(|| {
-            RexsError::attribute(
-                c,
-                "number_of_teeth",
-                "missing: the number of wheel teeth z2 is needed",
-            )
-        })?;
+    let z2 = reader.count(c, "number_of_teeth", "the number of wheel teeth z2", 500)?;
     let a = reader.required(
         parts.stage,
         "center_distance",

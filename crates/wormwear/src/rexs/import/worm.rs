@@ -118,14 +118,7 @@ pub(super) struct WormSources {
 pub(super) fn read_worm(reader: &Reader, parts: &Parts) -> Result<(Worm, WormSources), RexsError> {
     let c = parts.worm;
     let profile = profile_of(reader, c)?;
-    let starts = reader.integer(c, "number_of_teeth")?.filter(|z| *z > 0);
-    let starts = starts.ok_or_else(|| {
-        RexsError::attribute(
-            c,
-            "number_of_teeth",
-            "missing: the number of starts z1 is needed",
-        )
-    })?;
+    let starts = reader.count(c, "number_of_teeth", "the number of starts z1", 10)?;
     let length = |id: &str, what: &str| reader.required(c, id, Quantity::Length, what);
     let d1 = length(
         "reference_diameter_worm_gear",
