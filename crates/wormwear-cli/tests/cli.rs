@@ -2082,10 +2082,7 @@ fn outputs_never_replace_devices_fifos_or_links_without_force() {
         .join("rexs/worm-stage-zi-2x41.rexs");
     let null = Path::new("/dev/null");
     for (args, what) in [
-        (
-            vec!["init", "--force", "-o", "/dev/null"],
-            "a device",
-        ),
+        (vec!["init", "--force", "-o", "/dev/null"], "a device"),
         (
             vec!["import", rexs.to_str().unwrap(), "-o", "/dev/null"],
             "a device",

@@ -707,7 +707,14 @@ impl<'a> Pipeline<'a> {
             self.warnings.extend(warnings);
             stresses
         })
-        .map_err(|e| e.to_string());
+        // The sector's mesh follows the fillet: a failure names the radius it was built with.
+        .map_err(|e| {
+            format!(
+                "{e} (the FE wheel sector with rating.root_fillet_radius_mm = {:.3e} mm; about \
+                 0.2 m_x, the hob's rounded tip edge, meshes)",
+                radius * 1e3
+            )
+        });
         match &result {
             Err(e) => self.warnings.push(format!("safety: S_F not computed: {e}")),
             Ok(r) if r.face_ends.stress > r.interior.stress => self.warnings.push(format!(

@@ -193,3 +193,25 @@ fn a_ratio_outside_its_range_is_not_a_pass_and_a_curve_read_outside_its_data_is_
         results.warnings
     );
 }
+
+#[test]
+fn a_root_sector_that_cannot_be_meshed_names_the_fillet_radius() {
+    // Issue 58: root_fillet_radius_mm = 1e-6 gave "S_F not computed: element 2 has a
+    // non-positive Jacobian" without naming the input.
+    let mut g = rated();
+    g.rating.safety.root_fillet_radius = Some(1e-9);
+    let results = wormwear::run(
+        &g,
+        Source::default(),
+        Request::new([Stage::Ltca]),
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    let root = &results.safety.as_ref().unwrap().rows[0];
+    assert_eq!(root.symbol, "S_F");
+    assert!(
+        matches!(&root.verdict, Verdict::NotComputed(why) if why.contains("rating.root_fillet_radius_mm")),
+        "{:?}",
+        root.verdict
+    );
+}
