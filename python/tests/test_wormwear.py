@@ -403,3 +403,22 @@ def test_step_solids_equal_the_cli_and_bad_requests_raise(cli, design_file, tmp_
         wormwear.run(gear, stages=["geometry"], step=True, step_teeth=0)
     with pytest.raises(wormwear.InputError, match="needs a life"):
         wormwear.run(gear, stages=["geometry"], step=True, step_state=2)
+
+
+def test_arguments_of_the_wrong_kind_are_refused_naming_the_argument(design_file, tmp_path):
+    # Issue 58: run("file.toml") raised AttributeError, stages="ltca" and compare("a", "b")
+    # iterated the strings' characters, step_teeth=-1 an OverflowError, NaN in with_ a JSON
+    # parser's "expected value at line 1 column 31", step_wear_um with step_cycles passed.
+    gear = wormwear.load(str(design_file))
+    with pytest.raises(TypeError, match="run: gear must be a wormwear.GearSet"):
+        wormwear.run(str(design_file))
+    with pytest.raises(TypeError, match="stages must be a list"):
+        wormwear.run(gear, stages="ltca")
+    with pytest.raises(ValueError, match="step_teeth"):
+        wormwear.run(gear, step=True, step_teeth=-1)
+    with pytest.raises(ValueError, match="exclude each other"):
+        wormwear.run(gear, ["wear"], cycles=20000, step_cycles=10000, step_wear_um=4.0)
+    with pytest.raises(TypeError, match="compare: runs must be a list"):
+        wormwear.compare("a", tmp_path / "out")
+    with pytest.raises(wormwear.InputError, match=r"with_\(conditions.worm_torque_nm\): nan"):
+        gear.with_(**{"conditions.worm_torque_nm": float("nan")})

@@ -21,6 +21,7 @@ given a ``dask.distributed.Client``.
 from __future__ import annotations
 
 import json
+import math
 import os
 import types
 import warnings
@@ -78,6 +79,9 @@ class GearSet:
             gear.with_(**{"conditions.worm_torque_nm": 50, "lubricant.temperature_c": 70})
 
         A value of None removes the field (it takes its default)."""
+        for name, value in changes.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise InputError(f"with_({name}): {value} is not a finite number")
         return GearSet(self._native.with_changes(json.dumps(changes, allow_nan=True)))
 
     def to_dict(self) -> dict:
@@ -130,6 +134,10 @@ def compare(
     curves overlaid), compare.csv and the curves into ``output``, and returns the key results
     as a DataFrame indexed by quantity, with a ``unit`` column and one column per run (labelled
     by its directory's name)."""
+    if isinstance(runs, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"compare: runs must be a list of run directories, got the single path {runs!r}"
+        )
     _page, labels, rows = _native.compare([os.fspath(r) for r in runs], os.fspath(output))
     frame = pd.DataFrame(
         [[unit] + [np.nan if v is None else v for v in values] for _, unit, values in rows],
@@ -345,6 +353,7 @@ def run(
     The GIL is released while it computes; Ctrl-C raises KeyboardInterrupt at the next stage or
     wear state. Raises :class:`InputError` for an input problem, :class:`ComputationError`
     for a failed computation."""
+    _check_run_arguments(gear, stages, step_cycles, step_wear_um, map_position, step_teeth, step_state)
     callback = None
     if progress is not None:
         def callback(kind: str, details: str) -> None:
@@ -361,6 +370,32 @@ def run(
         (step_teeth, step_state) if step else None,
     )
     return Results(native)
+
+
+def _check_run_arguments(gear, stages, step_cycles, step_wear_um, map_position, step_teeth, step_state) -> None:
+    """The arguments of :func:`run` checked at the boundary, each error naming the argument."""
+    if not isinstance(gear, GearSet):
+        raise TypeError(
+            "run: gear must be a wormwear.GearSet (wormwear.load(path) reads a gear file), "
+            f"got {type(gear).__name__} {gear!r}"
+        )
+    if isinstance(stages, (str, bytes)):
+        raise TypeError(
+            f"run: stages must be a list of stage names such as [{stages!r}], got the string "
+            f"{stages!r}"
+        )
+    if step_cycles is not None and step_wear_um is not None:
+        raise ValueError(
+            "run: step_cycles (fixed steps) and step_wear_um (adaptive steps) exclude each "
+            "other: give one"
+        )
+    for name, value in (
+        ("map_position", map_position),
+        ("step_teeth", step_teeth),
+        ("step_state", step_state),
+    ):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 0):
+            raise ValueError(f"run: {name} must be a whole number from 0 up, got {value!r}")
 
 
 def _settings_json(stages, cycles, step_cycles, step_wear_um, no_pitting) -> str:
