@@ -773,16 +773,22 @@ fn an_implausible_load_is_refused_and_an_overload_warned() {
     );
 }
 
-/// Writes the design case with each (from, to) replacement made (each must match) into `dir`,
-/// runs `ltca` on it and returns its exit code and stderr; no summary.json may be left.
-fn design_ltca(dir: &Path, edits: &[(&str, &str)]) -> (Option<i32>, String) {
+/// Writes the design case with each (from, to) replacement made (each must match) as `dir/name`.
+fn edited_design(dir: &Path, name: &str, edits: &[(&str, &str)]) -> PathBuf {
     let mut text = std::fs::read_to_string(example("gear-1x40-design.toml")).unwrap();
     for (from, to) in edits {
         assert!(text.contains(from), "{from}");
         text = text.replace(from, to);
     }
-    let path = dir.join("edited.toml");
+    let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Writes the design case with each (from, to) replacement made (each must match) into `dir`,
+/// runs `ltca` on it and returns its exit code and stderr; no summary.json may be left.
+fn design_ltca(dir: &Path, edits: &[(&str, &str)]) -> (Option<i32>, String) {
+    let path = edited_design(dir, "edited.toml", edits);
     let out_dir = dir.join("out");
     let _ = std::fs::remove_dir_all(&out_dir);
     let mut command = into("ltca", &path, &out_dir, &["-q"]);
@@ -1325,17 +1331,15 @@ fn a_life_killed_after_every_state_and_resumed_ends_as_the_uninterrupted_one() {
     // as soon as each new state is on disk and resumed, until it ends. The records and the
     // step table equal the uninterrupted run's byte for byte.
     let files = tempfile::tempdir().unwrap();
-    let design = files.path().join("pitted.toml");
-    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
-        .unwrap()
-        .replacen(
-            "step_wear_um = 4.0",
-            "step_wear_um = 4.0\nphases = [\n    { kind = \"wear\", until_cycles = 20000 },\n    \
-             { kind = \"pitting\", until_cycles = 30000, pressure_limit_mpa = 500.0 },\n    \
-             { kind = \"wear\", until_cycles = 60000 },\n]",
-            1,
-        );
-    std::fs::write(&design, text).unwrap();
+    let phases =
+        "step_wear_um = 4.0\nphases = [\n    { kind = \"wear\", until_cycles = 20000 },\n    \
+                  { kind = \"pitting\", until_cycles = 30000, pressure_limit_mpa = 500.0 },\n    \
+                  { kind = \"wear\", until_cycles = 60000 },\n]";
+    let design = edited_design(
+        files.path(),
+        "pitted.toml",
+        &[("step_wear_um = 4.0", phases)],
+    );
     let life = ["-q", "--cycles", "60000", "--step-cycles", "10000"];
     let whole = tempfile::tempdir().unwrap();
     assert!(wear_into(&design, whole.path(), &life).status.success());
@@ -1356,12 +1360,8 @@ fn a_life_with_the_heat_balance_killed_and_resumed_ends_as_the_uninterrupted_one
     // that state's own record (already written) and drifted from the kill on (oil temperature
     // 362.7267 against 362.7280 K at the first resumed state).
     let files = tempfile::tempdir().unwrap();
-    let design = files.path().join("balance.toml");
-    let text = std::fs::read_to_string(example("gear-1x40-design.toml"))
-        .unwrap()
-        .replacen("temperature_c = 59.85", "temperature = \"balance\"", 1);
-    assert!(text.contains("temperature = \"balance\""));
-    std::fs::write(&design, text).unwrap();
+    let balance = ("temperature_c = 59.85", "temperature = \"balance\"");
+    let design = edited_design(files.path(), "balance.toml", &[balance]);
     let life = ["-q", "--cycles", "30000", "--step-cycles", "10000"];
     let whole = tempfile::tempdir().unwrap();
     assert!(wear_into(&design, whole.path(), &life).status.success());

@@ -26,6 +26,17 @@ fn rated() -> GearSet {
     g
 }
 
+/// The results of a loaded analysis alone (with its safety table and warnings).
+fn loaded_analysis(g: &GearSet) -> wormwear::Results {
+    wormwear::run(
+        g,
+        Source::default(),
+        Request::new([Stage::Ltca]),
+        &mut |_| Ok(()),
+    )
+    .unwrap()
+}
+
 /// The table of a loaded analysis and a two-step life of 60 000 cycles.
 fn table(g: &GearSet) -> SafetyTable {
     let plan = wormwear::wear::WearPlan {
@@ -169,13 +180,7 @@ fn a_ratio_outside_its_range_is_not_a_pass_and_a_curve_read_outside_its_data_is_
     let mut g = rated();
     g.rating.safety.required_life_hours = Some(1e-9);
     g.housing.ambient = 273.15 - 50.0;
-    let results = wormwear::run(
-        &g,
-        Source::default(),
-        Request::new([Stage::Ltca]),
-        &mut |_| Ok(()),
-    )
-    .unwrap();
+    let results = loaded_analysis(&g);
     let table = results.safety.as_ref().unwrap();
     let temperature = table.rows.iter().find(|r| r.symbol == "S_T").unwrap();
     assert!(temperature.value.unwrap() < 0.0, "{temperature:?}");
@@ -200,13 +205,7 @@ fn a_root_sector_that_cannot_be_meshed_names_the_fillet_radius() {
     // non-positive Jacobian" without naming the input.
     let mut g = rated();
     g.rating.safety.root_fillet_radius = Some(1e-9);
-    let results = wormwear::run(
-        &g,
-        Source::default(),
-        Request::new([Stage::Ltca]),
-        &mut |_| Ok(()),
-    )
-    .unwrap();
+    let results = loaded_analysis(&g);
     let root = &results.safety.as_ref().unwrap().rows[0];
     assert_eq!(root.symbol, "S_F");
     assert!(
