@@ -156,7 +156,7 @@ pub fn from_backlash(
         no_pitting,
         ..Default::default()
     };
-    let plan = crate::life_plan(gear, &args)?;
+    let plan = crate::request::life_plan(gear, &args)?;
     let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
         if let (wormwear::Event::Bending(info), false) = (event, quiet) {
             crate::print_bending(info);

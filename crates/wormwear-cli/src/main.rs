@@ -5,6 +5,7 @@
 use anyhow::Context;
 use args::{CadArgs, LifeArgs};
 use clap::{Parser, Subcommand};
+use request::{life_request, planned_request, with_cad};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use wormwear::geometry::{Geometry, GeometrySummary};
@@ -15,6 +16,7 @@ mod calibrate_cmd;
 mod compare_cmd;
 mod init_cmd;
 mod rating_cmd;
+mod request;
 mod rexs_cmd;
 
 #[derive(Parser)]
@@ -723,33 +725,6 @@ fn print_ltca(results: &wormwear::Results) {
     }
 }
 
-/// The file's life plan with the command-line overrides applied.
-fn life_plan(gear: &GearSet, args: &LifeArgs) -> Result<wormwear::input::WearPlan, Failure> {
-    args.overrides()
-        .plan(gear, wormwear::runner::OverrideNames::Cli)
-        .map_err(|e| Failure::Input(e.into()))
-}
-
-/// The life request of `wear` and `run`: the plan, and the checked checkpoint with --resume.
-fn life_request(
-    dir: &Path,
-    gear: &GearSet,
-    args: &LifeArgs,
-    stages: &[wormwear::Stage],
-) -> Result<wormwear::Request, Failure> {
-    let plan = life_plan(gear, args)?;
-    let resume = match args.resume {
-        true => Some(
-            wormwear::output::wear::resume_state(dir, gear, &plan)
-                .map_err(|e| Failure::Input(e.into()))?,
-        ),
-        false => None,
-    };
-    let mut request = wormwear::Request::new(stages.iter().copied()).with_life(plan);
-    request.resume = resume;
-    Ok(request)
-}
-
 fn wear(
     file: &Path,
     dir: &Path,
@@ -758,8 +733,8 @@ fn wear(
     verbose: bool,
 ) -> Result<(), Failure> {
     let gear = load(file)?;
-    let mut request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
-    request.cad = cad.request(dir)?;
+    let request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
+    let request = with_cad(request, cad, dir, &gear)?;
     let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
     finish_life(&results, dir, quiet);
     Ok(())
@@ -824,20 +799,6 @@ fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearSt
     }
 }
 
-/// The request of `run` and `rating`: the stages `with_life` and the life request when the
-/// file has a `[wear]` section or the command line asks for a life, else `without`.
-fn planned_request(
-    dir: &Path,
-    gear: &GearSet,
-    args: &LifeArgs,
-    (with_life, without): (&[wormwear::Stage], &[wormwear::Stage]),
-) -> Result<wormwear::Request, Failure> {
-    match gear.wear.is_some() || args.overrides().asks_for_life() {
-        true => life_request(dir, gear, args, with_life),
-        false => Ok(wormwear::Request::new(without.iter().copied())),
-    }
-}
-
 fn run(
     file: &Path,
     dir: &Path,
@@ -848,8 +809,8 @@ fn run(
     use wormwear::Stage;
     let gear = load(file)?;
     let without_life = [Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report];
-    let mut request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
-    request.cad = cad.request(dir)?;
+    let request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
+    let request = with_cad(request, cad, dir, &gear)?;
     let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
     if !quiet {
         print_geometry(&results, dir);

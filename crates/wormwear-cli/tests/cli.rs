@@ -1368,6 +1368,45 @@ fn a_life_with_the_heat_balance_killed_and_resumed_ends_as_the_uninterrupted_one
     killed_after_every_state_and_resumed(&design, &life, whole.path());
 }
 
+#[test]
+fn a_resumed_finished_life_builds_the_worn_wheel_of_an_earlier_map_state() {
+    // Issue 58: resuming a finished life recomputes only its last state, so `--step-state` of
+    // an earlier map state warned "no map state" and built the last state's wheel. The map
+    // states' worn flanks are kept, sealed, on disk; the resumed run builds the same solid.
+    let dir = tempfile::tempdir().unwrap();
+    let design = example("gear-1x40-design.toml");
+    let life = [
+        "--cycles",
+        "20000",
+        "--step-cycles",
+        "10000",
+        "--step",
+        "--step-teeth",
+        "1",
+    ];
+    let at = |step: &'static str| [&life[..], &["--step-state", step]].concat();
+    let fresh = wear_into(&design, dir.path(), &at("1"));
+    assert!(fresh.status.success());
+    let worn = dir.path().join("wheel_worn.step");
+    let uninterrupted = std::fs::read(&worn).unwrap();
+    let last = wear_into(&design, dir.path(), &at("2"));
+    assert!(last.status.success());
+    assert_ne!(std::fs::read(&worn).unwrap(), uninterrupted);
+    let resumed = wear_into(&design, dir.path(), &[&at("1")[..], &["--resume"]].concat());
+    let said = String::from_utf8_lossy(&resumed.stderr);
+    assert!(resumed.status.success(), "{said}");
+    assert!(!said.contains("no map state"), "{said}");
+    assert_eq!(std::fs::read(&worn).unwrap(), uninterrupted);
+    // A worn flank changed after it was written is refused, naming its file.
+    let flank = dir.path().join("wear_flank_step1.json");
+    let text = std::fs::read_to_string(&flank).unwrap();
+    std::fs::write(&flank, text.replacen("\"cycles\":1", "\"cycles\":2", 1)).unwrap();
+    let changed = wear_into(&design, dir.path(), &[&at("1")[..], &["--resume"]].concat());
+    let said = String::from_utf8_lossy(&changed.stderr);
+    assert_eq!(changed.status.code(), Some(2), "{said}");
+    assert!(said.contains("wear_flank_step1.json"), "{said}");
+}
+
 /// Runs the life of `design` with the arguments `life` into a new directory, killed as soon as
 /// each new state is on disk and resumed, until it ends; its records and step table must equal
 /// those of the uninterrupted run in `whole`, byte for byte.

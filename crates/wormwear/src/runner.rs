@@ -96,6 +96,9 @@ pub struct Request {
     pub map_position: usize,
     /// The CAD solids (STEP) to build, None: none.
     pub cad: Option<crate::cad::CadRequest>,
+    /// The map state the CAD request asks for when a resumed life computed it before its
+    /// checkpoint (its worn flank: [`crate::output::wear::resumed_map_state`]); None: none.
+    pub resumed_map: Option<WearState>,
 }
 
 impl Request {
@@ -107,6 +110,7 @@ impl Request {
             resume: None,
             map_position: 0,
             cad: None,
+            resumed_map: None,
         }
     }
 
@@ -789,9 +793,11 @@ impl<'a> Pipeline<'a> {
         let Some(request) = self.request.cad else {
             return Ok(None);
         };
+        let resumed = self.request.resumed_map.take();
         let state = match (life, tca) {
             (Some(life), Some(tca)) => {
-                Some((self.worn_state(life, request.state), tca.loaded_flank))
+                let s = self.worn_state(life, resumed.as_ref(), request.state);
+                Some((s, tca.loaded_flank))
             }
             _ => None,
         };
@@ -808,13 +814,20 @@ impl<'a> Pipeline<'a> {
             .map_err(RunError::Cad)
     }
 
-    /// The life's state whose worn wheel is written: the map state of wear step `asked`, or
-    /// the last (with a warning when no map state has that step).
-    fn worn_state<'l>(&mut self, life: &'l Life, asked: Option<usize>) -> &'l WearState {
+    /// The life's state whose worn wheel is written: the map state of wear step `asked` (this
+    /// run's, or the one a resumed life computed before its checkpoint, `resumed`), or the
+    /// last (with a warning when no map state has that step).
+    fn worn_state<'l>(
+        &mut self,
+        life: &'l Life,
+        resumed: Option<&'l WearState>,
+        asked: Option<usize>,
+    ) -> &'l WearState {
         let last = life.maps.last().map_or(&life.end, |m| &m.state);
         let Some(step) = asked else { return last };
-        match life.maps.iter().find(|m| m.state.step == step) {
-            Some(m) => &m.state,
+        let mut states = life.maps.iter().map(|m| &m.state).chain(resumed);
+        match states.find(|s| s.step == step) {
+            Some(s) => s,
             None => {
                 let kept: Vec<String> =
                     life.maps.iter().map(|m| m.state.step.to_string()).collect();

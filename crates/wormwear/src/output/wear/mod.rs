@@ -6,7 +6,8 @@
 //! position) when asked (the CLI: every two seconds); maps of the cumulative wear, of the wear
 //! per cycle, of the film thickness and ratio, the loaded pattern and the node table at the map
 //! states (`[wear] map_cycles`, default 0, 1, 2, 4, 8, ...: files `*_step{N}`) and, without
-//! the suffix, the latest of them and the last; `wheel_flank_wear.vtp` with them.
+//! the suffix, the latest of them and the last; `wheel_flank_wear.vtp` with them; the worn
+//! flank of each map state, sealed (`wear_flank_step{N}.json`: a resumed life's `--step-state`).
 //!
 //! Rooms: `resume` reading back and checking a checkpoint and its records, `tables` the CSV
 //! tables and summary values, `maps` the map states' files; here the checkpoint and summary
@@ -159,7 +160,9 @@ pub fn write_life(
     dir: &Path,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let mut files = Vec::new();
+    let inputs = life_inputs(gear, &life.plan);
     for m in life.maps.iter().filter(|m| m.map && !m.last) {
+        files.push(write_map_flank(dir, &m.state, &inputs)?);
         let view = m.view();
         let maps = StateMaps {
             geo,
@@ -176,7 +179,7 @@ pub fn write_life(
         state: &life.end,
         ..last.view()
     };
-    let mut writer = LifeWriter::new(dir).with_inputs(life_inputs(gear, &life.plan));
+    let mut writer = LifeWriter::new(dir).with_inputs(inputs);
     files.extend(writer.write_state(gear, geo, tca, &life.plan, &view, true)?);
     Ok(files)
 }
@@ -329,6 +332,9 @@ impl LifeWriter {
         })?;
         write_atomic(&self.dir.join(CHECKPOINT), text.as_bytes())?;
         let mut files = vec![rpath, self.dir.join(CHECKPOINT)];
+        if let (true, Some(inputs)) = (view.map, &self.inputs) {
+            files.push(write_map_flank(&self.dir, state, inputs)?);
+        }
         files.extend(write_state(gear, geo, tca, plan, view, &self.dir, tables)?);
         Ok(files)
     }

@@ -268,3 +268,106 @@ pub fn resume_state(dir: &Path, gear: &GearSet, plan: &WearPlan) -> Result<WearS
     }
     Ok(state)
 }
+
+/// The file holding the worn flank of the map state of wear step `step`.
+pub fn map_flank_file(step: usize) -> String {
+    format!("wear_flank_step{step}.json")
+}
+
+/// A map state's worn flank as written: what the worn wheel of that state is built from.
+#[derive(serde::Serialize)]
+struct MapFlankOut<'a> {
+    step: usize,
+    cycles: f64,
+    removal: &'a FlankField,
+    plastic_set: &'a FlankField,
+    /// The inputs the state was computed with ([`life_inputs`]).
+    inputs: &'a serde_json::Value,
+}
+
+/// A map state's worn flank as read.
+#[derive(serde::Deserialize)]
+struct MapFlankIn {
+    step: usize,
+    cycles: f64,
+    removal: FlankField,
+    plastic_set: FlankField,
+    inputs: serde_json::Value,
+}
+
+/// Writes the worn flank of a map state ([`map_flank_file`], sealed with its checksum and the
+/// life's inputs) so that a resumed life can still build the worn wheel of a state computed
+/// before its resume (`--step-state`). Returns the file written.
+pub(super) fn write_map_flank(
+    dir: &Path,
+    state: &WearState,
+    inputs: &serde_json::Value,
+) -> Result<PathBuf, OutputError> {
+    let path = dir.join(map_flank_file(state.step));
+    let flank = MapFlankOut {
+        step: state.step,
+        cycles: state.cycles,
+        removal: &state.removal,
+        plastic_set: &state.plastic_set,
+        inputs,
+    };
+    let text = crate::integrity::seal(&flank).map_err(|e| OutputError::Encode {
+        what: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// The map state of wear step `step` that a resumed life computed before its checkpoint, read
+/// back from its [`map_flank_file`] and checked: its checksum, its step and the inputs it was
+/// computed with (they must equal this run's). The state carries the worn flank, the step
+/// and the cycles only (no records). None: no such file.
+pub fn resumed_map_state(
+    dir: &Path,
+    gear: &GearSet,
+    plan: &WearPlan,
+    step: usize,
+) -> Result<Option<WearState>, ResumeError> {
+    let path = dir.join(map_flank_file(step));
+    let refused = |why: String| {
+        ResumeError::Refused(format!(
+            "--step-state {step}: {} {why}; run the life again without --resume to rebuild it",
+            path.display()
+        ))
+    };
+    let text = match crate::files::read_text(&path, crate::files::OWN_FILE_LIMIT) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(refused(format!("cannot be read: {e}"))),
+    };
+    let flank: MapFlankIn = crate::integrity::open(&text).map_err(|e| {
+        refused(format!(
+            "is not the sealed worn flank it was written as: {e}"
+        ))
+    })?;
+    if flank.step != step {
+        return Err(refused(format!("holds step {}", flank.step)));
+    }
+    let changes = input_changes(&flank.inputs, &life_inputs(gear, plan));
+    if !changes.is_empty() {
+        return Err(refused(format!(
+            "was computed with other inputs ({}, ...)",
+            changes[0]
+        )));
+    }
+    Ok(Some(WearState {
+        step: flank.step,
+        cycles: flank.cycles,
+        removal: flank.removal,
+        plastic_set: flank.plastic_set,
+        records: Vec::new(),
+        pitted_phases: Vec::new(),
+        pitted: Vec::new(),
+        band_factor: None,
+        warm: None,
+        stopped: None,
+        damage: Vec::new(),
+        found_phases: Vec::new(),
+    }))
+}
