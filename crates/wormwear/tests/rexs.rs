@@ -758,3 +758,20 @@ fn a_count_outside_its_range_is_named_with_its_value_not_called_missing() {
         );
     }
 }
+
+#[test]
+fn deeply_nested_json_is_named_as_such() {
+    // Issue 58: a 200 000-deep array was "expected XML ..., JSON ... or a zip", and a deep
+    // object a bare "recursion limit exceeded".
+    let depth = 200_000;
+    let array = format!("{}{}", "[".repeat(depth), "]".repeat(depth));
+    let err = rexs::parse_bytes(array.as_bytes(), "x")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("a JSON array"), "{err}");
+    let object = format!("{}1{}", "{\"model\":".repeat(depth), "}".repeat(depth));
+    let err = rexs::parse_bytes(object.as_bytes(), "x")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("nested deeper than 128 levels"), "{err}");
+}

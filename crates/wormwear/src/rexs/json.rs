@@ -7,13 +7,27 @@
 use super::{Attribute, Component, Model, Ref, Relation, RexsError, Value};
 use serde_json::{json, Map, Value as Json};
 
+/// What is wrong with a text that does not parse as JSON; nesting beyond the parser's limit
+/// is named as such (a REXS model nests a few levels).
+fn json_error(e: &serde_json::Error) -> String {
+    if e.to_string().starts_with("recursion limit exceeded") {
+        format!(
+            "JSON nested deeper than 128 levels (at line {} column {}; a REXS model nests 5)",
+            e.line(),
+            e.column()
+        )
+    } else {
+        format!("JSON: {e}")
+    }
+}
+
 /// Parses a `.rexsj` document.
 pub(super) fn parse(text: &str, name: &str) -> Result<Model, RexsError> {
     let err = |message: String| RexsError::Format {
         path: name.to_string(),
         message,
     };
-    let doc: Json = serde_json::from_str(text).map_err(|e| err(format!("JSON: {e}")))?;
+    let doc: Json = serde_json::from_str(text).map_err(|e| err(json_error(&e)))?;
     let m = doc
         .get("model")
         .and_then(Json::as_object)

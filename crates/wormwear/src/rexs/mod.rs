@@ -177,6 +177,11 @@ pub fn parse_bytes(bytes: &[u8], name: &str) -> Result<Model, RexsError> {
         json::parse(trimmed, name)
     } else if trimmed.starts_with('<') {
         xml::parse(trimmed, name)
+    } else if trimmed.starts_with('[') {
+        Err(RexsError::Format {
+            path: name.to_string(),
+            message: "a JSON array; a REXS JSON file is the object {\"model\": ...}".into(),
+        })
     } else {
         Err(RexsError::Format {
             path: name.to_string(),
