@@ -486,7 +486,12 @@ impl<'a> Pipeline<'a> {
             source,
             request,
             on_event,
-            warnings: Vec::new(),
+            // The input's own warnings (values outside a law's data) come first.
+            warnings: gear
+                .warnings
+                .iter()
+                .map(|w| format!("input: {w}"))
+                .collect(),
         }
     }
 

@@ -1117,5 +1117,14 @@ fn an_oil_temperature_outside_the_viscosity_data_is_warned() {
             .iter()
             .find(|w| w.contains("lubricant.temperature_c"));
         assert_eq!(warning.is_some(), warned, "{t}: {:?}", g.warnings);
+        // A run says it too (the CLI prints the results' warnings; they were in
+        // summary.json's geometry section alone).
+        let request = wormwear::Request::new([wormwear::Stage::Geometry]);
+        let results = wormwear::run(&g, Default::default(), request, &mut |_| Ok(())).unwrap();
+        let said = results
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("input: lubricant.temperature_c"));
+        assert_eq!(said, warned, "{t}: {:?}", results.warnings);
     }
 }
