@@ -462,14 +462,15 @@ fn variants(json: &str) -> PyResult<Vec<Variant>> {
         .collect()
 }
 
-/// The variants of a grid (JSON {dotted: [values]}) as JSON [[name, {dotted: value}]], and
-/// the parameter names.
+/// The variants of a grid (JSON [[dotted, [values]], ...] in the grid's order) as JSON
+/// [[name, {dotted: value}]], and the parameter names.
 #[pyfunction]
 fn expand_grid(grid_json: &str) -> PyResult<(Vec<String>, String)> {
-    let grid: toml::Table =
+    // A list of (name, values) pairs: the grid's order, the first name varying slowest.
+    let axes: Vec<(String, toml::Value)> =
         serde_json::from_str(grid_json).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let (parameters, variants) =
-        wormwear::sweep::grid_variants(&grid).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        wormwear::sweep::axes_variants(axes).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let list: Vec<(String, serde_json::Map<String, serde_json::Value>)> = variants
         .iter()
         .map(|v| {

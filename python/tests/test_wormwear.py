@@ -180,6 +180,15 @@ def test_variants_and_pickling(design_file):
     assert "wear" not in gear.with_(wear=None).to_dict()
 
 
+def test_the_grid_varies_its_first_name_slowest_in_the_given_order():
+    # Issue 59: the names were sorted alphabetically (the README says the first varies slowest).
+    grid = {"lubricant.composite_roughness_um": [0.5, 1.0], "conditions.worm_torque_nm": [30.0, 60.0, 90.0]}
+    parameters, variants = wormwear._variants(grid, None)
+    assert parameters == list(grid)
+    firsts = [values["lubricant.composite_roughness_um"] for _, values in variants]
+    assert firsts == [0.5, 0.5, 0.5, 1.0, 1.0, 1.0]
+
+
 def rows_of(frame):
     """Rows comparable across engines: everything but the wall time."""
     return frame.drop(columns=["seconds"]).sort_values("variant").reset_index(drop=True)

@@ -414,7 +414,7 @@ def _variants(grid, cases) -> tuple:
     if (grid is None) == (cases is None):
         raise ValueError("sweep: give grid (dotted name -> list of values) or cases (a list of dicts), one of the two")
     if grid is not None:
-        parameters, variants = _native.expand_grid(json.dumps(dict(grid)))
+        parameters, variants = _native.expand_grid(json.dumps(list(dict(grid).items())))
         return parameters, json.loads(variants)
     parameters, variants = [], []
     width = len(str(len(cases)))

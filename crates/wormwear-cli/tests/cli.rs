@@ -1557,7 +1557,9 @@ fn a_sweep_whose_variants_all_fail_names_the_first_error() {
         "base = \"gear.toml\"\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque\" = [1.0]\n",
     )
     .unwrap();
-    let out = into("sweep", &file, &dir.path().join("out"), &["-q"])
+    // Given by its bare name from its own directory (issue 59: the base was read from "").
+    let out = into("sweep", Path::new("sweep.toml"), Path::new("out"), &["-q"])
+        .current_dir(dir.path())
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
@@ -1566,6 +1568,7 @@ fn a_sweep_whose_variants_all_fail_names_the_first_error() {
         err.contains("every variant failed; the first, v1:") && err.contains("worm_torque"),
         "{err}"
     );
+    assert!(file.exists());
 }
 
 /// `wormwear sweep` of a 3 x 2 grid of torque x roughness on the design example: six rows in

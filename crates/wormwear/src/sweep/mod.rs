@@ -171,9 +171,10 @@ impl Sweep {
                 message: e.to_string(),
             })
         };
-        let file: SweepFile = toml::from_str(&read(path)?)
+        let text = read(path)?;
+        let file: SweepFile = toml::from_str(&text)
             .map_err(|e| SweepError::Invalid(format!("{}: {e}", path.display())))?;
-        let folder = path.parent().unwrap_or(Path::new("."));
+        let folder = folder_of(path);
         let base_path = folder.join(&file.base);
         // A base that cannot be read is named as the sweep file wrote it.
         let named = |e: SweepError| match e {
@@ -200,7 +201,7 @@ impl Sweep {
             no_pitting: file.no_pitting,
         };
         let (parameters, variants) = match (file.grid, file.cases) {
-            (Some(grid), None) => grid_variants(&grid)?,
+            (Some(grid), None) => axes_variants(in_file_order(flat(&grid), &text))?,
             (None, Some(cases)) => case_variants(&cases)?,
             _ => {
                 return Err(SweepError::Invalid(format!(
@@ -279,11 +280,61 @@ fn flatten(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value
     }
 }
 
+/// [`flatten`] from the top.
+fn flat(table: &toml::Table) -> Vec<(String, toml::Value)> {
+    let mut out = Vec::new();
+    flatten(table, "", &mut out);
+    out
+}
+
+/// The grid's names (`axes`) in the order the sweep file's `text` writes them under `[grid]`
+/// (the TOML reader's tables sort their keys); a name not found keeps its place after them.
+fn in_file_order(mut axes: Vec<(String, toml::Value)>, text: &str) -> Vec<(String, toml::Value)> {
+    fn walk(table: &toml::de::DeTable, prefix: &str, out: &mut Vec<(usize, String)>) {
+        for (key, value) in table {
+            let name = match prefix.is_empty() {
+                true => key.get_ref().to_string(),
+                false => format!("{prefix}.{}", key.get_ref()),
+            };
+            match value.get_ref() {
+                toml::de::DeValue::Table(t) => walk(t, &name, out),
+                _ => out.push((key.span().start, name)),
+            }
+        }
+    }
+    let Ok(document) = toml::de::DeTable::parse(text) else {
+        return axes;
+    };
+    let mut positions = Vec::new();
+    let grid = document
+        .get_ref()
+        .iter()
+        .find(|(k, _)| k.get_ref() == "grid");
+    if let Some((_, value)) = grid {
+        if let toml::de::DeValue::Table(t) = value.get_ref() {
+            walk(t, "", &mut positions);
+        }
+    }
+    let position = |name: &str| {
+        let found = positions.iter().find(|(_, n)| n == name);
+        found.map_or(usize::MAX, |(p, _)| *p)
+    };
+    axes.sort_by_key(|(name, _)| position(name));
+    axes
+}
+
 /// Every combination of the grid's values, the first name varying slowest; variants named
-/// v1, v2, ... (zero-padded).
+/// v1, v2, ... (zero-padded). The table's names in its key order ([`axes_variants`] takes
+/// them in a given order).
 pub fn grid_variants(grid: &toml::Table) -> Result<(Vec<String>, Vec<Variant>), SweepError> {
-    let mut axes = Vec::new();
-    flatten(grid, "", &mut axes);
+    axes_variants(flat(grid))
+}
+
+/// Every combination of the values of `axes` (name, list of values), the first name varying
+/// slowest; variants named v1, v2, ... (zero-padded).
+pub fn axes_variants(
+    axes: Vec<(String, toml::Value)>,
+) -> Result<(Vec<String>, Vec<Variant>), SweepError> {
     let mut lists = Vec::new();
     for (name, value) in &axes {
         match value {
@@ -528,6 +579,15 @@ impl Row {
 
 /// That the base (`base_path`, written `written` in the sweep file) lies in `folder` or below
 /// it, symbolic links resolved; else an error that reads nothing of it.
+/// The folder of a file the sweep's relative paths start from: its parent, or the current
+/// directory for a bare file name (whose parent is the empty path).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 fn confined(folder: &Path, base_path: &Path, written: &str) -> Result<(), SweepError> {
     let resolve = |p: &Path| {
         std::fs::canonicalize(p).map_err(|e| SweepError::Read {
@@ -878,7 +938,29 @@ pub fn variant_dir(dir: &Path, variant: &Variant) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
-    use super::{csv_field, csv_text};
+    use super::{axes_variants, csv_field, csv_text, flat, folder_of, in_file_order};
+    use std::path::Path;
+
+    #[test]
+    fn a_bare_sweep_file_name_is_in_the_current_directory() {
+        // Issue 59: `wormwear sweep sweep-k.toml` read its base from "" ("cannot read :").
+        assert_eq!(folder_of(Path::new("sweep-k.toml")), Path::new("."));
+        assert_eq!(folder_of(Path::new("a/sweep.toml")), Path::new("a"));
+        assert_eq!(folder_of(Path::new("/sweep.toml")), Path::new("/"));
+    }
+
+    #[test]
+    fn the_grid_varies_its_first_name_slowest_in_the_files_order() {
+        // Issue 59: names were sorted alphabetically, not in the order the file gives them.
+        let text = "[grid]\n\"z.torque\" = [1.0, 2.0]\nm.x = [0.0]\na.speed = [3.0, 4.0, 5.0]\n";
+        let file: toml::Table = toml::from_str(text).unwrap();
+        let grid = file["grid"].as_table().unwrap();
+        let axes = in_file_order(flat(grid), text);
+        let (names, variants) = axes_variants(axes).unwrap();
+        assert_eq!(names, ["z.torque", "m.x", "a.speed"]);
+        let firsts: Vec<String> = variants.iter().map(|v| v.values[0].1.to_string()).collect();
+        assert_eq!(firsts, ["1.0", "1.0", "1.0", "2.0", "2.0", "2.0"]);
+    }
 
     #[test]
     fn a_cell_that_reads_as_a_formula_is_shown_as_text() {
