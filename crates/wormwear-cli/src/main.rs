@@ -33,7 +33,8 @@ mod rexs_cmd;
                   Outputs: summary.json, CSV, SVG, report.html, STL and VTK (.vtp) files; see the README."
 )]
 struct Cli {
-    /// Print only errors.
+    /// Print only errors and warnings: no progress, results or file lists (the ISO/TR 14521
+    /// rating's notes on its formulas' ranges are left out too; summary.json keeps them).
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
     /// Print progress as lines on stderr, also when stderr is not a terminal (CI logs, pipes),
@@ -372,7 +373,7 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
             force,
         } => init_cmd::init(*profile, output.as_deref(), *force, cli.quiet),
         Command::Compare { runs, output } => compare_cmd::compare(runs, output, cli.quiet),
-        Command::Check { file, json } => check(file, *json),
+        Command::Check { file, json } => check(file, *json, cli.quiet),
         Command::Geometry { file, output, cad } => geometry(file, output, cad, cli.quiet),
         Command::Tca { file, output } => tca(file, output, cli.quiet),
         Command::Ltca {
@@ -449,10 +450,23 @@ fn build_geometry(gear: &GearSet, file: &Path) -> Result<Geometry, Failure> {
     })
 }
 
-fn check(file: &Path, json: bool) -> Result<(), Failure> {
+/// `check`: the file validated, its geometry built and the checks `run` makes before any work
+/// passed ([`wormwear::Request::check`]: a load the loaded analysis holds, a life that can
+/// end); the derived data printed (nothing but the warnings, on stderr, when quiet).
+fn check(file: &Path, json: bool, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
     let geo = build_geometry(&gear, file)?;
+    let request = planned_request(Path::new("."), &gear, &LifeArgs::default(), RUN_STAGES)?;
+    request.check(&gear).map_err(|e| {
+        Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display())))
+    })?;
     let summary = GeometrySummary::new(&gear, &geo);
+    if quiet {
+        for w in &summary.warnings {
+            eprintln!("warning: {w}");
+        }
+        return Ok(());
+    }
     if json {
         let text = serde_json::to_string_pretty(&summary)
             .context("encoding JSON")
@@ -799,6 +813,17 @@ fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearSt
     }
 }
 
+/// The stages of `run`: with a life, and without.
+const RUN_STAGES: (&[wormwear::Stage], &[wormwear::Stage]) = (
+    &wormwear::Stage::ALL,
+    &[
+        wormwear::Stage::Geometry,
+        wormwear::Stage::Tca,
+        wormwear::Stage::Ltca,
+        wormwear::Stage::Report,
+    ],
+);
+
 fn run(
     file: &Path,
     dir: &Path,
@@ -806,10 +831,8 @@ fn run(
     quiet: bool,
     verbose: bool,
 ) -> Result<(), Failure> {
-    use wormwear::Stage;
     let gear = load(file)?;
-    let without_life = [Stage::Geometry, Stage::Tca, Stage::Ltca, Stage::Report];
-    let request = planned_request(dir, &gear, args, (&Stage::ALL, &without_life))?;
+    let request = planned_request(dir, &gear, args, RUN_STAGES)?;
     let request = with_cad(request, cad, dir, &gear)?;
     let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
     if !quiet {

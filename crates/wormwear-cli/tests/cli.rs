@@ -69,6 +69,39 @@ fn check_accepts_every_example() {
 }
 
 #[test]
+fn check_refuses_what_run_refuses_and_is_silent_when_quiet() {
+    // Issue 59: 60 000 N m on the worm passed `check`; only `run` refused it. `-q check`
+    // printed the whole listing.
+    let dir = tempfile::tempdir().unwrap();
+    let heavy = edited_design(
+        dir.path(),
+        "heavy.toml",
+        &[("worm_torque_nm = 60.0", "worm_torque_nm = 60000.0")],
+    );
+    let out = bin().arg("check").arg(&heavy).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("conditions.worm_torque_nm = 60000"), "{err}");
+    let hot = edited_design(
+        dir.path(),
+        "hot.toml",
+        &[("temperature_c = 59.85", "temperature_c = 250.0")],
+    );
+    let out = bin().args(["-q", "check"]).arg(&hot).output().unwrap();
+    assert!(out.status.success());
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("warning: lubricant.temperature_c = 250"),
+        "{err}"
+    );
+}
+
+#[test]
 fn check_json_has_the_derived_quantities() {
     let out = bin()
         .args(["check", "--json"])
