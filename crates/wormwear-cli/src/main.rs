@@ -15,6 +15,7 @@ mod args;
 mod calibrate_cmd;
 mod compare_cmd;
 mod init_cmd;
+mod interrupt;
 mod rating_cmd;
 mod request;
 mod rexs_cmd;
@@ -297,6 +298,7 @@ pub(crate) enum Failure {
 
 fn main() -> ExitCode {
     restore_sigpipe();
+    interrupt::install();
     let cli = Cli::parse();
     // One run per output directory: the lock lives until the process ends.
     let _lock = match lock_output(&cli) {
@@ -522,6 +524,9 @@ fn analyse(
     let life_cycles = request.life.as_ref().map_or(1.0, |p| p.life_cycles);
     let progress = life_progress(quiet || verbose || request.life.is_none());
     let mut writer = wormwear::output::wear::LifeWriter::new(dir);
+    if request.life.is_some() {
+        interrupt::life_started(dir);
+    }
     let mut on_event = |event: wormwear::Event| -> Result<(), wormwear::RunError> {
         match event {
             wormwear::Event::Bending(info) if !quiet => print_bending(info),
@@ -914,6 +919,7 @@ fn sweep(file: &Path, dir: &Path, base_anywhere: bool, quiet: bool) -> Result<()
         SweepError::Output(_) => Failure::Run(e.into()),
         _ => Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display()))),
     })?;
+    interrupt::sweep_started(dir);
     if !quiet {
         eprintln!(
             "sweep: {} variants of {} on {} threads",

@@ -1440,6 +1440,40 @@ fn a_resumed_finished_life_builds_the_worn_wheel_of_an_earlier_map_state() {
     assert!(said.contains("wear_flank_step1.json"), "{said}");
 }
 
+#[cfg(unix)]
+#[test]
+fn ctrl_c_in_a_life_says_where_it_stopped_and_how_to_resume() {
+    // Issue 59: Ctrl-C ended a life with exit 130 and no word of --resume.
+    let dir = tempfile::tempdir().unwrap();
+    let design = example("gear-1x40-design.toml");
+    let life = ["-q", "--cycles", "40000", "--step-cycles", "10000"];
+    let mut run = into("wear", &design, dir.path(), &life)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let checkpoint = dir.path().join("wear_checkpoint.json");
+    let start = std::time::Instant::now();
+    while !checkpoint.exists() && start.elapsed().as_secs() < 300 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    // SAFETY: a plain kill(2) of our own child.
+    unsafe { libc::kill(run.id() as libc::pid_t, libc::SIGINT) };
+    let out = run.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted: the life's last saved state is step"),
+        "{err}"
+    );
+    let command = format!(
+        "wormwear wear {} -o {} {} --resume",
+        design.display(),
+        dir.path().display(),
+        life.join(" ")
+    );
+    assert!(err.contains(&command), "{err}\nnot: {command}");
+}
+
 /// Runs the life of `design` with the arguments `life` into a new directory, killed as soon as
 /// each new state is on disk and resumed, until it ends; its records and step table must equal
 /// those of the uninterrupted run in `whole`, byte for byte.
