@@ -1447,7 +1447,7 @@ fn ctrl_c_in_a_life_says_where_it_stopped_and_how_to_resume() {
     let dir = tempfile::tempdir().unwrap();
     let design = example("gear-1x40-design.toml");
     let life = ["-q", "--cycles", "40000", "--step-cycles", "10000"];
-    let mut run = into("wear", &design, dir.path(), &life)
+    let run = into("wear", &design, dir.path(), &life)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
