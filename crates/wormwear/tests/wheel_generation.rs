@@ -569,3 +569,27 @@ fn flank_interpolation_between_node_columns_is_exact_to_the_grid() {
     );
     assert!(sliver < 1e-8, "theta error in the root sliver {sliver:e} m");
 }
+
+#[test]
+fn a_centre_distance_changed_alone_names_the_blank_radii_that_follow_it() {
+    // Issue 59: the design example at 130 mm failed with "...at the blank top...: Fillet" and
+    // a list of inputs, none of them the cause. The message now gives the throat and outer
+    // radii that follow the cutting centre distance, and with them the gear builds.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("centre_distance_mm = 125.0", "centre_distance_mm = 130.0");
+    let moved = input::load_from_str(&text).unwrap();
+    let err = Geometry::build(&moved).unwrap_err().to_string();
+    assert!(!err.contains("Fillet"), "{err}");
+    assert!(
+        err.contains("raise wheel.throat_radius_mm to about 108.94 mm")
+            && err.contains("(to about 115.00 mm)"),
+        "{err}"
+    );
+    let fitted = text
+        .replace("throat_radius_mm = 103.94", "throat_radius_mm = 108.94")
+        .replace("outer_radius_mm = 110.0", "outer_radius_mm = 115.0");
+    let g = input::load_from_str(&fitted).unwrap();
+    assert!(Geometry::build(&g).is_ok());
+}

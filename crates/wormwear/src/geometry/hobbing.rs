@@ -198,13 +198,18 @@ impl<'a> Hobbing<'a> {
     ) -> Result<(f64, f64), GeometryError> {
         let top = self.envelope(flank, blank_top, z);
         if top.kind != PointKind::Flank {
+            let cut_by = match top.kind {
+                PointKind::Fillet => "the hob's tip edge cuts there, not its flank",
+                PointKind::NotReached => "the hob does not reach there",
+                PointKind::RootCut => "the hob's root cylinder cuts there",
+                PointKind::Flank => "",
+            };
             return Err(GeometryError::Wheel(format!(
                 "the hob does not generate the {} flank at the blank top (r = {:.4} mm, \
-                 z = {:.4} mm): {:?}",
+                 z = {:.4} mm): {cut_by}",
                 flank.name(),
                 blank_top * 1e3,
                 z * 1e3,
-                top.kind
             )));
         }
         let depth = self.hob.def.tip_radius - self.hob.def.root_radius;

@@ -39,6 +39,39 @@ pub struct Geometry {
     pub teeth: u32,
 }
 
+/// What to change when the hob does not generate the wheel blank (MODEL §3.2): where the blank
+/// lies well below the hob's reach at the throat (the centre distance moved, the blank did
+/// not), the throat and outer radii that follow the cutting centre distance; else the inputs
+/// that shape the envelope and the direction that brings the blank inside it.
+fn blank_fit(gear: &GearSet) -> String {
+    let mm = 1e3;
+    let reach = gear.cutting.centre_distance - gear.hob.root_radius;
+    let below = reach - gear.wheel.throat_radius;
+    // The examples' blanks sit 0.01 mm below the hob's root; half a millimetre is a blank
+    // left behind by a changed centre distance.
+    if below > 0.5e-3 {
+        let throat = reach - 0.01e-3;
+        return format!(
+            "the wheel blank does not follow the cutting centre distance: the hob's root reaches \
+             r = {:.2} mm at the throat (cutting.centre_distance_mm - hob.root_radius_mm), \
+             {:.2} mm above wheel.throat_radius_mm = {:.2}; a changed centre distance moves the \
+             wheel's teeth with it: raise wheel.throat_radius_mm to about {:.2} mm and \
+             wheel.outer_radius_mm by as much (to about {:.2} mm), or keep the centre distance \
+             and change the worm and the hob instead",
+            reach * mm,
+            below * mm,
+            gear.wheel.throat_radius * mm,
+            throat * mm,
+            (gear.wheel.outer_radius + throat - gear.wheel.throat_radius) * mm
+        );
+    }
+    "the blank must lie inside the region the hob envelops: lower wheel.outer_radius_mm or \
+     wheel.face_width_mm, or check the hob against the wheel ([hob] starts, lead_mm, \
+     tip_radius_mm and pressure angle; [cutting] centre_distance_mm, offset_mm and \
+     inclination_deg; wheel.teeth)"
+        .to_string()
+}
+
 impl Geometry {
     /// Builds all flanks with the grid of the gear set's analysis settings.
     pub fn build(gear: &GearSet) -> Result<Self, GeometryError> {
@@ -77,16 +110,9 @@ impl Geometry {
             centre_distance: gear.nominal_centre_distance,
         };
         let hobbing = Hobbing::new(&hob, gear.cutting, gear.wheel.teeth);
-        let wheel_hint = |e: GeometryError| {
-            match e {
-            GeometryError::Wheel(m) => GeometryError::Wheel(format!(
-                "{m}; the inputs that shape it: [hob] starts, lead_mm, tip_radius_mm and \
-                 pressure angle, [cutting] centre_distance_mm, offset_mm and inclination_deg, \
-                 [wheel] teeth, outer_radius_mm and face_width_mm (the blank must lie inside the region the hob envelops: a \
-                 smaller outer radius or face width, or a hob matching the wheel's teeth)"
-            )),
+        let wheel_hint = |e: GeometryError| match e {
+            GeometryError::Wheel(m) => GeometryError::Wheel(format!("{m}; {}", blank_fit(gear))),
             other => other,
-        }
         };
         let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)
             .map_err(wheel_hint)?;
