@@ -408,11 +408,15 @@ impl NativeResults {
     }
 
     /// Writes the files the CLI writes for the same stages into `directory` (created), under
-    /// the same lock; returns the paths written.
+    /// the same lock, first removing what an earlier run left there of these stages (all, for
+    /// the whole pipeline); returns the paths written.
     fn write(&self, py: Python<'_>, directory: &str) -> PyResult<Vec<String>> {
         let dir = Path::new(directory);
         let files = py.detach(|| {
             let _lock = wormwear::output::lock_directory(dir).map_err(|e| e.to_string())?;
+            // What an earlier run left there of these stages goes first, as the CLI does.
+            wormwear::output::owned::clear_earlier(dir, &self.results.stages)
+                .map_err(|e| error_chain(&e))?;
             wormwear::output::write_results(&self.results, dir, false).map_err(|e| error_chain(&e))
         });
         files

@@ -19,8 +19,12 @@ pub(crate) struct LifeArgs {
     #[arg(long)]
     pub(crate) no_pitting: bool,
     /// Continue from the checkpoint in the output directory.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "force")]
     pub(crate) resume: bool,
+    /// Replace the life the output directory holds (its checkpoint), which is refused
+    /// without it: start again from the unworn flank.
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 impl LifeArgs {

@@ -512,11 +512,13 @@ fn check(file: &Path, json: bool, quiet: bool) -> Result<(), Failure> {
 fn analyse(
     file: &Path,
     gear: &GearSet,
-    dir: &Path,
+    (dir, force): (&Path, bool),
     request: wormwear::Request,
     quiet: bool,
     verbose: bool,
 ) -> Result<(wormwear::Results, Vec<PathBuf>), Failure> {
+    request::check_held_life(dir, &request, force)?;
+    let earlier = request::EarlierOutputs::of(dir, &request);
     let source = wormwear::Source {
         file: file.display().to_string(),
         text: wormwear::files::read_text(file, wormwear::files::INPUT_LIMIT).unwrap_or_default(),
@@ -531,9 +533,10 @@ fn analyse(
         match event {
             wormwear::Event::Bending(info) if !quiet => print_bending(info),
             wormwear::Event::WearState(life) => {
-                writer
-                    .write_view(life)
-                    .map_err(|e| wormwear::RunError::Stopped(e.to_string()))?;
+                let stopped =
+                    |e: wormwear::output::OutputError| wormwear::RunError::Stopped(e.to_string());
+                earlier.clear().map_err(stopped)?;
+                writer.write_view(life).map_err(stopped)?;
                 let line = state_line(life.step.state);
                 if verbose {
                     eprintln!("{line}");
@@ -546,29 +549,13 @@ fn analyse(
         }
         Ok(())
     };
-    let results = wormwear::run(gear, source, request, &mut on_event).map_err(|e| {
-        let context = match &e {
-            wormwear::RunError::Geometry(_) => format!("geometry of {}", file.display()),
-            wormwear::RunError::Wear(wormwear::wear::WearError::Checkpoint(_)) => {
-                "--resume".to_string()
-            }
-            _ => String::new(),
-        };
-        let error = match context.is_empty() {
-            true => anyhow::Error::new(e),
-            false => anyhow::Error::new(e).context(context),
-        };
-        match error
-            .downcast_ref::<wormwear::RunError>()
-            .map(|e| e.is_input())
-        {
-            Some(true) => Failure::Input(error),
-            _ => Failure::Run(error),
-        }
-    })?;
+    let results =
+        wormwear::run(gear, source, request, &mut on_event).map_err(|e| run_failure(e, file))?;
     progress.finish_and_clear();
-    let files =
-        wormwear::output::write_results(&results, dir, true).map_err(|e| Failure::Run(e.into()))?;
+    let written = earlier
+        .clear()
+        .and_then(|()| wormwear::output::write_results(&results, dir, true));
+    let files = written.map_err(|e| Failure::Run(e.into()))?;
     for w in &results.warnings {
         eprintln!("warning: {w}");
     }
@@ -580,6 +567,27 @@ fn analyse(
         }
     }
     Ok((results, files))
+}
+
+/// A failed run as the CLI reports it: the input's errors (exit 2) apart from the
+/// computation's (1), with the file or option they concern.
+fn run_failure(e: wormwear::RunError, file: &Path) -> Failure {
+    let context = match &e {
+        wormwear::RunError::Geometry(_) => format!("geometry of {}", file.display()),
+        wormwear::RunError::Wear(wormwear::wear::WearError::Checkpoint(_)) => {
+            "--resume".to_string()
+        }
+        _ => String::new(),
+    };
+    let input = e.is_input();
+    let error = match context.is_empty() {
+        true => anyhow::Error::new(e),
+        false => anyhow::Error::new(e).context(context),
+    };
+    match input {
+        true => Failure::Input(error),
+        false => Failure::Run(error),
+    }
 }
 
 /// Where the FE bending model came from (cache or build), on stdout.
@@ -625,7 +633,7 @@ fn geometry(file: &Path, dir: &Path, cad: &CadArgs, quiet: bool) -> Result<(), F
     let gear = load(file)?;
     let mut request = wormwear::Request::new([wormwear::Stage::Geometry]);
     request.cad = cad.request(dir)?;
-    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
+    let (results, files) = analyse(file, &gear, (dir, false), request, quiet, false)?;
     if !quiet {
         print_files(&files);
         print_geometry(&results, dir);
@@ -647,7 +655,7 @@ fn print_geometry(results: &wormwear::Results, dir: &Path) {
 fn tca(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
     let request = wormwear::Request::new([wormwear::Stage::Tca]);
-    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
+    let (results, files) = analyse(file, &gear, (dir, false), request, quiet, false)?;
     if !quiet {
         print_files(&files);
         print_tca(&results);
@@ -688,7 +696,7 @@ fn ltca(file: &Path, dir: &Path, map_position: usize, quiet: bool) -> Result<(),
     check_map_position(file, &gear, map_position)?;
     let mut request = wormwear::Request::new([wormwear::Stage::Ltca]);
     request.map_position = map_position;
-    let (results, files) = analyse(file, &gear, dir, request, quiet, false)?;
+    let (results, files) = analyse(file, &gear, (dir, false), request, quiet, false)?;
     if !quiet {
         print_files(&files);
         print_ltca(&results);
@@ -754,7 +762,7 @@ fn wear(
     let gear = load(file)?;
     let request = life_request(dir, &gear, args, &[wormwear::Stage::Wear])?;
     let request = with_cad(request, cad, dir, &gear)?;
-    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    let (results, _) = analyse(file, &gear, (dir, args.force), request, quiet, verbose)?;
     finish_life(&results, dir, quiet);
     Ok(())
 }
@@ -839,7 +847,7 @@ fn run(
     let gear = load(file)?;
     let request = planned_request(dir, &gear, args, RUN_STAGES)?;
     let request = with_cad(request, cad, dir, &gear)?;
-    let (results, files) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    let (results, files) = analyse(file, &gear, (dir, args.force), request, quiet, verbose)?;
     if !quiet {
         print_geometry(&results, dir);
         print_tca(&results);

@@ -19,7 +19,7 @@ pub(crate) fn rating(
         args,
         (&[Stage::Ltca, Stage::Wear], &[Stage::Ltca]),
     )?;
-    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    let (results, _) = analyse(file, &gear, (dir, args.force), request, quiet, verbose)?;
     if let (Some(table), false) = (&results.safety, quiet) {
         print_safety(table);
         println!("results in {}", dir.display());

@@ -70,3 +70,55 @@ pub(crate) fn planned_request(
         false => Ok(wormwear::Request::new(without.iter().copied())),
     }
 }
+
+/// Refuses, before any work, a `request` that would replace the life its directory holds
+/// (its checkpoint) unless it continues it (--resume) or `force` says to replace it.
+pub(crate) fn check_held_life(
+    dir: &Path,
+    request: &wormwear::Request,
+    force: bool,
+) -> Result<(), Failure> {
+    let checkpoint = dir.join(wormwear::output::wear::CHECKPOINT);
+    let replaced = wormwear::output::owned::replaced_by(&request.stages).0;
+    let replaces_life = replaced.contains(&wormwear::Stage::Wear);
+    if request.resume.is_some() || force || !replaces_life || !checkpoint.exists() {
+        return Ok(());
+    }
+    let held = match wormwear::output::wear::read_checkpoint(dir) {
+        Ok(Some(s)) => format!("a life (step {}, {:.0} cycles)", s.step, s.cycles),
+        _ => format!("a life's checkpoint ({})", checkpoint.display()),
+    };
+    Err(Failure::Input(anyhow::anyhow!(
+        "{} holds {held}: continue it with --resume (the same file and options), or replace \
+         it with --force",
+        dir.display()
+    )))
+}
+
+/// The files an earlier run left in a directory that a request's run replaces
+/// ([`wormwear::output::owned::replaced_by`]): removed once, when the run writes its first
+/// file, so that none is read as this run's and a refused or failed run leaves them as they
+/// were. Kept with --resume, which continues them.
+pub(crate) struct EarlierOutputs {
+    dir: std::path::PathBuf,
+    stages: std::collections::BTreeSet<wormwear::Stage>,
+    cleared: std::cell::Cell<bool>,
+}
+
+impl EarlierOutputs {
+    pub(crate) fn of(dir: &Path, request: &wormwear::Request) -> Self {
+        Self {
+            dir: dir.to_path_buf(),
+            stages: request.stages.clone(),
+            cleared: std::cell::Cell::new(request.resume.is_some()),
+        }
+    }
+
+    /// Removes them, the first time only.
+    pub(crate) fn clear(&self) -> Result<(), wormwear::output::OutputError> {
+        if self.cleared.replace(true) {
+            return Ok(());
+        }
+        wormwear::output::owned::clear_earlier(&self.dir, &self.stages).map(|_| ())
+    }
+}

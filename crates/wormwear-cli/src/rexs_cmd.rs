@@ -72,7 +72,7 @@ pub fn export(
         )?,
         false => wormwear::Request::new(stages),
     };
-    let (results, _) = analyse(file, &gear, dir, request, quiet, verbose)?;
+    let (results, _) = analyse(file, &gear, (dir, life.force), request, quiet, verbose)?;
     let model = rexs::export::stage_model(&gear, Some(&results), &rexs::export::utc_now())
         .map_err(|e| Failure::Run(e.into()))?;
     let (encoding, extension) = match json {

@@ -1422,7 +1422,7 @@ fn a_resumed_finished_life_builds_the_worn_wheel_of_an_earlier_map_state() {
     assert!(fresh.status.success());
     let worn = dir.path().join("wheel_worn.step");
     let uninterrupted = std::fs::read(&worn).unwrap();
-    let last = wear_into(&design, dir.path(), &at("2"));
+    let last = wear_into(&design, dir.path(), &[&at("2")[..], &["--force"]].concat());
     assert!(last.status.success());
     assert_ne!(std::fs::read(&worn).unwrap(), uninterrupted);
     let resumed = wear_into(&design, dir.path(), &[&at("1")[..], &["--resume"]].concat());
@@ -1438,6 +1438,45 @@ fn a_resumed_finished_life_builds_the_worn_wheel_of_an_earlier_map_state() {
     let said = String::from_utf8_lossy(&changed.stderr);
     assert_eq!(changed.status.code(), Some(2), "{said}");
     assert!(said.contains("wear_flank_step1.json"), "{said}");
+}
+
+#[test]
+fn a_life_in_the_directory_is_not_restarted_without_force_and_stale_maps_go() {
+    // Issue 59: a run over a finished life restarted it silently, and a shorter life left
+    // the longer one's map states (wear_map_step2...) for report.html to show.
+    let dir = tempfile::tempdir().unwrap();
+    let design = example("gear-1x40-design.toml");
+    let longer = ["-q", "--cycles", "20000", "--step-cycles", "10000"];
+    assert!(wear_into(&design, dir.path(), &longer).status.success());
+    let stale = dir.path().join("wear_map_step2.csv");
+    assert!(stale.exists());
+    std::fs::write(dir.path().join("notes.txt"), "mine").unwrap();
+    let shorter = ["-q", "--cycles", "10000", "--step-cycles", "10000"];
+    let out = wear_into(&design, dir.path(), &shorter);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("holds a life (step 2, 20000 cycles)")
+            && err.contains("--resume")
+            && err.contains("--force"),
+        "{err}"
+    );
+    assert!(stale.exists(), "a refused run removed files");
+    let out = wear_into(&design, dir.path(), &[&shorter[..], &["--force"]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        !stale.exists(),
+        "the longer life's map state is still there"
+    );
+    assert!(dir.path().join("wear_map_step1.csv").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("notes.txt")).unwrap(),
+        "mine"
+    );
 }
 
 #[cfg(unix)]

@@ -12,7 +12,9 @@
 //! 5. [`lubrication`] — film thickness and local wear coefficient (MODEL §6); [`wear`] — Archard
 //!    wear over life, backlash, pitting phases (MODEL §7-8); [`traction`] — the local friction of
 //!    the mixed lubrication, [`friction`] — mesh loss, efficiency and oil temperature (MODEL §13);
-//! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9).
+//! 6. [`rating`] — ISO/TR 14521 efficiency, sigma_Hm, pitting lives, wear limits (MODEL §9);
+//!    [`safety`] — the safety table from the model's own results (MODEL §9.1);
+//! 7. [`cad`] — worm and wheel (unworn or worn) as B-spline solids for STEP.
 //!
 //! [`run`] chains them for one [`Request`] and returns one [`Results`] value; [`output`]
 //! writes results (summary.json, CSV, SVG, STL, report.html) atomically

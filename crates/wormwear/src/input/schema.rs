@@ -253,7 +253,7 @@ pub struct ThreadSpec {
     #[serde(default)]
     pub grinding_wheel: Option<GrindingWheelSpec>,
     /// Tip relief at the tip edge, um: parabolic, C (s / L)^2 over the last L of the flank
-    /// height (worm only; default 20 um; 0 = sharp edge).
+    /// height (worm only; default 0: a sharp edge, the published model).
     #[serde(default)]
     pub tip_relief_um: Option<f64>,
     /// Length L of the tip relief, measured radially from the tip, mm (default 1 mm).
@@ -351,7 +351,8 @@ pub struct WheelSpec {
     #[serde(default)]
     pub bearing_positions_mm: Option<Vec<f64>>,
     /// Edge relief of the teeth at the blank top and the face ends, um: parabolic,
-    /// C (s / L)^2 over the last L before the edge (default 20 um; 0 = sharp edges).
+    /// C (s / L)^2 over the last L before the edge (default 0: sharp edges, the published
+    /// model).
     #[serde(default)]
     pub edge_relief_um: Option<f64>,
     /// Length L of the edge relief, mm (default 1 mm).

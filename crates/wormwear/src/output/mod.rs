@@ -9,6 +9,7 @@ pub mod compare;
 pub mod friction;
 pub mod geometry;
 pub mod ltca;
+pub mod owned;
 pub mod plot;
 pub mod report;
 pub mod safety;
