@@ -56,5 +56,8 @@ pub(crate) fn print_safety(table: &wormwear::safety::SafetyTable) {
             r.unit,
             r.verdict.text()
         );
+        if !r.assumed.is_empty() {
+            println!("  {:<8} on assumed inputs: {}", "", r.assumed.join(", "));
+        }
     }
 }

@@ -647,7 +647,7 @@ impl<'a> Pipeline<'a> {
         (geo, tca, bending): (&Geometry, &Tca, &Bending),
         ltca: &Ltca,
         thermal: Option<&crate::friction::Thermal>,
-    ) -> Option<Result<crate::safety::Sump, String>> {
+    ) -> Option<Result<crate::safety::Sump, crate::safety::SumpError>> {
         if let Some(t) = thermal.filter(|t| t.mode == "balance") {
             return Some(Ok(crate::safety::Sump {
                 thermal: t.clone(),
@@ -684,9 +684,20 @@ impl<'a> Pipeline<'a> {
             thermal,
             own: false,
         })
-        .map_err(|e| e.to_string());
-        if let Err(e) = &result {
-            self.warnings.push(format!("safety: S_T not computed: {e}"));
+        .map_err(|e| crate::safety::SumpError {
+            above_c: match &e {
+                crate::friction::FrictionError::NoEquilibrium { limit_c, .. } => Some(*limit_c),
+                _ => None,
+            },
+            message: e.to_string(),
+        });
+        if let Err(e) = result.as_ref().map_err(|e| &e.above_c) {
+            if e.is_none() {
+                self.warnings.push(format!(
+                    "safety: S_T not computed: {}",
+                    result.as_ref().err().map_or("", |e| e.message.as_str())
+                ));
+            }
         }
         Some(result)
     }

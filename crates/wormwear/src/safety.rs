@@ -53,6 +53,10 @@ pub struct SafetyRow {
     pub verdict: Verdict,
     /// How the value and the allowable were obtained, with the figures beside it.
     pub source: String,
+    /// The inputs this row reads that the gear file marks as assumed
+    /// (`rating.assumed_inputs`), as `rating.` field names; empty: none.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub assumed: Vec<String>,
 }
 
 /// The safety table of one operating case (MODEL §9.1).
@@ -92,7 +96,7 @@ pub struct SafetyInputsOf<'a> {
     pub root_stress: Option<Result<RootStresses, String>>,
     /// The sump temperature's heat balance (None: no balance and no temperature limit; an
     /// error: why the balance has no solution).
-    pub sump: Option<Result<Sump, String>>,
+    pub sump: Option<Result<Sump, SumpError>>,
 }
 
 /// The heat balance behind S_T.
@@ -102,6 +106,15 @@ pub struct Sump {
     /// Whether it is the run's own (lubricant.temperature = "balance"), else solved for the
     /// table while the run held the lubricant's fixed temperature.
     pub own: bool,
+}
+
+/// Why the heat balance gave no sump temperature.
+#[derive(Debug, Clone)]
+pub struct SumpError {
+    pub message: String,
+    /// The temperature, degC, below which the oil has no steady state (the housing cannot
+    /// reject the loss there): the oil is hotter than it; None for other failures.
+    pub above_c: Option<f64>,
 }
 
 /// The gear with its torque times `factor` (the rating case of K_A).
@@ -130,6 +143,7 @@ pub fn safety_table(s: &SafetyInputsOf) -> SafetyTable {
     rows.push(pitting_row(s, required_cycles));
     rows.extend(wear_rows(s, required_cycles));
     rows.push(temperature_row(s));
+    mark_assumed(&mut rows, &s.gear.rating.assumed_inputs);
     SafetyTable {
         application_factor: inputs.application_factor,
         required_cycles,
@@ -171,14 +185,12 @@ pub fn warnings(table: &SafetyTable, endurance: Endurance, simulated: Option<f64
         )),
         _ => None,
     }));
-    warnings.extend(table.failed().map(|r| {
-        format!(
-            "safety: {} = {:.2} is below its minimum {} ({})",
-            r.symbol,
-            r.safety.unwrap_or(f64::NAN),
-            r.minimum,
-            r.quantity
-        )
+    warnings.extend(table.failed().map(|r| match r.safety {
+        Some(s) => format!(
+            "safety: {} = {s:.2} is below its minimum {} ({})",
+            r.symbol, r.minimum, r.quantity
+        ),
+        None => format!("safety: {} fails ({}): {}", r.symbol, r.quantity, r.source),
     }));
     warnings
 }
@@ -221,6 +233,45 @@ fn row(
         minimum,
         verdict,
         source,
+        assumed: Vec::new(),
+    }
+}
+
+/// The `[rating]` inputs each row reads, by its symbol (MODEL §9.1; the wear rows S_W, S_W,a
+/// ... alike), besides its minimum.
+fn inputs_read(symbol: &str) -> &'static [&'static str] {
+    let symbol = if symbol.starts_with("S_W") {
+        "S_W"
+    } else {
+        symbol
+    };
+    match symbol {
+        "S_F" => &[
+            "root_stress_allowable_mpa",
+            "root_fillet_radius_mm",
+            "application_factor",
+        ],
+        "S_delta" => &["deflection_limit_um", "application_factor"],
+        "S_H" => &["required_life_h", "application_factor"],
+        "S_W" => &[
+            "required_life_h",
+            "thickness_loss_limit_mm",
+            "mass_loss_limit_g",
+            "starts_per_hour",
+        ],
+        "S_T" => &["oil_temperature_limit_c"],
+        _ => &[],
+    }
+}
+
+/// Marks each row with the assumed inputs it reads (`assumed`: `[rating]` key names).
+fn mark_assumed(rows: &mut [SafetyRow], assumed: &[String]) {
+    for r in rows {
+        r.assumed = inputs_read(&r.symbol)
+            .iter()
+            .filter(|name| assumed.iter().any(|a| a == *name))
+            .map(|name| format!("rating.{name}"))
+            .collect();
     }
 }
 
@@ -518,7 +569,21 @@ fn temperature_row(s: &SafetyInputsOf) -> SafetyRow {
             },
             None,
         ),
-        Some(Err(e)) => (None, String::new(), Some(Verdict::NotComputed(e.clone()))),
+        // No steady state below a temperature above the limit: the oil passes the limit,
+        // whatever temperature it reaches (a verdict without a value).
+        Some(Err(SumpError {
+            message,
+            above_c: Some(above),
+        })) if limit.as_ref().is_ok_and(|l| l < above) => (
+            None,
+            format!("the heat balance: {message}"),
+            Some(Verdict::Fail),
+        ),
+        Some(Err(e)) => (
+            None,
+            String::new(),
+            Some(Verdict::NotComputed(e.message.clone())),
+        ),
         None => (None, "housing heat balance (MODEL §13)".into(), None),
     };
     let mut r = row(

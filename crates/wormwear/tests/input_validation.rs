@@ -802,7 +802,7 @@ fn geometry_failures_name_the_inputs_to_change() {
         ),
         (
             four_starts,
-            &["[hob] starts", "[wheel] teeth", "outer_radius_mm"][..],
+            &["[hob] starts", "wheel.teeth", "outer_radius_mm"][..],
         ),
     ] {
         let gear = input::load_from_str(&text).unwrap();

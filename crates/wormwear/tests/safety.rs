@@ -214,3 +214,41 @@ fn a_root_sector_that_cannot_be_meshed_names_the_fillet_radius() {
         root.verdict
     );
 }
+
+#[test]
+fn a_new_gear_from_init_gets_a_verdict_on_its_marked_assumptions() {
+    // Issue 59: `wormwear init --profile K` gave "needs input" in all five rows. The template
+    // now writes assumed allowables, listed in rating.assumed_inputs; every row that reads one
+    // says so. (Loaded analysis alone: S_W needs a life; rigid teeth for speed.)
+    let text = wormwear::input::template::gear_template(wormwear::input::ProfileType::K);
+    let mut g = wormwear::input::load_from_str(&text).unwrap();
+    g.bending.kind = BendingKind::None;
+    let table = loaded_analysis(&g).safety.unwrap();
+    for (symbol, assumed) in [
+        ("S_F", "rating.root_stress_allowable_mpa"),
+        ("S_delta", "rating.deflection_limit_um"),
+        ("S_H", "rating.required_life_h"),
+        ("S_T", "rating.oil_temperature_limit_c"),
+    ] {
+        let row = table.rows.iter().find(|r| r.symbol == symbol).unwrap();
+        assert!(
+            matches!(row.verdict, Verdict::Pass | Verdict::Fail),
+            "{symbol}: {:?}",
+            row.verdict
+        );
+        assert!(
+            row.assumed.iter().any(|a| a == assumed),
+            "{symbol}: {:?}",
+            row.assumed
+        );
+    }
+    // An assumed input the file does not give is refused, naming it.
+    let bad = text.replace("\"deflection_limit_um\",", "\"mass_loss_limit_g\",");
+    let err = wormwear::input::load_from_str(&bad)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("rating.assumed_inputs") && err.contains("mass_loss_limit_g"),
+        "{err}"
+    );
+}

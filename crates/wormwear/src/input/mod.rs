@@ -499,7 +499,7 @@ impl WearPlan {
 }
 
 /// Factors of the standard ratings (MODEL §9) the user may set.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct RatingFactors {
     /// Product of the mesh-friction factors Y_S Y_G Y_W Y_R (size, geometry, material,
     /// roughness).
@@ -512,6 +512,10 @@ pub struct RatingFactors {
     /// so that gears without them keep their fingerprints.
     #[serde(skip_serializing_if = "SafetyInputs::is_default")]
     pub safety: SafetyInputs,
+    /// The safety table's inputs the file marks as assumed (`rating.assumed_inputs`: their
+    /// `[rating]` key names); left out of the gear's JSON when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub assumed_inputs: Vec<String>,
 }
 
 impl Default for RatingFactors {
@@ -522,6 +526,7 @@ impl Default for RatingFactors {
             pitting_life_factor: 1.0,
             pitted_area_max_percent: 8.0,
             safety: SafetyInputs::default(),
+            assumed_inputs: Vec::new(),
         }
     }
 }

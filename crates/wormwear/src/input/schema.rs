@@ -114,6 +114,10 @@ pub struct RatingSpec {
     pub minimum_safety_pitting: Option<f64>,
     pub minimum_safety_wear: Option<f64>,
     pub minimum_safety_temperature: Option<f64>,
+    /// The inputs of this table that are assumed, not known (names of `[rating]` keys given
+    /// here; `wormwear init` lists those it writes): the safety rows that read them are marked
+    /// "assumed" in the table, rating.csv and the report.
+    pub assumed_inputs: Option<Vec<String>>,
 }
 
 /// Life simulation (MODEL §7.3, §8).

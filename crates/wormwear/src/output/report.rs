@@ -250,6 +250,19 @@ fn verdict_text(v: &serde_json::Value) -> String {
     }
 }
 
+/// A row's verdict, with the assumed inputs it reads ("pass, on assumed rating.x").
+fn assumed_verdict(row: &serde_json::Value) -> String {
+    let verdict = verdict_text(&row["verdict"]);
+    let assumed: Vec<&str> = row["assumed"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_str()).collect())
+        .unwrap_or_default();
+    match assumed.is_empty() {
+        true => verdict,
+        false => format!("{verdict}, on assumed {}", assumed.join(", ")),
+    }
+}
+
 /// The safety table (MODEL §9.1) at the top of the page, a row in red where its safety falls
 /// below its minimum.
 fn safety_section(h: &mut String, summary: &serde_json::Value, hours: Option<f64>) {
@@ -266,16 +279,23 @@ fn safety_section(h: &mut String, summary: &serde_json::Value, hours: Option<f64
             let h = hours.map_or(String::new(), |per| format!(" ({} h)", number(n * per)));
             format!("{} wheel cycles{h}", cycles_text(n))
         });
-    let _ = writeln!(
+    let _ =
+        writeln!(
         h,
         "<section id=\"safety\"><h2>Safety</h2><p>From the model (MODEL §9.1): K_A {}, required \
-         life {life}. {}</p><table><tr><th>quantity</th><th>symbol</th><th>value</th>\
+         life {life}. {}{}</p><table><tr><th>quantity</th><th>symbol</th><th>value</th>\
          <th>allowable</th><th>unit</th><th>safety</th><th>minimum</th><th>verdict</th>\
          <th>how</th></tr>",
         table["application_factor"],
         match failed {
             0 => String::new(),
             n => format!("<b class=\"fail\">{n} safety value(s) below the minimum.</b>"),
+        },
+        match rows.iter().any(|r| r["assumed"].as_array().is_some_and(|a| !a.is_empty())) {
+            true => " A verdict \"on assumed\" reads inputs the gear file marks as assumed \
+                     (rating.assumed_inputs): replace them with your requirement and your \
+                     material's data, and take them off the list.",
+            false => "",
         }
     );
     for r in rows {
@@ -296,7 +316,7 @@ fn safety_section(h: &mut String, summary: &serde_json::Value, hours: Option<f64
             escape(r["unit"].as_str().unwrap_or("")),
             safety(&r["safety"]),
             value(&r["minimum"]),
-            escape(&verdict_text(&r["verdict"])),
+            escape(&assumed_verdict(r)),
             escape(r["source"].as_str().unwrap_or(""))
         );
     }

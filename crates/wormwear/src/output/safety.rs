@@ -26,12 +26,13 @@ fn number(v: Option<f64>) -> String {
 
 /// `rating.csv`: quantity, symbol, unit, value, allowable, safety, minimum, verdict, source.
 pub fn safety_csv(table: &SafetyTable) -> String {
-    let mut text =
-        String::from("quantity,symbol,unit,value,allowable,safety,minimum,verdict,source\n");
+    let mut text = String::from(
+        "quantity,symbol,unit,value,allowable,safety,minimum,verdict,source,assumed_inputs\n",
+    );
     for r in &table.rows {
         let _ = writeln!(
             text,
-            "{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{}",
             field(&r.quantity),
             field(&r.symbol),
             field(&r.unit),
@@ -40,7 +41,8 @@ pub fn safety_csv(table: &SafetyTable) -> String {
             number(r.safety),
             r.minimum,
             field(&r.verdict.text()),
-            field(&r.source)
+            field(&r.source),
+            field(&r.assumed.join(" "))
         );
     }
     text

@@ -321,12 +321,46 @@ pub(super) fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingF
         100.0,
     );
     let safety = safety_inputs(ck, r);
+    let assumed = assumed_inputs(ck, r);
     Some(RatingFactors {
         friction_factor: ys? * yg? * yw? * yr?,
         pitting_life_factor: z?,
         pitted_area_max_percent: ap?,
         safety: safety?,
+        assumed_inputs: assumed?,
     })
+}
+
+/// `rating.assumed_inputs`: each a key of the safety table's inputs given in this `[rating]`.
+fn assumed_inputs(ck: &mut Checker, r: &RatingSpec) -> Option<Vec<String>> {
+    let given = |name: &str| match name {
+        "required_life_h" => r.required_life_h.is_some(),
+        "application_factor" => r.application_factor.is_some(),
+        "starts_per_hour" => r.starts_per_hour.is_some(),
+        "root_stress_allowable_mpa" => r.root_stress_allowable_mpa.is_some(),
+        "root_fillet_radius_mm" => r.root_fillet_radius_mm.is_some(),
+        "deflection_limit_um" => r.deflection_limit_um.is_some(),
+        "thickness_loss_limit_mm" => r.thickness_loss_limit_mm.is_some(),
+        "mass_loss_limit_g" => r.mass_loss_limit_g.is_some(),
+        "oil_temperature_limit_c" => r.oil_temperature_limit_c.is_some(),
+        _ => false,
+    };
+    let names = r.assumed_inputs.clone().unwrap_or_default();
+    let mut ok = true;
+    for name in &names {
+        if !given(name) {
+            ok = false;
+            ck.fail(
+                "rating.assumed_inputs",
+                name,
+                "must name a safety-table input given in [rating] (required_life_h, \
+                 application_factor, starts_per_hour, root_stress_allowable_mpa, \
+                 root_fillet_radius_mm, deflection_limit_um, thickness_loss_limit_mm, \
+                 mass_loss_limit_g, oil_temperature_limit_c)",
+            );
+        }
+    }
+    ok.then_some(names)
 }
 
 /// The safety table's inputs of `[rating]` (MODEL §9.1), in SI.
