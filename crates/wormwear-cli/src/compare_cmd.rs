@@ -14,6 +14,18 @@ pub fn compare(dirs: &[PathBuf], output: &Path, quiet: bool) -> Result<(), Failu
     })?;
     let page = write_comparison(&comparison, output).map_err(|e| Failure::Run(e.into()))?;
     if !quiet {
+        let first = &comparison.runs[0].label;
+        for r in &comparison.runs {
+            match &r.differences {
+                Some(d) if d.is_empty() => println!("{}: the inputs of {first}", r.label),
+                Some(d) => println!(
+                    "{}: inputs that differ from {first}: {}",
+                    r.label,
+                    d.join("; ")
+                ),
+                None => {}
+            }
+        }
         let labels: Vec<&str> = comparison.runs.iter().map(|r| r.label.as_str()).collect();
         println!("{:<40} {:<12} {}", "quantity", "unit", labels.join("  "));
         for row in &comparison.rows {

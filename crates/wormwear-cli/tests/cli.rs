@@ -2037,6 +2037,21 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
     let page = std::fs::read_to_string(out.join("compare.html")).unwrap();
     assert_eq!(page.matches("<svg").count(), 2);
     assert!(page.contains("(+50.0 %)"), "the torque's difference");
+    // The one input that differs is named (issue 59), on the page and on stdout.
+    let changed = "conditions.torque.Worm: 60.0 -&gt; 90.0";
+    assert!(
+        page.contains(&format!(
+            "inputs that differ from 60.0nm (SI): <code>{changed}</code></li>"
+        )),
+        "{page}"
+    );
+    let said = String::from_utf8_lossy(&compared.stdout);
+    assert!(
+        said.contains(
+            "90.0nm: inputs that differ from 60.0nm: conditions.torque.Worm: 60.0 -> 90.0\n"
+        ),
+        "{said}"
+    );
     // A directory that is not a run: exit 2, named.
     let not_a_run = bin()
         .arg("compare")

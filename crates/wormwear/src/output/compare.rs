@@ -15,6 +15,10 @@ pub struct ComparedRun {
     pub label: String,
     pub dir: PathBuf,
     pub title: String,
+    /// Its inputs that differ from the first run's, one `path: first -> this` line each (SI,
+    /// the validated gear's names); None for the first run, or where a summary.json does not
+    /// hold the gear (written by an earlier version).
+    pub differences: Option<Vec<String>>,
     /// The life's (cycles, backlash increase um, largest flank loss um), if it ran.
     pub life: Vec<(f64, f64, f64)>,
 }
@@ -216,6 +220,10 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
             },
             dir: dir.clone(),
             title: summary["input"]["title"].as_str().unwrap_or("").to_string(),
+            differences: summaries.first().and_then(|first: &Value| {
+                let (a, b) = (first["input"].get("gear")?, summary["input"].get("gear")?);
+                Some(super::wear::input_changes(a, b))
+            }),
             life: life_of(dir),
         });
         summaries.push(summary);
@@ -386,8 +394,22 @@ fn html(c: &Comparison, charts: &[PathBuf]) -> String {
          </style></head><body><h1>Comparison of runs</h1><ol>",
     );
     for r in &c.runs {
+        let differs = match r.differences.as_ref().map(Vec::is_empty) {
+            None => String::new(),
+            Some(true) => format!("<br>inputs: as {}", escape(&c.runs[0].label)),
+            Some(false) => format!(
+                "<br>inputs that differ from {} (SI): {}",
+                escape(&c.runs[0].label),
+                r.differences
+                    .iter()
+                    .flatten()
+                    .map(|d| format!("<code>{}</code>", escape(d)))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        };
         h.push_str(&format!(
-            "<li><b>{}</b>: {} <small>({})</small></li>",
+            "<li><b>{}</b>: {} <small>({})</small>{differs}</li>",
             escape(&r.label),
             escape(&r.title),
             escape(&r.dir.display().to_string())

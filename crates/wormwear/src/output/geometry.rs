@@ -257,10 +257,21 @@ pub fn summary_values(
     geo: &Geometry,
     input_file: &Path,
 ) -> Result<(serde_json::Value, serde_json::Value), OutputError> {
+    // The validated gear (SI) without its title and warnings: what `compare` sets side by
+    // side to name the inputs that differ between runs.
+    let mut validated = serde_json::to_value(gear).map_err(|e| OutputError::Encode {
+        what: "gear set".into(),
+        message: e.to_string(),
+    })?;
+    if let Some(map) = validated.as_object_mut() {
+        map.remove("title");
+        map.remove("warnings");
+    }
     let input = serde_json::json!({
         "file": input_file.display().to_string(),
         "title": gear.title,
         "program_version": env!("CARGO_PKG_VERSION"),
+        "gear": validated,
     });
     let geometry =
         serde_json::to_value(GeometrySummary::new(gear, geo)).map_err(|e| OutputError::Encode {
