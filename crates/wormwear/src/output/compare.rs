@@ -467,6 +467,9 @@ mod tests {
         assert_eq!(number(0.57211), "0.5721");
         assert_eq!(number(41.63), "41.63");
         assert_eq!(number(2.5e-8), "2.500e-8");
+        // Issue 59: a stiffness read "50693969 N/m"; whole numbers up to a million stay plain.
+        assert_eq!(number(50_693_969.0), "5.069e7");
+        assert_eq!(number(180_000.0), "180000");
         assert_eq!(difference(Some(50.0), Some(60.0)), "10 (+20.0 %)");
         assert_eq!(difference(None, Some(60.0)), "-");
     }

@@ -283,11 +283,11 @@ fn chart_with(
             .y_label_area_size(70)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(plot_err)?;
-        let (dx, dy) = (tick_decimals(x1 - x0), tick_decimals(y1 - y0));
+        let (fx, fy) = (AxisFormat::of(x0, x1), AxisFormat::of(y0, y1));
         chart
             .configure_mesh()
-            .x_label_formatter(&|v| tick_label_with(*v, dx))
-            .y_label_formatter(&|v| tick_label_with(*v, dy))
+            .x_label_formatter(&|v| fx.label(*v))
+            .y_label_formatter(&|v| fy.label(*v))
             .x_desc(x_label)
             .y_desc(y_label)
             .label_style(("sans-serif", 15))
@@ -349,6 +349,43 @@ pub fn tick_decimals(span: f64) -> usize {
         ((-step.log10().floor()) as i64 + 1).clamp(3, 9) as usize
     } else {
         3
+    }
+}
+
+/// How the ticks of one axis are written: all in scientific notation when the axis reaches
+/// beyond [1e-3, 1e5) in magnitude, else all plain with the decimals that tell them apart, so
+/// that one axis never mixes "80000" with "1.00e5".
+#[derive(Debug, Clone, Copy)]
+pub struct AxisFormat {
+    scientific: bool,
+    decimals: usize,
+}
+
+impl AxisFormat {
+    /// The format of an axis from `lo` to `hi`.
+    pub fn of(lo: f64, hi: f64) -> Self {
+        let largest = lo.abs().max(hi.abs());
+        Self {
+            scientific: largest >= 1e5 || (largest > 0.0 && largest < 1e-3),
+            decimals: tick_decimals(hi - lo),
+        }
+    }
+
+    /// The label of the tick at `v`.
+    pub fn label(&self, v: f64) -> String {
+        match (self.scientific, v == 0.0) {
+            (true, true) => "0".into(),
+            (true, false) => format!("{v:.2e}"),
+            (false, _) => {
+                let s = format!("{v:.*}", self.decimals);
+                let s = s.trim_end_matches('0').trim_end_matches('.');
+                if s == "-0" {
+                    "0".into()
+                } else {
+                    s.into()
+                }
+            }
+        }
     }
 }
 
@@ -924,6 +961,18 @@ mod tests {
         unique.dedup();
         assert_eq!(unique.len(), ticks.len(), "{ticks:?}");
         assert_eq!(tick_decimals(1000.0), 3);
+    }
+
+    #[test]
+    fn one_axis_writes_all_its_ticks_alike() {
+        // Issue 59: an axis over cycles read "80000" beside "1.00e5".
+        let f = AxisFormat::of(0.0, 180_000.0);
+        assert_eq!(f.label(80_000.0), "8.00e4");
+        assert_eq!(f.label(100_000.0), "1.00e5");
+        assert_eq!(f.label(0.0), "0");
+        let g = AxisFormat::of(0.0, 90.0);
+        assert_eq!(g.label(80.0), "80");
+        assert_eq!(g.label(12.5), "12.5");
     }
 
     #[test]

@@ -107,10 +107,11 @@ fn life_charts(
         (
             "wear_efficiency.svg",
             "Efficiency over life, from the contact's friction (MODEL §13)".to_string(),
-            "efficiency (%)",
+            // A fraction, as the tables and summary.json give it.
+            "efficiency (output / input power)",
             vec![
-                curve(&|r| 100.0 * r.friction.mesh_efficiency, "mesh", 0),
-                curve(&|r| 100.0 * r.friction.total_efficiency, "total", 1),
+                curve(&|r| r.friction.mesh_efficiency, "mesh", 0),
+                curve(&|r| r.friction.total_efficiency, "total", 1),
             ],
         ),
         (
