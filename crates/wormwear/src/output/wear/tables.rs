@@ -25,8 +25,7 @@ pub(super) fn write_tables(
     position_table(tca, &state.records).write(&path)?;
     files.push(path);
     update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
-    let (limit, _) =
-        crate::wear::WearLimits::backlash_limit(gear, &crate::rating::rate(gear), plan);
+    let limit = crate::wear::WearLimits::backlash_limit(gear, &crate::rating::rate(gear), plan);
     let charts = life_charts(&state.records, limit);
     for (name, title, y, series) in charts {
         let path = dir.join(name);
@@ -51,7 +50,7 @@ fn te_title(records: &[crate::wear::StepRecord]) -> String {
 /// transmission error, pressure, efficiency and oil temperature charts.
 fn life_charts(
     records: &[crate::wear::StepRecord],
-    backlash_limit: f64,
+    backlash_limit: (f64, f64),
 ) -> [(&'static str, String, &'static str, Vec<Series>); 6] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
@@ -273,11 +272,13 @@ pub fn summary_value(
 /// over it in orange (no wear: flat).
 /// The backlash curves with the life's backlash limit as a line across the
 /// cycles, when the curve reaches a quarter of it (else the limit would flatten the curve; the
-/// legend then gives it in words).
+/// legend then gives it in words). `(limit, per)`: the tangential backlash limit, m, and the
+/// normal flank loss per unit of it ([`crate::wear::WearLimits::backlash_limit`]), so that the
+/// legend also gives it as the flank loss the safety table reads.
 fn with_limit_line(
     mut series: Vec<Series>,
     records: &[crate::wear::StepRecord],
-    limit: f64,
+    (limit, per): (f64, f64),
 ) -> Vec<Series> {
     let (Some(first), Some(last)) = (records.first(), records.last()) else {
         return series;
@@ -286,7 +287,11 @@ fn with_limit_line(
         .iter()
         .map(|r| r.backlash_increase_m)
         .fold(0.0, f64::max);
-    let label = format!("backlash limit {:.0} um", limit * UM);
+    let label = format!(
+        "backlash limit {:.0} um (tangential; {:.0} um of normal flank loss)",
+        limit * UM,
+        limit * per * UM
+    );
     if reached >= 0.25 * limit {
         series.push(Series {
             label,
