@@ -285,6 +285,12 @@ fn ltca_writes_its_section_plots_and_tables() {
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
     assert!(summary["tca"]["kinematic_error_p2p_rad"].is_number());
+    // The stiffness chart's axis spans its ripple alone: the title gives the ripple (issue 59).
+    let chart = std::fs::read_to_string(out_dir.join("ltca_mesh_stiffness.svg")).unwrap();
+    assert!(
+        chart.contains("MN m/rad, ripple +/-"),
+        "no ripple in the title"
+    );
     // A position the file does not analyse is an input error, not a silent clamp.
     let positions = summary["ltca"]["solver_residuals"]
         .as_array()

@@ -407,6 +407,26 @@ fn transmission_error_chart(tca: &Tca, ltca: &Ltca, dir: &Path) -> Result<PathBu
     Ok(path)
 }
 
+/// The stiffness chart's title with its ripple, since the axis spans the ripple alone and
+/// magnifies it (issue 59: a 1 % ripple filled the chart without a word).
+fn stiffness_title(ltca: &Ltca) -> String {
+    let k: Vec<f64> = ltca.positions.iter().map(|p| p.stiffness_angular).collect();
+    let (lo, hi) = k
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let mean = k.iter().sum::<f64>() / k.len().max(1) as f64;
+    match mean > 0.0 && hi.is_finite() && lo.is_finite() {
+        true => format!(
+            "Mesh stiffness C2 / approach (mean {:.4} MN m/rad, ripple +/-{:.2} %)",
+            mean / 1e6,
+            50.0 * (hi - lo) / mean
+        ),
+        false => "Mesh stiffness C2 / approach".to_string(),
+    }
+}
+
 /// The angular mesh stiffness over the positions (MN m/rad).
 fn stiffness_chart(ltca: &Ltca, dir: &Path) -> Result<PathBuf, OutputError> {
     let np = ltca.positions.len();
@@ -422,7 +442,7 @@ fn stiffness_chart(ltca: &Ltca, dir: &Path) -> Result<PathBuf, OutputError> {
     let path = dir.join("ltca_mesh_stiffness.svg");
     line_chart(
         &path,
-        "Mesh stiffness C2 / approach",
+        &stiffness_title(ltca),
         "wheel rotation (tooth pitches from position 0)",
         "angular stiffness (MN m/rad)",
         &[k],
