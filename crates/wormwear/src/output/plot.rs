@@ -277,7 +277,7 @@ fn chart_with(
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
+            .caption(title, ("sans-serif", caption_size(title, width, 22)))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)
@@ -350,6 +350,15 @@ pub fn tick_decimals(span: f64) -> usize {
     } else {
         3
     }
+}
+
+/// A caption's font size, px: `size`, or smaller for a title that would not fit in `width` px
+/// (a sans-serif character is about half its size wide), at least 12 (issue 59: the worn
+/// friction map's title was cut at both ends).
+pub fn caption_size(title: &str, width: u32, size: u32) -> u32 {
+    let chars = title.chars().count().max(1) as f64;
+    let fits = (f64::from(width) - 24.0) / (0.52 * chars);
+    (fits.floor().max(0.0) as u32).clamp(12, size)
 }
 
 /// How the ticks of one axis are written: all in scientific notation when the axis reaches
@@ -568,7 +577,7 @@ pub fn flank_map(
         root.fill(&WHITE).map_err(plot_err)?;
         let (main, bar) = root.split_horizontally(width - 150);
         let mut chart = ChartBuilder::on(&main)
-            .caption(title, ("sans-serif", 21))
+            .caption(title, ("sans-serif", caption_size(title, width - 150, 21)))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)
@@ -961,6 +970,16 @@ mod tests {
         unique.dedup();
         assert_eq!(unique.len(), ticks.len(), "{ticks:?}");
         assert_eq!(tick_decimals(1000.0), 3);
+    }
+
+    #[test]
+    fn a_long_caption_gets_a_smaller_font_that_fits() {
+        assert_eq!(caption_size("Backlash increase", 900, 22), 22);
+        let long = "Local friction coefficient over the cycle at 180 000 cycles (load-weighted; \
+                    mean 0.0226, oil 59.9 C); grey: no contact";
+        let size = caption_size(long, 950, 21);
+        assert!(size < 21 && size >= 12, "{size}");
+        assert!(0.52 * f64::from(size) * long.chars().count() as f64 <= 950.0 - 24.0);
     }
 
     #[test]
