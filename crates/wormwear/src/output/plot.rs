@@ -978,7 +978,7 @@ mod tests {
         let long = "Local friction coefficient over the cycle at 180 000 cycles (load-weighted; \
                     mean 0.0226, oil 59.9 C); grey: no contact";
         let size = caption_size(long, 950, 21);
-        assert!(size < 21 && size >= 12, "{size}");
+        assert!((12..21).contains(&size), "{size}");
         assert!(0.52 * f64::from(size) * long.chars().count() as f64 <= 950.0 - 24.0);
     }
 
