@@ -1985,6 +1985,20 @@ fn init_writes_a_file_that_checks_and_runs_for_every_profile() {
     assert!(String::from_utf8_lossy(&to_dir.stderr).contains("is a directory"));
 }
 
+/// `wormwear compare RUNS -o OUT`, which must succeed: its output and compare.csv.
+fn compare_into(runs: &[PathBuf], out: &Path) -> (std::process::Output, String) {
+    let compared = bin()
+        .arg("compare")
+        .args(runs)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(compared.status.success(), "{compared:?}");
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    (compared, csv)
+}
+
 #[test]
 fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
     let dir = tempfile::tempdir().unwrap();
@@ -2010,15 +2024,7 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
         runs.push(out_dir);
     }
     let out = dir.path().join("compare");
-    let compared = bin()
-        .arg("compare")
-        .args(&runs)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(compared.status.success(), "{compared:?}");
-    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let (compared, csv) = compare_into(&runs, &out);
     let torque = csv.lines().find(|l| l.starts_with("Worm torque,")).unwrap();
     let values: Vec<f64> = torque
         .split(',')
@@ -2079,16 +2085,7 @@ fn compare_puts_two_design_runs_at_different_torques_side_by_side() {
     for (run, named) in runs.iter().zip(&formulas) {
         std::fs::rename(run, named).unwrap();
     }
-    let out = dir.path().join("compare-formulas");
-    let compared = bin()
-        .arg("compare")
-        .args(&formulas)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(compared.status.success(), "{compared:?}");
-    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let (_, csv) = compare_into(&formulas, &dir.path().join("compare-formulas"));
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,

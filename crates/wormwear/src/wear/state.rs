@@ -64,17 +64,32 @@ impl WearState {
     /// Unworn start.
     pub fn new(wf: &WheelFlank) -> Self {
         Self {
-            step: 0,
-            cycles: 0.0,
-            removal: FlankField::zeros(wf),
-            plastic_set: FlankField::zeros(wf),
+            damage: vec![0.0; wf.nodes.len()],
+            ..Self::flank_at(0, 0.0, FlankField::zeros(wf), FlankField::zeros(wf))
+        }
+    }
+
+    /// A state that holds only its worn flank (`removal` and `plastic_set`, m) after `step`
+    /// steps and `cycles` wheel cycles: no records, pits, damage or warm start (what the worn
+    /// wheel of a map state is built from).
+    pub fn flank_at(
+        step: usize,
+        cycles: f64,
+        removal: FlankField,
+        plastic_set: FlankField,
+    ) -> Self {
+        Self {
+            step,
+            cycles,
+            removal,
+            plastic_set,
             records: Vec::new(),
             pitted_phases: Vec::new(),
             pitted: Vec::new(),
             band_factor: None,
             warm: None,
             stopped: None,
-            damage: vec![0.0; wf.nodes.len()],
+            damage: Vec::new(),
             found_phases: Vec::new(),
         }
     }

@@ -356,18 +356,10 @@ pub fn resumed_map_state(
             changes[0]
         )));
     }
-    Ok(Some(WearState {
-        step: flank.step,
-        cycles: flank.cycles,
-        removal: flank.removal,
-        plastic_set: flank.plastic_set,
-        records: Vec::new(),
-        pitted_phases: Vec::new(),
-        pitted: Vec::new(),
-        band_factor: None,
-        warm: None,
-        stopped: None,
-        damage: Vec::new(),
-        found_phases: Vec::new(),
-    }))
+    Ok(Some(WearState::flank_at(
+        flank.step,
+        flank.cycles,
+        flank.removal,
+        flank.plastic_set,
+    )))
 }
