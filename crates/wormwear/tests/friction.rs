@@ -5,7 +5,7 @@
 mod common;
 
 use wormwear::friction::{heat_balance, MeshContacts};
-use wormwear::geometry::Geometry;
+use wormwear::geometry::{Geometry, WheelFlank};
 use wormwear::input::{self, BendingKind, FrictionLaw, GearSet};
 use wormwear::kinematics::{self, material_velocities};
 use wormwear::ltca;
@@ -14,6 +14,16 @@ fn design() -> GearSet {
     let mut g = common::example("gear-1x40-design.toml");
     g.bending.kind = BendingKind::None;
     g
+}
+
+/// The friction power density gathered on the flank's grid, integrated over it, W.
+fn on_flank(friction: &wormwear::friction::MeshFriction, wf: &WheelFlank) -> f64 {
+    friction
+        .flank_power_density
+        .iter()
+        .zip(&wf.cell_area)
+        .map(|(d, a)| d * a)
+        .sum()
 }
 
 #[test]
@@ -60,12 +70,7 @@ fn the_friction_loss_is_the_power_of_its_moments_about_the_worm_and_wheel_axes()
     assert!(friction.mesh_loss_w > 0.0);
     // Gathered on the flank's grid, the power density integrates to the mesh loss.
     let wf = geo.wheel_flank(tca.loaded_flank);
-    let on_flank: f64 = friction
-        .flank_power_density
-        .iter()
-        .zip(&wf.cell_area)
-        .map(|(d, a)| d * a)
-        .sum();
+    let on_flank = on_flank(&friction, wf);
     assert!(
         (on_flank / friction.mesh_loss_w - 1.0).abs() < 1e-12,
         "{on_flank} W on the flank"
@@ -159,12 +164,7 @@ fn a_life_with_the_heat_balance_holds_it_at_every_state_and_the_film_follows_the
             let r = view.state.records.last().unwrap();
             assert_eq!(f.mesh_loss_w, r.friction.mesh_loss_w);
             assert_eq!(view.thermal.oil_temperature_k, r.friction.oil_temperature_k);
-            let on_flank: f64 = f
-                .flank_power_density
-                .iter()
-                .zip(&wf.cell_area)
-                .map(|(d, a)| d * a)
-                .sum();
+            let on_flank = on_flank(f, wf);
             assert!((on_flank / f.mesh_loss_w - 1.0).abs() < 1e-12);
             views += 1;
             Ok(())
@@ -260,4 +260,62 @@ fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
             );
         }
     }
+}
+
+/// NaN cells of a flank field inside its finite extent on each face column (k = j ni + i).
+fn interior_holes(field: &[f64], ni: usize) -> usize {
+    field
+        .chunks(ni)
+        .map(|column| {
+            let loaded: Vec<usize> = (0..ni).filter(|&i| column[i].is_finite()).collect();
+            match (loaded.first(), loaded.last()) {
+                (Some(&a), Some(&b)) => (a..=b).filter(|&i| !column[i].is_finite()).count(),
+                _ => 0,
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn the_friction_maps_have_no_holes_between_positions_and_follow_the_passage() {
+    // The friction maps gather the positions' loaded cells on the flank's grid. At their
+    // centres alone, a grid finer than the band's travel between positions showed rows of
+    // "no contact" inside the loaded flank (the worn design gear at 180 000 cycles, issue 59;
+    // here the unworn one on a fine grid). Each cell now stands for the strip the band
+    // sweeps to the instants before and after it (MODEL §5.6's passage): no holes, the map
+    // still integrates to the mesh loss, and it hardly moves when the positions double.
+    let mut results = Vec::new();
+    for (height, face, positions) in [(80, 120, 20), (80, 120, 40)] {
+        let mut g = design();
+        g.analysis.flank_cells_height = height;
+        g.analysis.flank_cells_face = face;
+        g.analysis.positions = positions;
+        let geo = Geometry::build(&g).unwrap();
+        let tca = kinematics::analyse(&g, &geo).unwrap();
+        let l = ltca::analyse(&g, &geo, &tca).unwrap();
+        let friction = MeshContacts::new(&g, &geo, &tca, &l).friction(&g.lubricant, &g.friction);
+        let holes = interior_holes(&friction.flank_coefficient, height);
+        let wf = geo.wheel_flank(tca.loaded_flank);
+        let on_flank = on_flank(&friction, wf);
+        eprintln!(
+            "{height} x {face} cells, {positions} positions: {holes} holes, mesh loss {:.1} W",
+            friction.mesh_loss_w
+        );
+        assert_eq!(holes, 0);
+        assert!((on_flank / friction.mesh_loss_w - 1.0).abs() < 1e-12);
+        results.push((friction.flank_power_density, friction.mesh_loss_w));
+    }
+    // The power density's change from 20 to 40 positions, as a share of the map (L1).
+    let (a, b) = (&results[0], &results[1]);
+    let change: f64 =
+        a.0.iter()
+            .zip(&b.0)
+            .map(|(x, y)| (x - y).abs())
+            .sum::<f64>()
+            / a.0.iter().map(|x| x.abs()).sum::<f64>();
+    eprintln!(
+        "power density map: {:.1} % L1 change from 20 to 40 positions",
+        100.0 * change
+    );
+    assert!(change < 0.1, "{change}");
 }

@@ -19,6 +19,9 @@ use crate::ltca::{cell_sliding, FilmGeometry, FrictionInputs, Ltca};
 use crate::lubrication::LineContact;
 pub use crate::traction::LocalFriction;
 
+mod flank;
+use flank::FlankGrid;
+
 /// Errors of the heat balance; each names the input that decides it.
 #[derive(Debug, thiserror::Error)]
 pub enum FrictionError {
@@ -66,8 +69,9 @@ struct CellContact {
     area: f64,
     /// Index of the cell's slice in [`MeshContacts::lines`].
     line: usize,
-    /// The loaded flank's grid cells under the local cell, with their shares of it.
-    flank_cells: [(usize, f64); 3],
+    /// The loaded flank's grid cells under the strip the local cell stands for over the
+    /// cycle, with their shares of it: a range of [`MeshContacts::flank_shares`].
+    flank_cells: (usize, usize),
 }
 
 /// The loaded cells of a loaded analysis with their sliding speeds and line contacts
@@ -77,6 +81,8 @@ pub struct MeshContacts {
     cells: Vec<CellContact>,
     /// Areas of the loaded flank's grid cells, m^2.
     flank_areas: Vec<f64>,
+    /// (grid cell, share) of every cell's strip, in the order of [`Self::cells`].
+    flank_shares: Vec<(usize, f64)>,
     /// The line contact of each loaded slice: relative radius, rolling velocities, line load
     /// (the sum of p times the width across the line over the slice's cells), peak pressure.
     lines: Vec<LineContact>,
@@ -86,56 +92,6 @@ pub struct MeshContacts {
     flow_pressure: f64,
     /// Output power P2 = omega2 x mean transmitted wheel torque of the positions, W.
     pub output_power: f64,
-}
-
-/// The node columns of a flank grid: their z and radial limits (m), and the cell rows.
-struct FlankGrid<'a> {
-    z: &'a [f64],
-    r_low: &'a [f64],
-    r_high: &'a [f64],
-    rows: usize,
-}
-
-impl<'a> FlankGrid<'a> {
-    fn of(wf: &'a crate::geometry::WheelFlank) -> Self {
-        Self {
-            z: &wf.z,
-            r_low: &wf.r_low,
-            r_high: &wf.r_high,
-            rows: wf.cells_height,
-        }
-    }
-}
-
-/// The grid cells of the wheel flank `wf` under a local cell at (r, z) that spans
-/// z +- `half_dz` (m), with the share of that strip each takes: the cell columns the strip
-/// overlaps (a slice on a node column is half in the column on each side), in the row of r
-/// between the column's interpolated radial limits (clamped to the grid). Unused entries have
-/// share 0.
-fn flank_cells_at(wf: &FlankGrid, (r, z): (f64, f64), half_dz: f64) -> [(usize, f64); 3] {
-    let (ni, nj) = (wf.rows, wf.z.len() - 1);
-    let (z0, z1) = (wf.z[0], wf.z[nj]);
-    let column = |z: f64| ((z - z0) / (z1 - z0) * nj as f64).clamp(0.0, nj as f64);
-    let (a, b) = (column(z - half_dz), column(z + half_dz));
-    let row = |j: usize| {
-        let w = (column(z) - j as f64).clamp(0.0, 1.0);
-        let lo = wf.r_low[j] + w * (wf.r_low[j + 1] - wf.r_low[j]);
-        let hi = wf.r_high[j] + w * (wf.r_high[j + 1] - wf.r_high[j]);
-        let u = ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64 - 1e-9);
-        j * ni + (u.floor() as usize).min(ni - 1)
-    };
-    let mut out = [(0, 0.0); 3];
-    if b - a <= 0.0 {
-        let j = (a.floor() as usize).min(nj - 1);
-        out[0] = (row(j), 1.0);
-        return out;
-    }
-    let first = (a.floor() as usize).min(nj - 1);
-    for (slot, j) in (first..nj).take(3).enumerate() {
-        let overlap = (b.min(j as f64 + 1.0) - a.max(j as f64)).max(0.0);
-        out[slot] = (row(j), overlap / (b - a));
-    }
-    out
 }
 
 /// Friction over the mesh cycle (MODEL §13).
@@ -170,7 +126,8 @@ impl MeshContacts {
         let wf = geo.wheel_flank(tca.loaded_flank);
         let film = FilmGeometry::new(tca, wf);
         let grid = FlankGrid::of(wf);
-        let (mut cells, mut lines) = (Vec::new(), Vec::new());
+        let strips = flank::swept_strips(tca, ltca, 2.0 * std::f64::consts::PI / geo.teeth as f64);
+        let (mut cells, mut lines, mut flank_shares) = (Vec::new(), Vec::new(), Vec::new());
         for (n, pr) in ltca.positions.iter().enumerate() {
             let (slices, of_cell) = film.slice_lines(pr.position, &pr.cells, &pr.pressure);
             let sliding = cell_sliding(gear, geo, &pr.cells);
@@ -178,8 +135,10 @@ impl MeshContacts {
             lines.extend(slices);
             for k in (0..pr.cells.len()).filter(|&k| pr.pressure[k] > 0.0) {
                 let c = &pr.cells[k];
+                let start = flank_shares.len();
+                grid.cells_under(strips[n][k], c.z, c.half_dz, &mut flank_shares);
                 cells.push(CellContact {
-                    flank_cells: flank_cells_at(&grid, (c.r, c.z), c.half_dz),
+                    flank_cells: (start, flank_shares.len()),
                     position: n,
                     cell: k,
                     pressure: pr.pressure[k],
@@ -196,6 +155,7 @@ impl MeshContacts {
         Self {
             cells,
             flank_areas: wf.cell_area.clone(),
+            flank_shares,
             lines,
             positions: ltca.positions.len(),
             e_prime: inputs.e_prime,
@@ -266,13 +226,14 @@ impl MeshContacts {
     }
 
     /// The friction of the loaded cells `friction` ((position, cell, mu, density) in the
-    /// order of [`Self::cells`]) gathered on the flank's grid cells: the load-weighted mu and
-    /// the power density, sum of density x local area / (positions x grid cell area).
+    /// order of [`Self::cells`]) gathered on the flank's grid cells under the strips they
+    /// sweep over the cycle ([`flank::swept_strips`]): the load-weighted mu and the power
+    /// density, sum of density x local area / (positions x grid cell area).
     fn flank_fields(&self, friction: &[(usize, usize, f64, f64)]) -> (Vec<f64>, Vec<f64>) {
         let n = self.flank_areas.len();
         let (mut mu_load, mut load, mut power) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for (c, &(_, _, mu, density)) in self.cells.iter().zip(friction) {
-            for &(g, share) in &c.flank_cells {
+            for &(g, share) in &self.flank_shares[c.flank_cells.0..c.flank_cells.1] {
                 let force = c.pressure * c.area * share;
                 mu_load[g] += mu * force;
                 load[g] += force;
@@ -581,9 +542,10 @@ mod tests {
                 sliding_speed: 4.0,
                 area: 1e-6,
                 line: 0,
-                flank_cells: [(0, 1.0), (0, 0.0), (0, 0.0)],
+                flank_cells: (0, 1),
             }],
             flank_areas: vec![1e-6],
+            flank_shares: vec![(0, 1.0)],
             lines: vec![LineContact {
                 radius: 0.02,
                 u1: 2.0,
@@ -669,29 +631,5 @@ mod tests {
         )
         .unwrap();
         assert_eq!((fixed.oil_temperature_k, fixed.mode), (333.0, "fixed"));
-    }
-
-    #[test]
-    fn a_local_cell_is_shared_among_the_grid_columns_it_overlaps() {
-        // A flat flank grid: 4 columns over z in [-2, 2] mm, radii 0..10 mm in 5 rows.
-        let z = [-2e-3, -1e-3, 0.0, 1e-3, 2e-3];
-        let (r_low, r_high) = ([0.0; 5], [10e-3; 5]);
-        let wf = FlankGrid {
-            z: &z,
-            r_low: &r_low,
-            r_high: &r_high,
-            rows: 5,
-        };
-        // A strip on the node column z = 0 (half 0.5 mm): half in column 1, half in column 2.
-        let shares = flank_cells_at(&wf, (5e-3, 0.0), 0.5e-3);
-        let total: f64 = shares.iter().map(|s| s.1).sum();
-        assert!((total - 1.0).abs() < 1e-12, "{shares:?}");
-        assert_eq!((shares[0].0, shares[1].0), (5 + 2, 2 * 5 + 2));
-        assert!((shares[0].1 - 0.5).abs() < 1e-12 && (shares[1].1 - 0.5).abs() < 1e-12);
-        // Inside one column, all of it there; past the face end, clamped to the last column.
-        let inside = flank_cells_at(&wf, (1e-3, -1.5e-3), 0.2e-3);
-        assert_eq!(inside[0], (0, 1.0));
-        let beyond = flank_cells_at(&wf, (9.9e-3, 2e-3), 0.5e-3);
-        assert_eq!(beyond[0], (3 * 5 + 4, 1.0));
     }
 }
