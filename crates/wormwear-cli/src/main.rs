@@ -454,14 +454,17 @@ fn build_geometry(gear: &GearSet, file: &Path) -> Result<Geometry, Failure> {
 
 /// `check`: the file validated, its geometry built and the checks `run` makes before any work
 /// passed ([`wormwear::Request::check`]: a load the loaded analysis holds, a life that can
-/// end); the derived data printed (nothing but the warnings, on stderr, when quiet).
+/// end; [`wormwear::Request::check_geometry`]: a load the flanks can carry); the derived data printed (nothing but the warnings, on stderr, when quiet).
 fn check(file: &Path, json: bool, quiet: bool) -> Result<(), Failure> {
     let gear = load(file)?;
     let geo = build_geometry(&gear, file)?;
     let request = planned_request(Path::new("."), &gear, &LifeArgs::default(), RUN_STAGES)?;
-    request.check(&gear).map_err(|e| {
-        Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display())))
-    })?;
+    request
+        .check(&gear)
+        .and_then(|()| request.check_geometry(&gear, &geo))
+        .map_err(|e| {
+            Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display())))
+        })?;
     let summary = GeometrySummary::new(&gear, &geo);
     if quiet {
         for w in &summary.warnings {

@@ -68,6 +68,54 @@ fn check_accepts_every_example() {
     }
 }
 
+/// `wormwear check FILE`'s stderr, asserting that it refused the file (exit 2).
+fn check_refused(file: &Path) -> String {
+    let out = bin().arg("check").arg(file).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    err
+}
+
+#[test]
+fn a_face_width_typed_in_metres_is_refused_by_check_and_run_naming_it() {
+    // Issue 59: face_width_mm = 0.045 (45 mm typed in metres) passed `check`; `run` then
+    // said "the flow pressure lets the reachable cells carry only 1.2788240022852594e2 of the
+    // load 2.4e3". No flank of that size carries the load at the flow pressure: refused
+    // before any analysis, by both, naming the face width.
+    let dir = tempfile::tempdir().unwrap();
+    let thin = edited_design(
+        dir.path(),
+        "thin.toml",
+        &[
+            ("face_width_mm = 45.0", "face_width_mm = 0.045"),
+            ("section_offsets_mm = [-11.25, 0.0, 11.25]", ""),
+            ("web_thickness_mm = 15.0", ""),
+        ],
+    );
+    let err = check_refused(&thin);
+    for part in ["wheel.face_width_mm = 0.045", "far too small", "N in all"] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    let out = into("ltca", &thin, &dir.path().join("out"), &["-q"])
+        .output()
+        .unwrap();
+    let run_err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{run_err}");
+    assert!(run_err.contains("wheel.face_width_mm = 0.045"), "{run_err}");
+    assert!(!dir.path().join("out").join("summary.json").exists());
+    // The design gear itself passes.
+    let out = bin()
+        .arg("check")
+        .arg(example("gear-1x40-design.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 #[test]
 fn check_refuses_what_run_refuses_and_is_silent_when_quiet() {
     // Issue 59: 60 000 N m on the worm passed `check`; only `run` refused it. `-q check`
@@ -78,9 +126,7 @@ fn check_refuses_what_run_refuses_and_is_silent_when_quiet() {
         "heavy.toml",
         &[("worm_torque_nm = 60.0", "worm_torque_nm = 60000.0")],
     );
-    let out = bin().arg("check").arg(&heavy).output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let err = check_refused(&heavy);
     assert!(err.contains("conditions.worm_torque_nm = 60000"), "{err}");
     let hot = edited_design(
         dir.path(),

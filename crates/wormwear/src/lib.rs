@@ -58,8 +58,9 @@ pub fn run(
     on_event: &mut dyn FnMut(Event) -> Result<(), RunError>,
 ) -> Result<Results, RunError> {
     request.check(gear)?;
-    let mut pipeline = runner::Pipeline::new(gear, source, request, on_event);
     let geometry = geometry::Geometry::build(gear).map_err(RunError::Geometry)?;
+    request.check_geometry(gear, &geometry)?;
+    let mut pipeline = runner::Pipeline::new(gear, source, request, on_event);
     let tca = pipeline.unloaded_analysis(&geometry)?;
     let bending = pipeline.bending_model(&geometry)?;
     let ltca = pipeline.loaded_analysis(&geometry, tca.as_ref(), &bending)?;

@@ -135,7 +135,7 @@ pub const OVERLOAD_REFUSAL: f64 = 5.0;
 pub const OVERLOAD_TAG: &str = "overload:";
 
 /// The input field of the gear's torque.
-fn torque_field(gear: &GearSet) -> (&'static str, f64) {
+pub(crate) fn torque_field(gear: &GearSet) -> (&'static str, f64) {
     match gear.conditions.torque {
         Torque::Worm(t) => ("conditions.worm_torque_nm", t),
         Torque::Wheel(t) => ("conditions.wheel_torque_nm", t),

@@ -167,6 +167,15 @@ impl Request {
         }
     }
 
+    /// Checks the request against the gear's geometry, once built: for the loaded stages, a
+    /// load the flanks can carry ([`crate::ltca::flank_capacity_problem`]).
+    pub fn check_geometry(&self, gear: &GearSet, geo: &Geometry) -> Result<(), RunError> {
+        match crate::ltca::flank_capacity_problem(gear, geo) {
+            Some(problem) if self.needs_bending() => Err(RunError::Request(problem)),
+            _ => Ok(()),
+        }
+    }
+
     /// Whether the unloaded analysis is needed.
     pub(crate) fn needs_tca(&self) -> bool {
         self.has(Stage::Tca) || self.needs_bending()

@@ -408,6 +408,49 @@ pub fn shaft_torsion_problem(compliance: f64, wheel_torque: f64, teeth: u32) -> 
     })
 }
 
+/// A load no flank of the gear can carry (None: it can; MODEL §5.7): each studied tooth's
+/// active flank carries at most the flow pressure over its area, while the wheel torque T2
+/// needs a normal load of at least T2 / r_a on the flanks (no contact force has a longer lever
+/// about the wheel axis than the blank's outer radius r_a). A face width typed in metres (0.045
+/// for 45 mm) fails it; the solver refused such a gear only at its first position, in terms of
+/// its cells. None for the purely elastic contact (no flow pressure).
+pub fn flank_capacity_problem(gear: &GearSet, geo: &Geometry) -> Option<String> {
+    use crate::geometry::Flank;
+    use crate::input::Number;
+    let settings = LtcaSettings::from_gear(gear);
+    if !settings.flow_pressure.is_finite() {
+        return None;
+    }
+    let (_, wheel_torque) = torque_targets(gear, &settings);
+    let needed = wheel_torque.abs() / gear.wheel.outer_radius;
+    let teeth = 2 * gear.analysis.teeth_each_side + 1;
+    let area = [Flank::Left, Flank::Right]
+        .map(|f| geo.wheel_flank(f).active_area())
+        .into_iter()
+        .fold(0.0, f64::max);
+    let capacity = settings.flow_pressure * area * teeth as f64;
+    let (field, torque) = crate::rating::torque_field(gear);
+    (needed > capacity).then(|| {
+        format!(
+            "{field} = {}: the wheel torque (about {:.0} N m) needs a normal load of at least \
+             {:.0} N on the wheel's flanks (T2 over the blank's outer radius, \
+             wheel.outer_radius_mm = {}), more than the {teeth} teeth the analysis studies can \
+             carry at the flow pressure ({} MPa) on their active flanks of {:.4} mm^2 each \
+             ({:.0} N in all): the flank is far too small for the load; check wheel.face_width_mm = {} \
+             (millimetres) and the blank's radii, or lower the torque, or raise the flow \
+             pressure (analysis.flow_pressure_mpa, by default materials.wheel.hardness_gpa)",
+            Number(torque),
+            wheel_torque.abs(),
+            needed,
+            Number(gear.wheel.outer_radius * 1e3),
+            Number(settings.flow_pressure * 1e-6),
+            area * 1e6,
+            capacity,
+            Number(gear.wheel.face_width * 1e3),
+        )
+    })
+}
+
 /// Runs the loaded analysis with the gear's settings, without bending.
 pub fn analyse(gear: &GearSet, geo: &Geometry, tca: &Tca) -> Result<Ltca, LtcaError> {
     analyse_with(gear, geo, tca, &LtcaSettings::from_gear(gear), None)

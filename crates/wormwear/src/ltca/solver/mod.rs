@@ -326,10 +326,11 @@ fn check_capacity(problem: &Problem, cap: &[f64]) -> Result<(), SolverError> {
         .sum();
     if capacity <= problem.load {
         return Err(SolverError::Invalid(format!(
-            "the flow pressure lets the reachable cells carry only {capacity:e} of the load {:e}: \
-             raise the flow pressure (analysis.flow_pressure_mpa, by default the wheel's \
+            "the flow pressure lets the reachable cells carry only {:.1} N m of the wheel torque \
+             {:.1} N m (the flow pressure x area x lever of every cell that can touch): raise the \
+             flow pressure (analysis.flow_pressure_mpa, by default the wheel's \
              materials.wheel.hardness_gpa) or lower the torque (conditions)",
-            problem.load
+            capacity, problem.load
         )));
     }
     Ok(())
