@@ -361,6 +361,23 @@ pub fn caption_size(title: &str, width: u32, size: u32) -> u32 {
     (fits.floor().max(0.0) as u32).clamp(12, size)
 }
 
+/// `text` in lines of at most `width` pixels at a `size` px font (about 0.52 size a
+/// character), broken between words; a word longer than a line stands alone.
+pub fn wrapped(text: &str, width: u32, size: u32) -> Vec<String> {
+    let chars = ((f64::from(width) / (0.52 * f64::from(size))).floor() as usize).max(1);
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split_whitespace() {
+        match lines.last_mut() {
+            Some(line) if line.chars().count() + 1 + word.chars().count() <= chars => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
 /// How the ticks of one axis are written: all in scientific notation when the axis reaches
 /// beyond [1e-3, 1e5) in magnitude, else all plain with the decimals that tell them apart, so
 /// that one axis never mixes "80000" with "1.00e5".
@@ -742,13 +759,25 @@ fn colour_bar<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    // The label over the bar, wrapped to the bar's width (one line cut "friction power
+    // (MW/m^2)" at both ends).
+    let width = bar.dim_in_pixel().0;
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let style =
+        TextStyle::from(("sans-serif", 15).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    for (k, line) in wrapped(bar_label, width.saturating_sub(10), 15)
+        .iter()
+        .enumerate()
+    {
+        bar.draw_text(line, &style, (width as i32 / 2, 10 + 18 * k as i32))
+            .map_err(plot_err)?;
+    }
     let mut bar_chart = ChartBuilder::on(bar)
         .margin_top(60)
         .margin_bottom(70)
         .margin_right(70)
         .y_label_area_size(0)
         .right_y_label_area_size(60)
-        .caption(bar_label, ("sans-serif", 15))
         .build_cartesian_2d(0.0..1.0, lo..lo + span)
         .map_err(plot_err)?;
     bar_chart
@@ -787,6 +816,21 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_colour_bar_label_is_wrapped_to_the_bar_between_words() {
+        // 140 px at 15 px: 17 characters a line.
+        assert_eq!(
+            wrapped("friction power (MW/m^2)", 140, 15),
+            vec!["friction power", "(MW/m^2)"]
+        );
+        assert_eq!(wrapped("wear (um)", 140, 15), vec!["wear (um)"]);
+        // A word longer than a line stands alone, whole.
+        assert_eq!(
+            wrapped("a verylongwordthatdoesnotfit b", 60, 15),
+            vec!["a", "verylongwordthatdoesnotfit", "b"]
+        );
+    }
 
     #[test]
     fn a_flank_map_draws_each_cell_once_in_one_path_per_colour() {
