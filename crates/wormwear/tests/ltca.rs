@@ -349,3 +349,59 @@ fn the_loaded_pattern_has_no_holes_and_its_area_and_mean_converge() {
         assert!(change(pair[0].1, pair[1].1) < 0.05, "P_mean {results:?}");
     }
 }
+
+#[test]
+fn the_te_orders_are_the_sampled_te_s_and_do_not_depend_on_the_positions() {
+    // MODEL §16: amplitudes of the mesh orders of the loaded TE and of the unloaded KE. On a
+    // mesh with a 0.2 mm worm offset (a KE with orders; the design gear's own KE is zero):
+    // (1) the unloaded orders the loaded analysis gives (its TE plus the rigid approach at
+    //     each position) are the orders of the unloaded analysis' own kinematic error, two
+    //     paths to the same signal;
+    // (2) sampled at 20 or 40 positions a pitch, the first orders agree: they are the gear's,
+    //     not the sampling's.
+    let mut base = example("gear-1x40-design.toml");
+    base.operating.offset = 0.2e-3;
+    let mut first = Vec::new();
+    for positions in [20, 40] {
+        let mut g = base.clone();
+        g.analysis.positions = positions;
+        let geo = Geometry::build(&g).unwrap();
+        let tca = kinematics::analyse(&g, &geo).unwrap();
+        let l = ltca::analyse(&g, &geo, &tca).unwrap();
+        let orders = l.te_orders();
+        assert_eq!(orders.loaded_rad.len(), (positions - 1) / 2);
+        let ke: Vec<f64> = tca.positions.iter().map(|p| p.kinematic_error).collect();
+        let from_tca = ltca::mesh_order_amplitudes(&ke);
+        for (a, b) in orders.unloaded_rad.iter().zip(&from_tca) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        eprintln!(
+            "{positions} positions: loaded TE orders 1-3 {:.3?} urad, unloaded KE {:.3?} urad",
+            &orders.loaded_rad[..3]
+                .iter()
+                .map(|a| a * 1e6)
+                .collect::<Vec<_>>(),
+            &orders.unloaded_rad[..3]
+                .iter()
+                .map(|a| a * 1e6)
+                .collect::<Vec<_>>()
+        );
+        assert!(from_tca[0] > 1e-6, "the offset mesh has a KE with orders");
+        first.push((orders.loaded_rad, orders.unloaded_rad));
+    }
+    for h in 0..3 {
+        for (k, which) in [(0, "loaded"), (1, "unloaded")] {
+            let (a, b) = if k == 0 {
+                (first[0].0[h], first[1].0[h])
+            } else {
+                (first[0].1[h], first[1].1[h])
+            };
+            let largest = if k == 0 { first[0].0[0] } else { first[0].1[0] };
+            assert!(
+                (a - b).abs() < 0.05 * largest,
+                "{which} order {}: {a} at 20 positions, {b} at 40",
+                h + 1
+            );
+        }
+    }
+}

@@ -766,3 +766,51 @@ fn the_peak_wear_converges_with_the_global_grid() {
     assert!(change(&|r| r.wear_patch_max_m) < 0.05);
     assert!(change(&|r| r.mean_wear_m) < 0.05);
 }
+
+#[test]
+fn each_state_records_its_te_orders_and_its_worn_flank_s_ke() {
+    // MODEL §16 over life. Each state's loaded TE orders are its loaded analysis'; its KE is
+    // the worn flank's (the unworn one less the wear's rigid lag at each position): at the
+    // unworn state the loaded analysis' own (its TE plus the rigid approach), then growing as
+    // the wear takes a different depth at each position (the design gear's unworn KE is
+    // zero). A record from a checkpoint written before the KE was kept gives no unloaded
+    // orders rather than wrong ones.
+    let mut g = example("gear-1x40-design.toml");
+    g.bending.kind = wormwear::input::BendingKind::None;
+    let plan = wear::WearPlan {
+        step: wear::StepControl::Cycles(45_000.0),
+        ..wear::WearPlan::with_life(90_000.0)
+    };
+    let mut analysed = Vec::new();
+    let end = Bench::new(&g)
+        .simulate(&plan, None, &mut |view| {
+            analysed.push(view.ltca.te_orders());
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(analysed.len(), end.records.len());
+    for (r, of_ltca) in end.records.iter().zip(&analysed) {
+        let recorded = r.te_orders();
+        assert_eq!(recorded.loaded_rad, of_ltca.loaded_rad);
+        if r.step == 0 {
+            assert_eq!(recorded.unloaded_rad, of_ltca.unloaded_rad);
+        }
+    }
+    let unworn = end.records[0].te_orders().unloaded_rad[0];
+    let worn = end.records.last().unwrap().te_orders().unloaded_rad[0];
+    eprintln!(
+        "KE order 1: {:.3e} rad unworn, {worn:.3e} rad at 90 000 cycles",
+        unworn
+    );
+    assert!(unworn < 1e-9 && worn > 1e-6, "{unworn} -> {worn}");
+    let mut older = end.records.last().unwrap().clone();
+    for p in &mut older.positions {
+        p.kinematic_error_rad = None;
+    }
+    let orders = older.te_orders();
+    assert!(orders.unloaded_rad.is_empty());
+    assert_eq!(
+        orders.loaded_rad,
+        end.records.last().unwrap().te_orders().loaded_rad
+    );
+}

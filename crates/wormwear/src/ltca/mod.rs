@@ -16,6 +16,7 @@
 //! analyses over the positions.
 
 mod mesh;
+mod orders;
 pub(crate) mod passage;
 mod pattern;
 mod position;
@@ -23,6 +24,7 @@ pub mod solver;
 mod traction;
 
 use mesh::*;
+pub use orders::{mesh_order_amplitudes, TeOrders};
 pub use pattern::*;
 use position::*;
 use traction::torque_weights;

@@ -61,6 +61,9 @@ pub struct LtcaSummary {
     pub s2: f64,
     pub te_mean_rad: f64,
     pub te_p2p_rad: f64,
+    /// Amplitudes of the mesh orders 1..k of the loaded TE and of the unloaded KE (MODEL §16),
+    /// rad: `ltca_te_orders.csv`.
+    pub te_orders: crate::ltca::TeOrders,
     pub mesh_stiffness_mean_nm_per_rad: f64,
     /// The wheel shaft's torsional compliance in the bending model (0: none), rad/(N m); its
     /// share of the TE is -c_t C2 at every position.
@@ -108,6 +111,8 @@ impl LtcaSummary {
             .max_by(|a, b| a.1.total_cmp(b.1))
             .map(|(k, _)| &wf.cells[k]);
         let n = ltca.positions.len().max(1) as f64;
+        let mean =
+            |f: &dyn Fn(&PositionResult) -> f64| ltca.positions.iter().map(f).sum::<f64>() / n;
         Self {
             bending_model: ltca.bending_model.clone(),
             solver: format!("{:?}", ltca.solver),
@@ -115,12 +120,7 @@ impl LtcaSummary {
             wheel_torque_nm: ltca.wheel_torque,
             torque_balance: ltca.torque_balance,
             mesh_efficiency: ltca.mesh_efficiency,
-            friction_torque_nm: ltca
-                .positions
-                .iter()
-                .map(|p| p.friction_torque)
-                .sum::<f64>()
-                / n,
+            friction_torque_nm: mean(&|p| p.friction_torque),
             max_pressure_pa: ltca.max_pressure,
             max_pressure_r_mm: at_max.map_or(f64::NAN, |c| c.r * MM),
             max_pressure_z_mm: at_max.map_or(f64::NAN, |c| c.z * MM),
@@ -142,16 +142,12 @@ impl LtcaSummary {
             s2: ltca.s2,
             te_mean_rad: te_mean,
             te_p2p_rad: te_p2p,
+            te_orders: ltca.te_orders(),
             mesh_stiffness_mean_nm_per_rad: ltca.stiffness_mean(),
             wheel_shaft_torsion_rad_per_nm: ltca.shaft_torsion_compliance,
             mesh_stiffness_without_shaft_torsion_nm_per_rad: ltca
                 .stiffness_without_shaft_torsion_mean(),
-            mesh_stiffness_linear_mean_n_per_m: ltca
-                .positions
-                .iter()
-                .map(|p| p.stiffness_linear)
-                .sum::<f64>()
-                / n,
+            mesh_stiffness_linear_mean_n_per_m: mean(&|p| p.stiffness_linear),
             max_teeth_in_contact: ltca.max_teeth_in_contact(),
             power_balance: ltca.power_balance,
             warnings: ltca.warnings.clone(),
@@ -325,8 +321,57 @@ fn position_charts(
 ) -> Result<(), OutputError> {
     files.push(load_sharing_chart(tca, ltca, dir)?);
     files.push(transmission_error_chart(tca, ltca, dir)?);
+    files.extend(te_orders_files(&ltca.te_orders(), dir)?);
     files.push(stiffness_chart(ltca, dir)?);
     Ok(())
+}
+
+/// `ltca_te_orders.csv` (order; amplitudes of the loaded TE and of the unloaded KE at that
+/// mesh order, rad) and its chart `ltca_te_orders.svg` (MODEL §16).
+fn te_orders_files(
+    orders: &crate::ltca::TeOrders,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, OutputError> {
+    let mut csv = Csv::new(&[
+        "mesh_order",
+        "loaded_te_amplitude_rad",
+        "kinematic_error_amplitude_rad",
+    ]);
+    for (h, (te, ke)) in orders
+        .loaded_rad
+        .iter()
+        .zip(&orders.unloaded_rad)
+        .enumerate()
+    {
+        csv.row(&[(h + 1) as f64, *te, *ke]);
+    }
+    let table = dir.join("ltca_te_orders.csv");
+    csv.write(&table)?;
+    let series = |values: &[f64], label: &str, color: usize| Series {
+        label: label.into(),
+        points: values
+            .iter()
+            .enumerate()
+            .map(|(h, a)| ((h + 1) as f64, a * UM))
+            .collect(),
+        color,
+        bold: color == 0,
+    };
+    let chart = dir.join("ltca_te_orders.svg");
+    crate::plot::line_chart_marked(
+        &chart,
+        (
+            "Transmission error by mesh order (amplitude of each harmonic of the tooth-mesh \
+             frequency)",
+            "mesh order (1 = the tooth-mesh frequency)",
+            "amplitude (urad, wheel)",
+        ),
+        &[
+            series(&orders.loaded_rad, "loaded TE", 0),
+            series(&orders.unloaded_rad, "unloaded KE", 5),
+        ],
+    )?;
+    Ok(vec![table, chart])
 }
 
 /// The position n as a wheel rotation in tooth pitches from position 0.
@@ -394,8 +439,10 @@ fn transmission_error_chart(tca: &Tca, ltca: &Ltca, dir: &Path) -> Result<PathBu
     line_chart_spanned(
         &path,
         &format!(
-            "Loaded TE about its mean (mean {:.0} urad, mostly shaft torsion; p2p {:.1} urad)",
+            "Loaded TE about its mean (mean {:.0} urad, {:.0} of it the wheel shaft's torsion; \
+             p2p {:.1} urad)",
             m * UM,
+            -shaft_twist(ltca) * UM,
             p2p * UM
         ),
         "wheel rotation (tooth pitches from position 0)",
@@ -405,6 +452,19 @@ fn transmission_error_chart(tca: &Tca, ltca: &Ltca, dir: &Path) -> Result<PathBu
         0.02,
     )?;
     Ok(path)
+}
+
+/// The wheel shaft's mean torsion under the normal pressures' wheel torque, rad (0 without
+/// one in the bending model).
+fn shaft_twist(ltca: &Ltca) -> f64 {
+    let n = ltca.positions.len().max(1) as f64;
+    ltca.shaft_torsion_compliance
+        * ltca
+            .positions
+            .iter()
+            .map(|p| p.normal_wheel_torque)
+            .sum::<f64>()
+        / n
 }
 
 /// The stiffness chart's title with its ripple, since the axis spans the ripple alone and

@@ -34,6 +34,7 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
         &[
             "ltca_load_sharing",
             "ltca_transmission_error",
+            "ltca_te_orders",
             "ltca_mesh_stiffness",
             "ltca_pattern",
             "ltca_pressure_position*",
@@ -46,6 +47,7 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
             "wear_backlash",
             "wear_depth",
             "wear_transmission_error",
+            "wear_te_orders",
             "wear_pressure",
             "wear_efficiency",
             "wear_oil_temperature",

@@ -439,6 +439,8 @@ impl<'a> LifeLoop<'a> {
             .map(|p| PositionState {
                 te_rad: p.transmission_error,
                 te_relative_rad: p.transmission_error + lag[p.position],
+                // The worn flank's: the unworn KE (TE + approach) less the wear's rigid lag.
+                kinematic_error_rad: Some(p.transmission_error + p.approach - lag[p.position]),
                 tooth_load_n: p.tooth_load.clone(),
                 max_pressure_pa: p.max_pressure,
             })

@@ -283,6 +283,25 @@ impl StateFriction {
     }
 }
 
+impl StepRecord {
+    /// The mesh orders of this state's loaded TE and unloaded kinematic error (MODEL §16), from
+    /// its positions; the unloaded ones empty where a checkpoint written before they were
+    /// recorded left them out.
+    pub fn te_orders(&self) -> crate::ltca::TeOrders {
+        let loaded: Vec<f64> = self.positions.iter().map(|p| p.te_rad).collect();
+        let unloaded: Option<Vec<f64>> = self
+            .positions
+            .iter()
+            .map(|p| p.kinematic_error_rad)
+            .collect();
+        let mut orders = crate::ltca::TeOrders::of(&loaded, &unloaded.clone().unwrap_or_default());
+        if unloaded.is_none() {
+            orders.unloaded_rad.clear();
+        }
+        orders
+    }
+}
+
 /// One position of a state's loaded analysis (MODEL §7.7: load sharing and TE over life).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PositionState {
@@ -290,6 +309,11 @@ pub struct PositionState {
     pub te_rad: f64,
     /// TE + the rigid lag of the wear at this position, rad.
     pub te_relative_rad: f64,
+    /// Unloaded kinematic error of the state's worn flank (the unworn one's, TE plus the rigid
+    /// approach, less the wear's rigid lag), rad; None in a checkpoint written before it was
+    /// recorded.
+    #[serde(default)]
+    pub kinematic_error_rad: Option<f64>,
     /// Normal force per studied tooth (TCA tooth order), N.
     pub tooth_load_n: Vec<f64>,
     pub max_pressure_pa: f64,

@@ -38,6 +38,16 @@ pub const CHECKPOINT: &str = "wear_checkpoint.json";
 /// Name of the records file (JSON lines) in the output directory.
 pub const RECORDS: &str = "wear_records.jsonl";
 
+/// One state's mesh orders of the TE (MODEL §16) in summary.json: its step, cycles and the
+/// amplitudes, rad.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StateTeOrders {
+    pub step: usize,
+    pub cycles: f64,
+    #[serde(flatten)]
+    pub orders: crate::ltca::TeOrders,
+}
+
 /// The `wear` section of summary.json.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct WearSummary<'a> {
@@ -71,6 +81,9 @@ pub struct WearSummary<'a> {
     /// One record per state: the start and after each step (per-position curves in
     /// `wear_positions.csv`).
     pub steps: Vec<crate::wear::StepRecord>,
+    /// Per state, the mesh orders of the loaded TE and of the unloaded KE (MODEL §16; also
+    /// `wear_te_orders.csv`).
+    pub te_orders: Vec<StateTeOrders>,
 }
 
 /// The wear limits of the life (MODEL §9 (a), (d)) and where it reached them.

@@ -24,6 +24,9 @@ pub(super) fn write_tables(
     let path = dir.join("wear_positions.csv");
     position_table(tca, &state.records).write(&path)?;
     files.push(path);
+    let path = dir.join("wear_te_orders.csv");
+    te_orders_table(&state.records).write(&path)?;
+    files.push(path);
     update_summary(dir, "wear", summary_value(gear, geo, tca, plan, view)?)?;
     let limit = crate::wear::WearLimits::backlash_limit(gear, &crate::rating::rate(gear), plan);
     let charts = life_charts(&state.records, limit);
@@ -47,18 +50,18 @@ fn te_title(records: &[crate::wear::StepRecord]) -> String {
 }
 
 /// The curves over cycles: (file, title, y label, series) of the backlash, wear depth,
-/// transmission error, pressure, efficiency and oil temperature charts.
+/// transmission error, its mesh orders (MODEL §16), pressure, efficiency and oil temperature
+/// charts.
 fn life_charts(
     records: &[crate::wear::StepRecord],
     backlash_limit: (f64, f64),
-) -> [(&'static str, String, &'static str, Vec<Series>); 6] {
+) -> [(&'static str, String, &'static str, Vec<Series>); 7] {
     let curve = |f: &dyn Fn(&crate::wear::StepRecord) -> f64, label: &str, color: usize| Series {
         label: label.to_string(),
         points: records.iter().map(|r| (r.cycles * 1e-6, f(r))).collect(),
         color,
         bold: true,
     };
-    let te_title = te_title(records);
     [
         (
             "wear_backlash.svg",
@@ -78,7 +81,7 @@ fn life_charts(
         ),
         (
             "wear_transmission_error.svg",
-            te_title,
+            te_title(records),
             "TE peak to peak (urad, wheel)",
             vec![
                 curve(&|r| r.te_p2p_rad * UM, "peak-to-peak", 2),
@@ -88,6 +91,14 @@ fn life_charts(
                     4,
                 ),
             ],
+        ),
+        (
+            "wear_te_orders.svg",
+            "Loaded TE by mesh order over life (amplitudes of the first harmonics of the \
+             tooth-mesh frequency)"
+                .to_string(),
+            "amplitude (urad, wheel)",
+            te_order_curves(records),
         ),
         (
             "wear_pressure.svg",
@@ -120,6 +131,26 @@ fn life_charts(
             vec![curve(&|r| r.friction.oil_temperature_k - 273.15, "sump", 4)],
         ),
     ]
+}
+
+/// The loaded TE's mesh orders 1-4 over cycles (1e6, urad; MODEL §16).
+fn te_order_curves(records: &[crate::wear::StepRecord]) -> Vec<Series> {
+    let orders: Vec<(f64, Vec<f64>)> = records
+        .iter()
+        .map(|r| (r.cycles * 1e-6, r.te_orders().loaded_rad))
+        .collect();
+    (0..4)
+        .map(|h| Series {
+            label: format!("order {}", h + 1),
+            points: orders
+                .iter()
+                .filter_map(|(x, a)| a.get(h).map(|v| (*x, v * UM)))
+                .collect(),
+            color: h,
+            bold: true,
+        })
+        .filter(|s| !s.points.is_empty())
+        .collect()
 }
 
 /// Per state and position: TE, TE relative to the wear's rigid lag, largest pressure and the
@@ -155,6 +186,25 @@ pub fn position_table(tca: &Tca, records: &[crate::wear::StepRecord]) -> Csv {
             );
             csv.row(&row);
         }
+    }
+    csv
+}
+
+/// Per state: step, cycles and the amplitudes of the mesh orders 1..k of the loaded TE and of
+/// the unloaded KE, rad (MODEL §16; NaN where a state does not have them).
+pub fn te_orders_table(records: &[crate::wear::StepRecord]) -> Csv {
+    let orders: Vec<crate::ltca::TeOrders> = records.iter().map(|r| r.te_orders()).collect();
+    let k = orders.iter().map(|o| o.loaded_rad.len()).max().unwrap_or(0);
+    let mut header = vec!["step".to_string(), "cycles".to_string()];
+    header.extend((1..=k).map(|h| format!("loaded_te_order{h}_rad")));
+    header.extend((1..=k).map(|h| format!("kinematic_error_order{h}_rad")));
+    let mut csv = Csv::new(&header.iter().map(String::as_str).collect::<Vec<_>>());
+    for (r, o) in records.iter().zip(&orders) {
+        let at = |v: &[f64], h: usize| v.get(h).copied().unwrap_or(f64::NAN);
+        let mut row = vec![r.step as f64, r.cycles];
+        row.extend((0..k).map(|h| at(&o.loaded_rad, h)));
+        row.extend((0..k).map(|h| at(&o.unloaded_rad, h)));
+        csv.row(&row);
     }
     csv
 }
@@ -259,6 +309,15 @@ pub fn summary_value(
             .map(|r| crate::wear::StepRecord {
                 positions: Vec::new(),
                 ..r.clone()
+            })
+            .collect(),
+        te_orders: state
+            .records
+            .iter()
+            .map(|r| StateTeOrders {
+                step: r.step,
+                cycles: r.cycles,
+                orders: r.te_orders(),
             })
             .collect(),
     };
