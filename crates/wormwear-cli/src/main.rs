@@ -752,6 +752,9 @@ fn print_ltca(results: &wormwear::Results) {
             t.mode,
             t.viscosity_pa_s
         );
+        if let Some(lock) = &t.self_locking {
+            println!("{}", rating_cmd::self_locking_line(lock));
+        }
     }
 }
 

@@ -22,6 +22,14 @@ pub(crate) fn rating(
     let (results, _) = analyse(file, &gear, (dir, args.force), request, quiet, verbose)?;
     if let (Some(table), false) = (&results.safety, quiet) {
         print_safety(table);
+        // Beside the table: whether the wheel can drive the worm (MODEL §15).
+        if let Some(lock) = results
+            .thermal
+            .as_ref()
+            .and_then(|t| t.self_locking.as_ref())
+        {
+            println!("{}", self_locking_line(lock));
+        }
         println!("results in {}", dir.display());
     }
     Ok(())
@@ -60,4 +68,25 @@ pub(crate) fn print_safety(table: &wormwear::safety::SafetyTable) {
             println!("  {:<8} on assumed inputs: {}", "", r.assumed.join(", "));
         }
     }
+}
+
+/// The back-driving line (MODEL §15): eta' at rest and running, each with its verdict.
+pub(crate) fn self_locking_line(lock: &wormwear::friction::SelfLocking) -> String {
+    let verdict = |locked: bool| {
+        if locked {
+            "self-locking"
+        } else {
+            "back-drivable"
+        }
+    };
+    format!(
+        "back-driving (MODEL §15): static eta' {:.3}, {} (boundary friction {} against the \
+         {:.4} it locks from); running eta' {:.3}, {}",
+        lock.static_efficiency,
+        verdict(lock.static_self_locking),
+        lock.boundary_friction,
+        lock.locking_friction,
+        lock.dynamic_efficiency,
+        verdict(lock.dynamic_self_locking)
+    )
 }

@@ -325,12 +325,30 @@ fn ltca_writes_its_section_plots_and_tables() {
             "ltca_mesh_stiffness.svg",
             "ltca_pattern.svg",
             "ltca_pressure_position3_tooth0.svg",
+            "ltca_te_orders.csv",
+            "ltca_te_orders.svg",
         ],
     );
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
     assert!(summary["tca"]["kinematic_error_p2p_rad"].is_number());
+    // The TE's mesh orders (MODEL §16) and the back-driving (MODEL §15): beside the driving
+    // efficiency, eta' at rest below it, and a verdict with each.
+    assert!(
+        summary["ltca"]["te_orders"]["loaded_rad"][0]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let lock = &summary["friction"]["self_locking"];
+    let (driving, at_rest, running) = (
+        lock["driving_efficiency"].as_f64().unwrap(),
+        lock["static_efficiency"].as_f64().unwrap(),
+        lock["dynamic_efficiency"].as_f64().unwrap(),
+    );
+    assert!(at_rest < running && running < driving, "{lock}");
+    assert_eq!(lock["static_self_locking"].as_bool(), Some(at_rest <= 0.0));
     // The stiffness chart's axis spans its ripple alone: the title gives the ripple (issue 59).
     let chart = std::fs::read_to_string(out_dir.join("ltca_mesh_stiffness.svg")).unwrap();
     assert!(

@@ -579,7 +579,7 @@ impl<'a> Pipeline<'a> {
             &gear.housing,
             other,
         )
-        .map(Some)
+        .map(|t| Some(t.with_self_locking(gear, geo, ltca)))
         .map_err(RunError::Friction)
     }
 

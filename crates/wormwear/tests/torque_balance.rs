@@ -142,6 +142,19 @@ fn screw_efficiency(mu: f64, gamma: f64, alpha_n: f64) -> f64 {
     (alpha_n.cos() - mu * gamma.tan()) / (alpha_n.cos() + mu / gamma.tan())
 }
 
+/// Asperities that carry every pressure up to the flow pressure (summits dense and sharp, the
+/// film too thin to part them) at boundary friction mu, and a film that would shear at the same
+/// mu: mu uniform over the contact.
+fn uniform_friction(mu: f64) -> FrictionLaw {
+    FrictionLaw {
+        boundary: mu,
+        summit_density_radius_roughness: 1.0,
+        summit_roughness_radius: 0.1,
+        eyring_stress: 1e9,
+        limiting_shear: mu,
+    }
+}
+
 #[test]
 fn a_uniform_friction_gives_the_screws_closed_form_efficiency() {
     // Asperities that carry every pressure up to the flow pressure (summits dense and sharp,
@@ -149,13 +162,7 @@ fn a_uniform_friction_gives_the_screws_closed_form_efficiency() {
     // the same mu: mu is uniform over the contact.
     let mut g = design();
     for mu in [0.02, 0.05, 0.1] {
-        g.friction = FrictionLaw {
-            boundary: mu,
-            summit_density_radius_roughness: 1.0,
-            summit_roughness_radius: 0.1,
-            eyring_stress: 1e9,
-            limiting_shear: mu,
-        };
+        g.friction = uniform_friction(mu);
         let bench = common::Bench::new(&g);
         let l = analyse(&g, &bench);
         let eta = l.wheel_torque / (g.ratio() * l.worm_torque);
@@ -211,4 +218,49 @@ fn the_mesh_loss_converges_under_the_contact_mesh() {
     );
     assert!((t_fine / t_coarse - 1.0).abs() < 0.005);
     assert!((loss_fine / loss_coarse - 1.0).abs() < 0.02);
+}
+
+#[test]
+fn back_driving_gives_the_screws_closed_form_and_one_without_friction() {
+    // MODEL §15: the wheel driving the worm is the same contact with the sliding reversed.
+    // With a uniform mu the moments of the driving analysis give, for the power flow
+    // reversed, the screw's back-driving efficiency tan(gamma - rho') / tan(gamma) =
+    // (cos a_n - mu cot g) / (cos a_n + mu tan g) at the load's mean worm radius; their driving
+    // efficiency is the loaded analysis' own T2 / (u T1); without friction both are 1; and the
+    // gear self-locks past the friction where eta' = 0, tan(gamma) cos(a_n) on the screw.
+    let mut g = design();
+    let mu = 0.05;
+    g.friction = uniform_friction(mu);
+    let bench = common::Bench::new(&g);
+    let l = analyse(&g, &bench);
+    let arms = wormwear::friction::FrictionArms::new(&g, &bench.geo, &l);
+    let (driving, back) = arms.efficiencies(&|_, _| mu);
+    let own = l.wheel_torque / (g.ratio() * l.worm_torque);
+    assert!((driving - own).abs() < 1e-3, "{driving} vs {own}");
+    let (mut radius, mut load) = (0.0, 0.0);
+    for p in &l.positions {
+        for (c, pr) in p.cells.iter().zip(&p.pressure) {
+            let force = pr * c.cell.area();
+            radius += force * c.cell.centre.y.hypot(c.cell.centre.z);
+            load += force;
+        }
+    }
+    radius /= load;
+    let axial = (g.worm.normal_pressure_angle.tan() / g.worm.lead_angle().cos()).atan();
+    let gamma = (g.worm.lead_per_rad() / radius).atan();
+    let alpha_n = (axial.tan() * gamma.cos()).atan();
+    let screw = (alpha_n.cos() - mu / gamma.tan()) / (alpha_n.cos() + mu * gamma.tan());
+    let locking = gamma.tan() * alpha_n.cos();
+    eprintln!(
+        "mu {mu}: driving {driving:.4} (analysis {own:.4}); back-driving {back:.4}, screw \
+         {screw:.4}; self-locking from mu {:.4}, screw {locking:.4}",
+        arms.locking_friction()
+    );
+    assert!((back - screw).abs() < 0.003, "{back} vs {screw}");
+    assert!((arms.locking_friction() / locking - 1.0).abs() < 0.02);
+    assert_eq!(arms.efficiencies(&|_, _| 0.0), (1.0, 1.0));
+    // Past the locking friction eta' is negative: the verdict.
+    let locked = wormwear::friction::SelfLocking::new(&arms, &[], 1.5 * locking);
+    assert!(locked.static_self_locking && locked.static_efficiency < 0.0);
+    assert!(!locked.dynamic_self_locking && locked.dynamic_efficiency == 1.0);
 }

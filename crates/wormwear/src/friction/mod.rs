@@ -19,7 +19,9 @@ use crate::ltca::{cell_sliding, FilmGeometry, FrictionInputs, Ltca};
 use crate::lubrication::LineContact;
 pub use crate::traction::LocalFriction;
 
+mod backdriving;
 mod flank;
+pub use backdriving::{FrictionArms, SelfLocking};
 use flank::FlankGrid;
 
 /// Errors of the heat balance; each names the input that decides it.
@@ -303,6 +305,20 @@ pub struct Thermal {
     pub evaluations: usize,
     pub friction: MeshFriction,
     pub efficiency: Efficiency,
+    /// Back-driving and self-locking at this friction (MODEL §15); None until the runner adds
+    /// it ([`SelfLocking::new`]).
+    pub self_locking: Option<SelfLocking>,
+}
+
+impl Thermal {
+    /// With the back-driving and self-locking of its friction on the loaded analysis `ltca`
+    /// (MODEL §15): the running friction of its cells, and the boundary friction at rest.
+    pub fn with_self_locking(mut self, gear: &GearSet, geo: &Geometry, ltca: &Ltca) -> Self {
+        let arms = FrictionArms::new(gear, geo, ltca);
+        let locking = SelfLocking::new(&arms, &self.friction.cells, gear.friction.boundary);
+        self.self_locking = Some(locking);
+        self
+    }
 }
 
 /// Highest oil temperature the heat balance looks for, K (200 C: beyond any lubricant's range).
@@ -354,6 +370,7 @@ pub fn heat_balance_from(
             evaluations,
             friction,
             efficiency,
+            self_locking: None,
         }
     };
     if !housing.balance {

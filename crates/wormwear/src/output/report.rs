@@ -355,7 +355,7 @@ fn warnings_section(h: &mut String, summary: &serde_json::Value) {
 
 /// The key results: (label, where in summary.json — a stage's section, or `END` for the last
 /// wear state — key (dotted: nested), scale to the unit, unit).
-const KEY_RESULTS: [(&str, &str, &str, f64, &str); 20] = [
+const KEY_RESULTS: [(&str, &str, &str, f64, &str); 22] = [
     ("Ratio", "geometry", "ratio", 1.0, ""),
     ("Lead angle", "geometry", "lead_angle_deg", 1.0, "deg"),
     (
@@ -412,6 +412,20 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 20] = [
         "Efficiency from the contact's friction",
         "friction",
         "efficiency.total_efficiency",
+        1.0,
+        "",
+    ),
+    (
+        "Back-driving efficiency at rest (<= 0: self-locking, MODEL §15)",
+        "friction",
+        "self_locking.static_efficiency",
+        1.0,
+        "",
+    ),
+    (
+        "Back-driving efficiency running (<= 0: self-locking)",
+        "friction",
+        "self_locking.dynamic_efficiency",
         1.0,
         "",
     ),
