@@ -44,31 +44,18 @@ impl<'a> FlankGrid<'a> {
         let (z0, z1) = (self.z[0], self.z[nj]);
         let column = |z: f64| ((z - z0) / (z1 - z0) * nj as f64).clamp(0.0, nj as f64);
         let (a, b) = (column(z - half_dz), column(z + half_dz));
-        let columns: Vec<(usize, f64)> = if b - a <= 0.0 {
-            vec![((a.floor() as usize).min(nj - 1), 1.0)]
-        } else {
-            ((a.floor() as usize).min(nj - 1)..nj)
-                .map(|j| {
-                    (
-                        j,
-                        (b.min(j as f64 + 1.0) - a.max(j as f64)).max(0.0) / (b - a),
-                    )
-                })
-                .take_while(|&(j, _)| (j as f64) < b)
-                .filter(|&(_, share)| share > 0.0)
-                .collect()
-        };
-        for (j, column_share) in columns {
+        // The strip's share in column j, spread over the column's rows by radius.
+        let mut in_column = |j: usize, column_share: f64| {
             // The column's radial limits where the strip's centre lies along it.
             let t = (column(z) - j as f64).clamp(0.0, 1.0);
             let lo = self.r_low[j] + t * (self.r_low[j + 1] - self.r_low[j]);
             let hi = self.r_high[j] + t * (self.r_high[j + 1] - self.r_high[j]);
             let u = |r: f64| ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64);
             let (u0, u1) = (u(r.0.min(r.1)), u(r.0.max(r.1)));
-            let row = |u: f64| j * ni + (u.floor() as usize).min(ni - 1);
             if u1 - u0 <= 1e-9 {
-                out.push((row(u0.min(ni as f64 - 1e-9)), column_share));
-                continue;
+                let i = (u0.min(ni as f64 - 1e-9).floor() as usize).min(ni - 1);
+                out.push((j * ni + i, column_share));
+                return;
             }
             let mut i = u0.floor() as usize;
             while (i as f64) < u1 && i < ni {
@@ -77,6 +64,19 @@ impl<'a> FlankGrid<'a> {
                     out.push((j * ni + i, column_share * overlap / (u1 - u0)));
                 }
                 i += 1;
+            }
+        };
+        if b - a <= 0.0 {
+            in_column((a.floor() as usize).min(nj - 1), 1.0);
+            return;
+        }
+        for j in (a.floor() as usize).min(nj - 1)..nj {
+            if j as f64 >= b {
+                break;
+            }
+            let share = (b.min(j as f64 + 1.0) - a.max(j as f64)).max(0.0) / (b - a);
+            if share > 0.0 {
+                in_column(j, share);
             }
         }
     }

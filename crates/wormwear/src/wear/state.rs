@@ -294,11 +294,13 @@ impl StepRecord {
             .iter()
             .map(|p| p.kinematic_error_rad)
             .collect();
-        let mut orders = crate::ltca::TeOrders::of(&loaded, &unloaded.clone().unwrap_or_default());
-        if unloaded.is_none() {
-            orders.unloaded_rad.clear();
+        match unloaded {
+            Some(unloaded) => crate::ltca::TeOrders::of(&loaded, &unloaded),
+            None => crate::ltca::TeOrders {
+                loaded_rad: crate::ltca::mesh_order_amplitudes(&loaded),
+                unloaded_rad: Vec::new(),
+            },
         }
-        orders
     }
 }
 
