@@ -756,6 +756,9 @@ fn print_ltca(results: &wormwear::Results) {
             println!("{}", rating_cmd::self_locking_line(lock));
         }
     }
+    if let Some(s) = &results.spectrum {
+        println!("{}", rating_cmd::duty_cycle_lines(s));
+    }
 }
 
 fn wear(

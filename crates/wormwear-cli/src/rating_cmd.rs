@@ -21,6 +21,9 @@ pub(crate) fn rating(
     )?;
     let (results, _) = analyse(file, &gear, (dir, args.force), request, quiet, verbose)?;
     if let (Some(table), false) = (&results.safety, quiet) {
+        if let Some(s) = &results.spectrum {
+            println!("{}", duty_cycle_lines(s));
+        }
         print_safety(table);
         // Beside the table: whether the wheel can drive the worm (MODEL §15).
         if let Some(lock) = results
@@ -89,4 +92,42 @@ pub(crate) fn self_locking_line(lock: &wormwear::friction::SelfLocking) -> Strin
         lock.dynamic_efficiency,
         verdict(lock.dynamic_self_locking)
     )
+}
+
+/// The duty cycle's lines (MODEL §14): the spectrum's energy-weighted efficiency and Miner's
+/// pitting life, then one line per bin.
+pub(crate) fn duty_cycle_lines(spectrum: &wormwear::spectrum::Spectrum) -> String {
+    let life = spectrum
+        .pitting_life_cycles
+        .map_or("none".to_string(), |n| format!("{n:.3e} wheel cycles"));
+    let mut text = format!(
+        "duty cycle (MODEL §14; {} bins, the analysis above is bin {} of the largest load): \
+         efficiency {:.4} (mesh {:.4}) over the energy; first pit by Miner's sum {life} \
+         (damage-equivalent p_eq {:.0} MPa); mean worm speed {:.0} rpm\n",
+        spectrum.bins.len(),
+        spectrum.largest_load_bin,
+        spectrum.total_efficiency,
+        spectrum.mesh_efficiency,
+        spectrum.equivalent_pressure_pa * 1e-6,
+        spectrum.mean_worm_speed_rpm
+    );
+    text.push_str(
+        "  bin  worm N m  wheel N m     rpm   time  cycles  oil C    eta  wear %  damage %\n",
+    );
+    for b in &spectrum.bins {
+        text.push_str(&format!(
+            "  {:>3}  {:>8.2}  {:>9.1}  {:>6.0}  {:>5.3}  {:>6.3}  {:>5.1}  {:>5.3}  {:>6.1}  {:>8.1}\n",
+            b.bin,
+            b.worm_torque_nm,
+            b.wheel_torque_nm,
+            b.worm_speed_rpm,
+            b.time_share,
+            b.cycle_share,
+            b.oil_temperature_c,
+            b.total_efficiency,
+            100.0 * b.wear_share,
+            100.0 * b.damage_share
+        ));
+    }
+    text.trim_end().to_string()
 }

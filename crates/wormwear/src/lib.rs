@@ -40,6 +40,7 @@ pub mod rating;
 pub mod rexs;
 pub mod runner;
 pub mod safety;
+pub mod spectrum;
 pub mod subsurface;
 pub mod sweep;
 pub mod traction;
@@ -65,9 +66,18 @@ pub fn run(
     let bending = pipeline.bending_model(&geometry)?;
     let ltca = pipeline.loaded_analysis(&geometry, tca.as_ref(), &bending)?;
     let thermal = pipeline.friction(&geometry, tca.as_ref(), ltca.as_ref())?;
+    let unworn = (tca.as_ref(), ltca.as_ref(), thermal.as_ref());
+    let spectrum = pipeline.spectrum(&geometry, unworn, &bending)?;
     let life = pipeline.life(&geometry, tca.as_ref(), &bending)?;
     let analyses = (ltca.as_ref(), thermal.as_ref(), life.as_ref());
-    let safety = pipeline.safety(&geometry, tca.as_ref(), &bending, analyses)?;
+    let safety = pipeline.safety(
+        &geometry,
+        tca.as_ref(),
+        &bending,
+        analyses,
+        spectrum.as_ref(),
+    )?;
     let cad = pipeline.cad(&geometry, tca.as_ref(), life.as_ref())?;
-    Ok(pipeline.results(geometry, tca, bending, (ltca, thermal, safety), life, cad))
+    let analyses = (ltca, thermal, safety, spectrum.map(|s| s.1));
+    Ok(pipeline.results(geometry, tca, bending, analyses, life, cad))
 }

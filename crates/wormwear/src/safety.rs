@@ -97,6 +97,9 @@ pub struct SafetyInputsOf<'a> {
     /// The sump temperature's heat balance (None: no balance and no temperature limit; an
     /// error: why the balance has no solution).
     pub sump: Option<Result<Sump, SumpError>>,
+    /// The duty cycle's figures (MODEL §14; None for one operating point): S_H then reads
+    /// Miner's sum over its bins.
+    pub spectrum: Option<&'a crate::spectrum::Spectrum>,
 }
 
 /// The heat balance behind S_T.
@@ -127,10 +130,11 @@ pub fn scaled_torque(gear: &GearSet, factor: f64) -> GearSet {
     g
 }
 
-/// The wheel cycles (revolutions) of `hours` at the gear's speed.
+/// The wheel cycles (revolutions) of `hours` at the gear's speed (with a duty cycle, its
+/// time-weighted mean speed, MODEL §14).
 pub fn cycles_of_hours(gear: &GearSet, hours: f64) -> f64 {
     let u = gear.wheel.teeth as f64 / gear.worm.starts as f64;
-    hours * 3600.0 * gear.conditions.worm_speed / (2.0 * PI * u)
+    hours * 3600.0 * gear.mean_worm_speed() / (2.0 * PI * u)
 }
 
 /// The safety table (MODEL §9.1) in the order root, deflection, pitting, wear, temperature.
@@ -388,16 +392,33 @@ fn pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
          N_LI {:.3e} cycles",
         s.iso.sigma_hm_mpa, s.iso.pitting_safety, s.iso.n_li_cycles
     );
+    let (value, what) = match s.spectrum {
+        Some(spectrum) => (
+            spectrum.equivalent_pressure_pa,
+            format!(
+                "the damage-equivalent p_eq of the duty cycle's {} bins at their own torques \
+                 (MODEL §14: Miner's sum of each bin's share of the cycles over its life at its \
+                 p_eq = max over depth tau_1 / 0.300, unworn, at the most damaged cell; the \
+                 constant pressure of the same life)",
+                spectrum.bins.len()
+            ),
+        ),
+        None => (
+            s.ltca.equivalent_pressure_max,
+            "largest p_eq = max over depth tau_1 / 0.300 of the unworn loaded analysis (MODEL \
+             §8.1)"
+                .to_string(),
+        ),
+    };
     row(
         ("Pitting: equivalent pressure below the flank", "S_H", "MPa"),
-        Some(s.ltca.equivalent_pressure_max * 1e-6),
+        Some(value * 1e-6),
         required_cycles
             .map(|n| s.endurance.pressure(n) * 1e-6)
             .ok_or_else(|| Verdict::NeedsInput("rating.required_life_h".into())),
         inputs.minimum[2],
         format!(
-            "largest p_eq = max over depth tau_1 / 0.300 of the unworn loaded analysis (MODEL \
-             §8.1) against p_lim(N) = {:.0} MPa (N / {:.3e})^-{} at the required cycles{iso}",
+            "{what} against p_lim(N) = {:.0} MPa (N / {:.3e})^-{} at the required cycles{iso}",
             s.endurance.reference_pressure * 1e-6,
             s.endurance.life_factor * s.endurance.reference_cycles,
             s.endurance.exponent

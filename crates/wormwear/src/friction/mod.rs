@@ -416,6 +416,25 @@ const OIL_ITERATIONS: usize = 6;
 /// balance has converged when two passes differ by less than this, K.
 pub const OIL_TOLERANCE_K: f64 = 0.05;
 
+/// The unworn loaded analysis of `gear` (MODEL §5) with its bending model; with the heat
+/// balance and the transmitted torque, the friction the pressures carry is at the balance's oil
+/// temperature ([`oil_fixed_point`]).
+pub fn unworn_analysis(
+    gear: &GearSet,
+    geo: &Geometry,
+    tca: &Tca,
+    bending: Option<&dyn crate::ltca::BendingModel>,
+) -> Result<Ltca, crate::ltca::LtcaError> {
+    let analyse = |settings: &crate::ltca::LtcaSettings, warm: Option<&crate::ltca::WarmStart>| {
+        crate::ltca::analyse_worn(gear, geo, tca, settings, bending, None, warm)
+    };
+    let rating = crate::rating::rate(gear);
+    let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
+    let settings = crate::ltca::LtcaSettings::from_gear(gear);
+    let first = analyse(&settings, None)?;
+    oil_fixed_point((gear, geo, tca), other, (settings, first), analyse)
+}
+
 /// The loaded analysis `first` (run by `analyse` with `settings` and a warm start), and with
 /// the heat balance
 /// and the transmitted torque, again at the balance's oil temperature until two temperatures

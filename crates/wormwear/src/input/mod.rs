@@ -5,6 +5,7 @@
 //! parser's line and key), and every semantic problem as a [`FieldError`] naming the field, its
 //! value and the allowed range. All problems found are reported together.
 
+mod duty;
 pub mod schema;
 mod syntax;
 pub mod template;
@@ -14,6 +15,7 @@ use std::f64::consts::PI;
 use std::fmt;
 use std::path::Path;
 
+pub use duty::{cycle_shares, largest_load_bin, DutyBin};
 pub use schema::GearFile;
 use syntax::{parse_gear_file, syntax_error};
 pub use validate::Number;
@@ -750,7 +752,13 @@ pub struct GearSet {
     /// checkpoints and caches) when the oil temperature is fixed, as nothing then reads it.
     #[serde(skip_serializing_if = "Housing::is_unused")]
     pub housing: Housing,
+    /// The operating point: the one of `[conditions]`, or with a spectrum its bin of the
+    /// largest load (MODEL §14).
     pub conditions: Conditions,
+    /// The load spectrum's bins (MODEL §14); empty for one operating point (and left out of
+    /// the serialised gear then, so its fingerprints are those of `[conditions]`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub duty_cycle: Vec<DutyBin>,
     pub analysis: Analysis,
     /// Life to simulate, when the file asks for one.
     pub wear: Option<WearPlan>,

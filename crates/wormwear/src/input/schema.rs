@@ -25,7 +25,13 @@ pub struct GearFile {
     /// The housing's heat transfer (MODEL §13).
     #[serde(default)]
     pub housing: HousingSpec,
-    pub conditions: ConditionsSpec,
+    /// The operating point; absent when `[[duty_cycle]]` gives a load spectrum instead.
+    #[serde(default)]
+    pub conditions: Option<ConditionsSpec>,
+    /// Load spectrum (MODEL §14): bins of torque, worm speed and share of the running time;
+    /// absent: the one operating point of `[conditions]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub duty_cycle: Vec<DutyBinSpec>,
     #[serde(default)]
     pub analysis: AnalysisSpec,
     /// Life to simulate (wear stage); absent: no life run.
@@ -474,6 +480,30 @@ pub struct ConditionsSpec {
     pub wheel_torque_nm: Option<f64>,
     /// Worm speed, rpm.
     pub worm_speed_rpm: f64,
+}
+
+/// One bin of a load spectrum (`[[duty_cycle]]`, MODEL §14).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DutyBinSpec {
+    /// Driving torque on the worm, N m (give this or `wheel_torque_nm`).
+    #[serde(default)]
+    pub worm_torque_nm: Option<f64>,
+    /// Output torque on the wheel, N m.
+    #[serde(default)]
+    pub wheel_torque_nm: Option<f64>,
+    /// Worm speed, rpm.
+    pub worm_speed_rpm: f64,
+    /// Share of the running time, (0, 1]; the bins' shares sum to 1 (give this or `hours`).
+    #[serde(default)]
+    pub time_share: Option<f64>,
+    /// Running hours of the bin (the shares are the hours over their sum), h.
+    #[serde(default)]
+    pub hours: Option<f64>,
+    /// Oil temperature of the bin, degrees Celsius (default: `lubricant.temperature_c`; not
+    /// with `lubricant.temperature = "balance"`, which finds each bin's own).
+    #[serde(default)]
+    pub oil_temperature_c: Option<f64>,
 }
 
 /// Analysis settings. Every field has a default.

@@ -13,6 +13,7 @@ pub mod owned;
 pub mod plot;
 pub mod report;
 pub mod safety;
+pub mod spectrum;
 pub mod tca;
 pub mod text;
 pub mod vtk;
@@ -275,6 +276,9 @@ pub fn write_results(
             let wf = geo.wheel_flank(t.loaded_flank);
             files.extend(friction::write_friction(wf, thermal, dir)?);
         }
+        if let Some(s) = results.spectrum.as_ref() {
+            files.extend(spectrum::write_spectrum(s, dir)?);
+        }
         match results.life.as_ref() {
             Some(life) if !life_written => files.extend(wear::write_life(gear, geo, t, life, dir)?),
             _ => {}
@@ -291,8 +295,8 @@ pub fn write_results(
 }
 
 /// The sections of summary.json that [`write_results`] writes for `results` (into an empty
-/// directory), by name: `input`, `geometry`, `tca`, `ltca`, `rating`, `friction`, `wear` as the stages
-/// ran.
+/// directory), by name: `input`, `geometry`, `tca`, `ltca`, `rating`, `friction`, `duty_cycle`,
+/// `wear` as the stages ran.
 pub fn summary_sections(
     results: &crate::Results,
 ) -> Result<serde_json::Map<String, serde_json::Value>, OutputError> {
@@ -324,6 +328,9 @@ pub fn summary_sections(
     }
     if let Some(t) = results.thermal.as_ref() {
         map.insert("friction".into(), to_json("friction", t)?);
+    }
+    if let Some(s) = results.spectrum.as_ref() {
+        map.insert("duty_cycle".into(), to_json("duty_cycle", s)?);
     }
     if let Some((life, last)) = results
         .life

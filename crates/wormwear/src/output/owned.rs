@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 const PREFIXES: &[&str] = &[
     "axial_profiles",
     "cad_faces",
+    "duty_cycle",
     "friction_",
     "ltca_",
     "rating",
@@ -64,7 +65,13 @@ pub fn stage_of(name: &str) -> Option<Stage> {
         Some(Stage::Wear)
     } else if starts(&["tca_", "wheel_flank_tca"]) {
         Some(Stage::Tca)
-    } else if starts(&["ltca_", "friction_", "rating", "wheel_flank_ltca"]) {
+    } else if starts(&[
+        "ltca_",
+        "friction_",
+        "duty_cycle",
+        "rating",
+        "wheel_flank_ltca",
+    ]) {
         Some(Stage::Ltca)
     } else if starts(&["report"]) {
         Some(Stage::Report)

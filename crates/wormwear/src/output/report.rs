@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// Sections of the report: title, summary.json section, figures in order: a file stem, or a
 /// name prefix ending with `*` (all the files it starts, numbers in order).
-const SECTIONS: [(&str, &str, &[&str]); 6] = [
+const SECTIONS: [(&str, &str, &[&str]); 7] = [
     (
         "Geometry",
         "geometry",
@@ -40,6 +40,7 @@ const SECTIONS: [(&str, &str, &[&str]); 6] = [
             "ltca_pressure_position*",
         ],
     ),
+    ("Duty cycle (MODEL §14)", "duty_cycle", &["duty_cycle"]),
     (
         "Wear over life",
         "wear",
@@ -355,7 +356,7 @@ fn warnings_section(h: &mut String, summary: &serde_json::Value) {
 
 /// The key results: (label, where in summary.json — a stage's section, or `END` for the last
 /// wear state — key (dotted: nested), scale to the unit, unit).
-const KEY_RESULTS: [(&str, &str, &str, f64, &str); 22] = [
+const KEY_RESULTS: [(&str, &str, &str, f64, &str); 24] = [
     ("Ratio", "geometry", "ratio", 1.0, ""),
     ("Lead angle", "geometry", "lead_angle_deg", 1.0, "deg"),
     (
@@ -480,6 +481,20 @@ const KEY_RESULTS: [(&str, &str, &str, f64, &str); 22] = [
         1e-6,
         "MPa",
     ),
+    (
+        "Duty cycle: efficiency over the energy (MODEL §14)",
+        "duty_cycle",
+        "total_efficiency",
+        1.0,
+        "",
+    ),
+    (
+        "Duty cycle: first pit by Miner's sum over the bins (unworn)",
+        "duty_cycle",
+        "pitting_life_cycles",
+        1.0,
+        "wheel cycles",
+    ),
 ];
 
 /// The section name of [`KEY_RESULTS`] that stands for the last wear state.
@@ -561,6 +576,9 @@ fn stage_section(
     if let Some(serde_json::Value::Array(steps)) = section.get("steps") {
         wear_states_table(h, steps, hours);
     }
+    if let Some(serde_json::Value::Array(bins)) = section.get("bins") {
+        duty_cycle_table(h, bins);
+    }
     for prefix in prefixes {
         let paths = figures(dir, prefix);
         match prefix.strip_suffix('*') {
@@ -618,12 +636,51 @@ fn state_figures(h: &mut String, series: &str, paths: &[PathBuf]) {
 /// speed (the input's `conditions.worm_speed_rpm`); None when either is missing.
 fn hours_per_cycle(summary: &serde_json::Value, input_text: &str) -> Option<f64> {
     let ratio = summary["geometry"]["ratio"].as_f64()?;
-    let input: toml::Table = input_text.parse().ok()?;
-    let rpm = input.get("conditions")?.get("worm_speed_rpm")?;
-    let rpm = rpm
-        .as_float()
-        .or_else(|| rpm.as_integer().map(|i| i as f64))?;
+    // Under a duty cycle, its time-weighted mean speed (MODEL §14).
+    let mean = summary["duty_cycle"]["mean_worm_speed_rpm"].as_f64();
+    let given = || -> Option<f64> {
+        let input: toml::Table = input_text.parse().ok()?;
+        let rpm = input.get("conditions")?.get("worm_speed_rpm")?;
+        rpm.as_float()
+            .or_else(|| rpm.as_integer().map(|i| i as f64))
+    };
+    let rpm = mean.or_else(given)?;
     (rpm > 0.0).then(|| ratio / (rpm * 60.0))
+}
+
+/// The duty cycle's bins (MODEL §14) as a table: load, speed, shares, oil temperature,
+/// efficiency, pressures and each bin's share of the wear and of the pitting damage.
+fn duty_cycle_table(h: &mut String, bins: &[serde_json::Value]) {
+    const COLUMNS: [(&str, &str, f64, usize); 12] = [
+        ("bin", "bin", 1.0, 0),
+        ("worm torque (N m)", "worm_torque_nm", 1.0, 2),
+        ("wheel torque (N m)", "wheel_torque_nm", 1.0, 1),
+        ("worm speed (rpm)", "worm_speed_rpm", 1.0, 0),
+        ("time share", "time_share", 1.0, 3),
+        ("cycle share", "cycle_share", 1.0, 3),
+        ("oil (C)", "oil_temperature_c", 1.0, 1),
+        ("efficiency", "total_efficiency", 1.0, 4),
+        ("P_patch (MPa)", "pressure_patch_max_pa", 1e-6, 0),
+        ("largest p_eq (MPa)", "equivalent_pressure_max_pa", 1e-6, 0),
+        ("wear share (%)", "wear_share", 100.0, 1),
+        ("damage share (%)", "damage_share", 100.0, 1),
+    ];
+    h.push_str("<table><tr>");
+    for (label, ..) in COLUMNS {
+        let _ = write!(h, "<th>{}</th>", escape(label));
+    }
+    h.push_str("</tr>");
+    for b in bins {
+        h.push_str("<tr>");
+        for (_, key, scale, decimals) in COLUMNS {
+            let text = b[key]
+                .as_f64()
+                .map_or("-".into(), |v| format!("{:.*}", decimals, v * scale));
+            let _ = write!(h, "<td class=\"n\">{text}</td>");
+        }
+        h.push_str("</tr>");
+    }
+    h.push_str("</table>");
 }
 
 /// The wear states as a folded table.

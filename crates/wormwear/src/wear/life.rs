@@ -2,6 +2,7 @@
 //! phases of the schedule, pitting between steps, the maps' states, and the checks that a plan can
 //! end and that a life does not stall.
 
+use super::spectrum::{spectrum_cycle_wear, spectrum_node_loads, BinRecord, BinStart};
 use super::{
     cut_pits, forecast, per_cycle, pit_depths, pitted_fraction, Backlash, CycleWear, Phase,
     Pitting, PositionState, StepControl, StepRecord, WearError, WearLimits, WearPlan, WearState,
@@ -11,6 +12,7 @@ use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::kinematics::Tca;
 use crate::ltca::{stats, Ltca};
+use std::borrow::Cow;
 
 /// What the life loop hands out after each completed state: the state (to checkpoint), the
 /// loaded analysis, the per-cycle wear and the friction on that geometry.
@@ -64,7 +66,7 @@ pub fn simulate(
         state.plastic_set = FlankField::zeros(wf);
     }
     check_plan_can_end(gear, life)?;
-    let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life);
+    let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life)?;
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
     // A resumed run recomputes the state its checkpoint holds: its analysis must see the
@@ -73,19 +75,17 @@ pub fn simulate(
     state.records.retain(|r| r.step < state.step);
     let mut stalled = 0;
     loop {
-        let (l, band) = life_loop.analyse(&state)?;
-        let (cw, thermal) = life_loop.cycle_wear(&state, &l)?;
-        let loads = forecast::NodeLoads::new(
-            wf,
-            &l,
-            &cw,
-            &life.endurance,
-            life.pit_depth,
-            life.pitting_stress,
-        );
-        life_loop.start_forecast_phase(&mut state, &loads);
+        let a = life_loop.analyse_state(&state)?;
+        life_loop.start_forecast_phase(&mut state, &a.loads);
         let phase = life_loop.phase_at(&state, state.cycles);
-        let record = life_loop.record(&state, (&l, &thermal), &cw, phase, (step_cycles, substeps));
+        let mut record = life_loop.record(
+            &state,
+            (&a.ltca, &a.thermal),
+            &a.cycle,
+            phase,
+            (step_cycles, substeps),
+        );
+        record.bins = life_loop.bin_records(&a);
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
         state.stopped = life_loop.limits.passed(&record);
@@ -94,9 +94,9 @@ pub fn simulate(
         let last = left <= 1e-9 * life.life_cycles.max(1.0) || state.stopped.is_some();
         on_state(&StepView {
             state: &state,
-            ltca: &l,
-            cycle: &cw,
-            thermal: &thermal,
+            ltca: &a.ltca,
+            cycle: &a.cycle,
+            thermal: &a.thermal,
             last,
             map: life_loop.is_map_state(&state),
         })?;
@@ -105,15 +105,32 @@ pub fn simulate(
         }
         // What the next analysis starts from (after the checkpoint, which keeps what this
         // state's analysis used).
-        state.band_factor = band;
-        state.warm = Some(l.warm_start());
-        state.run_in(&l);
+        carry_starts(&mut state, &a);
         let before = state.cycles;
-        (step_cycles, substeps) = life_loop.step(&mut state, &l, cw, &loads, phase, left)?;
+        (step_cycles, substeps) = life_loop.step(&mut state, &a, phase, left)?;
         state.step += 1;
         stalled = stalled_steps(stalled, before, &state)?;
     }
     Ok(state)
+}
+
+/// Where the next loaded analyses start from after state analysis `a`: its band factors and
+/// warm starts (each bin's with a spectrum), and the running-in of its plastic indentation
+/// (the largest load's, MODEL §5.7, §14).
+fn carry_starts(state: &mut WearState, a: &StateAnalysis) {
+    state.band_factor = a.band;
+    state.warm = Some(a.ltca.warm_start());
+    if !a.bins.is_empty() {
+        state.bin_starts = a
+            .bins
+            .iter()
+            .map(|b| BinStart {
+                band_factor: b.band,
+                warm: Some(b.ltca.warm_start()),
+            })
+            .collect();
+    }
+    state.run_in(&a.ltca);
 }
 
 /// The count of consecutive steps that left the cycles where they were, with the one that
@@ -190,9 +207,7 @@ pub fn check_plan_can_end(gear: &GearSet, life: &WearPlan) -> Result<(), WearErr
 
 /// What the life loop of [`simulate`] works with, and its named steps.
 struct LifeLoop<'a> {
-    gear: &'a GearSet,
     geo: &'a Geometry,
-    tca: &'a Tca,
     settings: &'a crate::ltca::LtcaSettings,
     bending: Option<&'a dyn crate::ltca::BendingModel>,
     life: &'a WearPlan,
@@ -206,8 +221,41 @@ struct LifeLoop<'a> {
     sliding_speed: f64,
     pitting_limit: f64,
     limits: WearLimits,
-    /// MODEL §9's no-load, bearing and seal losses beside the mesh's, W (MODEL §13).
+    /// The bins the life runs (MODEL §14): the gear itself without a spectrum.
+    bins: Vec<LifeBin<'a>>,
+    /// The bin of the largest load (the gear's conditions), whose analysis the records show.
+    reference: usize,
+}
+
+/// One bin of a life (MODEL §14): the gear at the bin, its unloaded analysis and loaded
+/// analysis' settings, its share of the wheel's cycles, and MODEL §9's no-load, bearing and
+/// seal losses beside the mesh's at its speed, W (MODEL §13).
+struct LifeBin<'a> {
+    gear: Cow<'a, GearSet>,
+    tca: Cow<'a, Tca>,
+    settings: crate::ltca::LtcaSettings,
+    cycle_share: f64,
     other_losses: f64,
+}
+
+/// What a state's loaded analyses give (MODEL §7, §14): the analysis the record shows (the
+/// bin of the largest load's) with its band factor and friction, the wear of one cycle and the
+/// damage loads of the whole spectrum, and each bin's own (empty without a spectrum).
+struct StateAnalysis {
+    ltca: Ltca,
+    band: Option<f64>,
+    thermal: Thermal,
+    cycle: CycleWear,
+    loads: forecast::NodeLoads,
+    bins: Vec<BinAnalysis>,
+}
+
+/// One bin's loaded analysis, band factor, wear of one cycle and friction in a state.
+struct BinAnalysis {
+    ltca: Ltca,
+    band: Option<f64>,
+    cycle: CycleWear,
+    thermal: Thermal,
 }
 
 impl<'a> LifeLoop<'a> {
@@ -218,15 +266,14 @@ impl<'a> LifeLoop<'a> {
         settings: &'a crate::ltca::LtcaSettings,
         bending: Option<&'a dyn crate::ltca::BendingModel>,
         life: &'a WearPlan,
-    ) -> Self {
+    ) -> Result<Self, WearError> {
         let wf = geo.wheel_flank(tca.loaded_flank);
         let backlash = Backlash::new(gear, geo, tca);
         let initial_backlash = backlash.per_position(&FlankField::zeros(wf));
         let rating = crate::rating::rate(gear);
-        Self {
-            gear,
+        let (bins, reference) = life_bins(gear, geo, tca, settings)?;
+        Ok(Self {
             geo,
-            tca,
             settings,
             bending,
             life,
@@ -237,8 +284,102 @@ impl<'a> LifeLoop<'a> {
             sliding_speed: rating.sliding_speed_m_s,
             pitting_limit: gear.wheel_material.pitting_limit,
             limits: WearLimits::new(gear, geo, tca, life),
-            other_losses: rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w,
+            bins,
+            reference,
+        })
+    }
+
+    /// The loaded analyses of a state (MODEL §7, §14): the gear's, or each bin's with the
+    /// spectrum's wear of a cycle and damage loads summed over them.
+    fn analyse_state(&self, state: &WearState) -> Result<StateAnalysis, WearError> {
+        if self.bins.len() == 1 {
+            let (ltca, band) = self.analyse(state, 0)?;
+            let (cycle, thermal) = self.cycle_wear(state, 0, &ltca)?;
+            let loads = self.node_loads(&ltca, &cycle);
+            return Ok(StateAnalysis {
+                ltca,
+                band,
+                thermal,
+                cycle,
+                loads,
+                bins: Vec::new(),
+            });
         }
+        let mut bins = Vec::new();
+        for b in 0..self.bins.len() {
+            let (ltca, band) = self.analyse(state, b)?;
+            let (cycle, thermal) = self.cycle_wear(state, b, &ltca)?;
+            bins.push(BinAnalysis {
+                ltca,
+                band,
+                cycle,
+                thermal,
+            });
+        }
+        let shares = self.bins.iter().map(|b| b.cycle_share);
+        let wear: Vec<(f64, &CycleWear)> =
+            shares.clone().zip(bins.iter().map(|a| &a.cycle)).collect();
+        let cycle = spectrum_cycle_wear(&wear, self.reference);
+        let each: Vec<forecast::NodeLoads> = bins
+            .iter()
+            .map(|a| self.node_loads(&a.ltca, &a.cycle))
+            .collect();
+        let parts: Vec<(f64, &forecast::NodeLoads)> = shares.zip(&each).collect();
+        let loads = spectrum_node_loads(&parts, &self.life.endurance);
+        let r = &bins[self.reference];
+        Ok(StateAnalysis {
+            ltca: r.ltca.clone(),
+            band: r.band,
+            thermal: r.thermal.clone(),
+            cycle,
+            loads,
+            bins,
+        })
+    }
+
+    /// The damage loads of the flank's nodes under one loaded analysis and its wear of a cycle.
+    fn node_loads(&self, l: &Ltca, cw: &CycleWear) -> forecast::NodeLoads {
+        let life = self.life;
+        forecast::NodeLoads::new(
+            self.wf,
+            l,
+            cw,
+            &life.endurance,
+            life.pit_depth,
+            life.pitting_stress,
+        )
+    }
+
+    /// What a record keeps of each bin of a spectrum (empty without one).
+    fn bin_records(&self, a: &StateAnalysis) -> Vec<BinRecord> {
+        a.bins
+            .iter()
+            .zip(&self.bins)
+            .map(|(x, b)| BinRecord::of(b.cycle_share, &x.ltca, &x.cycle, self.wf, &x.thermal))
+            .collect()
+    }
+
+    /// Where bin `b`'s loaded analysis starts in a state: its band factor, the solver's warm
+    /// start and the oil temperature of the last record (K; None at the first state).
+    fn start_of<'s>(
+        &self,
+        state: &'s WearState,
+        b: usize,
+    ) -> (Option<f64>, Option<&'s crate::ltca::WarmStart>, Option<f64>) {
+        let last = state.records.last();
+        if self.bins.len() == 1 {
+            let oil = last.map(|r| r.friction.oil_temperature_k);
+            return (state.band_factor, state.warm.as_ref(), oil);
+        }
+        let start = state.bin_starts.get(b);
+        let oil = last
+            .and_then(|r| r.bins.get(b))
+            .map(|x| x.friction.oil_temperature_k);
+        (
+            start.and_then(|s| s.band_factor),
+            start.and_then(|s| s.warm.as_ref()),
+            oil,
+        )
     }
 
     /// The schedule of this life: the plan's, or the one its forecast has found so far.
@@ -289,15 +430,14 @@ impl<'a> LifeLoop<'a> {
     fn step(
         &self,
         state: &mut WearState,
-        l: &Ltca,
-        cw: CycleWear,
-        loads: &forecast::NodeLoads,
+        a: &StateAnalysis,
         phase: Option<(usize, Phase, f64)>,
         left: f64,
     ) -> Result<(f64, usize), WearError> {
+        let (l, cw, loads) = (&a.ltca, &a.cycle, &a.loads);
         let end = match phase {
             Some((k, Phase::Pitting { .. }, end)) => {
-                let advanced = self.pitting_step(state, l, &cw, loads, k, end);
+                let advanced = self.pitting_step(state, l, cw, loads, k, end);
                 return Ok((advanced, 1));
             }
             Some((_, Phase::Wear { .. }, end)) => end,
@@ -322,7 +462,7 @@ impl<'a> LifeLoop<'a> {
             StepControl::MaxRemoval(_) => left,
         };
         let target = state.cycles + step_cycles;
-        let substeps = self.wear_step(state, cw, step_cycles)?;
+        let substeps = self.wear_step(state, cw.clone(), step_cycles)?;
         // The sub-steps' sum lands on the step's end, and a step to a phase's end on that
         // end, exactly: a schedule's phases then start at the cycles they were found at.
         state.cycles = if (end - target).abs() <= 1e-9 * end {
@@ -372,13 +512,15 @@ impl<'a> LifeLoop<'a> {
     /// Loaded analysis on the worn geometry. The worn contact widens: the band of the local
     /// meshes starts as wide as the last analysis needed (no repeated widenings), carried in
     /// the state for an exact resume. An unworn flank is analysed as the LTCA stage does.
-    fn analyse(&self, state: &WearState) -> Result<(Ltca, Option<f64>), WearError> {
-        let mut local = *self.settings;
-        local.band_factor = state.band_factor.unwrap_or(self.settings.band_factor);
+    fn analyse(&self, state: &WearState, b: usize) -> Result<(Ltca, Option<f64>), WearError> {
+        let bin = &self.bins[b];
+        let (band_factor, warm_start, last) = self.start_of(state, b);
+        let mut local = bin.settings;
+        local.band_factor = band_factor.unwrap_or(bin.settings.band_factor);
         // The friction the pressures carry at the last state's oil temperature (MODEL §13:
         // the heat balance's lags one state); the first state's from the fixed point.
-        let last = state.records.last().map(|r| r.friction.oil_temperature_k);
-        if let Some(t) = last.filter(|t| *t > 0.0 && self.gear.housing.balance) {
+        let gear: &GearSet = &bin.gear;
+        if let Some(t) = last.filter(|t| *t > 0.0 && gear.housing.balance) {
             local.oil_temperature = t;
         }
         let changed = |f: &FlankField| f.values.iter().any(|&h| h != 0.0);
@@ -389,13 +531,13 @@ impl<'a> LifeLoop<'a> {
         let analyse = |settings: &crate::ltca::LtcaSettings,
                        warm: Option<&crate::ltca::WarmStart>| {
             crate::ltca::analyse_changed(
-                self.gear,
+                gear,
                 self.geo,
-                self.tca,
+                &bin.tca,
                 settings,
                 self.bending,
                 change,
-                warm.or(state.warm.as_ref()),
+                warm.or(warm_start),
             )
             .map_err(|source| WearError::Ltca {
                 step: state.step,
@@ -407,8 +549,8 @@ impl<'a> LifeLoop<'a> {
         let l = match last {
             Some(_) => first,
             None => {
-                let inputs = (self.gear, self.geo, self.tca);
-                let other = self.other_losses;
+                let inputs = (gear, self.geo, &*bin.tca);
+                let other = bin.other_losses;
                 crate::friction::oil_fixed_point(inputs, other, (local, first), analyse)?
             }
         };
@@ -420,7 +562,7 @@ impl<'a> LifeLoop<'a> {
             .unwrap_or(0);
         let band = (widenings > 0)
             .then(|| (local.band_factor * 1.6f64.powi(widenings as i32)).min(50.0))
-            .or(state.band_factor);
+            .or(band_factor);
         Ok((l, band))
     }
 
@@ -457,14 +599,20 @@ impl<'a> LifeLoop<'a> {
     /// The wear of one cycle of a state's loaded analysis `l` (MODEL §7.2) and its friction
     /// (MODEL §13): with the heat balance, the film of the wear at the balance's oil
     /// temperature (from the last record's, the temperature it starts from).
-    fn cycle_wear(&self, state: &WearState, l: &Ltca) -> Result<(CycleWear, Thermal), WearError> {
-        let gear = self.gear;
-        let contacts = MeshContacts::new(gear, self.geo, self.tca, l);
-        let start = state.records.last().map(|r| r.friction.oil_temperature_k);
+    fn cycle_wear(
+        &self,
+        state: &WearState,
+        b: usize,
+        l: &Ltca,
+    ) -> Result<(CycleWear, Thermal), WearError> {
+        let bin = &self.bins[b];
+        let (gear, tca) = (&*bin.gear, &*bin.tca);
+        let contacts = MeshContacts::new(gear, self.geo, tca, l);
+        let start = self.start_of(state, b).2;
         let thermal = heat_balance_from(
             &contacts,
             (&gear.lubricant, &gear.friction, &gear.housing),
-            self.other_losses,
+            bin.other_losses,
             start.filter(|t| *t > 0.0),
         )
         .map_err(|source| WearError::Friction {
@@ -475,9 +623,9 @@ impl<'a> LifeLoop<'a> {
         let cw = if gear.housing.balance {
             let mut at = gear.clone();
             at.lubricant = gear.lubricant.at_temperature(thermal.oil_temperature_k);
-            per_cycle(&at, self.geo, self.tca, l, self.life.film_load)
+            per_cycle(&at, self.geo, tca, l, self.life.film_load)
         } else {
-            per_cycle(gear, self.geo, self.tca, l, self.life.film_load)
+            per_cycle(gear, self.geo, tca, l, self.life.film_load)
         };
         Ok((cw, thermal))
     }
@@ -501,6 +649,7 @@ impl<'a> LifeLoop<'a> {
         let volume = state.removal.integral(wf);
         let worst_node = argmax(&state.removal.values).map(|k| &wf.nodes[k]);
         let worst_cell = argmax(&l.pattern).map(|k| &wf.cells[k]);
+        let patch = (self.settings.patch_across, self.settings.patch_along);
         StepRecord {
             step: state.step,
             cycles: state.cycles,
@@ -514,11 +663,7 @@ impl<'a> LifeLoop<'a> {
             max_wear_m: state.removal.max(),
             max_wear_r_m: worst_node.map_or(f64::NAN, |n| n.r),
             max_wear_z_m: worst_node.map_or(f64::NAN, |n| n.z),
-            wear_patch_max_m: state.removal.patch_mean_max(
-                wf,
-                self.settings.patch_across,
-                self.settings.patch_along,
-            ),
+            wear_patch_max_m: state.removal.patch_mean_max(wf, patch.0, patch.1),
             mean_wear_m: volume / self.active_area,
             worn_volume_m3: volume,
             backlash_m: b.linear_mean_m,
@@ -561,6 +706,7 @@ impl<'a> LifeLoop<'a> {
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             friction: super::StateFriction::of(thermal),
             positions,
+            bins: Vec::new(),
         }
     }
 
@@ -645,13 +791,58 @@ impl<'a> LifeLoop<'a> {
             if remaining <= 1e-9 * step_cycles {
                 return Ok(substeps);
             }
-            let (l, band) = self.analyse(state)?;
-            state.band_factor = band;
-            state.warm = Some(l.warm_start());
-            state.run_in(&l);
-            rate_map = self.cycle_wear(state, &l)?.0;
+            let a = self.analyse_state(state)?;
+            carry_starts(state, &a);
+            rate_map = a.cycle;
         }
     }
+}
+
+/// The bins of a life (MODEL §14) and the index of the largest load's: the gear itself without
+/// a spectrum; with one, each bin's gear, its own unloaded analysis (the sliding speeds follow
+/// the worm speed; the largest load's is `tca`, the gear's conditions) and settings.
+fn life_bins<'a>(
+    gear: &'a GearSet,
+    geo: &Geometry,
+    tca: &'a Tca,
+    settings: &crate::ltca::LtcaSettings,
+) -> Result<(Vec<LifeBin<'a>>, usize), WearError> {
+    let other_losses = |g: &GearSet| {
+        let rating = crate::rating::rate(g);
+        rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w
+    };
+    if !gear.has_spectrum() {
+        let bin = LifeBin {
+            gear: Cow::Borrowed(gear),
+            tca: Cow::Borrowed(tca),
+            settings: *settings,
+            cycle_share: 1.0,
+            other_losses: other_losses(gear),
+        };
+        return Ok((vec![bin], 0));
+    }
+    let duty = gear.duty_bins();
+    let shares = crate::input::cycle_shares(&duty);
+    let reference = crate::input::largest_load_bin(&duty, gear.ratio());
+    let mut bins = Vec::new();
+    for (b, (bin, share)) in duty.iter().zip(shares).enumerate() {
+        let at = gear.at_bin(bin);
+        let tca = match b == reference {
+            true => Cow::Borrowed(tca),
+            false => Cow::Owned(
+                crate::kinematics::analyse(&at, geo)
+                    .map_err(|source| WearError::Bin { bin: b + 1, source })?,
+            ),
+        };
+        bins.push(LifeBin {
+            settings: crate::ltca::LtcaSettings::from_gear(&at),
+            other_losses: other_losses(&at),
+            gear: Cow::Owned(at),
+            tca,
+            cycle_share: share,
+        });
+    }
+    Ok((bins, reference))
 }
 
 /// The cycles a phase lasts until.

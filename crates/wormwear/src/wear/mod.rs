@@ -22,6 +22,7 @@ mod cycle;
 pub mod forecast;
 mod life;
 mod limits;
+pub mod spectrum;
 mod state;
 
 pub use backlash::*;
@@ -80,6 +81,13 @@ pub enum WearError {
         cycles: f64,
         #[source]
         source: crate::friction::FrictionError,
+    },
+    /// The unloaded analysis of a duty-cycle bin (counted from 1) failed.
+    #[error("the unloaded analysis of duty-cycle bin {bin}")]
+    Bin {
+        bin: usize,
+        #[source]
+        source: crate::kinematics::KinematicsError,
     },
     #[error("the checkpoint does not match this gear's flank grid ({0})")]
     Checkpoint(String),

@@ -47,6 +47,10 @@ pub struct WearState {
     /// The schedule a pitting forecast has found so far (empty without a forecast).
     #[serde(default)]
     pub found_phases: Vec<Phase>,
+    /// Where each duty-cycle bin's loaded analysis starts (MODEL §14; empty without a
+    /// spectrum, whose one analysis starts from `band_factor` and `warm`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bin_starts: Vec<super::spectrum::BinStart>,
 }
 
 impl WearState {
@@ -91,6 +95,7 @@ impl WearState {
             stopped: None,
             damage: Vec::new(),
             found_phases: Vec::new(),
+            bin_starts: Vec::new(),
         }
     }
 
@@ -248,6 +253,11 @@ pub struct StepRecord {
     /// `wear_positions.csv`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub positions: Vec<PositionState>,
+    /// Each duty-cycle bin's figures in this state (MODEL §14; empty without a spectrum, whose
+    /// record's figures are its one analysis'). With a spectrum the record's loaded-analysis
+    /// figures are the bin of the largest load's, its wear and damage the spectrum's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bins: Vec<super::spectrum::BinRecord>,
 }
 
 /// Friction of a state's contact (MODEL §13): load-weighted mean coefficient, mesh loss P_Vz

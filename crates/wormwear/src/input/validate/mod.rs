@@ -9,12 +9,14 @@
 //! and [`validate`], which calls them in order.
 
 mod analysis;
+mod duty;
 mod life;
 mod mesh;
 mod service;
 mod worm;
 
 use analysis::*;
+use duty::*;
 use life::*;
 use mesh::*;
 use service::*;
@@ -157,11 +159,36 @@ fn mesh_checks(
 
 /// The lubricant, its friction law and the housing's heat balance (MODEL §6, §13); each is
 /// checked, so their errors all come.
-fn oil_parts(ck: &mut Checker, f: &GearFile) -> Option<(Lubricant, FrictionLaw, Housing)> {
+/// `worm_speed_rpm` is the speed the housing's default heat transfer is taken at.
+fn oil_parts(
+    ck: &mut Checker,
+    f: &GearFile,
+    worm_speed_rpm: f64,
+) -> Option<(Lubricant, FrictionLaw, Housing)> {
     let lubricant = lubricant(ck, &f.lubricant);
     let friction = friction_law(ck, &f.lubricant);
-    let housing = housing(ck, &f.housing, &f.lubricant, &f.operating, &f.conditions);
+    let housing = housing(ck, &f.housing, &f.lubricant, &f.operating, worm_speed_rpm);
     Some((lubricant?, friction?, housing?))
+}
+
+/// The oil's parts ([`oil_parts`]) and the operating point or spectrum ([`operation`]); the
+/// lubricant at the oil temperature of the spectrum's bin of the largest load when it has its
+/// own.
+fn oil_and_operation(
+    ck: &mut Checker,
+    f: &GearFile,
+) -> (Option<(Lubricant, FrictionLaw, Housing)>, Option<Operation>) {
+    let ratio = (f.worm.starts > 0 && f.wheel.teeth > 0)
+        .then(|| f.wheel.teeth as f64 / f.worm.starts as f64);
+    let mut oil = oil_parts(ck, f, reference_speed_rpm(f, ratio));
+    let (lube, housing) = (oil.as_ref().map(|o| &o.0), oil.as_ref().map(|o| &o.2));
+    let operation = operation(ck, f, lube, housing, ratio);
+    if let (Some(o), Some(t)) = (&mut oil, operation.as_ref().and_then(|o| o.oil_temperature)) {
+        if t != o.0.temperature {
+            o.0 = o.0.at_temperature(t);
+        }
+    }
+    (oil, operation)
 }
 
 /// Oil temperatures, degC, over which a lubricant's viscosity–temperature law is read within
@@ -191,8 +218,7 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     let op = operating_parts(&mut ck, &f.operating);
     let wheel = wheel_parts(&mut ck, &f.wheel);
     let (worm_material, wheel_material) = materials(&mut ck, &f.materials);
-    let oil = oil_parts(&mut ck, f);
-    let conditions = conditions(&mut ck, &f.conditions);
+    let (oil, operation) = oil_and_operation(&mut ck, f);
     let wear = f.wear.as_ref().and_then(|w| wear_plan(&mut ck, w));
     let rating = rating_factors(&mut ck, &f.rating);
     let bending = bending_plan(&mut ck, &f.bending, &f.worm, &f.wheel, &f.operating);
@@ -214,8 +240,8 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
     ) else {
         unreachable_input()?
     };
-    let (Some(worm_material), Some(wheel_material), Some(oil), Some(conditions)) =
-        (worm_material, wheel_material, oil, conditions)
+    let (Some(worm_material), Some(wheel_material), Some(oil), Some(operation)) =
+        (worm_material, wheel_material, oil, operation)
     else {
         unreachable_input()?
     };
@@ -244,7 +270,8 @@ pub(super) fn validate(f: &GearFile) -> Result<GearSet, InputError> {
         lubricant,
         friction,
         housing,
-        conditions,
+        conditions: operation.conditions,
+        duty_cycle: operation.bins,
         analysis,
         wear,
         rating: rating.unwrap_or_default(),

@@ -236,7 +236,7 @@ pub(super) fn housing(
     h: &HousingSpec,
     l: &LubricantSpec,
     op: &OperatingSpec,
-    c: &ConditionsSpec,
+    worm_speed_rpm: f64,
 ) -> Option<Housing> {
     let balance = ck.choice(
         "lubricant.temperature",
@@ -244,11 +244,9 @@ pub(super) fn housing(
         &[("fixed", false), ("balance", true)],
     );
     const INCH: f64 = 0.0254;
-    // 1 ft lbf/(min in^2 F) in W/(m^2 K).
-    let shigley_unit = 1.355_817_948 / 60.0 / (INCH * INCH) * 1.8;
     let a_inch = (op.centre_distance_mm * 1e-3 / INCH).max(0.0);
     let default_area = 43.2 * a_inch.powf(1.7) * INCH * INCH;
-    let default_coefficient = (c.worm_speed_rpm.max(0.0) / 6494.0 + 0.13) * shigley_unit;
+    let default_coefficient = default_heat_transfer(worm_speed_rpm);
     let mut get = |f: &str, v: Option<f64>, d: f64, lo: f64, hi: f64, unit: &str| match v {
         Some(v) => ck.range(&format!("housing.{f}"), v, lo, hi, unit),
         None => Some(d),
@@ -271,6 +269,16 @@ pub(super) fn housing(
         ambient: ambient? + 273.15,
         cooler: cooler?,
     })
+}
+
+/// The housing's default heat transfer coefficient at worm speed `worm_speed_rpm`, W/(m^2 K):
+/// n1/6494 + 0.13 ft lbf/(min in^2 F) for a case without fan (AGMA's estimate as given in
+/// Shigley's Mechanical Engineering Design, worm gearing).
+pub(super) fn default_heat_transfer(worm_speed_rpm: f64) -> f64 {
+    const INCH: f64 = 0.0254;
+    // 1 ft lbf/(min in^2 F) in W/(m^2 K).
+    let shigley_unit = 1.355_817_948 / 60.0 / (INCH * INCH) * 1.8;
+    (worm_speed_rpm.max(0.0) / 6494.0 + 0.13) * shigley_unit
 }
 
 pub(super) fn rating_factors(ck: &mut Checker, r: &RatingSpec) -> Option<RatingFactors> {
@@ -441,27 +449,42 @@ fn safety_inputs(ck: &mut Checker, r: &RatingSpec) -> Option<SafetyInputs> {
     })
 }
 
-pub(super) fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditions> {
+/// The torque and worm speed of `[conditions]` or of a duty-cycle bin (`section`: the name its
+/// fields are reported under).
+pub(super) fn conditions(
+    ck: &mut Checker,
+    section: &str,
+    c: &ConditionsSpec,
+) -> Option<Conditions> {
+    let field = |name: &str| format!("{section}.{name}");
     let torque = match (c.worm_torque_nm, c.wheel_torque_nm) {
         (Some(t), None) => ck
-            .positive("conditions.worm_torque_nm", t, 1e6, "N m")
+            .positive(&field("worm_torque_nm"), t, 1e6, "N m")
             .map(Torque::Worm),
         (None, Some(t)) => ck
-            .positive("conditions.wheel_torque_nm", t, 1e8, "N m")
+            .positive(&field("wheel_torque_nm"), t, 1e8, "N m")
             .map(Torque::Wheel),
         (Some(_), Some(_)) => {
             ck.fail(
-                "conditions.wheel_torque_nm",
+                &field("wheel_torque_nm"),
                 c.wheel_torque_nm.unwrap_or_default(),
-                "give either conditions.worm_torque_nm or conditions.wheel_torque_nm, not both",
+                format!(
+                    "give either {} or {}, not both",
+                    field("worm_torque_nm"),
+                    field("wheel_torque_nm")
+                ),
             );
             None
         }
         (None, None) => {
             ck.fail(
-                "conditions.worm_torque_nm",
+                &field("worm_torque_nm"),
                 "(missing)",
-                "give conditions.worm_torque_nm or conditions.wheel_torque_nm",
+                format!(
+                    "give {} or {}",
+                    field("worm_torque_nm"),
+                    field("wheel_torque_nm")
+                ),
             );
             None
         }
@@ -469,7 +492,7 @@ pub(super) fn conditions(ck: &mut Checker, c: &ConditionsSpec) -> Option<Conditi
     // Below 1e-3 rpm the film and sliding-speed formulas underflow (1e-300 rpm ended a life
     // in "the reachable cells carry only ... of the load").
     let speed = ck.range(
-        "conditions.worm_speed_rpm",
+        &field("worm_speed_rpm"),
         c.worm_speed_rpm,
         1e-3,
         20_000.0,

@@ -335,6 +335,7 @@ impl LifeWriter {
             warm: state.warm.as_ref(),
             damage: &state.damage,
             found_phases: &state.found_phases,
+            bin_starts: &state.bin_starts,
             record_count: state.records.len(),
             records_sha256: self.records_digest.hex(),
             inputs: self.inputs.as_ref(),

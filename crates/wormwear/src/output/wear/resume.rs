@@ -18,6 +18,8 @@ pub(super) struct CheckpointOut<'a> {
     pub(super) warm: Option<&'a crate::ltca::WarmStart>,
     pub(super) damage: &'a [f64],
     pub(super) found_phases: &'a [crate::wear::Phase],
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    pub(super) bin_starts: &'a [crate::wear::spectrum::BinStart],
     pub(super) record_count: usize,
     /// SHA-256 of the first `record_count` lines of [`RECORDS`] as written (each with its
     /// newline): the records are sealed with the checkpoint.
@@ -46,6 +48,8 @@ pub(super) struct CheckpointIn {
     pub(super) damage: Vec<f64>,
     #[serde(default)]
     pub(super) found_phases: Vec<crate::wear::Phase>,
+    #[serde(default)]
+    pub(super) bin_starts: Vec<crate::wear::spectrum::BinStart>,
     #[serde(default)]
     pub(super) record_count: Option<usize>,
     #[serde(default)]
@@ -184,6 +188,7 @@ pub fn read_resume(
             stopped: None,
             damage: c.damage,
             found_phases: c.found_phases,
+            bin_starts: c.bin_starts,
         },
         c.inputs,
     )))

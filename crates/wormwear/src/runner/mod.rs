@@ -14,6 +14,8 @@ use crate::wear::{CycleWear, StepView, WearError, WearState};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
+mod safety;
+
 /// A stage of the pipeline a request asks for. Each runs the stages it needs before it
 /// (the loaded analysis needs the unloaded one); what is written follows what was asked
 /// ([`crate::output::write_results`]).
@@ -402,6 +404,8 @@ pub struct Results {
     pub thermal: Option<crate::friction::Thermal>,
     /// The safety table from the model (MODEL §9.1), with a loaded analysis.
     pub safety: Option<crate::safety::SafetyTable>,
+    /// The duty cycle's bins on the unworn gear (MODEL §14), with a spectrum.
+    pub spectrum: Option<crate::spectrum::Spectrum>,
     /// The CAD solids, when asked for.
     pub cad: Option<crate::cad::CadSolids>,
     /// Warnings of the stages, each with its stage's prefix where the CLI prints one.
@@ -426,6 +430,8 @@ pub enum RunError {
     Ltca(#[source] crate::ltca::LtcaError),
     #[error("heat balance")]
     Friction(#[source] crate::friction::FrictionError),
+    #[error("duty cycle")]
+    Spectrum(#[source] crate::spectrum::SpectrumError),
     #[error("{}", wear_context(.0))]
     Wear(#[source] WearError),
     #[error("CAD solids")]
@@ -463,7 +469,7 @@ impl RunError {
                 | RunError::Wear(
                     WearError::Checkpoint(_) | WearError::Plan(_) | WearError::Friction { .. }
                 )
-        )
+        ) || matches!(self, RunError::Spectrum(e) if e.is_input())
     }
 }
 
@@ -583,205 +589,17 @@ impl<'a> Pipeline<'a> {
         .map_err(RunError::Friction)
     }
 
-    /// The safety table (MODEL §9.1) beside a loaded analysis: its strength rows from a
-    /// loaded analysis at K_A times the torque (the run's own when K_A is 1), the wear and
-    /// temperature rows from the run's life and heat balance at the nominal torque.
-    pub(crate) fn safety(
-        &mut self,
-        geo: &Geometry,
-        tca: Option<&Tca>,
-        bending: &Bending,
-        (ltca, thermal, life): (
-            Option<&Ltca>,
-            Option<&crate::friction::Thermal>,
-            Option<&Life>,
-        ),
-    ) -> Result<Option<crate::safety::SafetyTable>, RunError> {
-        let (Some(tca), Some(ltca)) = (tca, ltca) else {
-            return Ok(None);
-        };
-        let gear = self.gear;
-        let ka = gear.rating.safety.application_factor;
-        let scaled = (ka != 1.0).then(|| crate::safety::scaled_torque(gear, ka));
-        let ltca_ka = match &scaled {
-            Some(g) => {
-                let mut ignored = Vec::new();
-                Some(loaded_analysis(
-                    g,
-                    geo,
-                    tca,
-                    bending.model.as_ref(),
-                    &mut ignored,
-                )?)
-            }
-            None => None,
-        };
-        let endurance = self
-            .request
-            .life
-            .as_ref()
-            .or(gear.wear.as_ref())
-            .map_or(crate::input::Endurance::DEFAULT, |p| p.endurance);
-        let strength = ltca_ka.as_ref().unwrap_or(ltca);
-        let worm_deflection = match bending.model {
-            Some(_) => Some(self.worm_deflection(geo, strength)?),
-            None => None,
-        };
-        let root_stress = self.root_stress(geo, tca, strength);
-        let sump = self.sump_temperature((geo, tca, bending), ltca, thermal);
-        let table = crate::safety::safety_table(&crate::safety::SafetyInputsOf {
-            gear,
-            iso: &crate::rating::rate(scaled.as_ref().unwrap_or(gear)),
-            ltca: strength,
-            thermal,
-            records: life.map(|l| l.end.records.as_slice()),
-            endurance,
-            worm_deflection,
-            root_stress,
-            sump,
-        });
-        let simulated = life.and_then(|l| l.end.records.last()).map(|r| r.cycles);
-        self.warnings
-            .extend(crate::safety::warnings(&table, endurance, simulated));
-        Ok(Some(table))
-    }
-
-    /// The sump temperature of S_T (MODEL §9.1, §13): the run's own heat balance, or, when the
-    /// run holds the lubricant's fixed temperature and the table has a temperature limit, the
-    /// housing's heat balance at the nominal torque solved for the table alone (its `[housing]`
-    /// inputs or their defaults; with the transmitted torque, the loaded analysis again at the
-    /// balance's temperature, as a run with the balance does); an error is the row's reason.
-    fn sump_temperature(
-        &mut self,
-        (geo, tca, bending): (&Geometry, &Tca, &Bending),
-        ltca: &Ltca,
-        thermal: Option<&crate::friction::Thermal>,
-    ) -> Option<Result<crate::safety::Sump, crate::safety::SumpError>> {
-        if let Some(t) = thermal.filter(|t| t.mode == "balance") {
-            return Some(Ok(crate::safety::Sump {
-                thermal: t.clone(),
-                own: true,
-            }));
-        }
-        let gear = self.gear;
-        gear.rating.safety.oil_temperature_limit?;
-        let rating = crate::rating::rate(gear);
-        let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
-        let mut balanced = gear.clone();
-        balanced.housing.balance = true;
-        let analyse = |settings: &LtcaSettings, warm: Option<&crate::ltca::WarmStart>| {
-            let model = bending.model.as_ref().map(|b| b as &dyn BendingModel);
-            crate::ltca::analyse_worn(&balanced, geo, tca, settings, model, None, warm)
-        };
-        let settings = LtcaSettings::from_gear(&balanced);
-        let inputs = (&balanced, geo, tca);
-        let at_oil =
-            crate::friction::oil_fixed_point(inputs, other, (settings, ltca.clone()), analyse);
-        let ltca = match &at_oil {
-            Ok(l) => l,
-            Err(_) => ltca,
-        };
-        let contacts = crate::friction::MeshContacts::new(gear, geo, tca, ltca);
-        let result = crate::friction::heat_balance(
-            &contacts,
-            &gear.lubricant,
-            &gear.friction,
-            &balanced.housing,
-            other,
-        )
-        .map(|thermal| crate::safety::Sump {
-            thermal,
-            own: false,
-        })
-        .map_err(|e| crate::safety::SumpError {
-            above_c: match &e {
-                crate::friction::FrictionError::NoEquilibrium { limit_c, .. } => Some(*limit_c),
-                _ => None,
-            },
-            message: e.to_string(),
-        });
-        if let Err(e) = result.as_ref().map_err(|e| &e.above_c) {
-            if e.is_none() {
-                self.warnings.push(format!(
-                    "safety: S_T not computed: {}",
-                    result.as_ref().err().map_or("", |e| e.message.as_str())
-                ));
-            }
-        }
-        Some(result)
-    }
-
-    /// The wheel's root stresses under `ltca` (MODEL §9.1) when the safety table asks for them
-    /// (an allowable and a fillet radius given); a failure is the row's reason and a warning.
-    fn root_stress(
-        &mut self,
-        geo: &Geometry,
-        tca: &Tca,
-        ltca: &Ltca,
-    ) -> Option<Result<crate::bending::wheel_root::RootStresses, String>> {
-        let inputs = &self.gear.rating.safety;
-        let (Some(_), Some(radius)) = (inputs.root_stress_allowable, inputs.root_fillet_radius)
-        else {
-            return None;
-        };
-        let level = crate::bending::wheel_root::ROOT_LEVEL;
-        let result = crate::bending::wheel_root::root_stress_cached(
-            self.gear,
-            geo,
-            ltca,
-            (tca.loaded_flank, level, radius),
-            Some(&crate::bending::model::cache_dir()),
-        )
-        .map(|(stresses, warnings)| {
-            self.warnings.extend(warnings);
-            stresses
-        })
-        // The sector's mesh follows the fillet: a failure names the radius it was built with.
-        .map_err(|e| {
-            format!(
-                "{e} (the FE wheel sector with rating.root_fillet_radius_mm = {:.3e} mm; about \
-                 0.2 m_x, the hob's rounded tip edge, meshes)",
-                radius * 1e3
-            )
-        });
-        match &result {
-            Err(e) => self.warnings.push(format!("safety: S_F not computed: {e}")),
-            Ok(r) if r.face_ends.stress > r.interior.stress => self.warnings.push(format!(
-                "safety: the root stress within a module of a face end ({:.1} MPa) exceeds the \
-                 one inside ({:.1} MPa) that S_F uses; near the face ends it depends on the \
-                 mesh (the face edges' contact load), so S_F may be optimistic there",
-                r.face_ends.stress * 1e-6,
-                r.interior.stress * 1e-6
-            )),
-            Ok(_) => {}
-        }
-        Some(result)
-    }
-
-    /// The worm FE model's largest deflection at the mesh point over the positions of `ltca`
-    /// (MODEL §9.1), m; its compliance from the cache or computed once.
-    fn worm_deflection(&mut self, geo: &Geometry, ltca: &Ltca) -> Result<f64, RunError> {
-        let (compliance, warnings) =
-            crate::bending::worm_deflection::mesh_point_compliance(self.gear, geo)
-                .map_err(RunError::Bending)?;
-        self.warnings.extend(warnings);
-        Ok(ltca
-            .positions
-            .iter()
-            .map(|p| compliance.lateral_deflection(&p.worm_force()))
-            .fold(0.0, f64::max))
-    }
-
     /// The results of the run, with the ratings (MODEL §9) beside a loaded stage.
     pub(crate) fn results(
         self,
         geometry: Geometry,
         tca: Option<Tca>,
         bending: Bending,
-        (ltca, thermal, safety): (
+        (ltca, thermal, safety, spectrum): (
             Option<Ltca>,
             Option<crate::friction::Thermal>,
             Option<crate::safety::SafetyTable>,
+            Option<crate::spectrum::Spectrum>,
         ),
         life: Option<Life>,
         cad: Option<crate::cad::CadSolids>,
@@ -789,6 +607,7 @@ impl<'a> Pipeline<'a> {
         Results {
             thermal,
             safety,
+            spectrum,
             rating: self
                 .request
                 .needs_bending()
@@ -907,23 +726,10 @@ pub(crate) fn loaded_analysis(
     bending: Option<&FeBending>,
     warnings: &mut Vec<String>,
 ) -> Result<Ltca, RunError> {
-    let analyse = |settings: &LtcaSettings, warm: Option<&crate::ltca::WarmStart>| {
-        let model = bending.map(|b| b as &dyn BendingModel);
-        crate::ltca::analyse_worn(gear, geo, tca, settings, model, None, warm)
-            .map_err(RunError::Ltca)
-    };
-    let rating = crate::rating::rate(gear);
-    let other = rating.loss_churning_w + rating.loss_bearings_w + rating.loss_seals_w;
-    let settings = LtcaSettings::from_gear(gear);
-    let first = analyse(&settings, None)?;
-    let result =
-        crate::friction::oil_fixed_point((gear, geo, tca), other, (settings, first), analyse)?;
-    warnings.extend(
-        result
-            .warnings
-            .iter()
-            .map(|w| format!("loaded analysis: {w}")),
-    );
+    let model = bending.map(|b| b as &dyn BendingModel);
+    let result = crate::friction::unworn_analysis(gear, geo, tca, model).map_err(RunError::Ltca)?;
+    let said = result.warnings.iter();
+    warnings.extend(said.map(|w| format!("loaded analysis: {w}")));
     Ok(result)
 }
 
