@@ -3,6 +3,12 @@
 //! shares of the wear and of the pitting damage, Miner's sum of the damage over the bins and the
 //! damage-equivalent pressure S_H reads, the hottest bin S_T reads.
 //!
+//! Miner's sum reads each bin's largest equivalent pressure (the figure S_H reads for one
+//! operating point, MODEL §8.1, §9.1) as if the bins' largest acted at one point: conservative
+//! where they lie apart on the flank, exact where one spot decides (the sharp worm tip's trace of
+//! issue 54 at every load), and the one point's figure for a spectrum of identical bins. The life
+//! resolves the damage node by node ([`crate::wear::spectrum`]).
+//!
 //! The bins' shares of the wheel's cycles are their time shares times their worm speeds,
 //! normalised ([`crate::input::cycle_shares`]). A life under the spectrum is
 //! [`crate::wear::spectrum`]'s.
@@ -154,7 +160,7 @@ pub struct SpectrumBin {
     pub worn_volume_per_cycle_m3: f64,
     /// The bin's share of the spectrum's worn volume per wheel cycle.
     pub wear_share: f64,
-    /// The bin's share of the pitting damage at the spectrum's most damaged cell.
+    /// The bin's share of the pitting damage of Miner's sum.
     pub damage_share: f64,
     /// Wheel cycles to the first pit at the bin's largest equivalent pressure alone (the
     /// pressure–life curve, MODEL §8; None: no pressure).
@@ -174,9 +180,9 @@ pub struct Spectrum {
     /// Energy-weighted efficiencies: output energy over input energy over the running time.
     pub mesh_efficiency: f64,
     pub total_efficiency: f64,
-    /// Miner's sum over the bins at the most damaged cell of the flank: its damage-equivalent
-    /// pressure (the constant pressure of the same life on the curve), Pa, and the wheel
-    /// cycles to its first pit (None: no damage).
+    /// Miner's sum over the bins of their largest equivalent pressures: the damage-equivalent
+    /// pressure (the constant pressure of the same life on the curve), Pa, and the wheel cycles
+    /// to the first pit (None: no damage).
     pub equivalent_pressure_pa: f64,
     pub pitting_life_cycles: Option<f64>,
 }
@@ -189,7 +195,16 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
     let wf = geo.wheel_flank(runs[0].tca.loaded_flank);
     let volumes: Vec<f64> = runs.iter().map(|r| r.cycle.depth.integral(wf)).collect();
     let worn: f64 = shares.iter().zip(&volumes).map(|(c, v)| c * v).sum();
-    let (critical, rate) = most_damaged_cell(runs, &shares, curve);
+    let largest: Vec<f64> = runs
+        .iter()
+        .map(|r| r.ltca.equivalent_pressure_max)
+        .collect();
+    let parts: Vec<(f64, f64)> = shares
+        .iter()
+        .copied()
+        .zip(largest.iter().copied())
+        .collect();
+    let rate = miner_rate(&parts, curve);
     let hottest = (0..runs.len())
         .max_by(|&a, &b| {
             let t = |k: usize| runs[k].thermal.oil_temperature_k;
@@ -199,14 +214,7 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
     let mut spectrum_bins = Vec::new();
     for (k, ((run, bin), share)) in runs.iter().zip(&bins).zip(&shares).enumerate() {
         let e = &run.thermal.efficiency;
-        let p_eq = run
-            .ltca
-            .equivalent_pattern
-            .iter()
-            .copied()
-            .fold(0.0, f64::max);
-        let cell_rate =
-            critical.map_or(0.0, |c| share / curve.life(run.ltca.equivalent_pattern[c]));
+        let p_eq = largest[k];
         spectrum_bins.push(SpectrumBin {
             bin: k + 1,
             worm_torque_nm: run.ltca.worm_torque,
@@ -231,7 +239,11 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
             } else {
                 0.0
             },
-            damage_share: if rate > 0.0 { cell_rate / rate } else { 0.0 },
+            damage_share: if rate > 0.0 {
+                share / curve.life(p_eq) / rate
+            } else {
+                0.0
+            },
             pitting_life_cycles: Some(curve.life(p_eq)).filter(|n| n.is_finite()),
         });
     }
@@ -255,25 +267,8 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
     }
 }
 
-/// The cell of the flank with the largest damage per wheel cycle by Miner's sum over the bins,
-/// sum of c_b / N(p_b) with p_b the bin's equivalent pressure there (MODEL §8.1, §14), and
-/// that damage per cycle (None, 0: no cell is loaded).
-pub fn most_damaged_cell(
-    runs: &[BinRun],
-    shares: &[f64],
-    curve: &Endurance,
-) -> (Option<usize>, f64) {
-    let cells = runs[0].ltca.equivalent_pattern.len();
-    let mut best = (None, 0.0);
-    for c in 0..cells {
-        let rate: f64 = runs
-            .iter()
-            .zip(shares)
-            .map(|(r, s)| s / curve.life(r.ltca.equivalent_pattern[c]))
-            .sum();
-        if rate > best.1 {
-            best = (Some(c), rate);
-        }
-    }
-    best
+/// Miner's damage per wheel cycle of `parts` (cycle share, pressure Pa) on `curve`: the sum
+/// of c_b / N(p_b) (MODEL §8, §14).
+pub fn miner_rate(parts: &[(f64, f64)], curve: &Endurance) -> f64 {
+    parts.iter().map(|(c, p)| c / curve.life(*p)).sum()
 }

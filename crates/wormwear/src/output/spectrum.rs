@@ -80,7 +80,7 @@ const BARS: [(&str, usize); 4] = [
     ("running time", 5),
     ("wheel cycles", 0),
     ("wear (worn volume per cycle)", 4),
-    ("pitting damage (most damaged cell)", 1),
+    ("pitting damage (Miner's sum)", 1),
 ];
 
 /// The bar chart of each bin's shares (SVG text, 1000 x 560 px): one group of [`BARS`] per bin,

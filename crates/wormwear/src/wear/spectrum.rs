@@ -119,16 +119,3 @@ pub fn spectrum_node_loads(parts: &[(f64, &NodeLoads)], curve: &Endurance) -> No
         share: parts[0].1.share.clone(),
     }
 }
-
-/// The damage-equivalent pressure of a spectrum at one point (Pa): the constant pressure whose
-/// life on `curve` equals the spectrum's by Miner's sum of `parts` (cycle share, the bin's
-/// pressure): (sum of c_b p_b^(1/k))^k for the curve's exponent k. What S_H compares with the
-/// curve at the required cycles (MODEL §14).
-pub fn damage_equivalent_pressure(parts: &[(f64, f64)], curve: &Endurance) -> f64 {
-    let rate: f64 = parts.iter().map(|(c, p)| c / curve.life(*p)).sum();
-    if rate > 0.0 {
-        curve.pressure(1.0 / rate)
-    } else {
-        0.0
-    }
-}

@@ -145,9 +145,11 @@ fn time_shares(ck: &mut Checker, bins: &[DutyBinSpec]) -> Option<Vec<f64>> {
         .iter()
         .all(|b| b.hours.is_some() && b.time_share.is_none());
     if !by_share && !by_hours {
+        // The first bin with both or neither, or of another kind than the first.
+        let kind = |b: &DutyBinSpec| (b.time_share.is_some(), b.hours.is_some());
         let k = bins
             .iter()
-            .position(|b| b.time_share.is_some() == b.hours.is_some())
+            .position(|b| kind(b).0 == kind(b).1 || kind(b) != kind(&bins[0]))
             .unwrap_or(0);
         ck.fail(
             &format!("duty_cycle[{}]", k + 1),
