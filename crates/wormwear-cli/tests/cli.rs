@@ -53,6 +53,7 @@ fn check_accepts_every_example() {
         "gear-1x40-case-b.toml",
         "gear-1x40-case-c.toml",
         "gear-k-2x25.toml",
+        "gear-1x40-duty-cycle.toml",
     ] {
         let out = bin().arg("check").arg(example(name)).output().unwrap();
         assert!(
@@ -2412,4 +2413,115 @@ fn compare_refuses_what_is_not_a_run_summary_and_never_blocks_on_it() {
     let o = compare();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("device"));
+}
+
+#[test]
+fn an_explicit_one_bin_duty_cycle_writes_the_design_examples_bytes() {
+    // MODEL §14: one operating point is a one-bin spectrum, byte for byte: every file of a run
+    // with its life (records, checkpoint, maps, CSV, SVG) is the same; summary.json differs only
+    // in the input file's name, report.html in the input's text.
+    let dir = tempfile::tempdir().unwrap();
+    let one_bin = edited_design(
+        dir.path(),
+        "one-bin.toml",
+        &[(
+            "[conditions]\nworm_torque_nm = 60.0\nworm_speed_rpm = 1500.0\n",
+            "[[duty_cycle]]\nworm_torque_nm = 60.0\nworm_speed_rpm = 1500.0\ntime_share = 1.0\n",
+        )],
+    );
+    let args = ["-q", "--cycles", "20000", "--step-cycles", "10000"];
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for (file, out) in [(example("gear-1x40-design.toml"), &a), (one_bin, &b)] {
+        let done = into("run", &file, out, &args).output().unwrap();
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+    }
+    let mut names: Vec<_> = std::fs::read_dir(&a)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert!(
+        names.len() > 50 && names.iter().any(|n| n == "wear_steps.csv"),
+        "{names:?}"
+    );
+    for name in &names {
+        let (x, y) = (
+            std::fs::read(a.join(name)).unwrap(),
+            std::fs::read(b.join(name)).unwrap(),
+        );
+        match name.as_str() {
+            "report.html" => {}
+            "summary.json" => {
+                let read = |t: &[u8]| {
+                    let mut v: serde_json::Value = serde_json::from_slice(t).unwrap();
+                    v.as_object_mut().unwrap().remove("input");
+                    v
+                };
+                assert_eq!(read(&x), read(&y), "summary.json beyond its input section");
+            }
+            _ => assert!(x == y, "{name} differs"),
+        }
+    }
+    assert!(!b.join("duty_cycle.csv").exists());
+}
+
+#[test]
+fn the_duty_cycle_example_runs_its_life_and_rating() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = example("gear-1x40-duty-cycle.toml");
+    let args = ["--cycles", "20000", "--step-cycles", "10000"];
+    let rating = into("rating", &file, dir.path(), &args).output().unwrap();
+    let text = String::from_utf8_lossy(&rating.stdout);
+    assert!(
+        rating.status.success(),
+        "{}",
+        String::from_utf8_lossy(&rating.stderr)
+    );
+    assert!(
+        text.contains("duty cycle (MODEL §14; 3 bins") && text.contains("S_H"),
+        "{text}"
+    );
+    let run = into(
+        "run",
+        &file,
+        dir.path(),
+        &["-q", "--force", "--cycles", "20000"],
+    )
+    .output()
+    .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_files(
+        dir.path(),
+        &[
+            "duty_cycle.csv",
+            "duty_cycle.svg",
+            "wear_steps.csv",
+            "rating.csv",
+        ],
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let bins = summary["duty_cycle"]["bins"].as_array().unwrap();
+    assert_eq!(bins.len(), 3);
+    // Every record of the life carries its three bins, and their cycle shares sum to 1.
+    for step in summary["wear"]["steps"].as_array().unwrap() {
+        let shares: f64 = step["bins"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["cycle_share"].as_f64().unwrap())
+            .sum();
+        assert!((shares - 1.0).abs() < 1e-12, "{shares}");
+    }
+    let report = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    assert!(report.contains("Duty cycle (MODEL §14)") && report.contains("damage share (%)"));
 }
