@@ -775,3 +775,162 @@ fn deeply_nested_json_is_named_as_such() {
         .to_string();
     assert!(err.contains("nested deeper than 128 levels"), "{err}");
 }
+
+/// The duty-cycle example (MODEL §14) with its bins as `edit` makes them.
+fn spectrum_gear(edit: impl Fn(&str) -> String) -> GearSet {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-duty-cycle.toml");
+    input::load_from_str(&edit(&std::fs::read_to_string(path).unwrap())).unwrap()
+}
+
+#[test]
+fn a_duty_cycle_goes_out_as_a_load_spectrum_and_comes_back() {
+    // Three bins, one given by its wheel torque and one with its own oil temperature; the
+    // other worm rotation (a negative speed in the load cases).
+    let gear = spectrum_gear(|t| {
+        t.replace(
+            "worm_torque_nm = 60.0\nworm_speed_rpm = 1000.0",
+            "wheel_torque_nm = 1800.0\nworm_speed_rpm = 1000.0\noil_temperature_c = 75.0",
+        )
+        .replace(
+            "worm_rotation = \"positive\"",
+            "worm_rotation = \"negative\"",
+        )
+    });
+    assert_eq!(gear.duty_cycle.len(), 3);
+    for encoding in [Encoding::Xml, Encoding::Json] {
+        let model = rexs::export::stage_model(&gear, None, "2026-11-27T00:00:00Z").unwrap();
+        assert_eq!(model.load_cases.len(), 3);
+        // The varied attributes are in the load cases only (REXS: not in the master model).
+        for c in &model.components {
+            for varied in [
+                "rotational_speed",
+                "torque_around_u_axis",
+                "load_duration_fraction",
+            ] {
+                if c.kind == "shaft" && c.name == "worm shaft" || c.kind == "external_load" {
+                    assert!(c.attribute(varied).is_none(), "{} {varied}", c.kind);
+                }
+            }
+        }
+        let text = rexs::to_string(&model, encoding);
+        let back = rexs::parse_bytes(text.as_bytes(), "exported").unwrap();
+        // XML carries no value types (its scalars come back as text): the cases' ids and
+        // attributes there, the whole cases through JSON.
+        let ids = |m: &Model| -> Vec<(u64, Vec<(u64, String)>)> {
+            m.load_cases
+                .iter()
+                .map(|c| {
+                    let attrs = c.components.iter().flat_map(|x| {
+                        x.attributes
+                            .iter()
+                            .map(move |a| (x.id, format!("{} {}", a.id, a.value)))
+                    });
+                    (c.id, attrs.collect())
+                })
+                .collect()
+        };
+        assert_eq!(ids(&back), ids(&model));
+        if matches!(encoding, Encoding::Json) {
+            assert_eq!(back.load_cases, model.load_cases);
+        }
+        let imp = import::import(&back, None, "exported").unwrap();
+        let second = input::load_from_str(&imp.text)
+            .unwrap_or_else(|e| panic!("{e}\n--- gear file ---\n{}", imp.text));
+        assert_eq!(second.rotation, Rotation::Negative);
+        assert_eq!(second.conditions, gear.conditions);
+        assert_eq!(second.duty_cycle.len(), 3);
+        for (a, b) in gear.duty_cycle.iter().zip(&second.duty_cycle) {
+            assert_eq!(a.conditions.torque, b.conditions.torque);
+            assert!(close(
+                a.conditions.worm_speed,
+                b.conditions.worm_speed,
+                1e-12
+            ));
+            assert!(close(a.time_share, b.time_share, 1e-12));
+            assert!(close(a.oil_temperature, b.oil_temperature, 1e-12));
+        }
+    }
+}
+
+#[test]
+fn a_load_spectrum_varying_the_torque_over_hours_is_read_on_the_master_model() {
+    // A hand-made spectrum on the ZA stage: the speed stays in the master model, each load
+    // case varies the defining torque and gives its hours (load_duration, in minutes for one).
+    let mut model = rexs::read(&data("za-1x40-left.rexsj")).unwrap();
+    let load = model
+        .components
+        .iter()
+        .find(|c| {
+            c.kind == "external_load"
+                && c.attribute("defines_torque").map(|a| a.value.to_string()) == Some("true".into())
+        })
+        .map(|c| c.id)
+        .expect("the stage's defining load");
+    let unit = model
+        .components
+        .iter()
+        .find(|c| c.kind == "gear_unit")
+        .unwrap()
+        .id;
+    let case = |id: u64, torque: f64, duration: (f64, &str)| rexs::LoadCase {
+        id,
+        components: vec![
+            rexs::Component {
+                id: load,
+                kind: "external_load".into(),
+                name: String::new(),
+                attributes: vec![rexs::Attribute {
+                    id: "torque_around_u_axis".into(),
+                    unit: "N m".into(),
+                    value: rexs::Value::Float(torque),
+                }],
+            },
+            rexs::Component {
+                id: unit,
+                kind: "gear_unit".into(),
+                name: String::new(),
+                attributes: vec![rexs::Attribute {
+                    id: "load_duration".into(),
+                    unit: duration.1.into(),
+                    value: rexs::Value::Float(duration.0),
+                }],
+            },
+        ],
+    };
+    model.load_cases = vec![case(1, 40.0, (300.0, "h")), case(2, 80.0, (6000.0, "min"))];
+    let text = rexs::to_string(&model, Encoding::Json);
+    let back = rexs::parse_bytes(text.as_bytes(), "spectrum.rexsj").unwrap();
+    let imp = import::import(&back, None, "spectrum").unwrap();
+    let gear = input::load_from_str(&imp.text).unwrap();
+    let (_, single) = imported(&data("za-1x40-left.rexsj"));
+    assert_eq!(gear.duty_cycle.len(), 2);
+    // 300 h and 100 h: shares 0.75 and 0.25; the speed is the master model's.
+    assert!(close(gear.duty_cycle[0].time_share, 0.75, 1e-12));
+    assert!(close(gear.duty_cycle[1].time_share, 0.25, 1e-12));
+    for b in &gear.duty_cycle {
+        assert_eq!(b.conditions.worm_speed, single.conditions.worm_speed);
+    }
+    let member = |t: Torque| match t {
+        Torque::Worm(_) => "worm",
+        Torque::Wheel(_) => "wheel",
+    };
+    let magnitude = |t: Torque| match t {
+        Torque::Worm(x) | Torque::Wheel(x) => x,
+    };
+    assert_eq!(
+        member(gear.duty_cycle[0].conditions.torque),
+        member(single.conditions.torque)
+    );
+    assert_eq!(magnitude(gear.duty_cycle[0].conditions.torque), 40.0);
+    assert_eq!(magnitude(gear.duty_cycle[1].conditions.torque), 80.0);
+    // A load case without its duration is refused, naming it.
+    model.load_cases[1].components.pop();
+    let err = import::import(&model, None, "spectrum")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("load case 2") && err.contains("load_duration_fraction"),
+        "{err}"
+    );
+}

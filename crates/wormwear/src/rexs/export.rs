@@ -11,7 +11,7 @@
 //! reads these custom attributes back, so import -> export -> import gives the same gear.
 
 use super::import::CUSTOM_PREFIX;
-use super::{Attribute, Component, Model, Ref, Relation, RexsError, Value};
+use super::{Attribute, Component, LoadCase, Model, Ref, Relation, RexsError, Value};
 use crate::input::{BendingKind, GearSet, Hand, ProfileType, Rotation, Torque};
 use crate::Results;
 
@@ -185,6 +185,7 @@ pub fn stage_model(
     let _ = (worm_shaft, wheel_shaft);
     tools(&mut b, gear, worm, wheel);
     references(&mut b, gear, stage, casing, worm, wheel);
+    load_spectrum(&mut b.model, gear);
     if let Some(r) = results {
         let sections = crate::output::summary_sections(r)
             .map_err(|e| RexsError::Model(format!("results: {e}")))?;
@@ -474,6 +475,90 @@ fn loads(
                 (data, "stage_gear_data"),
             ],
         );
+    }
+}
+
+/// The duty cycle as the model's load spectrum (MODEL §14; REXS: a master model and one
+/// sub-model per load case holding only what varies): per bin, the gear unit's
+/// `load_duration_fraction` (%), the worm shaft's signed `rotational_speed`, each external
+/// load's `defines_torque` and `torque_around_u_axis` (0 on the one that does not define it:
+/// every case has the same attributes) and, with a fixed oil temperature, the casing's
+/// `temperature_lubricant`. Those attributes leave the master model. Nothing without a
+/// spectrum.
+fn load_spectrum(model: &mut Model, gear: &GearSet) {
+    if !gear.has_spectrum() {
+        return;
+    }
+    let find = |kind: &str, name: &str| {
+        model
+            .components
+            .iter()
+            .find(|c| c.kind == kind && (name.is_empty() || c.name == name))
+            .map_or(0, |c| c.id)
+    };
+    let unit = find("gear_unit", "");
+    let casing = find("gear_casing", "");
+    let shaft = find("shaft", "worm shaft");
+    let loads = [
+        find("external_load", "worm load"),
+        find("external_load", "wheel load"),
+    ];
+    let oil = !gear.housing.balance;
+    for c in model.components.iter_mut() {
+        let varied: &[&str] = match c.id {
+            id if id == shaft => &["rotational_speed"],
+            id if loads.contains(&id) => &["defines_torque", "torque_around_u_axis"],
+            id if id == casing && oil => &["temperature_lubricant"],
+            _ => &[],
+        };
+        c.attributes.retain(|a| !varied.contains(&a.id.as_str()));
+    }
+    let sign = match (gear.rotation == Rotation::Positive) == (gear.worm.hand == Hand::Right) {
+        true => 1.0,
+        false => -1.0,
+    };
+    let part = |id: u64, kind: &str, attributes: Vec<Attribute>| Component {
+        id,
+        kind: kind.into(),
+        name: String::new(),
+        attributes,
+    };
+    for (k, bin) in gear.duty_cycle.iter().enumerate() {
+        let (worm_t, wheel_t) = match bin.conditions.torque {
+            Torque::Worm(t) => (Some(t), None),
+            Torque::Wheel(t) => (None, Some(t)),
+        };
+        let rpm = bin.conditions.worm_speed * 60.0 / (2.0 * std::f64::consts::PI);
+        let mut components = vec![
+            part(
+                unit,
+                "gear_unit",
+                vec![float("load_duration_fraction", "%", 100.0 * bin.time_share)],
+            ),
+            part(
+                shaft,
+                "shaft",
+                vec![float("rotational_speed", "1 / min", sign * rpm)],
+            ),
+        ];
+        for (id, torque) in loads.into_iter().zip([worm_t, wheel_t]) {
+            components.push(part(
+                id,
+                "external_load",
+                vec![
+                    boolean("defines_torque", torque.is_some()),
+                    float("torque_around_u_axis", "N m", torque.unwrap_or(0.0)),
+                ],
+            ));
+        }
+        if oil {
+            let t = float("temperature_lubricant", "C", bin.oil_temperature - 273.15);
+            components.push(part(casing, "gear_casing", vec![t]));
+        }
+        model.load_cases.push(LoadCase {
+            id: k as u64 + 1,
+            components,
+        });
     }
 }
 

@@ -4,7 +4,7 @@
 //! (`floating_point`, `integer`, `boolean`, `enum`, `string`, `reference_component`,
 //! `floating_point_array`, ...).
 
-use super::{Attribute, Component, Model, Ref, Relation, RexsError, Value};
+use super::{Attribute, Component, LoadCase, Model, Ref, Relation, RexsError, Value};
 use serde_json::{json, Map, Value as Json};
 
 /// What is wrong with a text that does not parse as JSON; nesting beyond the parser's limit
@@ -49,6 +49,21 @@ pub(super) fn parse(text: &str, name: &str) -> Result<Model, RexsError> {
         model
             .components
             .push(component(c).map_err(|e| err(format!("components[{i}]: {e}")))?);
+    }
+    if let Some(spectrum) = m.get("load_spectrum").and_then(Json::as_object) {
+        for (i, case) in array(spectrum, "load_cases").iter().enumerate() {
+            let at = |e: String| err(format!("load_spectrum.load_cases[{i}]: {e}"));
+            let mut components = Vec::new();
+            for c in case
+                .get("components")
+                .and_then(Json::as_array)
+                .map_or(&[][..], |v| v)
+            {
+                components.push(component(c).map_err(at)?);
+            }
+            let id = id_of(case).map_err(at)?;
+            model.load_cases.push(LoadCase { id, components });
+        }
     }
     Ok(model)
 }
@@ -167,26 +182,8 @@ pub(super) fn write(model: &Model) -> String {
             o
         })
         .collect();
-    let components: Vec<Json> = model
-        .components
-        .iter()
-        .map(|c| {
-            let attributes: Vec<Json> = c
-                .attributes
-                .iter()
-                .map(|a| {
-                    let mut o = Map::new();
-                    o.insert("id".into(), json!(a.id));
-                    o.insert("unit".into(), json!(a.unit));
-                    let (k, v) = typed(&a.value);
-                    o.insert(k.into(), v);
-                    Json::Object(o)
-                })
-                .collect();
-            json!({"id": c.id, "type": c.kind, "name": c.name, "attributes": attributes})
-        })
-        .collect();
-    let doc = json!({"model": {
+    let components: Vec<Json> = model.components.iter().map(component_json).collect();
+    let mut doc = json!({"model": {
         "applicationId": model.application_id,
         "applicationVersion": model.application_version,
         "date": model.date,
@@ -194,9 +191,37 @@ pub(super) fn write(model: &Model) -> String {
         "relations": relations,
         "components": components,
     }});
+    if !model.load_cases.is_empty() {
+        let cases: Vec<Json> = model
+            .load_cases
+            .iter()
+            .map(|case| {
+                let components: Vec<Json> = case.components.iter().map(component_json).collect();
+                json!({"id": case.id, "components": components})
+            })
+            .collect();
+        doc["model"]["load_spectrum"] = json!({"id": 1, "load_cases": cases});
+    }
     let mut text = serde_json::to_string_pretty(&doc).unwrap_or_default();
     text.push('\n');
     text
+}
+
+/// A component as a JSON object.
+fn component_json(c: &Component) -> Json {
+    let attributes: Vec<Json> = c
+        .attributes
+        .iter()
+        .map(|a| {
+            let mut o = Map::new();
+            o.insert("id".into(), json!(a.id));
+            o.insert("unit".into(), json!(a.unit));
+            let (k, v) = typed(&a.value);
+            o.insert(k.into(), v);
+            Json::Object(o)
+        })
+        .collect();
+    json!({"id": c.id, "type": c.kind, "name": c.name, "attributes": attributes})
 }
 
 /// The JSON key and value of a typed value (text values as `string`).

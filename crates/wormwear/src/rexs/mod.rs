@@ -25,6 +25,17 @@ pub struct Model {
     pub date: String,
     pub relations: Vec<Relation>,
     pub components: Vec<Component>,
+    /// The load cases of the model's load spectrum (`<load_spectrum>`; empty: none). Each is a
+    /// sub-model holding only the attributes that vary, on components of the master model's
+    /// ids; its accumulation sub-model is not read.
+    pub load_cases: Vec<LoadCase>,
+}
+
+/// One load case of a REXS load spectrum: the varied attributes, by component id.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadCase {
+    pub id: u64,
+    pub components: Vec<Component>,
 }
 
 /// A relation between components (stage, assembly, side, flank, manufacturing_step,
@@ -260,6 +271,28 @@ pub fn to_string(model: &Model, encoding: Encoding) -> String {
 }
 
 impl Model {
+    /// The master model completed by load case `case` (REXS: a master model is calculable with
+    /// one sub-model): each of the case's attributes replaces or joins the one of the same id on
+    /// the master's component of the same id; the load spectrum itself is left out.
+    pub fn with_load_case(&self, case: &LoadCase) -> Model {
+        let mut model = Model {
+            load_cases: Vec::new(),
+            ..self.clone()
+        };
+        for varied in &case.components {
+            let Some(c) = model.components.iter_mut().find(|c| c.id == varied.id) else {
+                continue;
+            };
+            for a in &varied.attributes {
+                match c.attributes.iter_mut().find(|x| x.id == a.id) {
+                    Some(x) => *x = a.clone(),
+                    None => c.attributes.push(a.clone()),
+                }
+            }
+        }
+        model
+    }
+
     /// The component with this id.
     pub fn component(&self, id: u64) -> Option<&Component> {
         self.components.iter().find(|c| c.id == id)

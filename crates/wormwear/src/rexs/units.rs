@@ -31,6 +31,10 @@ pub enum Quantity {
     Conductivity,
     /// Dimensionless.
     Ratio,
+    /// A share of a whole (a load case's load_duration_fraction), to a fraction of 1.
+    Share,
+    /// A duration, to hours.
+    Duration,
 }
 
 impl Quantity {
@@ -49,6 +53,8 @@ impl Quantity {
             Quantity::PressureViscosity => "1/GPa",
             Quantity::Conductivity => "W/(m K)",
             Quantity::Ratio => "-",
+            Quantity::Share => "(fraction of 1)",
+            Quantity::Duration => "h",
         }
     }
 
@@ -67,6 +73,8 @@ impl Quantity {
             Quantity::PressureViscosity => &["mm^2 / N", "m^2 / N", "1 / GPa"],
             Quantity::Conductivity => &["W / (m K)"],
             Quantity::Ratio => &["none", ""],
+            Quantity::Share => &["%", "none", ""],
+            Quantity::Duration => &["h", "min", "s"],
         }
     }
 }
@@ -105,6 +113,11 @@ pub fn convert(value: f64, unit: &str, quantity: Quantity) -> Option<f64> {
         (Quantity::PressureViscosity, "1 / GPa") => 1.0,
         (Quantity::Conductivity, "W / (m K)") => 1.0,
         (Quantity::Ratio, "none" | "") => 1.0,
+        (Quantity::Share, "%") => 0.01,
+        (Quantity::Share, "none" | "") => 1.0,
+        (Quantity::Duration, "h") => 1.0,
+        (Quantity::Duration, "min") => 1.0 / 60.0,
+        (Quantity::Duration, "s") => 1.0 / 3600.0,
         _ => return None,
     };
     Some(value * factor)

@@ -6,7 +6,7 @@
 //! array is `<array><c>..</c>...</array>`, a matrix `<matrix><r><c>..</c></r>...</matrix>`. XML
 //! carries no value types, so scalars are kept as text ([`Value::Text`]) and typed when used.
 
-use super::{Attribute, Component, Model, Ref, Relation, RexsError, Value};
+use super::{Attribute, Component, LoadCase, Model, Ref, Relation, RexsError, Value};
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::{Reader, Writer};
 use std::collections::HashMap;
@@ -22,6 +22,8 @@ pub(super) fn parse(text: &str, name: &str) -> Result<Model, RexsError> {
         relation: None,
         component: None,
         attribute: None,
+        load_case: None,
+        in_accumulation: false,
     };
     let mut open: Vec<String> = Vec::new();
     loop {
@@ -82,6 +84,10 @@ struct Parser<'a> {
     relation: Option<Relation>,
     component: Option<Component>,
     attribute: Option<OpenAttribute>,
+    /// The `<load_case>` being read (its components are the varied attributes).
+    load_case: Option<LoadCase>,
+    /// Inside the load spectrum's `<accumulation>` (not read).
+    in_accumulation: bool,
 }
 
 impl Parser<'_> {
@@ -124,6 +130,22 @@ impl Parser<'_> {
             "relation" => self.open_relation(e, at, empty),
             "ref" => self.open_ref(e, at),
             "component" => self.open_component(e, at, empty),
+            "load_case" => {
+                let id = self.id(&self.attrs(e, at)?, "load_case", at)?;
+                let case = LoadCase {
+                    id,
+                    components: Vec::new(),
+                };
+                match empty {
+                    true => self.model.load_cases.push(case),
+                    false => self.load_case = Some(case),
+                }
+                Ok(())
+            }
+            "accumulation" => {
+                self.in_accumulation = !empty;
+                Ok(())
+            }
             "attribute" if self.component.is_some() => self.open_attribute(e, at, empty),
             "array" | "matrix" | "r" | "c" => {
                 let coded = tag == "array" && self.attrs(e, at)?.contains_key("coding");
@@ -187,10 +209,22 @@ impl Parser<'_> {
             attributes: Vec::new(),
         };
         match empty {
-            true => self.model.components.push(component),
+            true => self.finish_component(component),
             false => self.component = Some(component),
         }
         Ok(())
+    }
+
+    /// A component read: the master model's, the open load case's, or the accumulation's
+    /// (dropped).
+    fn finish_component(&mut self, c: Component) {
+        if self.in_accumulation {
+            return;
+        }
+        match self.load_case.as_mut() {
+            Some(case) => case.components.push(c),
+            None => self.model.components.push(c),
+        }
     }
 
     fn open_attribute(&mut self, e: &BytesStart, at: u64, empty: bool) -> Result<(), RexsError> {
@@ -235,9 +269,15 @@ impl Parser<'_> {
             }
             b"component" => {
                 if let Some(c) = self.component.take() {
-                    self.model.components.push(c);
+                    self.finish_component(c);
                 }
             }
+            b"load_case" => {
+                if let Some(case) = self.load_case.take() {
+                    self.model.load_cases.push(case);
+                }
+            }
+            b"accumulation" => self.in_accumulation = false,
             b"attribute" => {
                 if let Some(att) = self.attribute.take() {
                     let value = attribute_value(&att)
@@ -373,6 +413,20 @@ pub(super) fn write(model: &Model) -> String {
         write_component(&mut w, c);
     }
     let _ = w.write_event(Event::End(BytesEnd::new("components")));
+    if !model.load_cases.is_empty() {
+        let spectrum = BytesStart::new("load_spectrum").with_attributes([("id", "1")]);
+        let _ = w.write_event(Event::Start(spectrum));
+        for case in &model.load_cases {
+            let id = case.id.to_string();
+            let tag = BytesStart::new("load_case").with_attributes([("id", id.as_str())]);
+            let _ = w.write_event(Event::Start(tag));
+            for c in &case.components {
+                write_component(&mut w, c);
+            }
+            let _ = w.write_event(Event::End(BytesEnd::new("load_case")));
+        }
+        let _ = w.write_event(Event::End(BytesEnd::new("load_spectrum")));
+    }
     let _ = w.write_event(Event::End(BytesEnd::new("model")));
     let mut text = String::from_utf8(w.into_inner()).unwrap_or_default();
     text.push('\n');

@@ -36,7 +36,7 @@ use wheel::*;
 use worm::*;
 
 use super::units::{convert, Quantity};
-use super::{Component, Model, RexsError, Value};
+use super::{Component, LoadCase, Model, RexsError, Value};
 use std::cell::RefCell;
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -202,10 +202,18 @@ pub fn import(model: &Model, stage: Option<u64>, source: &str) -> Result<Importe
     let worm = worm_thread(&reader, &parts, &mut out)?;
     hob_thread(&reader, &parts, &worm, &mut out)?;
     let wheel = wheel_blank(&reader, &parts, &worm, &mut out)?;
-    operating(&reader, &parts, &worm, &wheel, &mut out)?;
+    // With a load spectrum the speed's sign (the rotation) is in its load cases: the first's.
+    let first = model.load_cases.first().map(|c| model.with_load_case(c));
+    let turning = first.as_ref().unwrap_or(model);
+    let (turning_reader, turning_parts) = (Reader::new(turning), Parts::locate(turning, &info)?);
+    let rotation = rotation(&turning_reader, &turning_parts, &worm)?;
+    operating(&reader, &parts, (&worm, &wheel), rotation, &mut out)?;
     materials(&reader, &parts, &mut out)?;
     lubricant(&reader, &parts, &mut out)?;
-    conditions(&reader, &parts, &worm, &mut out)?;
+    match model.load_cases.is_empty() {
+        true => conditions(&reader, &parts, &worm, &mut out)?,
+        false => duty_cycle(model, &info, &worm, &mut out)?,
+    }
     bending(&reader, &parts, &worm, &wheel, &mut out)?;
     unused_block(model, &reader, &parts, &mut out);
     Ok(Imported {

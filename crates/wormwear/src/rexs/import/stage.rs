@@ -4,11 +4,12 @@
 use super::*;
 
 /// [operating]: centre distance and its deviations.
+/// `rotation`: the worm's sense of rotation and its source ([`rotation`]).
 pub(super) fn operating(
     reader: &Reader,
     parts: &Parts,
-    worm: &Worm,
-    wheel: &Wheel,
+    (worm, wheel): (&Worm, &Wheel),
+    rotation: (&'static str, String),
     out: &mut GearText,
 ) -> Result<(), RexsError> {
     let s = parts.stage;
@@ -50,7 +51,6 @@ pub(super) fn operating(
     if tilt != 0.0 {
         out.warn(format!("worm_stage.inclination_angle_offset = {tilt} deg is not modelled (only the shaft-angle error is)"));
     }
-    let rotation = rotation(reader, parts, worm)?;
     out.field_text("worm_rotation", rotation.0, Some(&rotation.1));
     let ratio = wheel.teeth as f64 / worm.starts as f64;
     out.note(&format!(
@@ -108,6 +108,100 @@ pub(super) fn conditions(
     worm: &Worm,
     out: &mut GearText,
 ) -> Result<(), RexsError> {
+    let (speed, (member, torque, source)) = load(reader, parts, worm)?;
+    out.section("conditions");
+    out.field(&format!("{member}_torque_nm"), torque, &source);
+    out.field("worm_speed_rpm", speed.0, &speed.1);
+    driving_warning(reader, parts, out);
+    Ok(())
+}
+
+/// The file's note when it has the wheel driving.
+fn driving_warning(reader: &Reader, parts: &Parts, out: &mut GearText) {
+    if let Some(g) = parts.wheel_gear_data {
+        if reader.boolean(g, "is_driving_gear") == Some(true) {
+            out.warn(
+                "the file has the wheel driving; wormwear analyses the worm driving the wheel"
+                    .into(),
+            );
+        }
+    }
+    if let Some(g) = parts.worm_gear_data {
+        let _ = reader.boolean(g, "is_driving_gear");
+    }
+}
+
+/// [[duty_cycle]] from the model's load spectrum (MODEL §14): one bin per load case, its speed
+/// and torque read as `[conditions]` reads them on the master model completed by the case,
+/// its time share from the case's `load_duration_fraction` (or its hours from
+/// `load_duration`), its oil temperature from a varied `temperature_lubricant`.
+pub(super) fn duty_cycle(
+    model: &Model,
+    info: &StageInfo,
+    worm: &Worm,
+    out: &mut GearText,
+) -> Result<(), RexsError> {
+    for case in &model.load_cases {
+        let whole = model.with_load_case(case);
+        let (reader, parts) = (Reader::new(&whole), Parts::locate(&whole, info)?);
+        let (speed, (member, torque, source)) = load(&reader, &parts, worm)?;
+        let at = format!("load case {}", case.id);
+        out.section("[duty_cycle]");
+        out.field(
+            &format!("{member}_torque_nm"),
+            torque,
+            &format!("{at}: {source}"),
+        );
+        out.field("worm_speed_rpm", speed.0, &format!("{at}: {}", speed.1));
+        let (key, value, source) = case_duration(&reader, case)?;
+        out.field(key, value, &format!("{at}: {source}"));
+        let varied = case
+            .components
+            .iter()
+            .find(|c| c.attribute("temperature_lubricant").is_some());
+        if let Some(c) = varied.and_then(|v| whole.component(v.id)) {
+            if let Some(t) = reader.number(c, "temperature_lubricant", Quantity::Temperature)? {
+                let what = format!("{at}: {} [{}].temperature_lubricant", c.kind, c.id);
+                out.field("oil_temperature_c", t, &what);
+            }
+        }
+        if case.id == model.load_cases[0].id {
+            driving_warning(&reader, &parts, out);
+        }
+    }
+    Ok(())
+}
+
+/// A load case's share of the running time: `load_duration_fraction` (as `time_share`) or
+/// `load_duration` (as `hours`) on one of its components.
+fn case_duration(
+    reader: &Reader,
+    case: &LoadCase,
+) -> Result<(&'static str, f64, String), RexsError> {
+    for c in &case.components {
+        if let Some(share) = reader.number(c, "load_duration_fraction", Quantity::Share)? {
+            let source = format!("{} [{}].load_duration_fraction", c.kind, c.id);
+            return Ok(("time_share", share, source));
+        }
+        if let Some(hours) = reader.number(c, "load_duration", Quantity::Duration)? {
+            let source = format!("{} [{}].load_duration", c.kind, c.id);
+            return Ok(("hours", hours, source));
+        }
+    }
+    Err(RexsError::Model(format!(
+        "load case {}: no load_duration_fraction or load_duration: each load case of the \
+         load spectrum needs its share of the running time",
+        case.id
+    )))
+}
+
+/// The worm speed (rpm, |n|) with its source, and the defining torque ([`torque`]).
+#[allow(clippy::type_complexity)]
+fn load(
+    reader: &Reader,
+    parts: &Parts,
+    worm: &Worm,
+) -> Result<((f64, String), (&'static str, f64, String)), RexsError> {
     let z2 = reader.integer(parts.wheel, "number_of_teeth")?.unwrap_or(1) as f64;
     let ratio = z2 / worm.starts as f64;
     let speed = match worm_speed(reader, parts)? {
@@ -136,22 +230,7 @@ pub(super) fn conditions(
             }
         }
     };
-    let (member, torque, source) = torque(reader, parts)?;
-    out.section("conditions");
-    out.field(&format!("{member}_torque_nm"), torque, &source);
-    out.field("worm_speed_rpm", speed.0, &speed.1);
-    if let Some(g) = parts.wheel_gear_data {
-        if reader.boolean(g, "is_driving_gear") == Some(true) {
-            out.warn(
-                "the file has the wheel driving; wormwear analyses the worm driving the wheel"
-                    .into(),
-            );
-        }
-    }
-    if let Some(g) = parts.worm_gear_data {
-        let _ = reader.boolean(g, "is_driving_gear");
-    }
-    Ok(())
+    Ok((speed, torque(reader, parts)?))
 }
 
 /// The defining torque: "worm" or "wheel", |T| in N m, and its source.
