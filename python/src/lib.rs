@@ -328,7 +328,8 @@ impl NativeResults {
     }
 
     /// A table by name as (column names, columns of numbers): ltca_positions, ltca_pattern,
-    /// ltca_pressures, friction_map, wear_steps, wear_positions, wear_map; None when its stage did not run.
+    /// ltca_pressures, friction_map, duty_cycle, wear_steps, wear_positions, wear_map; None when
+    /// its stage did not run (duty_cycle: without a load spectrum).
     fn table(&self, name: &str) -> PyResult<Option<Columns>> {
         use wormwear::output::{ltca, wear};
         let r = &self.results;
@@ -346,6 +347,10 @@ impl NativeResults {
             "friction_map" => wf
                 .zip(r.thermal.as_ref())
                 .map(|(w, t)| wormwear::output::friction::friction_table(w, t)),
+            "duty_cycle" => r
+                .spectrum
+                .as_ref()
+                .map(wormwear::output::spectrum::spectrum_csv),
             "wear_steps" => life.map(|l| wear::steps_table(&l.end)),
             "wear_positions" => tca
                 .zip(life)
@@ -358,7 +363,7 @@ impl NativeResults {
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "no table {name:?}: ltca_positions, ltca_pattern, ltca_pressures, \
-                     friction_map, wear_steps, wear_positions, wear_map"
+                     friction_map, duty_cycle, wear_steps, wear_positions, wear_map"
                 )))
             }
         };

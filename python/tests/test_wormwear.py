@@ -444,3 +444,28 @@ def test_arguments_of_the_wrong_kind_are_refused_naming_the_argument(design_file
         wormwear.compare("a", tmp_path / "out")
     with pytest.raises(wormwear.InputError, match=r"with_\(conditions.worm_torque_nm\): nan"):
         gear.with_(**{"conditions.worm_torque_nm": float("nan")})
+
+
+def test_a_duty_cycle_equals_the_cli(cli, tmp_path):
+    # MODEL §14: the spectrum's section and its bins' table, in numbers and files; without
+    # bending and on a coarse grid to be quick.
+    g = wormwear.load(EXAMPLES / "gear-1x40-duty-cycle.toml").with_(
+        **{"bending.model": "none", "analysis.positions": 8,
+           "analysis.flank_cells_height": 20, "analysis.flank_cells_face": 30}
+    )
+    path = tmp_path / "duty.toml"
+    path.write_text(g.to_toml())
+    cli("-q", "ltca", path, "-o", tmp_path / "cli")
+    r = wormwear.run(g, stages=["ltca"])
+    written = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert_close(r.summary["duty_cycle"], written["duty_cycle"])
+    bins = r.duty_cycle.bins
+    file = pd.read_csv(tmp_path / "cli" / "duty_cycle.csv")
+    assert list(bins.columns) == list(file.columns) and len(bins) == 3
+    np.testing.assert_allclose(bins.to_numpy(float), file.to_numpy(float), rtol=6e-11, atol=0)
+    assert list(bins["bin"]) == [1, 2, 3]
+    assert bins["cycle_share"].sum() == pytest.approx(1.0, abs=1e-12)
+    assert r.duty_cycle.largest_load_bin == 3
+    # One operating point has no duty cycle.
+    assert wormwear.run(wormwear.load(EXAMPLES / "gear-1x40-design.toml").with_(
+        **{"bending.model": "none", "analysis.positions": 8}), stages=["ltca"]).duty_cycle is None

@@ -236,6 +236,11 @@ class Results:
       from the contact, MODEL §13), the DataFrame ``table`` (every flank cell: r_mm, z_mm,
       friction_coefficient, friction_power_density_w_m2) and the maps ``coefficient``
       (load-weighted friction coefficient over the cycle) and ``power_density`` (W/m^2);
+    - ``duty_cycle``: with a load spectrum (``[[duty_cycle]]``, MODEL §14), the
+      ``duty_cycle`` section's values (efficiencies over the energy, Miner's first pit, the
+      largest-load and hottest bins) and the DataFrame ``bins`` (one row per bin: torques,
+      speed, time and cycle shares, oil temperature, powers, efficiencies, pressures, wear
+      per cycle, shares of the wear and of the pitting damage); None for one operating point;
     - ``rating``: the standard's ratings (efficiency, sigma_Hm, lives...) and ``safety``, the
       safety table from the model (MODEL §9.1) as a DataFrame: one row per quantity (quantity,
       symbol, unit, value, allowable, safety, minimum, verdict, source; ``attrs`` holds
@@ -267,6 +272,12 @@ class Results:
                 coefficient=FlankMap._from_table(table, "friction_coefficient", "1"),
                 power_density=FlankMap._from_table(table, "friction_power_density_w_m2", "W/m^2"),
             )
+        duty = self.summary.get("duty_cycle")
+        self.duty_cycle = None
+        if duty is not None:
+            self.duty_cycle = _namespace(
+                {k: v for k, v in duty.items() if k != "bins"}, bins=self.table("duty_cycle")
+            )
         ltca = self.summary.get("ltca")
         self.ltca = None
         if ltca is not None:
@@ -292,7 +303,7 @@ class Results:
 
     def table(self, name: str) -> Optional[pd.DataFrame]:
         """A table by its file's name without ``.csv`` (ltca_positions, ltca_pattern,
-        ltca_pressures, friction_map, wear_steps, wear_positions, wear_map), at full precision (the files
+        ltca_pressures, friction_map, duty_cycle, wear_steps, wear_positions, wear_map), at full precision (the files
         round to 11 digits); None if its stage did not run."""
         got = self._native.table(name)
         if got is None:
@@ -302,7 +313,7 @@ class Results:
         for h in header:  # indices and counts as integers, as in the files
             col = frame[h]
             if len(col) and np.all(np.isfinite(col)) and np.all(col == np.round(col)) and (
-                h in ("i", "j", "position", "tooth", "slice", "column", "step", "substeps", "loaded_analyses")
+                h in ("i", "j", "position", "tooth", "slice", "column", "step", "substeps", "loaded_analyses", "bin")
             ):
                 frame[h] = col.astype(np.int64)
         return frame

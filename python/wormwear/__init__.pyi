@@ -51,6 +51,8 @@ class Results:
     #: friction section values (efficiency, oil temperature, MODEL §13) and table (DataFrame),
     #: coefficient / power_density (FlankMap, 1 and W/m^2).
     friction: Optional[types.SimpleNamespace]
+    #: with a load spectrum (MODEL §14): the duty_cycle section values and bins (DataFrame).
+    duty_cycle: Optional[types.SimpleNamespace]
     #: the standard's ratings and safety (DataFrame: the safety table from the model).
     rating: Optional[types.SimpleNamespace]
     def table(self, name: str) -> Optional[pd.DataFrame]: ...

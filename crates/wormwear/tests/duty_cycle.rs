@@ -255,6 +255,9 @@ fn a_bad_spectrum_is_refused_naming_the_field() {
         ("[[duty_cycle]]\nworm_torque_nm = 30.0\nwheel_torque_nm = 900.0\nworm_speed_rpm = 1500.0\ntime_share = 1.0\n".into(), false, vec!["duty_cycle[1].wheel_torque_nm", "not both"]),
         ("[[duty_cycle]]\nworm_speed_rpm = 1500.0\ntime_share = 1.0\n".into(), false, vec!["duty_cycle[1].worm_torque_nm", "(missing)"]),
         (String::new(), false, vec!["conditions", "(missing)", "[[duty_cycle]]"]),
+        (bin(30.0, 1500.0, 0.5) + &bin(60.0, 1000.0, 0.5 + 1e-8), false, vec!["duty_cycle.time_share", "must sum to 1"]),
+        ("[[duty_cycle]]\nworm_torque_nm = 30.0\nworm_speed_rpm = 1500.0\nhours = 0.0\n\n[[duty_cycle]]\nworm_torque_nm = 60.0\nworm_speed_rpm = 1000.0\nhours = 10.0\n".into(), false, vec!["duty_cycle[1].hours", "> 0"]),
+        ("[[duty_cycle]]\nworm_torque_nm = 30.0\nworm_speed_rpm = 1500.0\nhours = 5.0\n\n[[duty_cycle]]\nworm_torque_nm = 60.0\nworm_speed_rpm = 1000.0\nhours = -5.0\n".into(), false, vec!["duty_cycle[2].hours", "-5"]),
         (bin(30.0, 1500.0, 1.0).replace("time_share", "oil_temperature_c = 300.0\ntime_share"), false, vec!["duty_cycle[1].oil_temperature_c", "300"]),
         ((0..51).map(|_| bin(30.0, 1500.0, 1.0 / 51.0)).collect(), false, vec!["duty_cycle", "51 bins", "at most 50"]),
     ];
@@ -267,6 +270,23 @@ fn a_bad_spectrum_is_refused_naming_the_field() {
             );
         }
     }
+    // An empty spectrum (a key before the first table).
+    let design = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/gear-1x40-design.toml"),
+    )
+    .unwrap()
+    .replace(
+        "[conditions]\nworm_torque_nm = 60.0\nworm_speed_rpm = 1500.0\n",
+        "",
+    );
+    let message = input::load_from_str(&format!("duty_cycle = []\n{design}"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("duty_cycle = (no bins)") && message.contains("empty spectrum"),
+        "{message}"
+    );
     // A bin's own oil temperature with the heat balance, which finds it.
     let text = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -30,8 +30,8 @@ pub struct GearFile {
     pub conditions: Option<ConditionsSpec>,
     /// Load spectrum (MODEL §14): bins of torque, worm speed and share of the running time;
     /// absent: the one operating point of `[conditions]`.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub duty_cycle: Vec<DutyBinSpec>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duty_cycle: Option<Vec<DutyBinSpec>>,
     #[serde(default)]
     pub analysis: AnalysisSpec,
     /// Life to simulate (wear stage); absent: no life run.

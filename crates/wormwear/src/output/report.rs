@@ -323,7 +323,42 @@ fn safety_section(h: &mut String, summary: &serde_json::Value, hours: Option<f64
             escape(r["source"].as_str().unwrap_or(""))
         );
     }
-    h.push_str("</table></section>\n");
+    h.push_str("</table>");
+    back_driving_rows(h, summary);
+    h.push_str("</section>\n");
+}
+
+/// Beside the safety table: whether the wheel can drive the worm (MODEL §15), at rest and
+/// running, each with its verdict and margin.
+fn back_driving_rows(h: &mut String, summary: &serde_json::Value) {
+    let lock = &summary["friction"]["self_locking"];
+    let (Some(at_rest), Some(running)) = (
+        lock["static_efficiency"].as_f64(),
+        lock["dynamic_efficiency"].as_f64(),
+    ) else {
+        return;
+    };
+    let verdict = |locked: &serde_json::Value| match locked.as_bool() {
+        Some(true) => "self-locking",
+        _ => "back-drivable",
+    };
+    let margin = format!(
+        "boundary friction {} against the {:.4} the gear locks from",
+        number(lock["boundary_friction"].as_f64().unwrap_or(f64::NAN)),
+        lock["locking_friction"].as_f64().unwrap_or(f64::NAN)
+    );
+    let _ = write!(
+        h,
+        "<table><tr><th>back-driving (MODEL §15)</th><th>efficiency eta'</th><th>verdict</th>\
+         <th>how</th></tr><tr><td>static: the wheel driving from rest (boundary friction)</td>\
+         <td class=\"n\">{at_rest:.3}</td><td>{}</td><td>{}</td></tr><tr><td>dynamic: the wheel \
+         driving at the running speed (the contact's friction)</td><td class=\"n\">{running:.3}\
+         </td><td>{}</td><td>eta' = (W - u M1) / (W - M2) from the loaded analysis' moments; \
+         at or below 0 the gear self-locks</td></tr></table>",
+        verdict(&lock["static_self_locking"]),
+        escape(&margin),
+        verdict(&lock["dynamic_self_locking"]),
+    );
 }
 
 /// The warnings of every stage.

@@ -6,8 +6,10 @@ use super::*;
 /// Most bins of a spectrum: each costs a loaded analysis at every state of a life.
 const MAX_BINS: usize = 50;
 
-/// How far the time shares may sum from 1 (they are then scaled to sum to 1 exactly).
-const SHARE_SUM_TOLERANCE: f64 = 1e-3;
+/// How far the time shares may sum from 1 (round-off of decimal shares; they are then scaled
+/// to sum to 1). Shares that do not sum to 1 are a mistake to name, not to scale away: hours
+/// are for durations that need not.
+const SHARE_SUM_TOLERANCE: f64 = 1e-9;
 
 /// What the operating sections give: the conditions the gear is analysed at (with a
 /// spectrum, its bin of the largest load), the spectrum's bins (empty for one point) and
@@ -28,7 +30,17 @@ pub(super) fn operation(
     housing: Option<&Housing>,
     ratio: Option<f64>,
 ) -> Option<Operation> {
-    match (&f.conditions, f.duty_cycle.is_empty()) {
+    let empty = Vec::new();
+    let bins = f.duty_cycle.as_ref().unwrap_or(&empty);
+    if f.duty_cycle.as_ref().is_some_and(|b| b.is_empty()) {
+        ck.fail(
+            "duty_cycle",
+            "(no bins)",
+            "an empty spectrum: give at least one [[duty_cycle]] table, or [conditions]",
+        );
+        return None;
+    }
+    match (&f.conditions, bins.is_empty()) {
         (Some(c), true) => Some(Operation {
             conditions: conditions(ck, "conditions", c)?,
             bins: Vec::new(),
@@ -37,7 +49,7 @@ pub(super) fn operation(
         (Some(_), false) => {
             ck.fail(
                 "duty_cycle",
-                format!("{} bins", f.duty_cycle.len()),
+                format!("{} bins", bins.len()),
                 "give [conditions] (one operating point) or [[duty_cycle]] (a load spectrum), \
                  not both",
             );
@@ -52,7 +64,7 @@ pub(super) fn operation(
             );
             None
         }
-        (None, false) => spectrum(ck, f, lubricant?, housing?, ratio?),
+        (None, false) => spectrum(ck, bins, f, (lubricant?, housing?), ratio?),
     }
 }
 
@@ -70,7 +82,7 @@ pub(super) fn reference_speed_rpm(f: &GearFile, ratio: Option<f64>) -> f64 {
             .unwrap_or(0.0)
     };
     let mut best: Option<&DutyBinSpec> = None;
-    for b in &f.duty_cycle {
+    for b in f.duty_cycle.iter().flatten() {
         if best.is_none_or(|x| load(b) > load(x)) {
             best = Some(b);
         }
@@ -81,23 +93,23 @@ pub(super) fn reference_speed_rpm(f: &GearFile, ratio: Option<f64>) -> f64 {
 /// The bins of `[[duty_cycle]]` (counted from 1 in messages), their shares scaled to sum to 1.
 fn spectrum(
     ck: &mut Checker,
+    specs: &[DutyBinSpec],
     f: &GearFile,
-    lubricant: &Lubricant,
-    housing: &Housing,
+    (lubricant, housing): (&Lubricant, &Housing),
     ratio: f64,
 ) -> Option<Operation> {
-    if f.duty_cycle.len() > MAX_BINS {
+    if specs.len() > MAX_BINS {
         ck.fail(
             "duty_cycle",
-            format!("{} bins", f.duty_cycle.len()),
+            format!("{} bins", specs.len()),
             format!("at most {MAX_BINS} bins (each is a loaded analysis at every state)"),
         );
         return None;
     }
-    let shares = time_shares(ck, &f.duty_cycle)?;
+    let shares = time_shares(ck, specs)?;
     let given_transfer = f.housing.heat_transfer_w_m2k.is_some();
     let mut bins = Vec::new();
-    for (k, (b, share)) in f.duty_cycle.iter().zip(shares).enumerate() {
+    for (k, (b, share)) in specs.iter().zip(shares).enumerate() {
         let name = format!("duty_cycle[{}]", k + 1);
         let spec = ConditionsSpec {
             worm_torque_nm: b.worm_torque_nm,
@@ -120,11 +132,11 @@ fn spectrum(
             heat_transfer,
         });
     }
-    if bins.len() != f.duty_cycle.len() {
+    if bins.len() != specs.len() {
         return None;
     }
     let largest = largest_load_bin(&bins, ratio);
-    let own_oil = f.duty_cycle[largest]
+    let own_oil = specs[largest]
         .oil_temperature_c
         .map(|_| bins[largest].oil_temperature);
     let conditions = bins[largest].conditions.clone();
@@ -183,7 +195,7 @@ fn time_shares(ck: &mut Checker, bins: &[DutyBinSpec]) -> Option<Vec<f64>> {
             total,
             format!(
                 "the bins' time shares sum to {total}; they must sum to 1 (within \
-                 {SHARE_SUM_TOLERANCE}), or give hours instead"
+                 {SHARE_SUM_TOLERANCE:e}), or give each bin's hours instead"
             ),
         );
         return None;
