@@ -692,7 +692,7 @@ impl<'a> LifeLoop<'a> {
                 l.mean_pressure * 1e-6,
                 self.pitting_limit * 1e-6,
             ),
-            loaded_analyses: state.loaded_analyses_before() + substeps.max(1),
+            loaded_analyses: state.loaded_analyses_before() + substeps.max(1) * self.bins.len(),
             thinnest_tooth_m: self.limits.thinnest(&state.removal).0,
             worn_through_loaded: self
                 .limits

@@ -215,7 +215,8 @@ pub struct StepRecord {
     #[serde(default)]
     pub n_li_model_cycles: Option<f64>,
     /// Loaded analyses run so far (this state's included): a step split by the stability
-    /// guard costs one per sub-step (MODEL §7.3: the geometry is frozen within one).
+    /// guard costs one per sub-step (MODEL §7.3: the geometry is frozen within one), one per
+    /// bin of a duty cycle (MODEL §14).
     #[serde(default)]
     pub loaded_analyses: usize,
     /// Thinnest wheel tooth left anywhere on the flank (the normal wear depth that would go
