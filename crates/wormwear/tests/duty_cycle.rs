@@ -261,6 +261,11 @@ fn a_bad_spectrum_is_refused_naming_the_field() {
         (bin(30.0, 1500.0, 1.0).replace("time_share", "oil_temperature_c = 300.0\ntime_share"), false, vec!["duty_cycle[1].oil_temperature_c", "300"]),
         ((0..51).map(|_| bin(30.0, 1500.0, 1.0 / 51.0)).collect(), false, vec!["duty_cycle", "51 bins", "at most 50"]),
     ];
+    let cases = cases.into_iter().chain([(
+        bin(30.0, 1500.0, 0.5) + "[[duty_cycle]]\nworm_torque_nm = 60.0\ntime_share = 0.5\n",
+        false,
+        vec!["duty_cycle[2] is missing the key `worm_speed_rpm`"],
+    )]);
     for (bins, keep, parts) in cases {
         let message = refusal(&bins, keep);
         for p in parts {

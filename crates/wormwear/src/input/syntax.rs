@@ -99,7 +99,19 @@ fn missing_keys(text: &str) -> Vec<String> {
         return Vec::new();
     };
     let mut out = Vec::new();
+    // A load spectrum stands for [conditions]; each of its bins needs its own keys.
+    let spectrum = root.get("duty_cycle").and_then(|v| v.as_array());
+    for (k, bin) in spectrum.into_iter().flatten().enumerate() {
+        let Err(e) = table_check::<super::schema::DutyBinSpec>(bin.clone()) else {
+            continue;
+        };
+        if let Some(key) = e.message().strip_prefix("missing field `") {
+            let key = key.split('`').next().unwrap_or_default();
+            out.push(format!("duty_cycle[{}] is missing the key `{key}`", k + 1));
+        }
+    }
     for &(path, required, check) in REQUIRED_TABLES {
+        let required = required && !(path == "conditions" && spectrum.is_some());
         let table = path
             .split('.')
             .try_fold(&root, |t, part| t.get(part)?.as_table());
