@@ -19,6 +19,7 @@ mod interrupt;
 mod rating_cmd;
 mod request;
 mod rexs_cmd;
+mod sweep_cmd;
 
 #[derive(Parser)]
 #[command(
@@ -239,6 +240,30 @@ enum Command {
         #[arg(long)]
         base_anywhere: bool,
     },
+    /// Spread and uncertainty (MODEL §17): the inputs a spread file gives ranges or normal
+    /// distributions are sampled (a seeded Latin hypercube) and every sample runs as a sweep
+    /// variant; spread.csv (one row per sample: inputs, key results) and spread.json (each
+    /// result's P10 / P50 / P90, min, max, and its rank correlation with each input).
+    /// Resumable as a sweep; the same seed gives the same bytes.
+    #[command(
+        after_help = "Example:\n  wormwear spread examples/spread-assembly.toml -o out/spread\n\n\
+                      Spread file (TOML):\n  \
+                      base = \"gear-1x40-design.toml\"   # relative to the spread file\n  \
+                      stages = [\"ltca\"]                # default; [\"ltca\", \"wear\"] with cycles\n  \
+                      [spread]\n  \
+                      samples = 64\n  \
+                      seed = 1\n  \
+                      [spread.inputs]\n  \
+                      \"operating.centre_distance_error_mm\" = [-0.03, 0.03]         # uniform\n  \
+                      \"lubricant.composite_roughness_um\" = { mean = 1.0, sd = 0.2, min = 0.5 }  # normal"
+    )]
+    Spread {
+        /// Spread file (TOML).
+        file: PathBuf,
+        /// Output directory (created if needed).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Take a worm stage from a REXS file (.rexs XML, .rexsj JSON, .rexsz zip; REXS 1.x) and
     /// write it as a commented gear file, then validate it as `check` does.
     #[command(
@@ -345,6 +370,7 @@ fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, Exi
         | Command::Rating { output, .. }
         | Command::Calibrate { output, .. }
         | Command::Sweep { output, .. }
+        | Command::Spread { output, .. }
         | Command::ExportRexs { output, .. }
         | Command::Validate { output, .. }
         | Command::Compare { output, .. } => Some(output),
@@ -422,7 +448,8 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
             file,
             output,
             base_anywhere,
-        } => sweep(file, output, *base_anywhere, cli.quiet),
+        } => sweep_cmd::sweep(file, output, *base_anywhere, cli.quiet),
+        Command::Spread { file, output } => sweep_cmd::spread(file, output, cli.quiet),
         Command::Import {
             file,
             output,
@@ -920,69 +947,6 @@ fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(),
     })?;
     if !quiet {
         println!("validation written to {}", path.display());
-    }
-    Ok(())
-}
-
-/// Runs a sweep file's variants into `dir`: a line per finished variant on stderr, the rows'
-/// table and page at the end. Fails only when no variant succeeds.
-fn sweep(file: &Path, dir: &Path, base_anywhere: bool, quiet: bool) -> Result<(), Failure> {
-    use wormwear::sweep::{BaseAccess, SweepError};
-    let access = match base_anywhere {
-        true => BaseAccess::Anywhere,
-        false => BaseAccess::Confined,
-    };
-    let study = wormwear::sweep::Sweep::load_with(file, access).map_err(|e| match e {
-        SweepError::Output(_) => Failure::Run(e.into()),
-        _ => Failure::Input(anyhow::Error::new(e).context(format!("in {}", file.display()))),
-    })?;
-    interrupt::sweep_started(dir);
-    if !quiet {
-        eprintln!(
-            "sweep: {} variants of {} on {} threads",
-            study.variants.len(),
-            study.base_file,
-            rayon_threads()
-        );
-    }
-    let on_progress = |p: wormwear::sweep::Progress| {
-        if quiet {
-            return;
-        }
-        let what = match (&p.row.error, p.reused) {
-            (Some(e), _) => format!("failed: {e}"),
-            (None, true) => "reused from an earlier run".to_string(),
-            (None, false) => format!("done in {:.1} s", p.row.seconds),
-        };
-        eprintln!("[{}/{}] {}: {what}", p.done, p.total, p.row.variant);
-    };
-    let rows = wormwear::sweep::run(&study, dir, &on_progress, &|| false)
-        .map_err(|e| Failure::Run(anyhow::Error::new(e).context("sweep")))?;
-    let failed = rows.iter().filter(|r| !r.ok).count();
-    if failed > 0 {
-        eprintln!(
-            "warning: sweep: {failed} of {} variants failed (their errors are in sweep.csv)",
-            rows.len()
-        );
-    }
-    if failed == rows.len() {
-        let first = rows.first().map_or(String::new(), |r| {
-            format!(
-                "; the first, {}: {}",
-                r.variant,
-                r.error.as_deref().unwrap_or("no message")
-            )
-        });
-        return Err(Failure::Run(anyhow::anyhow!(
-            "sweep: every variant failed{first}"
-        )));
-    }
-    if !quiet {
-        println!(
-            "sweep: {} variants ({failed} failed); results in {} (sweep.csv, sweep.html)",
-            rows.len(),
-            dir.display()
-        );
     }
     Ok(())
 }

@@ -41,6 +41,7 @@ pub mod rexs;
 pub mod runner;
 pub mod safety;
 pub mod spectrum;
+pub mod spread;
 pub mod subsurface;
 pub mod sweep;
 pub mod traction;

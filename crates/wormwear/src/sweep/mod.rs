@@ -174,26 +174,7 @@ impl Sweep {
         let text = read(path)?;
         let file: SweepFile = toml::from_str(&text)
             .map_err(|e| SweepError::Invalid(format!("{}: {e}", path.display())))?;
-        let folder = folder_of(path);
-        let base_path = folder.join(&file.base);
-        // A base that cannot be read is named as the sweep file wrote it.
-        let named = |e: SweepError| match e {
-            SweepError::Read { path, message } => SweepError::Invalid(format!(
-                "base = {:?}: cannot read {path}: {message}",
-                file.base
-            )),
-            e => e,
-        };
-        if access == BaseAccess::Confined {
-            confined(folder, &base_path, &file.base).map_err(named)?;
-        }
-        let base_file = base_path.display().to_string();
-        let base = input::parse_document(&read(&base_path).map_err(named)?).map_err(|source| {
-            SweepError::Base {
-                path: base_file.clone(),
-                source,
-            }
-        })?;
+        let (base_file, base) = base_document(folder_of(path), &file.base, access)?;
         let overrides = LifeOverrides {
             cycles: file.cycles,
             step_cycles: file.step_cycles,
@@ -265,9 +246,41 @@ impl Sweep {
     }
 }
 
+/// The base gear file `written` (relative to `folder`) as (its path as given, its document):
+/// readable, TOML, and with `access` confined, inside `folder` or below it.
+pub(crate) fn base_document(
+    folder: &Path,
+    written: &str,
+    access: BaseAccess,
+) -> Result<(String, toml::Table), SweepError> {
+    let base_path = folder.join(written);
+    // A base that cannot be read is named as the file wrote it.
+    let named = |e: SweepError| match e {
+        SweepError::Read { path, message } => {
+            SweepError::Invalid(format!("base = {written:?}: cannot read {path}: {message}"))
+        }
+        e => e,
+    };
+    if access == BaseAccess::Confined {
+        confined(folder, &base_path, written).map_err(named)?;
+    }
+    let base_file = base_path.display().to_string();
+    let text = crate::files::read_text(&base_path, crate::files::INPUT_LIMIT).map_err(|e| {
+        named(SweepError::Read {
+            path: base_file.clone(),
+            message: e.to_string(),
+        })
+    })?;
+    let base = input::parse_document(&text).map_err(|source| SweepError::Base {
+        path: base_file.clone(),
+        source,
+    })?;
+    Ok((base_file, base))
+}
+
 /// The names and values of a table, nested tables flattened to dotted names (`[grid]`
 /// written with bare dotted keys nests them).
-fn flatten(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
+pub(crate) fn flatten(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
     for (key, value) in table {
         let name = match prefix.is_empty() {
             true => key.clone(),

@@ -1,0 +1,270 @@
+//! Spread and uncertainty (MODEL §17): the sampler's marginals against their distributions
+//! (Kolmogorov–Smirnov), percentiles of a known distribution, a linear model's rank
+//! correlations against the analytic correlations, a spread of zero-width ranges against the
+//! nominal run, one seed one set of bytes, and refusals naming the input.
+
+use std::path::Path;
+use wormwear::spread::sampling::{normal_cdf, Distribution};
+use wormwear::spread::{sample_variants, stats, Input, Spread};
+
+/// The values of input `k` over the samples.
+fn column(inputs: &[Input], samples: usize, seed: u64, k: usize) -> Vec<f64> {
+    sample_variants(inputs, samples, seed)
+        .iter()
+        .map(|v| v.values[k].1.as_float().unwrap())
+        .collect()
+}
+
+/// Kolmogorov–Smirnov's statistic of `values` against the CDF `cdf`.
+fn ks(values: &[f64], cdf: impl Fn(f64) -> f64) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len() as f64;
+    v.iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            let f = cdf(x);
+            (f - i as f64 / n).abs().max(((i + 1) as f64 / n - f).abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+fn input(name: &str, distribution: Distribution) -> Input {
+    Input {
+        name: name.into(),
+        distribution,
+    }
+}
+
+#[test]
+fn the_marginals_follow_their_distributions() {
+    let n = 400;
+    // KS's critical value at the 1 % level, 1.63 / sqrt(n); a Latin hypercube stratifies
+    // every marginal, so it lies far below.
+    let critical = 1.63 / (n as f64).sqrt();
+    let inputs = [
+        input(
+            "a",
+            Distribution::Uniform {
+                min: -0.03,
+                max: 0.05,
+            },
+        ),
+        input(
+            "b",
+            Distribution::Normal {
+                mean: 1.0,
+                sd: 0.2,
+                min: f64::NEG_INFINITY,
+                max: f64::INFINITY,
+            },
+        ),
+        input(
+            "c",
+            Distribution::Normal {
+                mean: 1.0,
+                sd: 0.2,
+                min: 0.8,
+                max: 1.5,
+            },
+        ),
+    ];
+    let a = column(&inputs, n, 3, 0);
+    assert!(ks(&a, |x| ((x + 0.03) / 0.08).clamp(0.0, 1.0)) < critical);
+    let b = column(&inputs, n, 3, 1);
+    let d = ks(&b, |x| normal_cdf((x - 1.0) / 0.2));
+    assert!(d < critical, "normal: D = {d}");
+    // The truncated normal: within its bounds, its CDF renormalised over them.
+    let c = column(&inputs, n, 3, 2);
+    assert!(c.iter().all(|x| (0.8..=1.5).contains(x)));
+    let (lo, hi) = (normal_cdf(-1.0), normal_cdf(2.5));
+    let d = ks(&c, |x| (normal_cdf((x - 1.0) / 0.2) - lo) / (hi - lo));
+    assert!(d < critical, "truncated normal: D = {d}");
+    // Against a wrong distribution the statistic says so.
+    assert!(ks(&b, |x| normal_cdf((x - 1.1) / 0.2)) > critical);
+}
+
+#[test]
+fn percentiles_of_a_known_distribution() {
+    let inputs = [input(
+        "x",
+        Distribution::Normal {
+            mean: 0.0,
+            sd: 1.0,
+            min: f64::NEG_INFINITY,
+            max: f64::INFINITY,
+        },
+    )];
+    let x = column(&inputs, 2000, 11, 0);
+    // Phi^-1(0.1) = -1.2816, Phi^-1(0.5) = 0, Phi^-1(0.9) = 1.2816.
+    for (q, expected) in [
+        (0.1, -1.2815515655446004),
+        (0.5, 0.0),
+        (0.9, 1.2815515655446004),
+    ] {
+        let p = stats::percentile(&x, q).unwrap();
+        assert!((p - expected).abs() < 5e-3, "P{}: {p}", q * 100.0);
+    }
+}
+
+#[test]
+fn a_linear_models_rank_correlations_are_its_correlations() {
+    // y = 2 x1 + x2 with x1 uniform on [0, 1] and x2 uniform on [0, 3]: the correlations are
+    // a_i sigma_i / sigma_y = 2 / sqrt 13 and 3 / sqrt 13 (sigma_i = width / sqrt 12); the
+    // rank correlations of this near-Gaussian sum lie within 0.02 of them.
+    let inputs = [
+        input("x1", Distribution::Uniform { min: 0.0, max: 1.0 }),
+        input("x2", Distribution::Uniform { min: 0.0, max: 3.0 }),
+    ];
+    let n = 4000;
+    let (x1, x2) = (column(&inputs, n, 5, 0), column(&inputs, n, 5, 1));
+    let y: Vec<f64> = x1.iter().zip(&x2).map(|(a, b)| 2.0 * a + b).collect();
+    let r1 = stats::spearman(&x1, &y).unwrap();
+    let r2 = stats::spearman(&x2, &y).unwrap();
+    assert!((r1 - 2.0 / 13f64.sqrt()).abs() < 0.02, "{r1}");
+    assert!((r2 - 3.0 / 13f64.sqrt()).abs() < 0.02, "{r2}");
+    // An input the model does not read has none.
+    let inputs3 = [
+        inputs[0].clone(),
+        inputs[1].clone(),
+        input("x3", Distribution::Uniform { min: 0.0, max: 1.0 }),
+    ];
+    let x3 = column(&inputs3, n, 5, 2);
+    let y3: Vec<f64> = column(&inputs3, n, 5, 0)
+        .iter()
+        .zip(column(&inputs3, n, 5, 1))
+        .map(|(a, b)| 2.0 * a + b)
+        .collect();
+    assert!(stats::spearman(&x3, &y3).unwrap().abs() < 0.05);
+}
+
+/// A folder with a fast copy of the design gear (no bending, a coarse grid, no FE root stress)
+/// and a spread file over it with `inputs` and `samples`.
+fn fast_spread(dir: &Path, inputs: &str, samples: usize) -> std::path::PathBuf {
+    let design = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml"),
+    )
+    .unwrap();
+    let gear = design
+        .replace("[bending]\nmodel = \"fe\"", "[bending]\nmodel = \"none\"")
+        .replace("flank_cells_height = 40", "flank_cells_height = 20")
+        .replace("flank_cells_face = 60", "flank_cells_face = 30")
+        .replace("positions = 20", "positions = 6")
+        .replace("root_stress_allowable_mpa = 100.0", "")
+        .replace("root_fillet_radius_mm = 1.0", "");
+    std::fs::write(dir.join("fast.toml"), gear).unwrap();
+    let file = dir.join("spread.toml");
+    std::fs::write(
+        &file,
+        format!("base = \"fast.toml\"\n[spread]\nsamples = {samples}\nseed = 4\n[spread.inputs]\n{inputs}"),
+    )
+    .unwrap();
+    file
+}
+
+#[test]
+fn zero_width_ranges_give_the_nominal_run_and_one_seed_one_set_of_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = fast_spread(
+        dir.path(),
+        "\"operating.centre_distance_error_mm\" = [0.0, 0.0]\n\"operating.worm_offset_mm\" = [0.0, 0.0]\n",
+        3,
+    );
+    let spread = Spread::load(&file).unwrap();
+    let out = wormwear::spread::run(&spread, &dir.path().join("a"), &|_| {}, &|| false).unwrap();
+    // The nominal run of the base, as a gear of its own.
+    let gear = wormwear::input::load(&dir.path().join("fast.toml")).unwrap();
+    let request = wormwear::Request::new([wormwear::Stage::Ltca]);
+    let nominal =
+        wormwear::run(&gear, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
+    let l = nominal.ltca.unwrap();
+    for results in &out.results {
+        assert_eq!(results[0], l.max_pressure);
+        assert_eq!(results[1], l.pressure_patch_max);
+        assert_eq!(results[4], l.te_stats().1);
+        assert_eq!(
+            results[6],
+            nominal.thermal.as_ref().unwrap().efficiency.mesh_efficiency
+        );
+    }
+    // A sampled spread: again into another directory, the same bytes; another seed differs.
+    let file = fast_spread(
+        dir.path(),
+        "\"operating.worm_offset_mm\" = [-0.05, 0.05]\n",
+        3,
+    );
+    let spread = Spread::load(&file).unwrap();
+    for name in ["b", "c"] {
+        wormwear::spread::run(&spread, &dir.path().join(name), &|_| {}, &|| false).unwrap();
+    }
+    for f in ["spread.csv", "spread.json"] {
+        let read = |d: &str| std::fs::read(dir.path().join(d).join(f)).unwrap();
+        assert_eq!(read("b"), read("c"), "{f}");
+    }
+    let other = std::fs::read_to_string(&file)
+        .unwrap()
+        .replace("seed = 4", "seed = 5");
+    std::fs::write(&file, other).unwrap();
+    let reseeded = Spread::load(&file).unwrap();
+    assert_ne!(reseeded.sweep.variants, spread.sweep.variants);
+}
+
+#[test]
+fn a_bad_spread_file_is_refused_naming_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, usize, &[&str]); 8] = [
+        (
+            "\"operating.centre_distance_eror_mm\" = [-0.03, 0.03]\n",
+            4,
+            &[
+                "no field operating.centre_distance_eror_mm",
+                "operating.centre_distance_error_mm",
+            ],
+        ),
+        (
+            "\"worm.profile\" = [0.0, 1.0]\n",
+            4,
+            &["worm.profile", "not a number"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = [0.05, -0.05]\n",
+            4,
+            &["inverted range"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = [0.05]\n",
+            4,
+            &["[min, max]"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = { mean = 0.0, sd = -1.0 }\n",
+            4,
+            &["sd must be >= 0"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = { mean = 0.2, sd = 0.1, max = 0.1 }\n",
+            4,
+            &["the mean 0.2 must lie within"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = [-0.05, 0.05]\n",
+            0,
+            &["spread.samples = 0", "[2, 4096]"],
+        ),
+        (
+            "\"operating.worm_offset_mm\" = [-0.05, 0.05]\n",
+            5000,
+            &["spread.samples = 5000"],
+        ),
+    ];
+    for (inputs, samples, parts) in cases {
+        let file = fast_spread(dir.path(), inputs, samples);
+        let message = match Spread::load(&file) {
+            Ok(_) => panic!("accepted: {inputs}"),
+            Err(e) => e.to_string(),
+        };
+        for p in parts {
+            assert!(message.contains(p), "{p:?} not in {message}");
+        }
+    }
+}
