@@ -2525,3 +2525,28 @@ fn the_duty_cycle_example_runs_its_life_and_rating() {
     let report = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
     assert!(report.contains("Duty cycle (MODEL §14)") && report.contains("damage share (%)"));
 }
+
+#[test]
+fn a_spread_with_an_unknown_field_exits_2_naming_the_nearest() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        example("gear-1x40-design.toml"),
+        dir.path().join("gear.toml"),
+    )
+    .unwrap();
+    let file = dir.path().join("spread.toml");
+    std::fs::write(
+        &file,
+        "base = \"gear.toml\"\n[spread]\nsamples = 8\n[spread.inputs]\n\"operating.worm_ofset_mm\" = [-0.05, 0.05]\n",
+    )
+    .unwrap();
+    let out = into("spread", &file, &dir.path().join("out"), &[])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("operating.worm_ofset_mm") && err.contains("operating.worm_offset_mm"),
+        "{err}"
+    );
+}
