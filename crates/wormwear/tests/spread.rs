@@ -187,6 +187,20 @@ fn zero_width_ranges_give_the_nominal_run_and_one_seed_one_set_of_bytes() {
             nominal.thermal.as_ref().unwrap().efficiency.mesh_efficiency
         );
     }
+    // A fixed field is set in every sample and is not an input.
+    let fixed = fast_spread(
+        dir.path(),
+        "\"operating.worm_offset_mm\" = [-0.05, 0.05]\n[spread.fixed]\n\"analysis.positions\" = 4\n",
+        2,
+    );
+    let with_fixed = Spread::load(&fixed).unwrap();
+    assert_eq!(with_fixed.inputs.len(), 1);
+    for v in &with_fixed.sweep.variants {
+        assert_eq!(
+            v.values[1],
+            ("analysis.positions".to_string(), toml::Value::Integer(4))
+        );
+    }
     // A sampled spread: again into another directory, the same bytes; another seed differs.
     let file = fast_spread(
         dir.path(),
@@ -212,7 +226,9 @@ fn zero_width_ranges_give_the_nominal_run_and_one_seed_one_set_of_bytes() {
 #[test]
 fn a_bad_spread_file_is_refused_naming_the_input() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, usize, &[&str]); 8] = [
+    let cases: [(&str, usize, &[&str]); 10] = [
+        ("\"operating.worm_offset_mm\" = [-0.05, 0.05]\n[spread.fixed]\n\"operating.worm_offset_mm\" = 0.0\n", 4, &["spread.fixed.\"operating.worm_offset_mm\"", "also an input"]),
+        ("\"operating.worm_offset_mm\" = [-0.05, 0.05]\n[spread.fixed]\n\"bending.modle\" = \"none\"\n", 4, &["spread.fixed", "modle"]),
         (
             "\"operating.centre_distance_eror_mm\" = [-0.03, 0.03]\n",
             4,

@@ -59,6 +59,9 @@ struct SpreadSpec {
     #[serde(default)]
     sampler: Option<String>,
     inputs: toml::Table,
+    /// Fields every sample sets to the same value (e.g. `"bending.model" = "none"`).
+    #[serde(default)]
+    fixed: Option<toml::Table>,
 }
 
 /// One uncertain input: its dotted name in the gear file and its distribution.
@@ -113,7 +116,11 @@ impl Spread {
             step_wear_um: file.step_wear_um,
             no_pitting: file.no_pitting,
         };
-        let variants = sample_variants(&inputs, samples, seed);
+        let mut variants = sample_variants(&inputs, samples, seed);
+        let fixed = fixed_values(file.spread.fixed.as_ref(), &base, &inputs)?;
+        for v in &mut variants {
+            v.values.extend(fixed.iter().cloned());
+        }
         let parameters = inputs.iter().map(|i| i.name.clone()).collect();
         let stages = file.stages.unwrap_or_else(|| vec!["ltca".into()]);
         let sweep = Sweep::new(
@@ -131,6 +138,34 @@ impl Spread {
             seed,
         })
     }
+}
+
+/// The fields `[spread.fixed]` sets in every sample, by dotted name: each a field of the base
+/// document (an unknown name is refused with the nearest), none of them an input.
+fn fixed_values(
+    fixed: Option<&toml::Table>,
+    base: &toml::Table,
+    inputs: &[Input],
+) -> Result<Vec<(String, toml::Value)>, SweepError> {
+    let mut values = Vec::new();
+    crate::sweep::flatten(fixed.unwrap_or(&toml::Table::new()), "", &mut values);
+    for (name, _) in &values {
+        let field = format!("spread.fixed.\"{name}\"");
+        if inputs.iter().any(|i| &i.name == name) {
+            return Err(SweepError::Invalid(format!(
+                "{field}: also an input; a field is either sampled or fixed"
+            )));
+        }
+    }
+    // The base with the fixed values must be a valid gear (a misspelt name is refused there).
+    let fixed_variant = Variant {
+        name: "fixed".into(),
+        values: values.clone(),
+    };
+    crate::sweep::variant_document(base, &fixed_variant)
+        .and_then(|d| crate::input::load_document(&d))
+        .map_err(|e| SweepError::Invalid(format!("spread.fixed: {e}")))?;
+    Ok(values)
 }
 
 /// The sample count, 2 to [`MAX_SAMPLES`].
