@@ -29,17 +29,7 @@ pub(crate) fn sweep(
             super::rayon_threads()
         );
     }
-    let on_progress = |p: wormwear::sweep::Progress| {
-        if quiet {
-            return;
-        }
-        let what = match (&p.row.error, p.reused) {
-            (Some(e), _) => format!("failed: {e}"),
-            (None, true) => "reused from an earlier run".to_string(),
-            (None, false) => format!("done in {:.1} s", p.row.seconds),
-        };
-        eprintln!("[{}/{}] {}: {what}", p.done, p.total, p.row.variant);
-    };
+    let on_progress = progress(quiet);
     let rows = wormwear::sweep::run(&study, dir, &on_progress, &|| false)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("sweep")))?;
     let failed = rows.iter().filter(|r| !r.ok).count();
@@ -71,6 +61,21 @@ pub(crate) fn sweep(
     Ok(())
 }
 
+/// The line on stderr for each finished variant or sample (none when `quiet`).
+fn progress(quiet: bool) -> impl Fn(wormwear::sweep::Progress) + Sync {
+    move |p: wormwear::sweep::Progress| {
+        if quiet {
+            return;
+        }
+        let what = match (&p.row.error, p.reused) {
+            (Some(e), _) => format!("failed: {e}"),
+            (None, true) => "reused from an earlier run".to_string(),
+            (None, false) => format!("done in {:.1} s", p.row.seconds),
+        };
+        eprintln!("[{}/{}] {}: {what}", p.done, p.total, p.row.variant);
+    }
+}
+
 /// Runs a spread file's samples into `dir` (MODEL §17): a line per finished sample on stderr,
 /// each key result's P10 / P50 / P90 at the end. Fails only when no sample succeeds.
 pub(crate) fn spread(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure> {
@@ -90,16 +95,7 @@ pub(crate) fn spread(file: &Path, dir: &Path, quiet: bool) -> Result<(), Failure
             super::rayon_threads()
         );
     }
-    let on_progress = |p: wormwear::sweep::Progress| {
-        if !quiet {
-            let what = match (&p.row.error, p.reused) {
-                (Some(e), _) => format!("failed: {e}"),
-                (None, true) => "reused".to_string(),
-                (None, false) => format!("done in {:.1} s", p.row.seconds),
-            };
-            eprintln!("[{}/{}] {}: {what}", p.done, p.total, p.row.variant);
-        }
-    };
+    let on_progress = progress(quiet);
     let out = wormwear::spread::run(&spread, dir, &on_progress, &|| false)
         .map_err(|e| Failure::Run(anyhow::Error::new(e).context("spread")))?;
     let failed = out.rows.iter().filter(|r| !r.ok).count();

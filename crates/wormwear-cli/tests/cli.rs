@@ -1720,22 +1720,25 @@ fn the_library_runner_and_writers_give_the_cli_files_byte_for_byte() {
     }
 }
 
+/// Writes the design example as `dir/gear.toml` and `text` beside it as `dir/name` (a sweep or
+/// spread file over it); returns the latter's path.
+fn beside_a_gear(dir: &Path, name: &str, text: &str) -> PathBuf {
+    std::fs::copy(example("gear-1x40-design.toml"), dir.join("gear.toml")).unwrap();
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
 /// A sweep whose every variant fails says why in its message (the first variant's error), not
 /// only in sweep.csv (issue 38's probe: "every variant failed" named nothing).
 #[test]
 fn a_sweep_whose_variants_all_fail_names_the_first_error() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::copy(
-        example("gear-1x40-design.toml"),
-        dir.path().join("gear.toml"),
-    )
-    .unwrap();
-    let file = dir.path().join("sweep.toml");
-    std::fs::write(
-        &file,
+    let file = beside_a_gear(
+        dir.path(),
+        "sweep.toml",
         "base = \"gear.toml\"\nstages = [\"ltca\"]\n[grid]\n\"conditions.worm_torque\" = [1.0]\n",
-    )
-    .unwrap();
+    );
     // Given by its bare name from its own directory (issue 59: the base was read from "").
     let out = into("sweep", Path::new("sweep.toml"), Path::new("out"), &["-q"])
         .current_dir(dir.path())
@@ -2529,17 +2532,11 @@ fn the_duty_cycle_example_runs_its_life_and_rating() {
 #[test]
 fn a_spread_with_an_unknown_field_exits_2_naming_the_nearest() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::copy(
-        example("gear-1x40-design.toml"),
-        dir.path().join("gear.toml"),
-    )
-    .unwrap();
-    let file = dir.path().join("spread.toml");
-    std::fs::write(
-        &file,
+    let file = beside_a_gear(
+        dir.path(),
+        "spread.toml",
         "base = \"gear.toml\"\n[spread]\nsamples = 8\n[spread.inputs]\n\"operating.worm_ofset_mm\" = [-0.05, 0.05]\n",
-    )
-    .unwrap();
+    );
     let out = into("spread", &file, &dir.path().join("out"), &[])
         .output()
         .unwrap();
