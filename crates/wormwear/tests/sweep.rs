@@ -332,3 +332,66 @@ fn a_sweep_builds_each_bending_model_once_before_its_variants() {
     assert!(distinct_bending_models(&sweep_of(&base, &["tca"]), &all).is_empty());
     assert!(distinct_bending_models(&sweep_of(&fast_base(), &["ltca"]), &all).is_empty());
 }
+
+/// Lives overlap each state's writing with the next state's analysis on the thread pool
+/// (issue 55): a sweep with more lives than the pool has threads holds every thread with a
+/// life, and must still finish (a life waiting for its analysis keeps its pool working), each
+/// life as it runs alone (the same rows on the global pool as on one thread, and as a sweep of
+/// that variant alone).
+#[test]
+fn lives_in_a_sweep_holding_every_pool_thread_finish_as_they_run_alone() {
+    let count = rayon::current_num_threads() + 1;
+    let torques: Vec<String> = (0..count)
+        .map(|k| format!("{:.1}", 30.0 + 30.0 * k as f64 / count as f64))
+        .collect();
+    let grid: toml::Table = toml::from_str(&format!(
+        r#""conditions.worm_torque_nm" = [{}]"#,
+        torques.join(", ")
+    ))
+    .unwrap();
+    let (parameters, variants) = grid_variants(&grid).unwrap();
+    let stages = ["wear".to_string()];
+    let overrides = LifeOverrides {
+        cycles: Some(3e4),
+        step_cycles: Some(1e4),
+        ..Default::default()
+    };
+    let sweep = |variants: Vec<Variant>| {
+        Sweep::new(
+            "design (fast lives)".into(),
+            fast_base(),
+            parameters.clone(),
+            variants,
+            Some(&stages),
+            overrides,
+        )
+        .unwrap()
+    };
+    let rows_of = |sweep: &Sweep| {
+        let dir = tempfile::tempdir().unwrap();
+        strip_times(&run(sweep, dir.path(), &|_| {}, &|| false).unwrap())
+    };
+    let on_one_thread = |sweep: &Sweep| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        pool.install(|| rows_of(sweep))
+    };
+    let all = sweep(variants.clone());
+    let rows = rows_of(&all);
+    assert_eq!(rows.len(), count);
+    for r in &rows {
+        assert!(r.ok, "{r:#?}");
+        assert!(r.max_wear_end_m.unwrap() > 0.0, "{r:#?}");
+        assert_eq!(r.life_cycles, Some(3e4), "{r:#?}");
+    }
+    assert_eq!(on_one_thread(&all), rows);
+    let last = count - 1;
+    let alone = on_one_thread(&sweep(variants[last..].to_vec()));
+    assert_eq!(alone[0].max_wear_end_m, rows[last].max_wear_end_m);
+    assert_eq!(
+        alone[0].backlash_increase_end_m,
+        rows[last].backlash_increase_end_m
+    );
+}

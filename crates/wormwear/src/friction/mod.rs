@@ -18,6 +18,7 @@ use crate::kinematics::Tca;
 use crate::ltca::{cell_sliding, FilmGeometry, FrictionInputs, Ltca};
 use crate::lubrication::LineContact;
 pub use crate::traction::LocalFriction;
+use rayon::prelude::*;
 
 mod backdriving;
 mod flank;
@@ -76,6 +77,9 @@ struct CellContact {
     flank_cells: (usize, usize),
 }
 
+/// One position's slices, loaded cells (indices local to the position) and flank shares.
+type PositionContacts = (Vec<LineContact>, Vec<CellContact>, Vec<(usize, f64)>);
+
 /// The loaded cells of a loaded analysis with their sliding speeds and line contacts
 /// (MODEL §13), ready to give the friction at any oil temperature.
 #[derive(Debug, Clone)]
@@ -129,26 +133,43 @@ impl MeshContacts {
         let film = FilmGeometry::new(tca, wf);
         let grid = FlankGrid::of(wf);
         let strips = flank::swept_strips(tca, ltca, 2.0 * std::f64::consts::PI / geo.teeth as f64);
+        // Positions are independent: on the pool, then joined in their order (on many cores
+        // this part would otherwise wait for one thread, issue 55).
+        let per_position: Vec<PositionContacts> = ltca
+            .positions
+            .par_iter()
+            .enumerate()
+            .map(|(n, pr)| {
+                let (lines, of_cell) = film.slice_lines(pr.position, &pr.cells, &pr.pressure);
+                let sliding = cell_sliding(gear, geo, &pr.cells);
+                let (mut cells, mut flank_shares) = (Vec::new(), Vec::new());
+                for k in (0..pr.cells.len()).filter(|&k| pr.pressure[k] > 0.0) {
+                    let c = &pr.cells[k];
+                    let start = flank_shares.len();
+                    grid.cells_under(strips[n][k], c.z, c.half_dz, &mut flank_shares);
+                    cells.push(CellContact {
+                        flank_cells: (start, flank_shares.len()),
+                        position: n,
+                        cell: k,
+                        pressure: pr.pressure[k],
+                        sliding_speed: sliding[k].speed,
+                        area: c.cell.area(),
+                        line: of_cell[k],
+                    });
+                }
+                (lines, cells, flank_shares)
+            })
+            .collect();
         let (mut cells, mut lines, mut flank_shares) = (Vec::new(), Vec::new(), Vec::new());
-        for (n, pr) in ltca.positions.iter().enumerate() {
-            let (slices, of_cell) = film.slice_lines(pr.position, &pr.cells, &pr.pressure);
-            let sliding = cell_sliding(gear, geo, &pr.cells);
-            let first = lines.len();
-            lines.extend(slices);
-            for k in (0..pr.cells.len()).filter(|&k| pr.pressure[k] > 0.0) {
-                let c = &pr.cells[k];
-                let start = flank_shares.len();
-                grid.cells_under(strips[n][k], c.z, c.half_dz, &mut flank_shares);
-                cells.push(CellContact {
-                    flank_cells: (start, flank_shares.len()),
-                    position: n,
-                    cell: k,
-                    pressure: pr.pressure[k],
-                    sliding_speed: sliding[k].speed,
-                    area: c.cell.area(),
-                    line: first + of_cell[k],
-                });
-            }
+        for (position_lines, position_cells, shares) in per_position {
+            let (first_line, first_share) = (lines.len(), flank_shares.len());
+            lines.extend(position_lines);
+            flank_shares.extend(shares);
+            cells.extend(position_cells.into_iter().map(|c| CellContact {
+                line: first_line + c.line,
+                flank_cells: (first_share + c.flank_cells.0, first_share + c.flank_cells.1),
+                ..c
+            }));
         }
         let mean = |f: &dyn Fn(&crate::ltca::PositionResult) -> f64| {
             ltca.positions.iter().map(f).sum::<f64>() / ltca.positions.len().max(1) as f64

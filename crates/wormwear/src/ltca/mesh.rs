@@ -246,8 +246,11 @@ pub(super) fn local_mesh(
             },
         });
     }
-    base.iter()
-        .flat_map(|s| {
+    // Slices in parallel, in their order (on many cores idle threads help the positions
+    // that take longest, issue 55).
+    use rayon::prelude::*;
+    base.par_iter()
+        .flat_map_iter(|s| {
             slice_cells(
                 s,
                 tca,

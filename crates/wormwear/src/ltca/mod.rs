@@ -597,7 +597,7 @@ pub fn analyse_changed(
     let oil = gear.lubricant.at_temperature(settings.oil_temperature);
     let friction = position_friction((gear, geo, tca), settings, &oil);
 
-    let mut positions: Vec<PositionResult> = (0..tca.positions.len())
+    let positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
         .map(|n| {
             solve_position(
@@ -616,11 +616,13 @@ pub fn analyse_changed(
                 warm,
                 friction.as_ref(),
             )
+            .map(|mut p| {
+                // In the position's own task: no second wait for the slowest (issue 55).
+                p.equivalent = position_equivalents(&p, &settings.subsurface);
+                p
+            })
         })
         .collect::<Result<_, _>>()?;
-    positions
-        .par_iter_mut()
-        .for_each(|p| p.equivalent = position_equivalents(p, &settings.subsurface));
     let ratio = geo.teeth as f64 / gear.worm.starts as f64;
     Ok(over_the_cycle(
         positions,

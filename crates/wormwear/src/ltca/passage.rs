@@ -112,28 +112,48 @@ pub(crate) fn band_samples(
     positions: &[PositionResult],
     tau: f64,
 ) -> Vec<Vec<Sample>> {
-    let mut runs = CellRuns::index(
+    use rayon::prelude::*;
+    let runs = CellRuns::index(
         positions,
         tca.positions.len(),
         tca.teeth.len(),
         wf.cells_face,
     );
-    // Samples per node column.
-    let mut columns: Vec<Vec<Sample>> = vec![Vec::new(); wf.cells_face + 1];
+    // Each node column from its own lines, in their order: columns in parallel (on many
+    // cores this part would otherwise wait for one thread, issue 55).
+    let mut lines_of: Vec<Vec<&crate::kinematics::SliceContact>> =
+        vec![Vec::new(); wf.cells_face + 1];
     for line in &tca.contact_lines {
-        let theta2 = tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
-        let mut cells = match tca.teeth.iter().position(|&k| k == line.tooth) {
-            Some(t) => runs.take(positions, line.position, t, line.slice),
-            None => Vec::new(),
-        };
-        cells.sort_by(|a, b| a.r.total_cmp(&b.r));
-        let time = tca.sigma * theta2;
-        columns[line.slice].push(sample_of(cells, line, time, wf, tca, runs.last_column));
+        lines_of[line.slice].push(line);
     }
-    for samples in &mut columns {
-        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
-    }
-    columns
+    lines_of
+        .par_iter()
+        .map(|lines| {
+            // A key's profile goes to its first line only (keys hold their column).
+            let mut taken = Vec::new();
+            let mut samples: Vec<Sample> = lines
+                .iter()
+                .map(|line| {
+                    let theta2 =
+                        tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
+                    let tooth = tca.teeth.iter().position(|&k| k == line.tooth);
+                    let key = tooth.map(|t| runs.key(line.position, t, line.slice));
+                    let mut cells = match key.filter(|k| !taken.contains(k)) {
+                        Some(k) => {
+                            taken.push(k);
+                            runs.profile(positions, k)
+                        }
+                        None => Vec::new(),
+                    };
+                    cells.sort_by(|a, b| a.r.total_cmp(&b.r));
+                    let time = tca.sigma * theta2;
+                    sample_of(cells, line, time, wf, tca, runs.last_column)
+                })
+                .collect();
+            samples.sort_by(|a, b| a.time.total_cmp(&b.time));
+            samples
+        })
+        .collect()
 }
 
 /// Pressure profiles per (position, tooth, slice) from the local cells. A slice's cells are
@@ -200,17 +220,10 @@ impl CellRuns {
         table
     }
 
-    /// The profile of a key, once (a second line with the same key gets none).
-    fn take(
-        &mut self,
-        positions: &[PositionResult],
-        position: usize,
-        tooth_index: usize,
-        slice: usize,
-    ) -> Vec<ProfileCell> {
-        let key = self.key(position, tooth_index, slice);
+    /// The profile of a key (`key`).
+    fn profile(&self, positions: &[PositionResult], key: usize) -> Vec<ProfileCell> {
         let mut profile = Vec::new();
-        let mut run = std::mem::replace(&mut self.head[key], Self::NONE);
+        let mut run = self.head[key];
         while run != Self::NONE {
             let (at, start, end, next) = self.runs[run];
             let pr = &positions[at];

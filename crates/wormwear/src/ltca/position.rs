@@ -142,27 +142,35 @@ fn contact_problem(
     bending: Option<&dyn BendingModel>,
     load: f64,
 ) -> Option<(Problem, Vec<f64>, f64)> {
-    let blocks: Vec<Block> = tooth_ranges(cells)
-        .into_iter()
-        .map(|(start, size)| {
-            // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
-            // of a tooth differ only slightly (line-aligned areas vary by the line's
-            // obliquity), and the tangential term's small asymmetry on curved flanks is
-            // dropped. Entries are assembled as the solver reads them: the rows of the
-            // cells that carry load, and the screened solve's candidate block.
-            let group = &cells[start..start + size];
-            let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
-            let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
-            Block::influence(start, pair, &contact, &levers)
+    use rayon::prelude::*;
+    // The teeth's blocks and the bending term are independent: on the pool (on many cores
+    // idle threads help the positions that take longest, issue 55).
+    let contact_blocks = || -> Vec<Block> {
+        tooth_ranges(cells)
+            .into_par_iter()
+            .map(|(start, size)| {
+                // Upper triangle, mirrored: Love's term is symmetric for equal cells; the cells
+                // of a tooth differ only slightly (line-aligned areas vary by the line's
+                // obliquity), and the tangential term's small asymmetry on curved flanks is
+                // dropped. Entries are assembled as the solver reads them: the rows of the
+                // cells that carry load, and the screened solve's candidate block.
+                let group = &cells[start..start + size];
+                let contact: Vec<_> = group.iter().map(|c| c.cell).collect();
+                let levers: Vec<f64> = group.iter().map(|c| c.lever).collect();
+                Block::influence(start, pair, &contact, &levers)
+            })
+            .collect()
+    };
+    let bending_term = || {
+        bending.map(|b| {
+            let mut lr = b.coefficients(cells);
+            for (i, c) in cells.iter().enumerate() {
+                lr.divide_row(i, c.lever);
+            }
+            lr
         })
-        .collect();
-    let low_rank = bending.map(|b| {
-        let mut lr = b.coefficients(cells);
-        for (i, c) in cells.iter().enumerate() {
-            lr.divide_row(i, c.lever);
-        }
-        lr
-    });
+    };
+    let (blocks, low_rank) = rayon::join(contact_blocks, bending_term);
     // Sign of the worm moments: all loaded cells push the worm the same way.
     let s: f64 = cells.iter().map(|c| c.worm_lever.signum()).sum();
     if s == 0.0 {

@@ -36,7 +36,8 @@ pub struct StepView<'a> {
 /// 0.78 a, a the local Hertz half-width there, MODEL §12 g), then the phase passes without
 /// wear. Until the life is reached, or a wear limit is ([`WearLimits`]: the pointed tip, or the
 /// backlash limit if the plan stops there; the state's `stopped` says which). `on_state` is
-/// called after every record (checkpoint, files); an error from it stops the run.
+/// called on the calling thread after every record (checkpoint, files) while the pool steps
+/// and analyses the next state; an error from it stops the run (after that analysis).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     gear: &GearSet,
@@ -48,23 +49,7 @@ pub fn simulate(
     mut state: WearState,
     on_state: &mut dyn FnMut(&StepView) -> Result<(), WearError>,
 ) -> Result<WearState, WearError> {
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    if state.removal.values.len() != wf.nodes.len() || state.removal.cells_height != wf.cells_height
-    {
-        return Err(WearError::Checkpoint(format!(
-            "{} x {} cells, the gear has {} x {}",
-            state.removal.cells_height, state.removal.cells_face, wf.cells_height, wf.cells_face
-        )));
-    }
-    if state.pitted.len() != wf.nodes.len() {
-        state.pitted = vec![false; wf.nodes.len()];
-    }
-    if state.damage.len() != wf.nodes.len() {
-        state.damage = vec![0.0; wf.nodes.len()];
-    }
-    if !state.plastic_set.fits(wf) {
-        state.plastic_set = FlankField::zeros(wf);
-    }
+    fit_to_flank(&mut state, geo.wheel_flank(tca.loaded_flank))?;
     check_plan_can_end(gear, life)?;
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life)?;
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
@@ -74,8 +59,9 @@ pub fn simulate(
     // the state's own record, which it writes again.
     state.records.retain(|r| r.step < state.step);
     let mut stalled = 0;
+    let mut analysis = life_loop.analyse_state(&state)?;
     loop {
-        let a = life_loop.analyse_state(&state)?;
+        let a = analysis;
         life_loop.start_forecast_phase(&mut state, &a.loads);
         let phase = life_loop.phase_at(&state, state.cycles);
         let mut record = life_loop.record(
@@ -92,26 +78,87 @@ pub fn simulate(
         state.records.push(record);
         let left = life.life_cycles - state.cycles;
         let last = left <= 1e-9 * life.life_cycles.max(1.0) || state.stopped.is_some();
-        on_state(&StepView {
-            state: &state,
+        let map = life_loop.is_map_state(&state);
+        if last {
+            on_state(&StepView::of(&state, &a, last, map))?;
+            break;
+        }
+        // The next state is stepped and analysed while this one is written (`on_state` on
+        // this thread): the writing leaves the life's critical path (issue 55). The next
+        // state's copy holds the last record only, all a step and an analysis read.
+        let mut next = state_to_step(&mut state);
+        let view = StepView::of(&state, &a, last, map);
+        let mut stepped = None;
+        // In place: the calling thread writes, the pool steps and analyses; a pool thread
+        // (a sweep's variant) keeps stealing while it waits, so the pool cannot deadlock.
+        let written = rayon::in_place_scope(|scope| {
+            scope.spawn(|_| {
+                stepped = Some((|| {
+                    // What the next analysis starts from (after the checkpoint, which keeps
+                    // what this state's analysis used).
+                    carry_starts(&mut next, &a);
+                    let before = next.cycles;
+                    let steps = life_loop.step(&mut next, &a, phase, left)?;
+                    next.step += 1;
+                    let stalled = stalled_steps(stalled, before, &next)?;
+                    let analysis = life_loop.analyse_state(&next)?;
+                    Ok::<_, WearError>((steps, stalled, analysis))
+                })());
+            });
+            on_state(&view)
+        });
+        written?;
+        ((step_cycles, substeps), stalled, analysis) = stepped.expect("the scope ran the step")?;
+        next.records = std::mem::take(&mut state.records);
+        state = next;
+    }
+    Ok(state)
+}
+
+/// Checks that a starting state (a checkpoint's) has the loaded flank's grid, and gives it
+/// the fields it lacks (pits, damage and plastic set of earlier versions).
+fn fit_to_flank(state: &mut WearState, wf: &WheelFlank) -> Result<(), WearError> {
+    if state.removal.values.len() != wf.nodes.len() || state.removal.cells_height != wf.cells_height
+    {
+        return Err(WearError::Checkpoint(format!(
+            "{} x {} cells, the gear has {} x {}",
+            state.removal.cells_height, state.removal.cells_face, wf.cells_height, wf.cells_face
+        )));
+    }
+    if state.pitted.len() != wf.nodes.len() {
+        state.pitted = vec![false; wf.nodes.len()];
+    }
+    if state.damage.len() != wf.nodes.len() {
+        state.damage = vec![0.0; wf.nodes.len()];
+    }
+    if !state.plastic_set.fits(wf) {
+        state.plastic_set = FlankField::zeros(wf);
+    }
+    Ok(())
+}
+
+impl<'a> StepView<'a> {
+    /// The view of `state` with its analysis `a`.
+    fn of(state: &'a WearState, a: &'a StateAnalysis, last: bool, map: bool) -> Self {
+        Self {
+            state,
             ltca: &a.ltca,
             cycle: &a.cycle,
             thermal: &a.thermal,
             last,
-            map: life_loop.is_map_state(&state),
-        })?;
-        if last {
-            break;
+            map,
         }
-        // What the next analysis starts from (after the checkpoint, which keeps what this
-        // state's analysis used).
-        carry_starts(&mut state, &a);
-        let before = state.cycles;
-        (step_cycles, substeps) = life_loop.step(&mut state, &a, phase, left)?;
-        state.step += 1;
-        stalled = stalled_steps(stalled, before, &state)?;
     }
-    Ok(state)
+}
+
+/// A copy of `state` to step from, holding its last record only (a step and the analysis of
+/// the state it reaches read no other: [`WearState::previous_record`]).
+fn state_to_step(state: &mut WearState) -> WearState {
+    let records = std::mem::take(&mut state.records);
+    let mut next = state.clone();
+    next.records = records.last().cloned().into_iter().collect();
+    state.records = records;
+    next
 }
 
 /// Where the next loaded analyses start from after state analysis `a`: its band factors and

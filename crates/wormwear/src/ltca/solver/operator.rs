@@ -344,7 +344,7 @@ pub(super) fn low_rank_add(
     lr: &LowRank,
     x: &[f64],
     y: &mut [f64],
-    dot: impl Fn(&[f64], &[f64]) -> f64,
+    dot: impl Fn(&[f64], &[f64]) -> f64 + Sync,
 ) {
     let k = lr.rank;
     let mut ft = vec![0.0; k];
@@ -373,19 +373,37 @@ pub(super) fn low_rank_add(
         }
         *out = sum;
     }
-    for (i, yi) in y.iter_mut().enumerate() {
-        let (row, ranges) = lr.packed_row(i);
-        let mut sum = 0.0;
-        let mut at = 0;
-        for &(a, b) in ranges {
-            if a < b {
-                sum += dot(&row[at..at + b - a], &cft[a..b]);
-                at += b - a;
+    // Rows are independent (each its own dot): in chunks on the pool when the product is
+    // big enough to pay for it, the same sums either way. On many cores this is what lets
+    // idle threads help a position that takes longer than the others (issue 55).
+    let row_product = |first: usize, ys: &mut [f64]| {
+        for (i, yi) in (first..).zip(ys.iter_mut()) {
+            let (row, ranges) = lr.packed_row(i);
+            let mut sum = 0.0;
+            let mut at = 0;
+            for &(a, b) in ranges {
+                if a < b {
+                    sum += dot(&row[at..at + b - a], &cft[a..b]);
+                    at += b - a;
+                }
             }
+            *yi += sum;
         }
-        *yi += sum;
+    };
+    if lr.values.len() >= PARALLEL_ROW_ENTRIES {
+        use rayon::prelude::*;
+        y.par_chunks_mut(ROW_CHUNK)
+            .enumerate()
+            .for_each(|(c, ys)| row_product(c * ROW_CHUNK, ys));
+    } else {
+        row_product(0, y);
     }
 }
+
+/// The low-rank term's stored entries from which its rows' product runs on the pool.
+const PARALLEL_ROW_ENTRIES: usize = 65_536;
+/// Rows per task of the low-rank term's row product.
+const ROW_CHUNK: usize = 256;
 
 /// [`low_rank_add`] compiled for AVX2 + FMA; chosen at run time.
 #[cfg(target_arch = "x86_64")]
