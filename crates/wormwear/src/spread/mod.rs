@@ -11,7 +11,8 @@
 //! [spread]
 //! samples = 64                     # 2 to MAX_SAMPLES
 //! seed = 1                         # default 1
-//! sampler = "latin-hypercube"      # the default and, so far, the only one
+//! sampler = "latin-hypercube"      # default; "sobol": Saltelli's design, samples (inputs + 2)
+//!                                  # runs, and the first-order and total Sobol indices
 //! [spread.inputs]
 //! "operating.centre_distance_error_mm" = [-0.03, 0.03]                     # uniform
 //! "lubricant.composite_roughness_um" = { mean = 1.0, sd = 0.2, min = 0.5 } # normal, truncated
@@ -20,6 +21,7 @@
 //! Rooms: `sampling` the points and the distributions, `stats` the percentiles and rank
 //! correlations; here the file, the run and the files it writes (`spread.csv`, `spread.json`).
 
+mod html;
 pub mod sampling;
 pub mod stats;
 
@@ -35,7 +37,9 @@ pub const MAX_SAMPLES: usize = 4096;
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SpreadFile {
-    base: String,
+    /// The base gear file (a spread file's; absent where the base is given, Python).
+    #[serde(default)]
+    base: Option<String>,
     #[serde(default)]
     stages: Option<Vec<String>>,
     #[serde(default)]
@@ -72,13 +76,44 @@ pub struct Input {
     pub distribution: Distribution,
 }
 
+/// How a spread samples its inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sampler {
+    /// A seeded Latin hypercube of `samples` points (the default).
+    LatinHypercube,
+    /// Saltelli's design from a scrambled Sobol sequence: `samples` base points, `samples`
+    /// (inputs + 2) runs, and each input's first-order and total Sobol indices.
+    Sobol,
+}
+
+impl Sampler {
+    /// The name in a spread file and in spread.json.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampler::LatinHypercube => "latin-hypercube",
+            Sampler::Sobol => "sobol",
+        }
+    }
+
+    /// The runs of `samples` samples of `inputs` inputs.
+    pub fn runs(self, samples: usize, inputs: usize) -> usize {
+        match self {
+            Sampler::LatinHypercube => samples,
+            Sampler::Sobol => samples * (inputs + 2),
+        }
+    }
+}
+
 /// A spread: the sweep of its samples, its inputs and how they were sampled.
 #[derive(Debug, Clone)]
 pub struct Spread {
     pub sweep: Sweep,
     pub inputs: Vec<Input>,
+    /// The samples asked for (with the Sobol sampler, the base points: the runs are
+    /// [`Sampler::runs`]).
     pub samples: usize,
     pub seed: u64,
+    pub sampler: Sampler,
 }
 
 impl Spread {
@@ -97,18 +132,41 @@ impl Spread {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
+        let Some(base_name) = file.base.as_deref() else {
+            return Err(SweepError::Invalid(format!(
+                "{}: base: name the base gear file (base = \"gear.toml\", relative to the \
+                 spread file)",
+                path.display()
+            )));
+        };
         let access = crate::sweep::BaseAccess::Confined;
-        let (base_file, base) = crate::sweep::base_document(folder, &file.base, access)?;
-        let inputs = inputs(&file.spread.inputs, &base)?;
-        let samples = sample_count(file.spread.samples)?;
-        if let Some(s) = file.spread.sampler.as_deref() {
-            if !s.eq_ignore_ascii_case("latin-hypercube") {
-                return Err(SweepError::Invalid(format!(
-                    "spread.sampler = {s:?}: the sampler is \"latin-hypercube\" (the Sobol \
-                     sequence is not built yet)"
-                )));
-            }
+        let (base_file, base) = crate::sweep::base_document(folder, base_name, access)?;
+        Self::build(base_file, base, file)
+    }
+
+    /// A spread of the gear document `base` (named `base_file`) from a spread file's tables
+    /// as JSON, without `base` (the Python package's `wormwear.spread`): `stages`, `cycles`,
+    /// ..., and `spread` with `samples`, `seed`, `sampler`, `inputs` and `fixed`.
+    pub fn of_document(
+        base_file: String,
+        base: toml::Table,
+        spec: serde_json::Value,
+    ) -> Result<Self, SweepError> {
+        let file: SpreadFile = serde_json::from_value(spec)
+            .map_err(|e| SweepError::Invalid(format!("spread: {e}")))?;
+        if file.base.is_some() {
+            return Err(SweepError::Invalid(
+                "spread: base: the base gear is given; leave base out".into(),
+            ));
         }
+        Self::build(base_file, base, file)
+    }
+
+    /// The spread of `file` on the base document: inputs checked and sampled.
+    fn build(base_file: String, base: toml::Table, file: SpreadFile) -> Result<Self, SweepError> {
+        let inputs = inputs(&file.spread.inputs, &base)?;
+        let sampler = sampler(file.spread.sampler.as_deref())?;
+        let samples = sample_count(file.spread.samples, sampler, inputs.len())?;
         let seed = file.spread.seed.unwrap_or(1);
         let overrides = LifeOverrides {
             cycles: file.cycles,
@@ -116,7 +174,7 @@ impl Spread {
             step_wear_um: file.step_wear_um,
             no_pitting: file.no_pitting,
         };
-        let mut variants = sample_variants(&inputs, samples, seed);
+        let mut variants = sample_variants(&inputs, samples, seed, sampler);
         let fixed = fixed_values(file.spread.fixed.as_ref(), &base, &inputs)?;
         for v in &mut variants {
             v.values.extend(fixed.iter().cloned());
@@ -136,7 +194,21 @@ impl Spread {
             inputs,
             samples,
             seed,
+            sampler,
         })
+    }
+}
+
+/// The sampler a spread file names (default: the Latin hypercube).
+fn sampler(name: Option<&str>) -> Result<Sampler, SweepError> {
+    match name {
+        None => Ok(Sampler::LatinHypercube),
+        Some(s) if s.eq_ignore_ascii_case("latin-hypercube") => Ok(Sampler::LatinHypercube),
+        Some(s) if s.eq_ignore_ascii_case("sobol") => Ok(Sampler::Sobol),
+        Some(s) => Err(SweepError::Invalid(format!(
+            "spread.sampler = {s:?}: unknown sampler: allowed \"latin-hypercube\" (default) or \
+             \"sobol\""
+        ))),
     }
 }
 
@@ -168,11 +240,29 @@ fn fixed_values(
     Ok(values)
 }
 
-/// The sample count, 2 to [`MAX_SAMPLES`].
-fn sample_count(n: i64) -> Result<usize, SweepError> {
-    if !(2..=MAX_SAMPLES as i64).contains(&n) {
+/// The sample count: 2 to [`MAX_SAMPLES`] runs (with the Sobol sampler, `n` (inputs + 2)
+/// runs; at most 128 inputs).
+fn sample_count(n: i64, sampler: Sampler, inputs: usize) -> Result<usize, SweepError> {
+    let most = match sampler {
+        Sampler::LatinHypercube => MAX_SAMPLES,
+        Sampler::Sobol => MAX_SAMPLES / (inputs + 2),
+    };
+    if sampler == Sampler::Sobol && inputs > 128 {
         return Err(SweepError::Invalid(format!(
-            "spread.samples = {n}: out of range: allowed integers [2, {MAX_SAMPLES}]"
+            "spread.inputs: {inputs} inputs: the Sobol sampler takes at most 128"
+        )));
+    }
+    if !(2..=most as i64).contains(&n) {
+        let why = match sampler {
+            Sampler::LatinHypercube => String::new(),
+            Sampler::Sobol => format!(
+                " (the Sobol sampler runs samples x (inputs + 2) = samples x {}, at most \
+                 {MAX_SAMPLES} runs)",
+                inputs + 2
+            ),
+        };
+        return Err(SweepError::Invalid(format!(
+            "spread.samples = {n}: out of range: allowed integers [2, {most}]{why}"
         )));
     }
     Ok(n as usize)
@@ -202,13 +292,17 @@ fn inputs(table: &toml::Table, base: &toml::Table) -> Result<Vec<Input>, SweepEr
                      fields can be sampled"
                 )))
             }
+            // A field the base leaves at its default is sampled if the gear file takes it.
             None => {
-                let near = nearest_names(base, &name, 3);
-                return Err(SweepError::Invalid(format!(
-                    "{field}: the base gear file has no field {name} (the nearest: {}); give \
-                     a field the base file writes",
-                    near.join(", ")
-                )));
+                if let Err(why) = accepts(base, &name, &value) {
+                    let near = nearest_names(base, &name, 3);
+                    return Err(SweepError::Invalid(format!(
+                        "{field}: the base gear file has no field {name}, and the gear file \
+                         does not take it at the input's centre ({why}); the base's nearest \
+                         numeric fields: {}",
+                        near.join(", ")
+                    )));
+                }
             }
         }
         out.push(Input {
@@ -217,6 +311,19 @@ fn inputs(table: &toml::Table, base: &toml::Table) -> Result<Vec<Input>, SweepEr
         });
     }
     Ok(out)
+}
+
+/// Whether the gear file takes the field `name`, absent from `base`, at the middle of the
+/// input's range or its mean (Err: the loader's or the distribution's message).
+fn accepts(base: &toml::Table, name: &str, value: &toml::Value) -> Result<(), String> {
+    let d = distribution(name, value).map_err(|e| e.to_string())?;
+    let variant = Variant {
+        name: "check".into(),
+        values: vec![(name.to_string(), toml::Value::Float(d.centre()))],
+    };
+    crate::sweep::variant_document(base, &variant)
+        .and_then(|doc| crate::input::load_document(&doc).map(|_| ()))
+        .map_err(|e| e.to_string())
 }
 
 /// The inputs of `[spread.inputs]` by dotted name: bare dotted keys nest tables, which are
@@ -336,10 +443,19 @@ fn distribution(field: &str, value: &toml::Value) -> Result<Distribution, SweepE
 }
 
 /// The samples as sweep variants `s001`, `s002`, ... (zero-padded): the Latin hypercube points
-/// of `seed` mapped through each input's distribution.
-pub fn sample_variants(inputs: &[Input], samples: usize, seed: u64) -> Vec<Variant> {
-    let points = sampling::latin_hypercube(samples, inputs.len(), seed);
-    let width = samples.to_string().len();
+/// of `seed`, or Saltelli's design's rows ([`sampling::saltelli`], in its order), mapped
+/// through each input's distribution.
+pub fn sample_variants(
+    inputs: &[Input],
+    samples: usize,
+    seed: u64,
+    sampler: Sampler,
+) -> Vec<Variant> {
+    let points = match sampler {
+        Sampler::LatinHypercube => sampling::latin_hypercube(samples, inputs.len(), seed),
+        Sampler::Sobol => sampling::saltelli(samples, inputs.len(), seed),
+    };
+    let width = points.len().to_string().len();
     points
         .iter()
         .enumerate()
@@ -393,16 +509,32 @@ fn result_at(summary: &serde_json::Value, path: &str) -> Option<f64> {
 }
 
 /// What a spread gives: each sample's inputs and key results ([`RESULTS`]; NaN where a
-/// sample failed or the stage did not run), in sample order.
+/// sample failed or the stage did not run), and with lives each sample's backlash increase
+/// over the cycles (wheel cycles, m; empty without a life), in sample order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpreadResults {
     pub rows: Vec<Row>,
     pub inputs: Vec<Vec<f64>>,
     pub results: Vec<Vec<f64>>,
+    pub curves: Vec<Vec<(f64, f64)>>,
+}
+
+/// A life's backlash increase over its states from its summary.json (cycles, m).
+fn backlash_curve(summary: &serde_json::Value) -> Vec<(f64, f64)> {
+    summary["wear"]["steps"]
+        .as_array()
+        .map(|steps| {
+            steps
+                .iter()
+                .filter_map(|s| Some((s["cycles"].as_f64()?, s["backlash_increase_m"].as_f64()?)))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// Runs the samples of `spread` as a sweep into `dir` (local cores; finished samples of an
-/// earlier run with the same inputs are reused) and writes `spread.csv` and `spread.json`.
+/// earlier run with the same inputs are reused) and writes `spread.csv`, `spread.json` and
+/// `spread.html` (with its charts in `plots/`).
 pub fn run(
     spread: &Spread,
     dir: &Path,
@@ -412,6 +544,7 @@ pub fn run(
     let rows = crate::sweep::run(&spread.sweep, dir, on_progress, interrupt)?;
     let mut inputs = Vec::new();
     let mut results = Vec::new();
+    let mut curves = Vec::new();
     for (row, variant) in rows.iter().zip(&spread.sweep.variants) {
         inputs.push(
             variant
@@ -433,15 +566,18 @@ pub fn run(
                 .map(|(_, p)| result_at(&summary, p).unwrap_or(f64::NAN))
                 .collect(),
         );
+        curves.push(backlash_curve(&summary));
     }
     let out = SpreadResults {
         rows,
         inputs,
         results,
+        curves,
     };
     write_csv(spread, &out, &dir.join("spread.csv"))?;
     let json = serde_json::to_string_pretty(&summary(spread, &out)).unwrap_or_default() + "\n";
     crate::output::write_atomic(&dir.join("spread.json"), json.as_bytes())?;
+    html::write_html(dir, spread, &out)?;
     Ok(out)
 }
 
@@ -465,14 +601,22 @@ fn write_csv(spread: &Spread, out: &SpreadResults, path: &Path) -> Result<(), Sw
 
 /// `spread.json`: the base, the sampling, the inputs, each key result's min / P10 / P50 /
 /// P90 / max / mean over the samples that have it, and each result's rank correlation
-/// (Spearman) with each input; no time or machine, so that one seed gives the same bytes.
+/// (Spearman) with each input; with the Sobol sampler these over the design's A and B rows
+/// (independent points; the A_B rows mix them), and each result's first-order and total Sobol
+/// index per input. No time or machine, so that one seed gives the same bytes.
 pub fn summary(spread: &Spread, out: &SpreadResults) -> serde_json::Value {
-    let column =
-        |table: &[Vec<f64>], k: usize| -> Vec<f64> { table.iter().map(|r| r[k]).collect() };
+    let independent = match spread.sampler {
+        Sampler::LatinHypercube => out.results.len(),
+        Sampler::Sobol => (2 * spread.samples).min(out.results.len()),
+    };
+    let column = |table: &[Vec<f64>], k: usize, rows: usize| -> Vec<f64> {
+        table.iter().take(rows).map(|r| r[k]).collect()
+    };
     let mut results = serde_json::Map::new();
     let mut sensitivity = serde_json::Map::new();
+    let mut sobol = serde_json::Map::new();
     for (k, (name, _)) in RESULTS.iter().enumerate() {
-        let values = column(&out.results, k);
+        let values = column(&out.results, k, independent);
         let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
         if finite.is_empty() {
             continue;
@@ -488,21 +632,37 @@ pub fn summary(spread: &Spread, out: &SpreadResults) -> serde_json::Value {
         );
         let mut by_input = serde_json::Map::new();
         for (i, input) in spread.inputs.iter().enumerate() {
-            let rho = stats::spearman(&column(&out.inputs, i), &values);
+            let rho = stats::spearman(&column(&out.inputs, i, independent), &values);
             by_input.insert(input.name.clone(), serde_json::json!(rho));
         }
         sensitivity.insert(name.to_string(), serde_json::Value::Object(by_input));
+        if spread.sampler == Sampler::Sobol {
+            let all = column(&out.results, k, out.results.len());
+            let indices = stats::sobol_indices(&all, spread.samples, spread.inputs.len());
+            let by_input: serde_json::Map<String, serde_json::Value> = spread
+                .inputs
+                .iter()
+                .zip(indices)
+                .map(|(input, index)| (input.name.clone(), serde_json::json!(index)))
+                .collect();
+            sobol.insert(name.to_string(), serde_json::Value::Object(by_input));
+        }
     }
-    serde_json::json!({
+    let mut json = serde_json::json!({
         "base": spread.sweep.base_file,
         "stages": spread.sweep.settings.stages,
-        "sampler": "latin-hypercube",
+        "sampler": spread.sampler.name(),
         "samples": spread.samples,
+        "runs": out.rows.len(),
         "seed": spread.seed,
         "failed": out.rows.iter().filter(|r| !r.ok).count(),
         "inputs": spread.inputs,
         "results": results,
         "rank_correlation": sensitivity,
         "program_version": env!("CARGO_PKG_VERSION"),
-    })
+    });
+    if spread.sampler == Sampler::Sobol {
+        json["sobol_indices"] = serde_json::Value::Object(sobol);
+    }
+    json
 }

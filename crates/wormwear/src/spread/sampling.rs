@@ -1,5 +1,6 @@
 //! Sampling the uncertain inputs of a spread (MODEL §17): Latin hypercube points in the unit
 //! cube from a seeded ChaCha8 stream (the same seed gives the same points on every machine),
+//! or Saltelli's design from a scrambled Sobol sequence for the Sobol indices,
 //! and each input's distribution mapping a unit coordinate to its value (uniform over a range,
 //! or a normal distribution truncated to bounds, by its inverse CDF).
 
@@ -29,6 +30,37 @@ pub fn latin_hypercube(samples: usize, dims: usize, seed: u64) -> Vec<Vec<f64>> 
         }
     }
     points
+}
+
+/// Saltelli's design for the first-order and total Sobol indices (Saltelli et al., "Variance
+/// based sensitivity analysis of model output", Comput. Phys. Commun. 181, 2010, 259-270): two
+/// matrices A and B of `base` points each, from one Owen-scrambled Sobol sequence in 2 `dims`
+/// dimensions (A its first `dims` coordinates, B the others; `seed` picks the scrambling), then
+/// for each input i the matrix A_B^i: A with its column i from B. Rows: A, B, A_B^1, ...,
+/// A_B^dims, `base` each: `base` (`dims` + 2) points in (0, 1). `base` at most 2^16 and
+/// `dims` at most 128 (the sequence's 256 dimensions).
+pub fn saltelli(base: usize, dims: usize, seed: u64) -> Vec<Vec<f64>> {
+    // The sequence's values are multiples of 2^-24 in [0, 1): the middle of their interval.
+    let unit = |k: usize, d: usize| {
+        let scramble = (seed ^ (seed >> 32)) as u32;
+        f64::from(sobol_burley::sample(k as u32, d as u32, scramble)) + 0.5 / (1u64 << 24) as f64
+    };
+    let a: Vec<Vec<f64>> = (0..base)
+        .map(|k| (0..dims).map(|d| unit(k, d)).collect())
+        .collect();
+    let b: Vec<Vec<f64>> = (0..base)
+        .map(|k| (0..dims).map(|d| unit(k, dims + d)).collect())
+        .collect();
+    let mut rows = a.clone();
+    rows.extend(b.iter().cloned());
+    for i in 0..dims {
+        rows.extend(a.iter().zip(&b).map(|(ra, rb)| {
+            let mut r = ra.clone();
+            r[i] = rb[i];
+            r
+        }));
+    }
+    rows
 }
 
 /// How one input varies.

@@ -1,5 +1,6 @@
 //! The statistics of a spread (MODEL §17): percentiles of a result over the samples, and the
-//! rank correlation of a result with an input (Spearman's rho), the sensitivity it reports.
+//! rank correlation of a result with an input (Spearman's rho), the sensitivity it reports;
+//! with Saltelli's design, each input's first-order and total Sobol indices.
 
 /// The `q`-quantile (0..=1) of `values` (finite ones only; None when there are none): linear
 /// interpolation between the order statistics at (n - 1) q (Hyndman & Fan's type 7, the
@@ -96,4 +97,61 @@ mod tests {
         assert!((spearman(&x, &z).unwrap() + 1.0).abs() < 1e-12);
         assert_eq!(spearman(&x, &[1.0; 20]), None);
     }
+}
+
+/// A first-order and a total Sobol index of one input.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SobolIndex {
+    pub first: f64,
+    pub total: f64,
+}
+
+/// Each input's Sobol indices from the outputs `y` of Saltelli's design
+/// ([`super::sampling::saltelli`]: blocks A, B, A_B^1, ... of `base` rows): the first-order
+/// S_i = (1/N) sum f(B) (f(A_B^i) - f(A)) / V (Saltelli et al. 2010, Table 2 (b)) and the
+/// total S_Ti = (1/2N) sum (f(A) - f(A_B^i))^2 / V (Jansen's estimator, ibid. (f)), V the
+/// variance of f over A and B. Rows where a needed value is not finite are left out; None
+/// where fewer than 2 rows remain or V = 0.
+pub fn sobol_indices(y: &[f64], base: usize, dims: usize) -> Vec<Option<SobolIndex>> {
+    let block = |k: usize| &y[k * base..(k + 1) * base];
+    let (a, b) = (block(0), block(1));
+    let both: Vec<f64> = a
+        .iter()
+        .chain(b)
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let variance = if both.len() < 2 {
+        0.0
+    } else {
+        let mean = both.iter().sum::<f64>() / both.len() as f64;
+        both.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (both.len() - 1) as f64
+    };
+    (0..dims)
+        .map(|i| {
+            let ab = block(2 + i);
+            let rows: Vec<(f64, f64, f64)> = (0..base)
+                .map(|j| (a[j], b[j], ab[j]))
+                .filter(|(fa, fb, fab)| fa.is_finite() && fb.is_finite() && fab.is_finite())
+                .collect();
+            if rows.len() < 2 || variance <= 0.0 {
+                return None;
+            }
+            let n = rows.len() as f64;
+            let first = rows
+                .iter()
+                .map(|(fa, fb, fab)| fb * (fab - fa))
+                .sum::<f64>()
+                / n;
+            let total = rows
+                .iter()
+                .map(|(fa, _, fab)| (fa - fab).powi(2))
+                .sum::<f64>()
+                / (2.0 * n);
+            Some(SobolIndex {
+                first: first / variance,
+                total: total / variance,
+            })
+        })
+        .collect()
 }

@@ -188,6 +188,20 @@ fn slug(name: &str) -> String {
         .collect()
 }
 
+/// The opening of a study's page (sweep.html, spread.html) up to its body, with `title`.
+pub(crate) fn page_head(title: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>{}</title><style>\
+         body{{font-family:sans-serif;max-width:1150px;margin:2em auto;color:#222}}\
+         table{{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}}\
+         td,th{{border:1px solid #ccc;padding:.2em .5em}} td.n{{text-align:right;\
+         font-variant-numeric:tabular-nums}} tr.fail td{{color:#a40}} img{{max-width:100%}}\
+         h2{{border-bottom:2px solid #1f77b4}}</style></head><body>\n",
+        escape(title)
+    )
+}
+
 /// Writes `dir/sweep.html` and its charts in `dir/plots`; returns the page's path.
 pub fn write_html(dir: &Path, sweep: &Sweep, rows: &[Row]) -> Result<PathBuf, OutputError> {
     let plots = dir.join("plots");
@@ -197,16 +211,10 @@ pub fn write_html(dir: &Path, sweep: &Sweep, rows: &[Row]) -> Result<PathBuf, Ou
     })?;
     let mut h = String::new();
     let failed = rows.iter().filter(|r| !r.ok).count();
+    h.push_str(&page_head(&format!("wormwear sweep — {}", sweep.base_file)));
     let _ = write!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
-         <title>wormwear sweep — {base}</title><style>\
-         body{{font-family:sans-serif;max-width:1150px;margin:2em auto;color:#222}}\
-         table{{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}}\
-         td,th{{border:1px solid #ccc;padding:.2em .5em}} td.n{{text-align:right;\
-         font-variant-numeric:tabular-nums}} tr.fail td{{color:#a40}} img{{max-width:100%}}\
-         h2{{border-bottom:2px solid #1f77b4}}</style></head><body>\n\
-         <h1>Sweep of {base}</h1>\n<p>{n} variants ({failed} failed); stages: {stages}. \
+        "<h1>Sweep of {base}</h1>\n<p>{n} variants ({failed} failed); stages: {stages}. \
          Every variant's full output is in <code>variants/NAME/</code>; the numbers are in \
          <a href=\"sweep.csv\">sweep.csv</a>.</p>\n",
         base = escape(&sweep.base_file),
