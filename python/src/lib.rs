@@ -570,6 +570,41 @@ fn run_variant(
     serde_json::to_string(&row).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
+/// Runs a spread of `base` (MODEL §17) on the local cores into `directory` as `wormwear spread`
+/// does: `spec_json` is a spread file's tables as JSON without `base` (`stages`, `cycles`, ...,
+/// `spread`). Returns spread.json's text.
+#[pyfunction]
+fn spread(
+    py: Python<'_>,
+    base: &NativeGear,
+    spec_json: &str,
+    directory: String,
+) -> PyResult<String> {
+    let spec: serde_json::Value =
+        serde_json::from_str(spec_json).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let study = wormwear::spread::Spread::of_document(
+        base.source.file.clone(),
+        base.document.clone(),
+        spec,
+    )
+    .map_err(|e| InputError::new_err(error_chain(&e)))?;
+    let done: Result<(), String> = py.detach(|| {
+        let dir = Path::new(&directory);
+        std::fs::create_dir_all(dir).map_err(|e| format!("{directory}: {e}"))?;
+        let _lock = wormwear::output::lock_directory(dir).map_err(|e| e.to_string())?;
+        let interrupt = || interrupted();
+        wormwear::spread::run(&study, dir, &|_| {}, &interrupt)
+            .map(|_| ())
+            .map_err(|e| error_chain(&e))
+    });
+    done.map_err(PyOSError::new_err)?;
+    if interrupted() {
+        return Err(PyKeyboardInterrupt::new_err("spread interrupted"));
+    }
+    std::fs::read_to_string(Path::new(&directory).join("spread.json"))
+        .map_err(|e| PyOSError::new_err(e.to_string()))
+}
+
 /// The CSV of rows (JSON) as `wormwear sweep` writes it.
 #[pyfunction]
 fn write_sweep_csv(path: &str, parameters: Vec<String>, rows_json: &str) -> PyResult<()> {
@@ -638,6 +673,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(expand_grid, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(spread, m)?)?;
     m.add_function(wrap_pyfunction!(run_variant, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;

@@ -469,3 +469,39 @@ def test_a_duty_cycle_equals_the_cli(cli, tmp_path):
     # One operating point has no duty cycle.
     assert wormwear.run(wormwear.load(EXAMPLES / "gear-1x40-design.toml").with_(
         **{"bending.model": "none", "analysis.positions": 8}), stages=["ltca"]).duty_cycle is None
+
+
+def test_a_spread_equals_the_cli_and_bad_inputs_raise_naming_the_field(cli, fast_gear_file, tmp_path):
+    base = wormwear.load(str(fast_gear_file))
+    inputs = {
+        "operating.worm_offset_mm": (-0.05, 0.05),
+        "conditions.worm_torque_nm": {"mean": 60.0, "sd": 5.0, "min": 50.0, "max": 70.0},
+    }
+    result = wormwear.spread(base, inputs, samples=4, seed=3, output=tmp_path / "py")
+    assert len(result.samples) == 4 and result.samples["ok"].all()
+    assert set(result.rank_correlation.columns) == set(inputs)
+    assert result.sobol_indices is None
+    assert (tmp_path / "py" / "spread.html").is_file()
+    # The CLI on the same spread file: the same samples and results to the bit.
+    spread_file = fast_gear_file.parent / "spread.toml"
+    spread_file.write_text(
+        f'base = "{fast_gear_file.name}"\n[spread]\nsamples = 4\nseed = 3\n[spread.inputs]\n'
+        '"operating.worm_offset_mm" = [-0.05, 0.05]\n'
+        '"conditions.worm_torque_nm" = { mean = 60.0, sd = 5.0, min = 50.0, max = 70.0 }\n'
+    )
+    cli("-q", "spread", spread_file, "-o", tmp_path / "cli")
+    assert (tmp_path / "cli" / "spread.csv").read_bytes() == (tmp_path / "py" / "spread.csv").read_bytes()
+    cli_summary = json.loads((tmp_path / "cli" / "spread.json").read_text())
+    assert cli_summary["results"] == result.summary["results"]
+    # The Sobol sampler: samples x (inputs + 2) runs and each result's indices.
+    sobol = wormwear.spread(
+        base, {"conditions.worm_torque_nm": (50.0, 70.0)}, samples=2, sampler="sobol", output=tmp_path / "sobol"
+    )
+    assert len(sobol.samples) == 6
+    efficiency = sobol.sobol_indices.set_index("result").loc["mesh_efficiency"]
+    assert efficiency["input"] == "conditions.worm_torque_nm" and np.isfinite(efficiency["total"])
+    # Bad input: the field named, with the nearest names.
+    with pytest.raises(wormwear.InputError, match="operating.centre_distance_error_mm"):
+        wormwear.spread(base, {"operating.centre_distance_eror_mm": (0.0, 0.01)}, output=tmp_path / "bad")
+    with pytest.raises(wormwear.InputError, match="inverted range"):
+        wormwear.spread(base, {"operating.worm_offset_mm": (0.05, -0.05)}, output=tmp_path / "bad")

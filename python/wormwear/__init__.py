@@ -47,6 +47,8 @@ __all__ = [
     "rexs_stages",
     "run",
     "sweep",
+    "spread",
+    "Spread",
     "STAGES",
 ]
 
@@ -507,3 +509,72 @@ def sweep(
     if directory is not None:
         _native.write_sweep_csv(os.path.join(directory, "sweep.csv"), parameters, json.dumps(rows))
     return _frame(parameters, rows)
+
+
+class Spread:
+    """What ``wormwear.spread`` gives (MODEL §17): ``samples`` (one row per run: the sample, its
+    inputs, ``ok`` and the key results, as spread.csv), ``summary`` (spread.json as a dict),
+    ``percentiles`` (one row per key result: count, min, p10, p50, p90, max, mean),
+    ``rank_correlation`` (results x inputs, Spearman's rho), ``sobol_indices`` (with the Sobol
+    sampler: a frame of result, input, first, total; else None) and ``directory``."""
+
+    def __init__(self, directory: str, summary: dict):
+        self.directory = directory
+        self.summary = summary
+        self.samples = pd.read_csv(os.path.join(directory, "spread.csv"))
+        self.percentiles = pd.DataFrame.from_dict(summary["results"], orient="index")
+        self.rank_correlation = pd.DataFrame.from_dict(summary["rank_correlation"], orient="index")
+        indices = summary.get("sobol_indices")
+        self.sobol_indices = None
+        if indices is not None:
+            records = [
+                {"result": result, "input": name, **(index or {"first": None, "total": None})}
+                for result, by_input in indices.items()
+                for name, index in by_input.items()
+            ]
+            self.sobol_indices = pd.DataFrame.from_records(records)
+
+    def __repr__(self) -> str:
+        return (
+            f"<wormwear.Spread {self.summary['runs']} runs of {self.summary['samples']} samples "
+            f"({self.summary['sampler']}), {self.summary['failed']} failed: {self.directory}>"
+        )
+
+
+def spread(
+    base: GearSet,
+    inputs: Mapping[str, Any],
+    *,
+    samples: int = 64,
+    seed: int = 1,
+    sampler: str = "latin-hypercube",
+    fixed: Optional[Mapping[str, Any]] = None,
+    stages: Optional[Sequence[str]] = None,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    output: "str | os.PathLike[str]",
+) -> Spread:
+    """The spread of ``base`` under uncertain inputs, as ``wormwear spread`` (MODEL §17):
+    ``inputs`` maps dotted names of the gear file to ``(min, max)`` (uniform) or
+    ``{"mean": .., "sd": .., "min": .., "max": ..}`` (normal, truncated); ``samples`` runs
+    (with ``sampler="sobol"`` the base points of Saltelli's design: samples x (inputs + 2)
+    runs, and the Sobol indices), ``seed``, ``fixed`` (fields set alike in every sample), the
+    stages and life overrides as ``sweep``. Runs on the local cores into ``output``
+    (spread.csv, spread.json, spread.html, variants/NAME/; a rerun reuses finished samples).
+    Bad input raises ``InputError`` naming the field."""
+    spec = json.loads(_settings_json(stages, cycles, step_cycles, step_wear_um, no_pitting))
+    spec = {k: v for k, v in spec.items() if v is not None and v is not False}
+    table = {
+        "samples": samples,
+        "seed": seed,
+        "sampler": sampler,
+        "inputs": {name: list(v) if isinstance(v, (tuple, list)) else dict(v) for name, v in inputs.items()},
+    }
+    if fixed is not None:
+        table["fixed"] = dict(fixed)
+    spec["spread"] = table
+    directory = os.fspath(output)
+    summary = json.loads(_native.spread(base._native, json.dumps(spec), directory))
+    return Spread(directory, summary)

@@ -86,4 +86,27 @@ def sweep(
     output: str | os.PathLike[str] | None = None,
     client: Any = None,
 ) -> pd.DataFrame: ...
+class Spread:
+    directory: str
+    summary: dict
+    samples: pd.DataFrame
+    percentiles: pd.DataFrame
+    rank_correlation: pd.DataFrame
+    sobol_indices: Optional[pd.DataFrame]
+
+def spread(
+    base: GearSet,
+    inputs: Mapping[str, Any],
+    *,
+    samples: int = 64,
+    seed: int = 1,
+    sampler: str = "latin-hypercube",
+    fixed: Optional[Mapping[str, Any]] = None,
+    stages: Optional[Sequence[str]] = None,
+    cycles: Optional[float] = None,
+    step_cycles: Optional[float] = None,
+    step_wear_um: Optional[float] = None,
+    no_pitting: bool = False,
+    output: str | os.PathLike[str],
+) -> Spread: ...
 def compare(runs: Sequence[str | os.PathLike[str]], output: str | os.PathLike[str]) -> pd.DataFrame: ...
