@@ -183,13 +183,29 @@ fn zero_width_ranges_give_the_nominal_run_and_one_seed_one_set_of_bytes() {
     let nominal =
         wormwear::run(&gear, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
     let l = nominal.ltca.unwrap();
+    let at = |name: &str| {
+        wormwear::spread::RESULTS
+            .iter()
+            .position(|(n, _)| *n == name)
+            .unwrap()
+    };
+    let wf = nominal
+        .geometry
+        .wheel_flank(nominal.tca.as_ref().unwrap().loaded_flank);
+    let loaded: Vec<bool> = l.pattern.iter().map(|p| *p > 0.0).collect();
+    let entry = nominal.tca.as_ref().unwrap().entry_at_low_z;
+    let shape = wormwear::kinematics::pattern_shape::PatternShape::of(wf, &loaded, entry).unwrap();
     for results in &out.results {
-        assert_eq!(results[0], l.max_pressure);
-        assert_eq!(results[1], l.pressure_patch_max);
-        assert_eq!(results[4], l.te_stats().1);
+        assert_eq!(results[at("max_pressure_pa")], l.max_pressure);
+        assert_eq!(results[at("pressure_patch_max_pa")], l.pressure_patch_max);
+        assert_eq!(results[at("te_p2p_rad")], l.te_stats().1);
         assert_eq!(
-            results[6],
+            results[at("mesh_efficiency")],
             nominal.thermal.as_ref().unwrap().efficiency.mesh_efficiency
+        );
+        assert_eq!(
+            results[at("pattern_centre_across_face")],
+            shape.centre_across_face
         );
     }
     // A fixed field is set in every sample and is not an input.

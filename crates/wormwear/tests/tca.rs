@@ -27,6 +27,18 @@ fn conjugate(name: &str) -> GearSet {
     g
 }
 
+/// The design gear cut by a hob 1 mm oversize at a 1 mm larger cutting centre distance (the
+/// hob swivelled to its own lead): a localised no-load pattern.
+fn localised() -> GearSet {
+    let mut over = conjugate("gear-1x40-design.toml");
+    over.hob.reference_radius += 1e-3;
+    over.hob.tip_radius += 1e-3;
+    over.hob.root_radius += 1e-3;
+    over.cutting.centre_distance += 1e-3;
+    over.cutting.inclination = over.hob.lead_angle() - over.worm.lead_angle();
+    over
+}
+
 fn run(g: &GearSet) -> (Geometry, Tca) {
     let geo = Geometry::build(g).unwrap();
     let tca = kinematics::analyse(g, &geo).unwrap();
@@ -269,12 +281,7 @@ fn localised_pattern_moves_linearly_as_first_order_theory_predicts() {
     // gap at each position by da (dX/dy1)/(de/dpsi) to first order; from these perturbed gaps
     // the kinematic error, separations and pattern follow. The full recomputation must move the
     // pattern the same way, linearly.
-    let mut over = conjugate("gear-1x40-design.toml");
-    over.hob.reference_radius += 1e-3;
-    over.hob.tip_radius += 1e-3;
-    over.hob.root_radius += 1e-3;
-    over.cutting.centre_distance += 1e-3;
-    over.cutting.inclination = over.hob.lead_angle() - over.worm.lead_angle();
+    let over = localised();
     let (geo, tca) = run(&over);
     let wf = geo.wheel_flank(tca.loaded_flank);
     let ev = kinematics::GapEvaluator::new(&over, &geo);
@@ -486,4 +493,77 @@ fn edge_reliefs_are_parabolic_and_vanish_inside() {
     let g = example("gear-1x40-design.toml");
     let ev = kinematics::GapEvaluator::new(&g, &geo);
     assert_eq!(ev.relief(top, 0.5 * g.wheel.face_width, ra), (0.0, 0.0));
+}
+
+/// The pattern's shape (MODEL §17): a known block of cells gives its own span and a centre
+/// inside it, the two entry sides mirror each other; the entry side the nodes' contact moments
+/// give agrees with the order in time of the TCA's contact lines (an independent route) and
+/// moves to the other face end with the worm's rotation; a localised pattern follows the worm
+/// along the wheel axis.
+#[test]
+fn the_pattern_shape_reads_its_cells_its_entry_side_and_follows_the_worm() {
+    use wormwear::kinematics::pattern_shape::PatternShape;
+    let over = localised();
+    let (geo, tca) = run(&over);
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let (ni, nj) = (wf.cells_height, wf.cells_face);
+    let block: Vec<bool> = (0..ni * nj)
+        .map(|k| (10..20).contains(&(k / ni)) && (5..15).contains(&(k % ni)))
+        .collect();
+    let (low, high) = (
+        PatternShape::of(wf, &block, true).unwrap(),
+        PatternShape::of(wf, &block, false).unwrap(),
+    );
+    assert_eq!(low.extent_along_face, 10.0 / nj as f64);
+    assert_eq!(low.extent_up_flank, 10.0 / ni as f64);
+    assert!(low.centre_across_face > 10.0 / nj as f64 && low.centre_across_face < 20.0 / nj as f64);
+    assert!((low.centre_across_face + high.centre_across_face - 1.0).abs() < 1e-12);
+    assert!(PatternShape::of(wf, &vec![false; ni * nj], true).is_none());
+    // The contact lines within the marking thickness: their face position against time.
+    let tau = 2.0 * std::f64::consts::PI / over.wheel.teeth as f64;
+    let timed: Vec<(f64, f64)> = tca
+        .contact_lines
+        .iter()
+        .filter(|l| l.separation <= tca.marking_thickness && !l.at_end)
+        .map(|l| {
+            let theta2 = tca.positions[l.position].theta2 + tca.sigma * l.tooth as f64 * tau;
+            (tca.sigma * theta2, l.z)
+        })
+        .collect();
+    let n = timed.len() as f64;
+    let (mt, mz) = timed
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, z)| (a + t / n, b + z / n));
+    let covariance: f64 = timed.iter().map(|(t, z)| (t - mt) * (z - mz)).sum();
+    assert_eq!(
+        covariance > 0.0,
+        tca.entry_at_low_z,
+        "covariance {covariance:e}"
+    );
+    let mut reversed = over.clone();
+    reversed.rotation = wormwear::input::Rotation::Negative;
+    let (_, tca_reversed) = run(&reversed);
+    assert_ne!(tca_reversed.entry_at_low_z, tca.entry_at_low_z);
+    // The pattern's centre on the face (m) with the worm moved along the wheel axis.
+    let centre_z = |offset: f64| {
+        let mut g = over.clone();
+        g.operating.offset = offset;
+        let (geo, t) = run(&g);
+        let wf = geo.wheel_flank(t.loaded_flank);
+        let s = t.pattern_shape.unwrap();
+        let (entry, exit) = if t.entry_at_low_z {
+            (wf.z[0].min(wf.z[nj]), wf.z[0].max(wf.z[nj]))
+        } else {
+            (wf.z[0].max(wf.z[nj]), wf.z[0].min(wf.z[nj]))
+        };
+        entry + s.centre_across_face * (exit - entry)
+    };
+    let (minus, zero, plus) = (centre_z(-0.2e-3), centre_z(0.0), centre_z(0.2e-3));
+    eprintln!(
+        "pattern centre on the face at worm offsets -0.2 / 0 / +0.2 mm: {:.3} / {:.3} / {:.3} mm",
+        minus * 1e3,
+        zero * 1e3,
+        plus * 1e3
+    );
+    assert!(minus < zero && zero < plus, "{minus} {zero} {plus}");
 }

@@ -35,6 +35,7 @@ use std::f64::consts::PI;
 
 mod gap;
 mod node;
+pub mod pattern_shape;
 
 pub use gap::*;
 use node::*;
@@ -183,6 +184,10 @@ pub struct Tca {
     pub marking_thickness: f64,
     pub pattern_area: f64,
     pub active_area: f64,
+    /// Whether the contact enters the mesh at the flank's low-z face end (MODEL §17).
+    pub entry_at_low_z: bool,
+    /// The no-load pattern's centre and extent (None: no cell marked).
+    pub pattern_shape: Option<pattern_shape::PatternShape>,
     /// Per node column: lowest radius the worm flank reaches (trace of the worm tip), m.
     pub tip_trace: Vec<(f64, f64)>,
     /// Per node of the loaded flank.
@@ -374,6 +379,8 @@ pub fn analyse_with(
         .filter(|(_, &m)| m)
         .map(|(a, _)| a)
         .sum();
+    let entry_at_low_z = pattern_shape::entry_at_low_z(wf, &map.contact_theta2, sigma);
+    let shape = pattern_shape::PatternShape::of(wf, &marked, entry_at_low_z);
     let contact_lines = study.contact_lines(&blocks, &positions, &node_contact);
     let (node_gaps, cell_gaps) = GapBlock::joined(&blocks);
     Ok(Tca {
@@ -390,6 +397,8 @@ pub fn analyse_with(
         marking_thickness: j_mark,
         pattern_area,
         active_area: wf.active_area(),
+        entry_at_low_z,
+        pattern_shape: shape,
         tip_trace: tip_trace(&worm_cut, flank, wf),
         node_contact,
         pitch_sliding_speed: pitch_sliding_speed(gear, geo, theta1_dot, ev.ratio),

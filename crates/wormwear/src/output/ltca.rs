@@ -57,6 +57,9 @@ pub struct LtcaSummary {
     pub equivalent_pressure_definition: &'static str,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
+    /// The loaded pattern's (cells with pressure) centre across the face (0 at the entry
+    /// side, 1 at the exit side) and up the flank, and its extent (shares; MODEL §17).
+    pub pattern_shape: Option<crate::kinematics::pattern_shape::PatternShape>,
     pub s1: f64,
     pub s2: f64,
     pub te_mean_rad: f64,
@@ -138,6 +141,11 @@ impl LtcaSummary {
                 .map_or(f64::NAN, |(_, d)| d * MM),
             equivalent_pressure_definition: ltca.subsurface.criterion.definition(),
             contact_area_fraction: ltca.s0,
+            pattern_shape: crate::kinematics::pattern_shape::PatternShape::of(
+                wf,
+                &ltca.pattern.iter().map(|p| *p > 0.0).collect::<Vec<_>>(),
+                tca.entry_at_low_z,
+            ),
             s1: ltca.s1,
             s2: ltca.s2,
             te_mean_rad: te_mean,

@@ -27,6 +27,9 @@ pub struct TcaSummary {
     pub active_flank_area_mm2: f64,
     /// Marked area / active flank area.
     pub pattern_area_fraction: f64,
+    /// The no-load pattern's centre across the face (0 at the entry side, 1 at the exit side)
+    /// and up the flank, and its extent along the face and up the flank (shares; MODEL §17).
+    pub pattern_shape: Option<crate::kinematics::pattern_shape::PatternShape>,
     pub min_teeth_in_contact: usize,
     pub max_teeth_in_contact: usize,
     pub max_sliding_speed_m_s: f64,
@@ -50,6 +53,7 @@ impl TcaSummary {
             pattern_area_mm2: tca.pattern_area * MM * MM,
             active_flank_area_mm2: tca.active_area * MM * MM,
             pattern_area_fraction: tca.pattern_area / tca.active_area,
+            pattern_shape: tca.pattern_shape,
             min_teeth_in_contact: counts.clone().min().unwrap_or(0),
             max_teeth_in_contact: counts.max().unwrap_or(0),
             max_sliding_speed_m_s: tca.max_sliding_speed(),

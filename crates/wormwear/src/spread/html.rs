@@ -274,6 +274,17 @@ fn tornado_svg(label: &str, summary: &serde_json::Value, name: &str, spread: &Sp
             left + 170.0 * m as f64 + 16.0
         );
     }
+    for v in [-1.0, -0.5, 0.0, 0.5, 1.0] {
+        let _ = writeln!(
+            svg,
+            "<line x1=\"{0:.1}\" x2=\"{0:.1}\" y1=\"{top}\" y2=\"{1:.1}\" stroke=\"{2}\"/>\
+             <text x=\"{0:.1}\" y=\"{3:.1}\" font-size=\"12\" text-anchor=\"middle\">{v}</text>",
+            x(v),
+            top + plot_h,
+            if v == 0.0 { "black" } else { "#ddd" },
+            top + plot_h + 16.0
+        );
+    }
     for (k, input) in inputs.iter().enumerate() {
         let y0 = top + row * k as f64;
         let _ = writeln!(
@@ -300,17 +311,6 @@ fn tornado_svg(label: &str, summary: &serde_json::Value, name: &str, spread: &Sp
                 c.2
             );
         }
-    }
-    for v in [-1.0, -0.5, 0.0, 0.5, 1.0] {
-        let _ = writeln!(
-            svg,
-            "<line x1=\"{0:.1}\" x2=\"{0:.1}\" y1=\"{top}\" y2=\"{1:.1}\" stroke=\"{2}\"/>\
-             <text x=\"{0:.1}\" y=\"{3:.1}\" font-size=\"12\" text-anchor=\"middle\">{v}</text>",
-            x(v),
-            top + plot_h,
-            if v == 0.0 { "black" } else { "#ddd" },
-            top + plot_h + 16.0
-        );
     }
     svg.push_str("</svg>\n");
     svg

@@ -472,7 +472,7 @@ pub fn sample_variants(
 
 /// The key results a spread reports, by name, and where each is in a variant's summary.json
 /// (a dotted path; `wear.end.` the life's last record, `safety.` the safety table's row).
-pub const RESULTS: [(&str, &str); 14] = [
+pub const RESULTS: [(&str, &str); 21] = [
     ("max_pressure_pa", "ltca.max_pressure_pa"),
     ("pressure_patch_max_pa", "ltca.pressure_patch_max_pa"),
     (
@@ -480,6 +480,34 @@ pub const RESULTS: [(&str, &str); 14] = [
         "ltca.equivalent_pressure_max_pa",
     ),
     ("contact_area_fraction", "ltca.contact_area_fraction"),
+    (
+        "pattern_centre_across_face",
+        "ltca.pattern_shape.centre_across_face",
+    ),
+    (
+        "pattern_centre_up_flank",
+        "ltca.pattern_shape.centre_up_flank",
+    ),
+    (
+        "pattern_extent_along_face",
+        "ltca.pattern_shape.extent_along_face",
+    ),
+    (
+        "pattern_extent_up_flank",
+        "ltca.pattern_shape.extent_up_flank",
+    ),
+    (
+        "no_load_pattern_centre_across_face",
+        "tca.pattern_shape.centre_across_face",
+    ),
+    (
+        "no_load_pattern_extent_along_face",
+        "tca.pattern_shape.extent_along_face",
+    ),
+    (
+        "no_load_pattern_extent_up_flank",
+        "tca.pattern_shape.extent_up_flank",
+    ),
     ("te_p2p_rad", "ltca.te_p2p_rad"),
     (
         "mesh_stiffness_mean_nm_per_rad",

@@ -1,0 +1,90 @@
+//! The shape of a contact pattern on the loaded wheel flank (MODEL §17): where it sits across
+//! the face, from the face end where the contact enters the mesh to the one where it leaves, and
+//! up the flank, and how far it reaches along the face and up the flank. What a workshop reads
+//! off a marking test (MODEL §4.4), for the no-load pattern and the loaded one alike.
+
+use crate::geometry::WheelFlank;
+
+/// The shape of a pattern: its cells' area-weighted centre and their span, as shares of the
+/// flank grid (the active flank between the face ends and between the flank's lower and upper
+/// limits of each column).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PatternShape {
+    /// Centre across the face: 0 at the entry side's face end, 1 at the exit side's.
+    pub centre_across_face: f64,
+    /// Centre up the flank: 0 at the flank's lower limit (the wheel's root side), 1 at its
+    /// upper limit.
+    pub centre_up_flank: f64,
+    /// Share of the face the pattern spans, from its first to its last column of cells.
+    pub extent_along_face: f64,
+    /// Share of the flank height it spans, from its lowest to its highest row of cells.
+    pub extent_up_flank: f64,
+    /// Face position (wheel axis, mm) of the entry side's face end.
+    pub entry_side_z_mm: f64,
+}
+
+impl PatternShape {
+    /// The shape of the cells `in_pattern` (flank-grid cell order: column j, row i at
+    /// j * rows + i) of `wf`, with the contact entering at the low-z face end when
+    /// `entry_at_low_z`. None for an empty pattern.
+    pub fn of(wf: &WheelFlank, in_pattern: &[bool], entry_at_low_z: bool) -> Option<Self> {
+        let (ni, nj) = (wf.cells_height, wf.cells_face);
+        let (mut area, mut across, mut up) = (0.0, 0.0, 0.0);
+        let (mut j_lo, mut j_hi, mut i_lo, mut i_hi) = (usize::MAX, 0, usize::MAX, 0);
+        for j in 0..nj {
+            for i in 0..ni {
+                let k = j * ni + i;
+                if !in_pattern.get(k).copied().unwrap_or(false) {
+                    continue;
+                }
+                let a = wf.cell_area[k];
+                area += a;
+                across += a * (j as f64 + 0.5) / nj as f64;
+                up += a * (i as f64 + 0.5) / ni as f64;
+                (j_lo, j_hi) = (j_lo.min(j), j_hi.max(j));
+                (i_lo, i_hi) = (i_lo.min(i), i_hi.max(i));
+            }
+        }
+        if area <= 0.0 {
+            return None;
+        }
+        let from_low_z = across / area;
+        let (z_first, z_last) = (wf.z[0], wf.z[nj]);
+        Some(Self {
+            centre_across_face: if entry_at_low_z {
+                from_low_z
+            } else {
+                1.0 - from_low_z
+            },
+            centre_up_flank: up / area,
+            extent_along_face: (j_hi + 1 - j_lo) as f64 / nj as f64,
+            extent_up_flank: (i_hi + 1 - i_lo) as f64 / ni as f64,
+            entry_side_z_mm: 1e3
+                * if entry_at_low_z {
+                    z_first.min(z_last)
+                } else {
+                    z_first.max(z_last)
+                },
+        })
+    }
+}
+
+/// Whether the contact enters the mesh at the flank's low-z face end: the driven wheel angle
+/// at which each node of `wf` is in contact (`contact_theta2`, rad, NaN where none; `sigma`
+/// the driven sense) grows with z when the contact sweeps from low z to high z. The sign of the
+/// least-squares slope of sigma theta2 on z over the nodes.
+pub fn entry_at_low_z(wf: &WheelFlank, contact_theta2: &[f64], sigma: f64) -> bool {
+    let ni = wf.cells_height;
+    let pairs: Vec<(f64, f64)> = contact_theta2
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.is_finite())
+        .map(|(k, t)| (wf.z[k / (ni + 1)], sigma * t))
+        .collect();
+    let n = pairs.len().max(1) as f64;
+    let (mz, mt) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (z, t)| (a + z / n, b + t / n));
+    let covariance: f64 = pairs.iter().map(|(z, t)| (z - mz) * (t - mt)).sum();
+    covariance >= 0.0
+}
