@@ -570,16 +570,8 @@ fn run_variant(
     serde_json::to_string(&row).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
-/// Runs a spread of `base` (MODEL §17) on the local cores into `directory` as `wormwear spread`
-/// does: `spec_json` is a spread file's tables as JSON without `base` (`stages`, `cycles`, ...,
-/// `spread`). Returns spread.json's text.
-#[pyfunction]
-fn spread(
-    py: Python<'_>,
-    base: &NativeGear,
-    spec_json: &str,
-    directory: String,
-) -> PyResult<String> {
+/// The spread of `base` from a spread file's tables as JSON, without `base`.
+fn spread_of(base: &NativeGear, spec_json: &str) -> PyResult<wormwear::spread::Spread> {
     let spec: serde_json::Value =
         serde_json::from_str(spec_json).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let study = wormwear::spread::Spread::of_document(
@@ -588,12 +580,33 @@ fn spread(
         spec,
     )
     .map_err(|e| InputError::new_err(error_chain(&e)))?;
+    Ok(study)
+}
+
+/// Runs a spread of `base` (MODEL §17) on the local cores into `directory` as `wormwear spread`
+/// does: `spec_json` is a spread file's tables as JSON without `base` (`stages`, `cycles`, ...,
+/// `spread`). Returns spread.json's text and the count of samples reused from `directory`
+/// (finished there with the same inputs: by an earlier run, or by Dask tasks).
+#[pyfunction]
+fn spread(
+    py: Python<'_>,
+    base: &NativeGear,
+    spec_json: &str,
+    directory: String,
+) -> PyResult<(String, usize)> {
+    let study = spread_of(base, spec_json)?;
+    let reused = std::sync::atomic::AtomicUsize::new(0);
     let done: Result<(), String> = py.detach(|| {
         let dir = Path::new(&directory);
         std::fs::create_dir_all(dir).map_err(|e| format!("{directory}: {e}"))?;
         let _lock = wormwear::output::lock_directory(dir).map_err(|e| e.to_string())?;
         let interrupt = || interrupted();
-        wormwear::spread::run(&study, dir, &|_| {}, &interrupt)
+        let progress = |p: wormwear::sweep::Progress| {
+            if p.reused {
+                reused.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            }
+        };
+        wormwear::spread::run(&study, dir, &progress, &interrupt)
             .map(|_| ())
             .map_err(|e| error_chain(&e))
     });
@@ -601,8 +614,30 @@ fn spread(
     if interrupted() {
         return Err(PyKeyboardInterrupt::new_err("spread interrupted"));
     }
-    std::fs::read_to_string(Path::new(&directory).join("spread.json"))
-        .map_err(|e| PyOSError::new_err(e.to_string()))
+    let summary = std::fs::read_to_string(Path::new(&directory).join("spread.json"))
+        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    Ok((summary, reused.into_inner()))
+}
+
+/// The samples of a spread of `base` (`spec_json` as [`spread`]'s) as sweep variants, JSON
+/// [[name, {dotted: value}], ...]: what a Dask client runs one task each.
+#[pyfunction]
+fn spread_variants(base: &NativeGear, spec_json: &str) -> PyResult<String> {
+    let study = spread_of(base, spec_json)?;
+    let list: Vec<(String, serde_json::Map<String, serde_json::Value>)> = study
+        .sweep
+        .variants
+        .iter()
+        .map(|v| {
+            let values = v
+                .values
+                .iter()
+                .map(|(n, t)| (n.clone(), serde_json::to_value(t).unwrap_or_default()))
+                .collect();
+            (v.name.clone(), values)
+        })
+        .collect();
+    serde_json::to_string(&list).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
 /// The CSV of rows (JSON) as `wormwear sweep` writes it.
@@ -674,6 +709,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(expand_grid, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(spread, m)?)?;
+    m.add_function(wrap_pyfunction!(spread_variants, m)?)?;
     m.add_function(wrap_pyfunction!(run_variant, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;

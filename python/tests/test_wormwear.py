@@ -493,6 +493,14 @@ def test_a_spread_equals_the_cli_and_bad_inputs_raise_naming_the_field(cli, fast
     assert (tmp_path / "cli" / "spread.csv").read_bytes() == (tmp_path / "py" / "spread.csv").read_bytes()
     cli_summary = json.loads((tmp_path / "cli" / "spread.json").read_text())
     assert cli_summary["results"] == result.summary["results"]
+    # On a Dask LocalCluster of two worker processes: the same samples and results.
+    from dask.distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with Client(cluster) as client:
+            on_dask = wormwear.spread(base, inputs, samples=4, seed=3, output=tmp_path / "dask", client=client)
+    assert on_dask.reused == 4 and result.reused == 0
+    assert (tmp_path / "dask" / "spread.csv").read_bytes() == (tmp_path / "py" / "spread.csv").read_bytes()
     # The Sobol sampler: samples x (inputs + 2) runs and each result's indices.
     sobol = wormwear.spread(
         base, {"conditions.worm_torque_nm": (50.0, 70.0)}, samples=2, sampler="sobol", output=tmp_path / "sobol"

@@ -516,10 +516,12 @@ class Spread:
     inputs, ``ok`` and the key results, as spread.csv), ``summary`` (spread.json as a dict),
     ``percentiles`` (one row per key result: count, min, p10, p50, p90, max, mean),
     ``rank_correlation`` (results x inputs, Spearman's rho), ``sobol_indices`` (with the Sobol
-    sampler: a frame of result, input, first, total; else None) and ``directory``."""
+    sampler: a frame of result, input, first, total; else None), ``directory`` and ``reused``
+    (the samples found finished there: by an earlier run, or by Dask tasks)."""
 
-    def __init__(self, directory: str, summary: dict):
+    def __init__(self, directory: str, summary: dict, reused: int = 0):
         self.directory = directory
+        self.reused = reused
         self.summary = summary
         self.samples = pd.read_csv(os.path.join(directory, "spread.csv"))
         self.percentiles = pd.DataFrame.from_dict(summary["results"], orient="index")
@@ -555,6 +557,7 @@ def spread(
     step_wear_um: Optional[float] = None,
     no_pitting: bool = False,
     output: "str | os.PathLike[str]",
+    client: Any = None,
 ) -> Spread:
     """The spread of ``base`` under uncertain inputs, as ``wormwear spread`` (MODEL §17):
     ``inputs`` maps dotted names of the gear file to ``(min, max)`` (uniform) or
@@ -562,8 +565,10 @@ def spread(
     (with ``sampler="sobol"`` the base points of Saltelli's design: samples x (inputs + 2)
     runs, and the Sobol indices), ``seed``, ``fixed`` (fields set alike in every sample), the
     stages and life overrides as ``sweep``. Runs on the local cores into ``output``
-    (spread.csv, spread.json, spread.html, variants/NAME/; a rerun reuses finished samples).
-    Bad input raises ``InputError`` naming the field."""
+    (spread.csv, spread.json, spread.html, variants/NAME/; a rerun reuses finished samples),
+    or with a ``dask.distributed.Client`` one task per sample, each writing its folder in
+    ``output`` (a directory all workers see), then the spread's files from them. Bad input
+    raises ``InputError`` naming the field."""
     spec = json.loads(_settings_json(stages, cycles, step_cycles, step_wear_um, no_pitting))
     spec = {k: v for k, v in spec.items() if v is not None and v is not False}
     table = {
@@ -576,5 +581,17 @@ def spread(
         table["fixed"] = dict(fixed)
     spec["spread"] = table
     directory = os.fspath(output)
-    summary = json.loads(_native.spread(base._native, json.dumps(spec), directory))
-    return Spread(directory, summary)
+    if client is not None:
+        variants = json.loads(_native.spread_variants(base._native, json.dumps(spec)))
+        settings = _settings_json(
+            stages if stages is not None else ["ltca"], cycles, step_cycles, step_wear_um, no_pitting
+        )
+        os.makedirs(directory, exist_ok=True)
+        base_future = client.scatter(base, broadcast=True)
+        futures = client.map(
+            _run_variant_task, variants, base=base_future, settings=settings, directory=directory, pure=False
+        )
+        client.gather(futures)
+    # Locally: every sample; after Dask: the finished samples are reused, the files written.
+    text, reused = _native.spread(base._native, json.dumps(spec), directory)
+    return Spread(directory, json.loads(text), reused)

@@ -88,6 +88,7 @@ def sweep(
 ) -> pd.DataFrame: ...
 class Spread:
     directory: str
+    reused: int
     summary: dict
     samples: pd.DataFrame
     percentiles: pd.DataFrame
@@ -108,5 +109,6 @@ def spread(
     step_wear_um: Optional[float] = None,
     no_pitting: bool = False,
     output: str | os.PathLike[str],
+    client: Any = None,
 ) -> Spread: ...
 def compare(runs: Sequence[str | os.PathLike[str]], output: str | os.PathLike[str]) -> pd.DataFrame: ...
