@@ -8,7 +8,7 @@ use wormwear::bending::fe::element_stiffness;
 use wormwear::bending::fe::Elastic;
 use wormwear::bending::root_mesh::fillet_sector_mesh;
 use wormwear::bending::wheel_root::{
-    root_mesh_settings, root_stress, root_stress_cached, RootStressError,
+    forget_kept_sector, root_mesh_settings, root_stress, root_stress_cached, RootStressError,
 };
 use wormwear::geometry::Geometry;
 use wormwear::input::{BendingKind, GearSet, Torque};
@@ -75,6 +75,32 @@ fn the_root_stress_is_linear_in_the_pressures_and_nearly_so_in_the_torque() {
     assert!((0.975..1.0).contains(&ratio), "{ratio}");
     // The tensile fibre is on the loaded flank's side (the tooth bends away from the load).
     assert!(base.interior.tension_on_loaded_side);
+}
+
+/// A spread's samples move the worm, not the wheel: the sector and its factorised stiffness
+/// are built once and kept. The kept sector gives the root stress a fresh build gives, to the
+/// bit; another fillet (another sector) is not served the kept one.
+#[test]
+fn a_kept_sector_gives_the_fresh_root_stress_and_another_fillet_builds_its_own() {
+    let (g, geo, flank, ltca) = loaded(60.0);
+    // The worm moved along the wheel axis: the same wheel, another load.
+    let mut moved = g.clone();
+    moved.operating.offset += 0.05e-3;
+    let tca = wormwear::kinematics::analyse(&moved, &geo).unwrap();
+    let settings = wormwear::ltca::LtcaSettings::from_gear(&moved);
+    let moved_ltca = wormwear::ltca::analyse_with(&moved, &geo, &tca, &settings, None).unwrap();
+    forget_kept_sector();
+    let first = root_stress(&g, &geo, &ltca, flank, (1, FILLET)).unwrap();
+    let kept = root_stress(&moved, &geo, &moved_ltca, flank, (1, FILLET)).unwrap();
+    forget_kept_sector();
+    let fresh = root_stress(&moved, &geo, &moved_ltca, flank, (1, FILLET)).unwrap();
+    assert_eq!(kept, fresh);
+    assert_ne!(kept.interior.stress, first.interior.stress);
+    let other = root_stress(&g, &geo, &ltca, flank, (1, 0.8e-3)).unwrap();
+    forget_kept_sector();
+    let other_fresh = root_stress(&g, &geo, &ltca, flank, (1, 0.8e-3)).unwrap();
+    assert_eq!(other, other_fresh);
+    assert_ne!(other.interior.stress, first.interior.stress);
 }
 
 #[test]

@@ -18,7 +18,7 @@
 //! contact force enters as a consistent nodal load (the flank face's shape functions at the
 //! cell's point), so no nodal force puts its own singular stress into the tooth.
 
-use super::fe::{element_stress, natural_coordinates, shape, solve};
+use super::fe::{element_stress, natural_coordinates, shape, KeptFactor};
 use super::fe::{Elastic, FeError, Load};
 use super::root_mesh::{fillet_sector_mesh, FilletMeshError, FilletMeshSettings};
 use super::root_mesh::{flank_row, FilletSector, Side};
@@ -234,53 +234,129 @@ fn load_cases(ltca: &Ltca, flank: &FlankLoads) -> Result<LoadCases, RootStressEr
 /// The filleted sector of refinement `level` solved under every (position, tooth in the
 /// middle) load case of `ltca` on the wheel's `flank`.
 pub struct LoadedSector {
-    pub sector: FilletSector,
+    kept: std::sync::Arc<KeptSector>,
     material: Elastic,
     side: Side,
     labels: Vec<(usize, i32)>,
     solutions: Vec<Vec<[f64; 3]>>,
 }
 
+/// A sector mesh and its factorised stiffness, kept for the next run of the same wheel
+/// (a spread's samples move the worm, not the wheel): `key` names all it depends on.
+struct KeptSector {
+    key: String,
+    sector: FilletSector,
+    factor: KeptFactor,
+}
+
+/// The last sector built in this process (one: a sector's factor takes up to a gigabyte).
+static KEPT_SECTOR: std::sync::Mutex<Option<std::sync::Arc<KeptSector>>> =
+    std::sync::Mutex::new(None);
+
+/// The sector of `gear`'s wheel at refinement `level` with fillet radius `fillet_radius` (m)
+/// and its factorised stiffness: the kept one when its key is the same, else built (and
+/// kept). The key holds everything the wheel's flanks, the sector and its stiffness read:
+/// the worm, hob, cutting placement, blank and body, the analysis grid, the wheel's
+/// elasticity, the level and the fillet; not the operating placement or the load. A new
+/// sector passes `check` (its loads fit it) before it is factorised.
+fn kept_sector(
+    gear: &GearSet,
+    geo: &Geometry,
+    (level, fillet_radius): (usize, f64),
+    material: &Elastic,
+    check: &dyn Fn(&FilletSector) -> Result<(), RootStressError>,
+) -> Result<std::sync::Arc<KeptSector>, RootStressError> {
+    let key = serde_json::json!({
+        "worm": gear.worm,
+        "hob": gear.hob,
+        "cutting": gear.cutting,
+        "wheel": gear.wheel,
+        "body": format!("{:?}", gear.wheel_body()),
+        "nominal_centre_distance": gear.nominal_centre_distance,
+        "analysis": gear.analysis,
+        "material": [material.youngs_modulus, material.poisson_ratio],
+        "level": level,
+        "fillet_radius": fillet_radius,
+    })
+    .to_string();
+    // Not held while building: runs of other wheels build theirs side by side (the first
+    // runs of one wheel may each build it once).
+    {
+        let kept = KEPT_SECTOR.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(k) = kept.as_ref().filter(|k| k.key == key) {
+            return Ok(k.clone());
+        }
+    }
+    let sector = fillet_sector_mesh(
+        geo,
+        &root_mesh_settings(gear, level, fillet_radius),
+        gear.hob.tip_radius,
+        gear.cutting.centre_distance,
+    )?;
+    check(&sector)?;
+    let fixed: Vec<(usize, usize, f64)> = sector
+        .clamped
+        .iter()
+        .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
+        .collect();
+    let factor = KeptFactor::new(&sector.mesh, material, &fixed)?;
+    let built = std::sync::Arc::new(KeptSector {
+        key,
+        sector,
+        factor,
+    });
+    *KEPT_SECTOR.lock().unwrap_or_else(|e| e.into_inner()) = Some(built.clone());
+    Ok(built)
+}
+
+/// Lets the kept sector go (its memory with it); the next root stress builds its own.
+pub fn forget_kept_sector() {
+    *KEPT_SECTOR.lock().unwrap_or_else(|e| e.into_inner()) = None;
+}
+
 impl LoadedSector {
-    /// Builds and solves the sector; `fillet_radius` in m.
+    /// Builds (or takes the kept one, [`kept_sector`]) and solves the sector;
+    /// `fillet_radius` in m.
     pub fn solve(
         gear: &GearSet,
         geo: &Geometry,
         ltca: &Ltca,
         (flank, level, fillet_radius): (Flank, usize, f64),
     ) -> Result<Self, RootStressError> {
-        let sector = fillet_sector_mesh(
-            geo,
-            &root_mesh_settings(gear, level, fillet_radius),
-            gear.hob.tip_radius,
-            gear.cutting.centre_distance,
-        )?;
-        let side = Side::of(flank);
-        let loads = FlankLoads {
-            gear,
-            wf: geo.wheel_flank(flank),
-            sector: &sector,
-            side,
-            tau: 2.0 * std::f64::consts::PI / geo.teeth as f64,
-        };
-        let (cases, labels) = load_cases(ltca, &loads)?;
-        let fixed: Vec<(usize, usize, f64)> = sector
-            .clamped
-            .iter()
-            .flat_map(|&n| (0..3).map(move |d| (n, d, 0.0)))
-            .collect();
         let material = Elastic {
             youngs_modulus: gear.wheel_material.youngs_modulus,
             poisson_ratio: gear.wheel_material.poisson_ratio,
         };
-        let solutions = solve(&sector.mesh, &material, &fixed, &cases)?;
+        let side = Side::of(flank);
+        fn loads_on<'a>(
+            (gear, geo, flank): (&'a GearSet, &'a Geometry, Flank),
+            sector: &'a FilletSector,
+        ) -> FlankLoads<'a> {
+            FlankLoads {
+                gear,
+                wf: geo.wheel_flank(flank),
+                sector,
+                side: Side::of(flank),
+                tau: 2.0 * std::f64::consts::PI / geo.teeth as f64,
+            }
+        }
+        let on = (gear, geo, flank);
+        let check = |sector: &FilletSector| load_cases(ltca, &loads_on(on, sector)).map(|_| ());
+        let kept = kept_sector(gear, geo, (level, fillet_radius), &material, &check)?;
+        let (cases, labels) = load_cases(ltca, &loads_on(on, &kept.sector))?;
+        let solutions = kept.factor.solve(&cases);
         Ok(Self {
-            sector,
+            kept,
             material,
             side,
             labels,
             solutions,
         })
+    }
+
+    /// The sector mesh.
+    pub fn sector(&self) -> &FilletSector {
+        &self.kept.sector
     }
 }
 
@@ -351,7 +427,7 @@ struct RootSection {
 impl LoadedSector {
     /// Body-frame point of element e at natural point xi, m.
     fn point(&self, e: usize, xi: [f64; 3]) -> [f64; 3] {
-        let m = &self.sector.mesh;
+        let m = &self.kept.sector.mesh;
         let (n, _) = shape(xi);
         std::array::from_fn(|d| {
             m.elements[e]
@@ -365,14 +441,14 @@ impl LoadedSector {
     /// The root section at face coordinate z (in the layer holding it; the tooth block's first
     /// row's bottom faces span the chord), 3 Gauss points per element.
     fn section(&self, z: f64) -> Option<RootSection> {
-        let lz = &self.sector.layer_z;
+        let lz = &self.kept.sector.layer_z;
         let last = lz.len() - 2;
         let li = lz
             .iter()
             .position(|&v| v > z)
             .map_or(last, |i| i.saturating_sub(1).min(last));
         let zeta = (2.0 * (z - lz[li]) / (lz[li + 1] - lz[li]) - 1.0).clamp(-1.0, 1.0);
-        let row = &self.sector.root_section[li];
+        let row = &self.kept.sector.root_section[li];
         let (&first, &last) = (row.first()?, row.last()?);
         let (pa, pb) = (
             self.point(first, [-1.0, -1.0, zeta]),
@@ -410,7 +486,7 @@ impl LoadedSector {
         let n = section.normal;
         let (mut membrane, mut bending) = (0.0, 0.0);
         for &(e, xi, w, s) in &section.points {
-            let t = element_stress(&self.sector.mesh, e, &self.material, u, xi)?;
+            let t = element_stress(&self.kept.sector.mesh, e, &self.material, u, xi)?;
             let sigma = [[t[0], t[5], t[4]], [t[5], t[1], t[3]], [t[4], t[3], t[2]]];
             let normal: f64 = (0..3)
                 .map(|i| (0..3).map(|j| n[i] * sigma[i][j] * n[j]).sum::<f64>())
@@ -426,7 +502,7 @@ impl LoadedSector {
     /// (fixed places whatever the mesh), over every load case; stations nearer a face end than
     /// `edge` (m) go to the face-end reading.
     pub fn root_stresses(&self, edge: f64) -> Result<RootStresses, FeError> {
-        let lz = &self.sector.layer_z;
+        let lz = &self.kept.sector.layer_z;
         let (z_lo, z_hi) = (lz[0], lz[lz.len() - 1]);
         let (mut interior, mut face_ends) = (RootStress::NONE, RootStress::NONE);
         for k in 0..=ROOT_STATIONS {

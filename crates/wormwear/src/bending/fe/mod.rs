@@ -17,6 +17,7 @@ mod system;
 pub use checks::*;
 pub use congruence::{element_stiffnesses, ElementStiffnesses};
 use ordering::*;
+pub(crate) use system::KeptFactor;
 use system::*;
 
 /// Natural coordinates of the 20 nodes: 8 corners, then the 12 edge midpoints.

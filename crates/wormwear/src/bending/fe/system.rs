@@ -471,34 +471,121 @@ impl Factor<'_> {
         difference_cases: usize,
         wanted: Option<&[usize]>,
     ) -> Mat<f64> {
-        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
-        let (free, cases) = (rhs.nrows(), rhs.ncols());
-        let order = self.order;
-        let (symbolic, values) = (&order.symbolic, &self.values);
+        solve_factored(
+            self.order,
+            &self.values,
+            &mut self.mem,
+            rhs,
+            (difference_cases, wanted),
+        )
+    }
+
+    /// The factor's values, for a [`KeptFactor`].
+    fn into_values(self) -> Vec<f64> {
+        self.values
+    }
+}
+
+/// [`Factor::solve`] on an order, its factor's values and a work buffer.
+fn solve_factored(
+    order: &BlockedLast,
+    values: &[f64],
+    mem: &mut faer::dyn_stack::MemBuffer,
+    rhs: Mat<f64>,
+    (difference_cases, wanted): (usize, Option<&[usize]>),
+) -> Mat<f64> {
+    use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+    let (free, cases) = (rhs.nrows(), rhs.ncols());
+    let symbolic = &order.symbolic;
+    let par = faer::get_global_parallelism();
+    let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(order.forward[i], c)]);
+    drop(rhs);
+    let supernodal = match symbolic.raw() {
+        SymbolicCholeskyRaw::Supernodal(s) => Some((s, SupernodalLltRef::new(s, values))),
+        SymbolicCholeskyRaw::Simplicial(_) => None,
+    };
+    match supernodal {
+        Some((_, l)) => forward_sparse(l, y.as_mut(), par),
+        None => lower_solve(symbolic, values, y.as_mut(), false, par, mem),
+    }
+    for c in 0..difference_cases.min(cases) {
+        for i in 0..order.unblocked {
+            y[(i, c)] = 0.0;
+        }
+    }
+    match (supernodal, wanted) {
+        (Some((s, l)), Some(rows)) => {
+            let needed = supernodes_on_paths(s, rows.iter().map(|&i| order.inverse[i]));
+            backward_on(l, y.as_mut(), &needed, par);
+        }
+        _ => lower_solve(symbolic, values, y.as_mut(), true, par, mem),
+    }
+    Mat::<f64>::from_fn(free, cases, |i, c| y[(order.inverse[i], c)])
+}
+
+/// A system factorised once and kept for the load cases of many runs (the same mesh,
+/// material and supports, all prescribed displacements zero): the root stress's sector over
+/// the samples of a spread.
+pub(crate) struct KeptFactor {
+    order: BlockedLast,
+    values: Vec<f64>,
+    map: Vec<usize>,
+    prescribed: Vec<Option<f64>>,
+}
+
+impl KeptFactor {
+    /// Assembles, orders and factorises `mesh` with `material` held at `fixed` (every value
+    /// zero: a load's right-hand side is then the load alone).
+    pub(crate) fn new(
+        mesh: &Mesh,
+        material: &crate::bending::fe::Elastic,
+        fixed: &[Fixed],
+    ) -> Result<Self, FeError> {
+        if fixed.iter().any(|f| f.2 != 0.0) {
+            return Err(FeError::Factorisation(
+                "a kept factorisation holds its supports at zero displacement".into(),
+            ));
+        }
+        let elements = super::element_stiffnesses(mesh, material)?;
+        let system = assemble(mesh, &elements, fixed, &[], &[]);
+        let free = system.matrix.nrows();
+        let node = free_dof_nodes(&system.map, free);
+        let order = BlockedLast::ordered(
+            system.matrix.symbolic(),
+            &node,
+            &vec![false; free],
+            SizeLimits::NONE,
+        )?;
+        let values = order.factorize(system.matrix, 1)?.into_values();
+        Ok(Self {
+            order,
+            values,
+            map: system.map,
+            prescribed: system.prescribed,
+        })
+    }
+
+    /// The displacements of every node under each load case, [case][node], m.
+    pub(crate) fn solve(&self, loads: &[Vec<Load>]) -> Vec<Vec<[f64; 3]>> {
+        let free = self.order.forward.len();
+        let rhs = load_vectors(loads, &self.map, free);
         let par = faer::get_global_parallelism();
-        let mut y = Mat::<f64>::from_fn(free, cases, |i, c| rhs[(order.forward[i], c)]);
-        drop(rhs);
-        let supernodal = match symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => Some((s, SupernodalLltRef::new(s, values))),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
+        let scratch = self
+            .order
+            .symbolic
+            .solve_in_place_scratch::<f64>(loads.len().max(1), par);
+        let mut mem = faer::dyn_stack::MemBuffer::new(scratch);
+        let x = solve_factored(&self.order, &self.values, &mut mem, rhs, (0, None));
+        let solution = Solution {
+            x,
+            map: self.map.clone(),
+            prescribed: self.prescribed.clone(),
+            difference_cases: 0,
         };
-        match supernodal {
-            Some((_, l)) => forward_sparse(l, y.as_mut(), par),
-            None => lower_solve(symbolic, values, y.as_mut(), false, par, &mut self.mem),
-        }
-        for c in 0..difference_cases.min(cases) {
-            for i in 0..order.unblocked {
-                y[(i, c)] = 0.0;
-            }
-        }
-        match (supernodal, wanted) {
-            (Some((s, l)), Some(rows)) => {
-                let needed = supernodes_on_paths(s, rows.iter().map(|&i| order.inverse[i]));
-                backward_on(l, y.as_mut(), &needed, par);
-            }
-            _ => lower_solve(symbolic, values, y.as_mut(), true, par, &mut self.mem),
-        }
-        Mat::<f64>::from_fn(free, cases, |i, c| y[(order.inverse[i], c)])
+        let nodes = self.prescribed.len() / 3;
+        (0..loads.len())
+            .map(|c| (0..nodes).map(|n| solution.at(c, n)).collect())
+            .collect()
     }
 }
 
