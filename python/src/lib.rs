@@ -640,6 +640,13 @@ fn spread_variants(base: &NativeGear, spec_json: &str) -> PyResult<String> {
     serde_json::to_string(&list).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
+/// Lets go of the root stress's kept FE sector (the last wheel's, kept for the next run of
+/// the same wheel; up to a few hundred MB).
+#[pyfunction]
+fn forget_kept_sector() {
+    wormwear::bending::wheel_root::forget_kept_sector();
+}
+
 /// The CSV of rows (JSON) as `wormwear sweep` writes it.
 #[pyfunction]
 fn write_sweep_csv(path: &str, parameters: Vec<String>, rows_json: &str) -> PyResult<()> {
@@ -710,6 +717,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(spread, m)?)?;
     m.add_function(wrap_pyfunction!(spread_variants, m)?)?;
+    m.add_function(wrap_pyfunction!(forget_kept_sector, m)?)?;
     m.add_function(wrap_pyfunction!(run_variant, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;

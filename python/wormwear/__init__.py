@@ -49,6 +49,7 @@ __all__ = [
     "sweep",
     "spread",
     "Spread",
+    "forget_kept_sector",
     "STAGES",
 ]
 
@@ -595,3 +596,9 @@ def spread(
     # Locally: every sample; after Dask: the finished samples are reused, the files written.
     text, reused = _native.spread(base._native, json.dumps(spec), directory)
     return Spread(directory, json.loads(text), reused)
+
+
+def forget_kept_sector() -> None:
+    """Lets go of the FE sector the root stress (S_F) keeps for the next run of the same wheel
+    (up to a few hundred MB in a long session); the next S_F builds its own."""
+    _native.forget_kept_sector()
