@@ -152,12 +152,17 @@ impl<'a> StepView<'a> {
 }
 
 /// A copy of `state` to step from, holding its last record only (a step and the analysis of
-/// the state it reaches read no other: [`WearState::previous_record`]).
+/// the state it reaches read no other: [`WearState::previous_record`]), and no warm starts
+/// (the step's [`carry_starts`] sets them from the analysis: copying them would be waste).
 fn state_to_step(state: &mut WearState) -> WearState {
     let records = std::mem::take(&mut state.records);
+    let warm = state.warm.take();
+    let bin_starts = std::mem::take(&mut state.bin_starts);
     let mut next = state.clone();
     next.records = records.last().cloned().into_iter().collect();
     state.records = records;
+    state.warm = warm;
+    state.bin_starts = bin_starts;
     next
 }
 
