@@ -496,10 +496,11 @@ fn edge_reliefs_are_parabolic_and_vanish_inside() {
 }
 
 /// The pattern's shape (MODEL §17): a known block of cells gives its own span and a centre
-/// inside it, the two entry sides mirror each other; the entry side the nodes' contact moments
-/// give agrees with the order in time of the TCA's contact lines (an independent route) and
-/// moves to the other face end with the worm's rotation; a localised pattern follows the worm
-/// along the wheel axis.
+/// inside it, the two entry sides mirror each other; the entering side (where the worm's
+/// surface comes into the mesh) is where the TCA's contact lines in the pattern start: in time
+/// they sweep the face from the entering side to the leaving side (an independent route, from
+/// the lines' order in time), and it moves to the other face end with the worm's rotation; a
+/// localised pattern follows the worm along the wheel axis.
 #[test]
 fn the_pattern_shape_reads_its_cells_its_entry_side_and_follows_the_worm() {
     use wormwear::kinematics::pattern_shape::PatternShape;

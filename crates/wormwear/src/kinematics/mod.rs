@@ -184,7 +184,8 @@ pub struct Tca {
     pub marking_thickness: f64,
     pub pattern_area: f64,
     pub active_area: f64,
-    /// Whether the contact enters the mesh at the flank's low-z face end (MODEL §17).
+    /// Whether the worm's thread enters the mesh at the flank's low-z face end (the entering
+    /// side, MODEL §17; [`pattern_shape::entry_at_low_z`]).
     pub entry_at_low_z: bool,
     /// The no-load pattern's centre and extent (None: no cell marked).
     pub pattern_shape: Option<pattern_shape::PatternShape>,
@@ -379,7 +380,12 @@ pub fn analyse_with(
         .filter(|(_, &m)| m)
         .map(|(a, _)| a)
         .sum();
-    let entry_at_low_z = pattern_shape::entry_at_low_z(wf, &map.contact_theta2, sigma);
+    let entry_at_low_z = pattern_shape::entry_at_low_z(
+        &geo.worm,
+        &gear.operating,
+        gear.worm.reference_radius,
+        theta1_dot,
+    );
     let shape = pattern_shape::PatternShape::of(wf, &marked, entry_at_low_z);
     let contact_lines = study.contact_lines(&blocks, &positions, &node_contact);
     let (node_gaps, cell_gaps) = GapBlock::joined(&blocks);

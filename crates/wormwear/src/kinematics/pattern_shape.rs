@@ -1,5 +1,6 @@
 //! The shape of a contact pattern on the loaded wheel flank (MODEL §17): where it sits across
-//! the face, from the face end where the contact enters the mesh to the one where it leaves, and
+//! the face, from the face end where the worm's thread enters the mesh (the entering side) to
+//! the one where it leaves (the leaving side), and
 //! up the flank, and how far it reaches along the face and up the flank. What a workshop reads
 //! off a marking test (MODEL §4.4), for the no-load pattern and the loaded one alike.
 
@@ -10,7 +11,7 @@ use crate::geometry::WheelFlank;
 /// limits of each column).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PatternShape {
-    /// Centre across the face: 0 at the entry side's face end, 1 at the exit side's.
+    /// Centre across the face: 0 at the entering side's face end, 1 at the leaving side's.
     pub centre_across_face: f64,
     /// Centre up the flank: 0 at the flank's lower limit (the wheel's root side), 1 at its
     /// upper limit.
@@ -69,22 +70,27 @@ impl PatternShape {
     }
 }
 
-/// Whether the contact enters the mesh at the flank's low-z face end: the driven wheel angle
-/// at which each node of `wf` is in contact (`contact_theta2`, rad, NaN where none; `sigma`
-/// the driven sense) grows with z when the contact sweeps from low z to high z. The sign of the
-/// least-squares slope of sigma theta2 on z over the nodes.
-pub fn entry_at_low_z(wf: &WheelFlank, contact_theta2: &[f64], sigma: f64) -> bool {
-    let ni = wf.cells_height;
-    let pairs: Vec<(f64, f64)> = contact_theta2
-        .iter()
-        .enumerate()
-        .filter(|(_, t)| t.is_finite())
-        .map(|(k, t)| (wf.z[k / (ni + 1)], sigma * t))
-        .collect();
-    let n = pairs.len().max(1) as f64;
-    let (mz, mt) = pairs
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (z, t)| (a + z / n, b + t / n));
-    let covariance: f64 = pairs.iter().map(|(z, t)| (z - mz) * (t - mt)).sum();
-    covariance >= 0.0
+/// Whether the worm's thread enters the mesh at the wheel's low-z face end: the entering side
+/// is the face end from which the worm's surface, and the oil it carries, comes into the mesh
+/// (the leaving side, where a workshop puts the pattern, is the other). At the pitch point on
+/// the line of centres the worm's material velocity (`material_velocities`, worm turning at
+/// `theta1_dot` rad/s of thread advance, placed by `placement`) points along the wheel axis,
+/// from the entering side to the leaving side: its wheel-frame z component decides. A property
+/// of the worm's rotation sense alone (not of the flanks or the pattern), so a pattern's centre
+/// across the face does not jump when the flanks change a little (the covariance of the nodes'
+/// contact moments with z over the whole flank, used before, is near zero on a conjugate flank
+/// and flipped between cutting settings 0.1 mm apart). Within a localised pattern the contact
+/// lines sweep the face from the entering side to the leaving side (tests/tca.rs).
+pub fn entry_at_low_z(
+    worm: &crate::geometry::ThreadSurface,
+    placement: &crate::input::Placement,
+    reference_radius: f64,
+    theta1_dot: f64,
+) -> bool {
+    let pitch_point = nalgebra::Vector3::new(0.0, reference_radius, 0.0);
+    let v = super::material_velocities(&pitch_point, worm, placement, theta1_dot, 1.0);
+    placement
+        .vector_worm_to_wheel(&nalgebra::Vector3::from(v.worm))
+        .z
+        > 0.0
 }
