@@ -640,6 +640,50 @@ fn spread_variants(base: &NativeGear, spec_json: &str) -> PyResult<String> {
     serde_json::to_string(&list).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
+/// The contact-pattern assistant (MODEL §17) on `base` as `wormwear pattern` does: `target_json`
+/// the target's components ({"centre_across_face": 0.6, ...}), `bounds_json` [[name, min, max],
+/// ...] or null (the default settings), the loaded pattern when `loaded`, at most `evaluations`
+/// analyses; its files into `directory`. Returns pattern.json's text. Bad input raises
+/// InputError naming it; an interrupt (Ctrl-C) stops the search at the next evaluation and
+/// raises KeyboardInterrupt.
+#[pyfunction]
+fn pattern(
+    py: Python<'_>,
+    base: &NativeGear,
+    target_json: &str,
+    bounds_json: &str,
+    loaded: bool,
+    evaluations: usize,
+    directory: String,
+) -> PyResult<String> {
+    use wormwear::pattern_assistant::{Assistant, Target, Which};
+    let target: Target = serde_json::from_str(target_json)
+        .map_err(|e| InputError::new_err(format!("target: {e}")))?;
+    let bounds: Option<Vec<(String, f64, f64)>> = serde_json::from_str(bounds_json)
+        .map_err(|e| InputError::new_err(format!("vary: {e} (a map of name to (min, max))")))?;
+    let which = if loaded { Which::Loaded } else { Which::NoLoad };
+    let (file, text) = (base.source.file.clone(), base.source.text.clone());
+    let study = Assistant::new(file, text, target, bounds, which, evaluations)
+        .map_err(|e| InputError::new_err(error_chain(&e)))?;
+    let done: Result<(), String> = py.detach(|| {
+        let dir = Path::new(&directory);
+        std::fs::create_dir_all(dir).map_err(|e| format!("{directory}: {e}"))?;
+        let _lock = wormwear::output::lock_directory(dir).map_err(|e| e.to_string())?;
+        let outcome = study
+            .run(&|_, _| {}, &|| interrupted())
+            .map_err(|e| error_chain(&e))?;
+        wormwear::pattern_assistant::write(&study, &outcome, dir)
+            .map(|_| ())
+            .map_err(|e| error_chain(&e))
+    });
+    done.map_err(PyOSError::new_err)?;
+    if interrupted() {
+        return Err(PyKeyboardInterrupt::new_err("pattern search interrupted"));
+    }
+    std::fs::read_to_string(Path::new(&directory).join("pattern.json"))
+        .map_err(|e| PyOSError::new_err(e.to_string()))
+}
+
 /// Lets go of the root stress's kept FE sector (the last wheel's, kept for the next run of
 /// the same wheel; up to a few hundred MB).
 #[pyfunction]
@@ -718,6 +762,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spread, m)?)?;
     m.add_function(wrap_pyfunction!(spread_variants, m)?)?;
     m.add_function(wrap_pyfunction!(forget_kept_sector, m)?)?;
+    m.add_function(wrap_pyfunction!(pattern, m)?)?;
     m.add_function(wrap_pyfunction!(run_variant, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep_csv, m)?)?;
     m.add_function(wrap_pyfunction!(rexs_stages, m)?)?;

@@ -517,3 +517,25 @@ def test_a_spread_equals_the_cli_and_bad_inputs_raise_naming_the_field(cli, fast
         wormwear.spread(base, {"operating.centre_distance_eror_mm": (0.0, 0.01)}, output=tmp_path / "bad")
     with pytest.raises(wormwear.InputError, match="inverted range"):
         wormwear.spread(base, {"operating.worm_offset_mm": (0.05, -0.05)}, output=tmp_path / "bad")
+
+
+def test_the_pattern_assistant_equals_the_cli_and_bad_inputs_raise_naming_them(cli, design_file, tmp_path):
+    base = wormwear.load(design_file)
+    target = {"centre_across_face": 0.6}
+    vary = {"cutting.inclination_deg": (-0.3, 0.3)}
+    found = wormwear.pattern(base, target, vary=vary, evaluations=6, output=tmp_path / "py")
+    assert list(found.settings["name"]) == ["cutting.inclination_deg"]
+    assert found.objective["best"] <= found.objective["start"]
+    assert len(found.path) == found.summary["evaluations"] <= 6
+    assert abs(found.after["centre_across_face"] - 0.6) <= abs(found.before["centre_across_face"] - 0.6)
+    assert found.gear.validated()["cutting"]["inclination"] == pytest.approx(
+        math.radians(found.settings["best"][0]), abs=1e-12
+    )
+    # The CLI on the same gear and target: the same search, the same best gear file.
+    cli("-q", "pattern", design_file, "--target", "centre_across_face=0.6", "--vary",
+        "cutting.inclination_deg=-0.3:0.3", "--evaluations", "6", "-o", tmp_path / "cli")
+    assert (tmp_path / "cli" / "search.csv").read_bytes() == (tmp_path / "py" / "search.csv").read_bytes()
+    with pytest.raises(wormwear.InputError, match="centre_across_face"):
+        wormwear.pattern(base, {"centre": 0.6}, output=tmp_path / "bad")
+    with pytest.raises(wormwear.InputError, match="cutting.centre_distance_mm"):
+        wormwear.pattern(base, target, vary={"cutting.centre_distanse_mm": (124.5, 125.5)}, output=tmp_path / "bad")

@@ -49,6 +49,8 @@ __all__ = [
     "sweep",
     "spread",
     "Spread",
+    "pattern",
+    "Pattern",
     "forget_kept_sector",
     "STAGES",
 ]
@@ -596,6 +598,62 @@ def spread(
     # Locally: every sample; after Dask: the finished samples are reused, the files written.
     text, reused = _native.spread(base._native, json.dumps(spec), directory)
     return Spread(directory, json.loads(text), reused)
+
+
+class Pattern:
+    """What ``wormwear.pattern`` gives (MODEL §17): ``settings`` (one row per setting: name, min,
+    max, start, best), ``before`` and ``after`` (the pattern's shape at the start and at the
+    best settings: centre_across_face, centre_up_flank, extent_along_face, extent_up_flank),
+    ``objective`` (start and best), ``path`` (search.csv: every evaluation in order),
+    ``gear`` (the best gear file as a GearSet), ``summary`` (pattern.json as a dict) and
+    ``directory``."""
+
+    def __init__(self, directory: str, summary: dict):
+        self.directory = directory
+        self.summary = summary
+        self.settings = pd.DataFrame.from_records(summary["settings"])
+        self.before = summary["start"]["shape"]
+        self.after = summary["best"]["shape"]
+        self.objective = {"start": summary["start"]["objective"], "best": summary["best"]["objective"]}
+        self.path = pd.read_csv(os.path.join(directory, "search.csv"))
+        self.gear = load(os.path.join(directory, summary["best_gear_file"]))
+
+    def __repr__(self) -> str:
+        return (
+            f"<wormwear.Pattern {self.summary['pattern']} pattern, objective {self.objective['start']:.3e} -> "
+            f"{self.objective['best']:.3e} in {self.summary['evaluations']} evaluations "
+            f"({self.summary['stopped']}): {self.directory}>"
+        )
+
+
+def pattern(
+    base: GearSet,
+    target: Mapping[str, float],
+    *,
+    vary: Optional[Mapping[str, Sequence[float]]] = None,
+    loaded: bool = False,
+    evaluations: int = 60,
+    output: "str | os.PathLike[str]",
+) -> Pattern:
+    """The contact-pattern assistant, as ``wormwear pattern`` (MODEL §17): searches the cutting
+    settings of ``base`` for the pattern closest to ``target`` (any of centre_across_face,
+    centre_up_flank, extent_along_face, extent_up_flank: shares in [0, 1], the centre across
+    the face from the entering to the leaving side). ``vary`` maps dotted gear-file names (and
+    ``"hob.oversize_mm"``) to ``(min, max)``; None: the cutting centre distance, the hob swivel
+    and the hob oversize around the base's. ``loaded``: the loaded pattern instead of the
+    no-load one. Writes gear.toml (the best settings), pattern.json, search.csv, before/ and
+    after/ into ``output``. Bad input raises ``InputError`` naming it."""
+    bounds = None
+    if vary is not None:
+        bounds = []
+        for name, range_ in vary.items():
+            low, high = range_
+            bounds.append([name, float(low), float(high)])
+    directory = os.fspath(output)
+    text = _native.pattern(
+        base._native, json.dumps(dict(target)), json.dumps(bounds), bool(loaded), int(evaluations), directory
+    )
+    return Pattern(directory, json.loads(text))
 
 
 def forget_kept_sector() -> None:

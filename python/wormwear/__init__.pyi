@@ -111,5 +111,24 @@ def spread(
     output: str | os.PathLike[str],
     client: Any = None,
 ) -> Spread: ...
+class Pattern:
+    directory: str
+    summary: dict
+    settings: pd.DataFrame
+    before: dict
+    after: dict
+    objective: dict
+    path: pd.DataFrame
+    gear: GearSet
+
+def pattern(
+    base: GearSet,
+    target: Mapping[str, float],
+    *,
+    vary: Optional[Mapping[str, Sequence[float]]] = None,
+    loaded: bool = False,
+    evaluations: int = 60,
+    output: str | os.PathLike[str],
+) -> Pattern: ...
 def forget_kept_sector() -> None: ...
 def compare(runs: Sequence[str | os.PathLike[str]], output: str | os.PathLike[str]) -> pd.DataFrame: ...

@@ -16,6 +16,7 @@ mod calibrate_cmd;
 mod compare_cmd;
 mod init_cmd;
 mod interrupt;
+mod pattern_cmd;
 mod rating_cmd;
 mod request;
 mod rexs_cmd;
@@ -264,6 +265,11 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// The contact-pattern assistant (MODEL §17): searches the cutting settings (cutting centre
+    /// distance, hob swivel, hob oversize, or any fields named, within bounds) for those that
+    /// bring the no-load (or loaded) pattern closest to a target shape (Nelder–Mead).
+    #[command(after_help = pattern_cmd::AFTER_HELP)]
+    Pattern(pattern_cmd::PatternArgs),
     /// Take a worm stage from a REXS file (.rexs XML, .rexsj JSON, .rexsz zip; REXS 1.x) and
     /// write it as a commented gear file, then validate it as `check` does.
     #[command(
@@ -374,6 +380,7 @@ fn lock_output(cli: &Cli) -> Result<Option<wormwear::output::DirectoryLock>, Exi
         | Command::ExportRexs { output, .. }
         | Command::Validate { output, .. }
         | Command::Compare { output, .. } => Some(output),
+        Command::Pattern(args) => Some(&args.output),
     };
     let lock = match output
         .map(|dir| wormwear::output::lock_directory(dir))
@@ -450,6 +457,7 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
             base_anywhere,
         } => sweep_cmd::sweep(file, output, *base_anywhere, cli.quiet),
         Command::Spread { file, output } => sweep_cmd::spread(file, output, cli.quiet),
+        Command::Pattern(args) => pattern_cmd::pattern(args, cli.quiet),
         Command::Import {
             file,
             output,

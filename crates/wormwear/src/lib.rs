@@ -34,6 +34,7 @@ pub mod kinematics;
 pub mod ltca;
 pub mod lubrication;
 pub mod output;
+pub mod pattern_assistant;
 pub mod pitting;
 pub use output::plot;
 pub mod rating;

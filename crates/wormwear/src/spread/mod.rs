@@ -345,7 +345,7 @@ fn input_names(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::V
 
 /// The `count` dotted names of the numeric fields of `doc` nearest to `name` (edit distance;
 /// what an unknown name most likely meant).
-fn nearest_names(doc: &toml::Table, name: &str, count: usize) -> Vec<String> {
+pub(crate) fn nearest_names(doc: &toml::Table, name: &str, count: usize) -> Vec<String> {
     let mut leaves = Vec::new();
     crate::sweep::flatten(doc, "", &mut leaves);
     let mut scored: Vec<(usize, String)> = leaves
@@ -376,7 +376,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The value at a dotted name of a gear document.
-fn lookup<'a>(doc: &'a toml::Table, name: &str) -> Option<&'a toml::Value> {
+pub(crate) fn lookup<'a>(doc: &'a toml::Table, name: &str) -> Option<&'a toml::Value> {
     let mut parts = name.split('.');
     let mut value = doc.get(parts.next()?)?;
     for p in parts {
@@ -386,7 +386,7 @@ fn lookup<'a>(doc: &'a toml::Table, name: &str) -> Option<&'a toml::Value> {
 }
 
 /// A number of a spread file (integers read as floats).
-fn number(v: &toml::Value) -> Option<f64> {
+pub(crate) fn number(v: &toml::Value) -> Option<f64> {
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
 }
 
