@@ -21,6 +21,37 @@
 
 use crate::input::Endurance;
 
+/// The share of the active flank whose pitting is first pitting (A_p10 = 2 %, MODEL §8.1, §9:
+/// Rank's N_LI): the pitting safety reads the equivalent pressure exceeded on it, the forecast
+/// starts pitting once the nodes whose damage has reached 1 make it up.
+pub const FIRST_PITTING_SHARE: f64 = 0.02;
+
+/// The value exceeded on `share` of the active flank (MODEL §8.1 "Which p_eq decides"): the
+/// area-weighted quantile of the per-cell `values` of the flank grid (areas `cell_area`, m^2,
+/// the cells where `active`: `WheelFlank::cell_area`, `WheelFlank::active`), the value of the
+/// cell where the area of the cells at or above it reaches `share` of the active area. A
+/// uniform field gives its value; cells holding less than `share` of the area above the rest
+/// (a spike, a saturated edge strip) do not move it. 0 where fewer than `share` of the area
+/// carries a value (or no cell is active).
+pub fn exceeded_on_share(values: &[f64], cell_area: &[f64], active: &[bool], share: f64) -> f64 {
+    let mut cells: Vec<(f64, f64)> = (0..values.len().min(cell_area.len()))
+        .filter(|&k| active.get(k).copied().unwrap_or(false))
+        .map(|k| (values[k], cell_area[k]))
+        .collect();
+    let active: f64 = cells.iter().map(|c| c.1).sum();
+    cells.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let wanted = share * active;
+    let mut above = 0.0;
+    for (value, area) in cells {
+        above += area;
+        // (a share reached exactly by whole cells must not miss by the sum's rounding)
+        if above >= wanted * (1.0 - 1e-12) {
+            return value.max(0.0);
+        }
+    }
+    0.0
+}
+
 impl Endurance {
     /// Life at the pressure `p` on the pressure–life curve, cycles:
     /// N = f N_ref (p / p_ref)^(-1/b), f the life factor. Infinite for p <= 0 (an unloaded
@@ -118,6 +149,43 @@ impl CellLoad {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_share_exceeded_reads_the_load_not_a_narrow_strip_or_spike() {
+        use super::FIRST_PITTING_SHARE as TWO;
+        // A flank grid of 40 x 60 equal cells, every cell active.
+        let n = 40 * 60;
+        let (area, active) = (vec![1e-6; n], vec![true; n]);
+        let exceeded_on_share =
+            |v: &[f64], share: f64| super::exceeded_on_share(v, &area, &active, share);
+        // A uniform Hertz-like load: p0 everywhere (any share).
+        let p0 = 612e6;
+        assert_eq!(exceeded_on_share(&vec![p0; n], TWO), p0);
+        // Its sqrt growth with the load carries straight through.
+        let scaled: Vec<f64> = vec![p0 * 4.5f64.sqrt(); n];
+        assert_eq!(exceeded_on_share(&scaled, TWO), p0 * 4.5f64.sqrt());
+        // A saturated strip of one row (1/40 = 2.5 % > 2 %) is read; two thirds of that row
+        // (1.7 %) is not, nor a one-cell spike of 3 p0.
+        let strip = |cells: usize| {
+            let mut v = vec![p0; n];
+            for j in 0..cells {
+                v[j * 40] = 1e9;
+            }
+            v
+        };
+        assert_eq!(exceeded_on_share(&strip(60), TWO), 1e9);
+        assert_eq!(exceeded_on_share(&strip(40), TWO), p0);
+        let mut spike = vec![p0; n];
+        spike[1234] = 3.0 * p0;
+        assert_eq!(exceeded_on_share(&spike, TWO), p0);
+        // A graded field: the value at the 98th area percentile. Cells k = 0..n carry k; the
+        // 2 % largest are the last 48: the 48th from the top is n - 48.
+        let graded: Vec<f64> = (0..n).map(|k| k as f64).collect();
+        assert_eq!(exceeded_on_share(&graded, TWO), (n - 48) as f64);
+        // Inactive cells do not count; a pattern on less than 2 % of the flank gives 0.
+        let mut small = vec![0.0; n];
+        small[7] = p0;
+        assert_eq!(exceeded_on_share(&small, TWO), 0.0);
+    }
     use super::*;
 
     #[test]

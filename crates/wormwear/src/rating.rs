@@ -81,6 +81,19 @@ pub fn rank_first_pitting_cycles(
     rank_formula(sliding_speed, sigma_hm_mpa, sigma_hlim_mpa).filter(|n| *n <= LIFE_LIMIT_CYCLES)
 }
 
+/// The stress sigma_Hm, MPa, at which Rank's N_LI (MODEL §9) is `cycles`: the formula
+/// inverted, sigma = sigma_Hlim / 520 exp[(28.078 - ln(N / (1e6 f_v))) / 4.666], f_v its speed
+/// factor. None where the speed factor is not positive (v_gm below 0.31 m/s) or the cycles or
+/// sigma_Hlim are not.
+pub fn rank_stress_for_cycles(sliding_speed: f64, cycles: f64, sigma_hlim_mpa: f64) -> Option<f64> {
+    let speed = 1.0 + 0.860 * (3.0 * sliding_speed / 3.0).ln();
+    if !(speed > 0.0 && cycles > 0.0 && sigma_hlim_mpa > 0.0) {
+        return None;
+    }
+    let log = (28.078 - (cycles / (1e6 * speed)).ln()) / 4.666;
+    Some(sigma_hlim_mpa / 520.0 * log.exp()).filter(|s| s.is_finite())
+}
+
 /// Rank's N_LI formula itself, None only where its speed factor or stress is not positive.
 fn rank_formula(sliding_speed: f64, sigma_hm_mpa: f64, sigma_hlim_mpa: f64) -> Option<f64> {
     let v_ref = 3.0;

@@ -145,6 +145,7 @@ pub fn safety_table(s: &SafetyInputsOf) -> SafetyTable {
         .map(|h| cycles_of_hours(s.gear, h));
     let mut rows = vec![root_row(inputs, s.root_stress.as_ref()), deflection_row(s)];
     rows.push(pitting_row(s, required_cycles));
+    rows.push(published_pitting_row(s, required_cycles));
     rows.extend(wear_rows(s, required_cycles));
     rows.push(temperature_row(s));
     mark_assumed(&mut rows, &s.gear.rating.assumed_inputs);
@@ -256,7 +257,7 @@ fn inputs_read(symbol: &str) -> &'static [&'static str] {
             "application_factor",
         ],
         "S_delta" => &["deflection_limit_um", "application_factor"],
-        "S_H" => &["required_life_h", "application_factor"],
+        "S_H" | "S_H,pub" => &["required_life_h", "application_factor"],
         "S_W" => &[
             "required_life_h",
             "thickness_loss_limit_mm",
@@ -382,9 +383,11 @@ fn deflection_row(s: &SafetyInputsOf) -> SafetyRow {
     )
 }
 
-/// Pitting (S_H): the largest equivalent pressure below the flank (MODEL §8.1) of the
-/// loaded analysis at K_A times the torque against the bronze's pressure–life curve at the
-/// required cycles (MODEL §8); the standard's sigma_Hm and S_H beside it.
+/// Pitting (S_H): p_eq,2%, the equivalent pressure below the flank exceeded on 2 % of the
+/// active flank (MODEL §8.1, "Which p_eq decides"), of the loaded analysis at K_A times the
+/// torque (or the duty cycle's damage-equivalent map's, MODEL §14) against the bronze's
+/// pressure–life curve at the required cycles (MODEL §8); the largest (an edge's) and the
+/// standard's sigma_Hm and S_H beside it.
 fn pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
     let inputs = &s.gear.rating.safety;
     let iso = format!(
@@ -392,20 +395,23 @@ fn pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
          N_LI {:.3e} cycles",
         s.iso.sigma_hm_mpa, s.iso.pitting_safety, s.iso.n_li_cycles
     );
-    let (value, what) = match s.spectrum {
+    let (value, largest, what) = match s.spectrum {
         Some(spectrum) => (
             spectrum.equivalent_pressure_pa,
+            spectrum.equivalent_pressure_max_pa,
             format!(
-                "the damage-equivalent p_eq of the duty cycle's {} bins at their own torques \
-                 (MODEL §14: Miner's sum of each bin's share of the cycles over its life at its \
-                 p_eq = max over depth tau_1 / 0.300, unworn, at the most damaged cell; the \
-                 constant pressure of the same life)",
+                "p_eq,2% of the duty cycle's {} bins at their own torques (MODEL §14: at each \
+                 cell Miner's sum of each bin's share of the cycles over its life at the cell's \
+                 p_eq = max over depth tau_1 / 0.300, unworn, as the constant pressure of the \
+                 same life; the value exceeded on 2 % of the active flank)",
                 spectrum.bins.len()
             ),
         ),
         None => (
+            s.ltca.equivalent_pressure_first_pitting,
             s.ltca.equivalent_pressure_max,
-            "largest p_eq = max over depth tau_1 / 0.300 of the unworn loaded analysis (MODEL \
+            "p_eq,2%: the equivalent pressure (max over depth tau_1 / 0.300) of the unworn \
+             loaded analysis exceeded on 2 % of the active flank, first pitting's area (MODEL \
              §8.1)"
                 .to_string(),
         ),
@@ -418,10 +424,45 @@ fn pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
             .ok_or_else(|| Verdict::NeedsInput("rating.required_life_h".into())),
         inputs.minimum[2],
         format!(
-            "{what} against p_lim(N) = {:.0} MPa (N / {:.3e})^-{} at the required cycles{iso}",
+            "{what} against p_lim(N) = {:.0} MPa (N / {:.3e})^-{} at the required cycles; the \
+             largest cell's {:.0} MPa beside it (edges, where the flow pressure binds, MODEL \
+             §5.7){iso}",
             s.endurance.reference_pressure * 1e-6,
             s.endurance.life_factor * s.endurance.reference_cycles,
-            s.endurance.exponent
+            s.endurance.exponent,
+            largest * 1e-6
+        ),
+    )
+}
+
+/// Pitting in the published coupling (MODEL §12 k), beside S_H: the loaded pattern's mean
+/// pressure P_mean at K_A times the torque against the stress at which Rank's N_LI (MODEL §9,
+/// sigma_Hlim of the wheel's bronze, the sliding speed at the reference diameter) equals the
+/// required cycles.
+fn published_pitting_row(s: &SafetyInputsOf, required_cycles: Option<f64>) -> SafetyRow {
+    let (speed, limit) = (s.iso.sliding_speed_m_s, s.iso.pitting_limit_mpa);
+    let allowable = match required_cycles {
+        None => Err(Verdict::NeedsInput("rating.required_life_h".into())),
+        Some(n) => crate::rating::rank_stress_for_cycles(speed, n, limit).ok_or_else(|| {
+            Verdict::NotComputed(format!(
+                "Rank's N_LI has no stress for {n:.3e} cycles at a sliding speed of {speed:.2} \
+                 m/s (its speed factor is not positive below 0.31 m/s)"
+            ))
+        }),
+    };
+    row(
+        (
+            "Pitting, published coupling: the pattern's mean pressure (Rank's N_LI)",
+            "S_H,pub",
+            "MPa",
+        ),
+        Some(s.ltca.mean_pressure * 1e-6),
+        allowable,
+        s.gear.rating.safety.minimum[2],
+        format!(
+            "P_mean of the unworn loaded pattern's non-zero cells in place of sigma_Hm in Rank's \
+             N_LI (MODEL §9, §12 k: sigma_Hlim {limit:.0} MPa, v_gm {speed:.2} m/s) against the \
+             stress at which N_LI is the required cycles"
         ),
     )
 }

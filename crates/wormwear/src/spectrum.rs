@@ -3,11 +3,12 @@
 //! shares of the wear and of the pitting damage, Miner's sum of the damage over the bins and the
 //! damage-equivalent pressure S_H reads, the hottest bin S_T reads.
 //!
-//! Miner's sum reads each bin's largest equivalent pressure (the figure S_H reads for one
-//! operating point, MODEL §8.1, §9.1) as if the bins' largest acted at one point: conservative
-//! where they lie apart on the flank, exact where one spot decides (the sharp worm tip's trace of
-//! issue 54 at every load), and the one point's figure for a spectrum of identical bins. The life
-//! resolves the damage node by node ([`crate::wear::spectrum`]).
+//! Pitting reads an area (MODEL §8.1 "Which p_eq decides"): at each cell of the flank grid
+//! Miner's sum over the bins of the cell's equivalent pressures gives the constant pressure of
+//! the same life, and S_H reads that map's p_eq,2%, exceeded on 2 % of the active flank (the
+//! one operating point's figure for a spectrum of identical bins); its largest cell is shown
+//! beside. The bins' damage shares are Miner's over their own p_eq,2%. The life resolves the
+//! damage node by node ([`crate::wear::spectrum`]).
 //!
 //! The bins' shares of the wheel's cycles are their time shares times their worm speeds,
 //! normalised ([`crate::input::cycle_shares`]). A life under the spectrum is
@@ -156,14 +157,16 @@ pub struct SpectrumBin {
     pub max_pressure_pa: f64,
     pub pressure_patch_max_pa: f64,
     pub equivalent_pressure_max_pa: f64,
+    /// p_eq,2% of the bin's loaded analysis (MODEL §8.1), Pa: what its damage share reads.
+    pub equivalent_pressure_first_pitting_pa: f64,
     pub max_wear_per_cycle_m: f64,
     pub worn_volume_per_cycle_m3: f64,
     /// The bin's share of the spectrum's worn volume per wheel cycle.
     pub wear_share: f64,
-    /// The bin's share of the pitting damage of Miner's sum.
+    /// The bin's share of the pitting damage of Miner's sum over the bins' p_eq,2%.
     pub damage_share: f64,
-    /// Wheel cycles to the first pit at the bin's largest equivalent pressure alone (the
-    /// pressure–life curve, MODEL §8; None: no pressure).
+    /// Wheel cycles to first pitting at the bin's p_eq,2% alone (the pressure–life curve,
+    /// MODEL §8; None: no pressure).
     pub pitting_life_cycles: Option<f64>,
 }
 
@@ -180,11 +183,15 @@ pub struct Spectrum {
     /// Energy-weighted efficiencies: output energy over input energy over the running time.
     pub mesh_efficiency: f64,
     pub total_efficiency: f64,
-    /// Miner's sum over the bins of their largest equivalent pressures: the damage-equivalent
-    /// pressure (the constant pressure of the same life on the curve), Pa, and the wheel cycles
-    /// to the first pit (None: no damage).
+    /// The damage-equivalent pressure exceeded on 2 % of the active flank (MODEL §8.1, §14):
+    /// at each cell Miner's sum over the bins of its equivalent pressures gives the constant
+    /// pressure of the same life on the curve; its p_eq,2%, Pa, and the wheel cycles to first
+    /// pitting there (None: no damage). What S_H reads.
     pub equivalent_pressure_pa: f64,
     pub pitting_life_cycles: Option<f64>,
+    /// The largest cell's damage-equivalent pressure (an edge's, where the flow pressure
+    /// binds), Pa: shown beside.
+    pub equivalent_pressure_max_pa: f64,
 }
 
 /// The spectrum's figures from its bins' runs (`runs` in the gear's bin order) with the
@@ -195,16 +202,17 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
     let wf = geo.wheel_flank(runs[0].tca.loaded_flank);
     let volumes: Vec<f64> = runs.iter().map(|r| r.cycle.depth.integral(wf)).collect();
     let worn: f64 = shares.iter().zip(&volumes).map(|(c, v)| c * v).sum();
-    let largest: Vec<f64> = runs
+    let first_pitting: Vec<f64> = runs
         .iter()
-        .map(|r| r.ltca.equivalent_pressure_max)
+        .map(|r| r.ltca.equivalent_pressure_first_pitting)
         .collect();
     let parts: Vec<(f64, f64)> = shares
         .iter()
         .copied()
-        .zip(largest.iter().copied())
+        .zip(first_pitting.iter().copied())
         .collect();
     let rate = miner_rate(&parts, curve);
+    let equivalent = damage_equivalent_map(wf, runs, &shares, curve);
     let hottest = (0..runs.len())
         .max_by(|&a, &b| {
             let t = |k: usize| runs[k].thermal.oil_temperature_k;
@@ -214,7 +222,7 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
     let mut spectrum_bins = Vec::new();
     for (k, ((run, bin), share)) in runs.iter().zip(&bins).zip(&shares).enumerate() {
         let e = &run.thermal.efficiency;
-        let p_eq = largest[k];
+        let p_eq = first_pitting[k];
         spectrum_bins.push(SpectrumBin {
             bin: k + 1,
             worm_torque_nm: run.ltca.worm_torque,
@@ -231,7 +239,8 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
             total_efficiency: e.total_efficiency,
             max_pressure_pa: run.ltca.max_pressure,
             pressure_patch_max_pa: run.ltca.pressure_patch_max,
-            equivalent_pressure_max_pa: p_eq,
+            equivalent_pressure_max_pa: run.ltca.equivalent_pressure_max,
+            equivalent_pressure_first_pitting_pa: p_eq,
             max_wear_per_cycle_m: run.cycle.depth.max(),
             worn_volume_per_cycle_m3: volumes[k],
             wear_share: if worn > 0.0 {
@@ -257,13 +266,58 @@ pub fn summarise(gear: &GearSet, geo: &Geometry, runs: &[BinRun], curve: &Endura
         mean_worm_speed_rpm: gear.mean_worm_speed() * 30.0 / std::f64::consts::PI,
         mesh_efficiency: output / energy(&|b| b.output_power_w + b.mesh_loss_w),
         total_efficiency: output / energy(&|b| b.input_power_w),
-        equivalent_pressure_pa: if rate > 0.0 {
-            curve.pressure(1.0 / rate)
-        } else {
-            0.0
-        },
-        pitting_life_cycles: (rate > 0.0).then(|| 1.0 / rate),
+        equivalent_pressure_pa: equivalent.first_pitting,
+        pitting_life_cycles: Some(curve.life(equivalent.first_pitting)).filter(|n| n.is_finite()),
+        equivalent_pressure_max_pa: equivalent.largest,
         bins: spectrum_bins,
+    }
+}
+
+/// The duty cycle's damage-equivalent pressures over the flank (MODEL §8.1, §14): p_eq,2% and
+/// the largest cell's, Pa.
+struct DamageEquivalent {
+    first_pitting: f64,
+    largest: f64,
+}
+
+/// At each cell of the flank grid, Miner's sum over the bins (`shares` of the cycles) of the
+/// cell's equivalent pressure in each bin's loaded analysis, as the constant pressure of the
+/// same life on `curve`; its p_eq,2% and its largest.
+fn damage_equivalent_map(
+    wf: &crate::geometry::WheelFlank,
+    runs: &[BinRun],
+    shares: &[f64],
+    curve: &Endurance,
+) -> DamageEquivalent {
+    let cells = wf.cell_area.len();
+    let map: Vec<f64> = (0..cells)
+        .map(|c| {
+            let parts: Vec<(f64, f64)> = shares
+                .iter()
+                .zip(runs)
+                .map(|(share, r)| {
+                    (
+                        *share,
+                        r.ltca.equivalent_pattern.get(c).copied().unwrap_or(0.0),
+                    )
+                })
+                .collect();
+            let rate = miner_rate(&parts, curve);
+            if rate > 0.0 {
+                curve.pressure(1.0 / rate)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    DamageEquivalent {
+        first_pitting: crate::pitting::exceeded_on_share(
+            &map,
+            &wf.cell_area,
+            &wf.active,
+            crate::pitting::FIRST_PITTING_SHARE,
+        ),
+        largest: map.iter().copied().fold(0.0, f64::max),
     }
 }
 

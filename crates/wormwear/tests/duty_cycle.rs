@@ -132,8 +132,8 @@ fn miners_sum_of_a_spectrum_matches_a_hand_computation() {
     assert!((spectrum.bins[1].cycle_share - c2).abs() < 1e-12);
     assert_eq!(spectrum.largest_load_bin, 2);
     assert!((spectrum.mean_worm_speed_rpm - 1300.0).abs() < 1e-9);
-    // Each bin analysed alone as a gear of one operating point: its largest equivalent
-    // pressure, the figure S_H reads for one point.
+    // Each bin analysed alone as a gear of one operating point: its equivalent pressures, per
+    // cell of the flank grid, and their p_eq,2%, the figure S_H reads for one point.
     let alone = |torque: f64, rpm: f64| {
         let mut one = example("gear-1x40-design.toml");
         one.bending.kind = BendingKind::None;
@@ -141,28 +141,62 @@ fn miners_sum_of_a_spectrum_matches_a_hand_computation() {
         one.conditions.worm_speed = rpm * std::f64::consts::PI / 30.0;
         let request = Request::new([Stage::Ltca]);
         let r = wormwear::run(&one, Source::default(), request, &mut |_| Ok(())).unwrap();
-        r.ltca.unwrap().equivalent_pressure_max
+        let flank = r.tca.as_ref().unwrap().loaded_flank;
+        let wf = r.geometry.wheel_flank(flank).clone();
+        (r.ltca.unwrap(), wf)
     };
-    let (p1, p2) = (alone(30.0, 1500.0), alone(60.0, 1000.0));
-    assert_eq!(spectrum.bins[0].equivalent_pressure_max_pa, p1);
-    assert_eq!(spectrum.bins[1].equivalent_pressure_max_pa, p2);
-    let curve = input::Endurance::DEFAULT;
-    let (d1, d2) = (c1 / curve_life(&curve, p1), c2 / curve_life(&curve, p2));
-    let life = spectrum.pitting_life_cycles.unwrap();
-    assert!(
-        rel(life, 1.0 / (d1 + d2)) < 1e-12,
-        "{life} vs {}",
-        1.0 / (d1 + d2)
+    let ((l1, wf), (l2, _)) = (alone(30.0, 1500.0), alone(60.0, 1000.0));
+    let (p1, p2) = (
+        l1.equivalent_pressure_first_pitting,
+        l2.equivalent_pressure_first_pitting,
     );
+    assert_eq!(spectrum.bins[0].equivalent_pressure_first_pitting_pa, p1);
+    assert_eq!(spectrum.bins[1].equivalent_pressure_first_pitting_pa, p2);
+    assert_eq!(
+        spectrum.bins[0].equivalent_pressure_max_pa,
+        l1.equivalent_pressure_max
+    );
+    let curve = input::Endurance::DEFAULT;
+    // The bins' damage shares: Miner's over their p_eq,2%; each bin's life at its own.
+    let (d1, d2) = (c1 / curve_life(&curve, p1), c2 / curve_life(&curve, p2));
     assert!(rel(spectrum.bins[0].damage_share, d1 / (d1 + d2)) < 1e-12);
     assert!(rel(spectrum.bins[1].damage_share, d2 / (d1 + d2)) < 1e-12);
-    // The damage-equivalent pressure has that life on the curve, between the bins' own.
-    assert!(rel(curve_life(&curve, spectrum.equivalent_pressure_pa), life) < 1e-12);
-    let p = spectrum.equivalent_pressure_pa;
+    // The spectrum's: at each cell the constant pressure with the life of Miner's sum of the
+    // two bins' cells, then the value whose larger cells hold 2 % of the active area (by hand:
+    // the cells sorted by that pressure, their areas added from the top).
+    let inverse = |rate: f64| {
+        curve.reference_pressure
+            * (1.0 / rate / (curve.life_factor * curve.reference_cycles)).powf(-curve.exponent)
+    };
+    let mut cells: Vec<(f64, f64)> = (0..wf.cell_area.len())
+        .filter(|&c| wf.active[c])
+        .map(|c| {
+            let rate = c1 / curve_life(&curve, l1.equivalent_pattern[c])
+                + c2 / curve_life(&curve, l2.equivalent_pattern[c]);
+            let p = if rate > 0.0 { inverse(rate) } else { 0.0 };
+            (p, wf.cell_area[c])
+        })
+        .collect();
+    cells.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let total: f64 = cells.iter().map(|c| c.1).sum();
+    let mut above = 0.0;
+    let p = cells
+        .iter()
+        .find(|c| {
+            above += c.1;
+            above >= 0.02 * total * (1.0 - 1e-12)
+        })
+        .unwrap()
+        .0;
     assert!(
-        p >= p1.min(p2) && p <= p1.max(p2),
-        "{p} not within {p1}..{p2}"
+        rel(spectrum.equivalent_pressure_pa, p) < 1e-12,
+        "{} vs {p}",
+        spectrum.equivalent_pressure_pa
     );
+    let life = spectrum.pitting_life_cycles.unwrap();
+    assert!(rel(curve_life(&curve, p), life) < 1e-12, "{life}");
+    // The largest cell's beside it, on the flow pressure's plateau of the sharp tip edge.
+    assert!(spectrum.equivalent_pressure_max_pa > p);
     // S_H reads it at the required cycles, counted at the time-weighted mean speed.
     let table = results.safety.unwrap();
     let row = table.rows.iter().find(|r| r.symbol == "S_H").unwrap();

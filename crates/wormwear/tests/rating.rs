@@ -172,3 +172,21 @@ fn a_vanishing_torque_is_refused_naming_the_smallest_torque_that_is_not() {
         );
     }
 }
+
+/// The stress at which Rank's N_LI reaches given cycles is the formula's inverse: N_LI at that
+/// stress is those cycles, it falls as the cycles grow (exponent 1 / 4.666) and it has no
+/// value where the speed factor is not positive.
+#[test]
+fn rank_stress_for_cycles_inverts_n_li() {
+    for (speed, cycles) in [(1.0, 1e6), (3.79, 3.6e6), (8.0, 2e5)] {
+        let sigma = rating::rank_stress_for_cycles(speed, cycles, 520.0).unwrap();
+        let back = rating::rank_first_pitting_cycles(speed, sigma, 520.0).unwrap();
+        assert!(
+            (back / cycles - 1.0).abs() < 1e-12,
+            "{speed} {cycles}: {back}"
+        );
+        let tenfold = rating::rank_stress_for_cycles(speed, 10.0 * cycles, 520.0).unwrap();
+        assert!((sigma / tenfold - 10f64.powf(1.0 / 4.666)).abs() < 1e-12);
+    }
+    assert_eq!(rating::rank_stress_for_cycles(0.2, 1e6, 520.0), None);
+}

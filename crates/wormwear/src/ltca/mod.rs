@@ -243,8 +243,13 @@ pub struct Ltca {
     pub equivalent_pattern: Vec<f64>,
     /// Depth below the flank where that largest value is reached, per global cell, m.
     pub equivalent_depth: Vec<f64>,
-    /// Largest equivalent pressure of any local cell, Pa.
+    /// Largest equivalent pressure of any local cell, Pa (at a sharp edge: the flow
+    /// pressure's plateau, MODEL §5.7).
     pub equivalent_pressure_max: f64,
+    /// p_eq,2%: the equivalent pressure exceeded on 2 % of the active flank (MODEL §8.1,
+    /// "Which p_eq decides"; [`crate::pitting::exceeded_on_share`] of `equivalent_pattern`), Pa:
+    /// what the pitting safety reads.
+    pub equivalent_pressure_first_pitting: f64,
     /// How the equivalent pressure was evaluated (its criterion, the wheel's Poisson ratio).
     pub subsurface: SubsurfaceSettings,
     /// Mean worm torque T1 and transmitted wheel torque T2 over the positions, N m.
@@ -691,6 +696,12 @@ fn over_the_cycle(
         .iter()
         .flat_map(|p| p.equivalent.iter().map(|e| e.pressure))
         .fold(0.0, f64::max);
+    let equivalent_pressure_first_pitting = crate::pitting::exceeded_on_share(
+        &equivalent_pattern,
+        &wf.cell_area,
+        &wf.active,
+        crate::pitting::FIRST_PITTING_SHARE,
+    );
     let stats = PatternStats::of(wf, &pattern, settings.flow_pressure);
     // The largest local cell (the published P_max): the pattern's cell centres read the
     // profiles between cell centres, which can only be lower.
@@ -722,6 +733,7 @@ fn over_the_cycle(
         equivalent_pattern,
         equivalent_depth,
         equivalent_pressure_max,
+        equivalent_pressure_first_pitting,
         subsurface: settings.subsurface,
         worm_torque,
         wheel_torque,

@@ -54,6 +54,8 @@ pub struct LtcaSummary {
     /// pattern's cells; what the fatigue damage reads.
     pub equivalent_pressure_max_pa: f64,
     pub equivalent_pressure_depth_mm: f64,
+    /// p_eq,2%: exceeded on 2 % of the active flank (MODEL §8.1), what S_H reads, Pa.
+    pub equivalent_pressure_first_pitting_pa: f64,
     pub equivalent_pressure_definition: &'static str,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
@@ -139,6 +141,7 @@ impl LtcaSummary {
                 .zip(&ltca.equivalent_depth)
                 .max_by(|a, b| a.0.total_cmp(b.0))
                 .map_or(f64::NAN, |(_, d)| d * MM),
+            equivalent_pressure_first_pitting_pa: ltca.equivalent_pressure_first_pitting,
             equivalent_pressure_definition: ltca.subsurface.criterion.definition(),
             contact_area_fraction: ltca.s0,
             pattern_shape: crate::kinematics::pattern_shape::PatternShape::of(

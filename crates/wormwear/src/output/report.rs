@@ -686,7 +686,7 @@ fn hours_per_cycle(summary: &serde_json::Value, input_text: &str) -> Option<f64>
 /// The duty cycle's bins (MODEL §14) as a table: load, speed, shares, oil temperature,
 /// efficiency, pressures and each bin's share of the wear and of the pitting damage.
 fn duty_cycle_table(h: &mut String, bins: &[serde_json::Value]) {
-    const COLUMNS: [(&str, &str, f64, usize); 12] = [
+    const COLUMNS: [(&str, &str, f64, usize); 13] = [
         ("bin", "bin", 1.0, 0),
         ("worm torque (N m)", "worm_torque_nm", 1.0, 2),
         ("wheel torque (N m)", "wheel_torque_nm", 1.0, 1),
@@ -696,6 +696,12 @@ fn duty_cycle_table(h: &mut String, bins: &[serde_json::Value]) {
         ("oil (C)", "oil_temperature_c", 1.0, 1),
         ("efficiency", "total_efficiency", 1.0, 4),
         ("P_patch (MPa)", "pressure_patch_max_pa", 1e-6, 0),
+        (
+            "p_eq,2% (MPa)",
+            "equivalent_pressure_first_pitting_pa",
+            1e-6,
+            0,
+        ),
         ("largest p_eq (MPa)", "equivalent_pressure_max_pa", 1e-6, 0),
         ("wear share (%)", "wear_share", 100.0, 1),
         ("damage share (%)", "damage_share", 100.0, 1),

@@ -471,13 +471,18 @@ pub fn sample_variants(
 }
 
 /// The key results a spread reports, by name, and where each is in a variant's summary.json
-/// (a dotted path; `wear.end.` the life's last record, `safety.` the safety table's row).
-pub const RESULTS: [(&str, &str); 21] = [
+/// (a dotted path; `wear.end.` the life's last record, `wear.first_pitting` the cycles of the
+/// life's first record with pits, `safety.` the safety table's row).
+pub const RESULTS: [(&str, &str); 23] = [
     ("max_pressure_pa", "ltca.max_pressure_pa"),
     ("pressure_patch_max_pa", "ltca.pressure_patch_max_pa"),
     (
         "equivalent_pressure_max_pa",
         "ltca.equivalent_pressure_max_pa",
+    ),
+    (
+        "equivalent_pressure_first_pitting_pa",
+        "ltca.equivalent_pressure_first_pitting_pa",
     ),
     ("contact_area_fraction", "ltca.contact_area_fraction"),
     (
@@ -517,6 +522,7 @@ pub const RESULTS: [(&str, &str); 21] = [
     ("total_efficiency", "friction.efficiency.total_efficiency"),
     ("backlash_increase_end_m", "wear.end.backlash_increase_m"),
     ("wear_patch_max_end_m", "wear.end.wear_patch_max_m"),
+    ("first_pitting_cycles", "wear.first_pitting"),
     ("safety_root", "safety.S_F"),
     ("safety_deflection", "safety.S_delta"),
     ("safety_pitting", "safety.S_H"),
@@ -529,6 +535,14 @@ fn result_at(summary: &serde_json::Value, path: &str) -> Option<f64> {
         let rows = summary["rating"]["safety"]["rows"].as_array()?;
         let row = rows.iter().find(|r| r["symbol"] == symbol)?;
         return row["safety"].as_f64();
+    }
+    if path == "wear.first_pitting" {
+        // The first state with pits on the flank (NaN for a life without: none within it).
+        let steps = summary["wear"]["steps"].as_array()?;
+        let pitted = steps
+            .iter()
+            .find(|s| s["pitted_area_fraction"].as_f64().is_some_and(|f| f > 0.0))?;
+        return pitted["cycles"].as_f64();
     }
     if let Some(key) = path.strip_prefix("wear.end.") {
         return summary["wear"]["steps"].as_array()?.last()?[key].as_f64();
@@ -693,4 +707,31 @@ pub fn summary(spread: &Spread, out: &SpreadResults) -> serde_json::Value {
         json["sobol_indices"] = serde_json::Value::Object(sobol);
     }
     json
+}
+
+#[cfg(test)]
+mod tests {
+    /// A key result read off a summary: the life's first state with pits (none: absent), the
+    /// last record's value, a safety row's.
+    #[test]
+    fn key_results_are_read_where_the_summary_has_them() {
+        let steps = |shares: &[f64]| {
+            let s: Vec<serde_json::Value> = shares
+                .iter()
+                .enumerate()
+                .map(|(k, f)| {
+                    serde_json::json!({"cycles": 1e5 * k as f64, "pitted_area_fraction": f,
+                        "backlash_increase_m": 1e-6 * k as f64})
+                })
+                .collect();
+            serde_json::json!({"wear": {"steps": s}, "rating": {"safety": {"rows": [
+                {"symbol": "S_H", "safety": 0.7}, {"symbol": "S_H,pub", "safety": 1.3}]}}})
+        };
+        let pitted = steps(&[0.0, 0.0, 0.004, 0.03]);
+        assert_eq!(super::result_at(&pitted, "wear.first_pitting"), Some(2e5));
+        assert_eq!(super::result_at(&steps(&[0.0, 0.0]), "wear.first_pitting"), None);
+        let end = super::result_at(&pitted, "wear.end.backlash_increase_m");
+        assert_eq!(end, Some(3e-6));
+        assert_eq!(super::result_at(&pitted, "safety.S_H"), Some(0.7));
+    }
 }

@@ -383,7 +383,9 @@ impl WearState {
     }
 
     /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
-    /// many, their share of the active flank, the largest damage.
+    /// many, their share of the active flank, the largest damage, read as first pitting only
+    /// where they make up its 2 % of the flank (A_p10, "Which p_eq decides"); fewer are local
+    /// damage (an edge's), said as such.
     fn damage_warning(&self, wf: &WheelFlank) -> Option<String> {
         let due: Vec<usize> = (0..self.damage.len())
             .filter(|&k| self.damage[k] >= forecast::REACHED)
@@ -396,12 +398,20 @@ impl WearState {
             pitted[k] = true;
         }
         let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
+        let share = pitted_fraction(wf, &pitted);
+        let first = crate::pitting::FIRST_PITTING_SHARE;
+        let reading = match share >= first {
+            true => "first pitting (2 % of the flank or more, A_p10): the model expects pits there",
+            false => {
+                "less than the 2 % of the flank that is first pitting (A_p10): local damage, \
+                 such as at an edge, not yet first pitting"
+            }
+        };
         Some(format!(
             "pitting: {} flank nodes (about {:.2} % of the active flank) have reached a fatigue \
-             damage of 1 at {} cycles (largest {:.3}): the model expects pits there (damage map; MODEL \
-             §8.1)",
+             damage of 1 at {} cycles (largest {:.3}): {reading} (damage map; MODEL §8.1)",
             due.len(),
-            100.0 * pitted_fraction(wf, &pitted),
+            100.0 * share,
             cycles_label(self.cycles),
             largest
         ))
