@@ -40,6 +40,7 @@ fn thread(
             profile_angle: alpha_n,
             profile_radius: (profile == ProfileType::C).then_some(100.0 * MM),
         }),
+        tip_edge_radius: 0.0,
         tip_relief: wormwear::input::EdgeRelief {
             amount: 0.0,
             length: 1e-3,

@@ -100,6 +100,8 @@ pub struct ThreadDef {
     pub grinding_wheel: Option<GrindingWheel>,
     /// Tip relief: amount at the edge (m; 0 = sharp) and length from the tip (m).
     pub tip_relief: EdgeRelief,
+    /// Radius of the broken tip edge in the axial section, m (0 = sharp; MODEL §2.3).
+    pub tip_edge_radius: f64,
 }
 
 /// A parabolic edge relief C (s / L)^2 over the last L before an edge (m, m).
@@ -188,6 +190,9 @@ pub struct WheelBlank {
     pub bearing_positions: Option<Vec<f64>>,
     /// Edge relief of the teeth (blank top, face ends).
     pub edge_relief: EdgeRelief,
+    /// Width along the wheel axis of the 45 deg chamfer at each face end, m (0 = sharp; MODEL
+    /// §2.3).
+    pub face_edge_chamfer: f64,
 }
 
 /// Elastic and wear properties of one member, SI.

@@ -269,6 +269,11 @@ pub struct ThreadSpec {
     /// Length L of the tip relief, measured radially from the tip, mm (default 1 mm).
     #[serde(default)]
     pub tip_relief_length_mm: Option<f64>,
+    /// Radius of the broken tip edge, mm: in the axial section the flank joins the tip
+    /// cylinder through a circle of this radius tangent to both (MODEL §2.3; worm only; default
+    /// 0: a sharp edge, the published gear).
+    #[serde(default)]
+    pub tip_edge_radius_mm: Option<f64>,
 }
 
 fn default_plane() -> String {
@@ -368,6 +373,10 @@ pub struct WheelSpec {
     /// Length L of the edge relief, mm (default 1 mm).
     #[serde(default)]
     pub edge_relief_length_mm: Option<f64>,
+    /// Width of a 45 deg chamfer at each face end of the teeth, mm, along the wheel axis (MODEL
+    /// §2.3; default 0: sharp face ends, the published gear).
+    #[serde(default)]
+    pub face_edge_chamfer_mm: Option<f64>,
 }
 
 /// Materials of worm and wheel (MODEL §11 defaults).

@@ -18,6 +18,10 @@ pub struct GapEvaluator<'a> {
     /// face ends), and the blank limits they refer to.
     pub tip_relief: crate::input::EdgeRelief,
     pub edge_relief: crate::input::EdgeRelief,
+    /// The worm's broken tip edge (MODEL §2.3).
+    pub tip_edge: TipEdge,
+    /// Width along z of the wheel's 45 deg face-end chamfers, m (0: sharp).
+    pub face_edge_chamfer: f64,
     pub blank: crate::geometry::BlankLimits,
     /// Loaded worm flank.
     pub flank: Flank,
@@ -42,6 +46,8 @@ impl<'a> GapEvaluator<'a> {
             frame: gear.operating.into(),
             tip_relief: gear.worm.tip_relief,
             edge_relief: gear.wheel.edge_relief,
+            tip_edge: TipEdge::of(&geo.worm, flank, gear.worm.tip_edge_radius),
+            face_edge_chamfer: gear.wheel.face_edge_chamfer,
             blank: geo.blank,
             flank,
             sigma: -flank.sign(),
@@ -103,16 +109,26 @@ impl<'a> GapEvaluator<'a> {
     }
 
     /// Normal relief at a wheel point (r, z) touching the worm at radius rho: the worm's tip
-    /// relief C (s/L)^2 with s = rho - (r_a1 - L), plus the wheel's edge relief towards the blank
-    /// top and the face ends. Returns the relief (m) and its derivative with respect to rho.
+    /// relief C (s/L)^2 with s = rho - (r_a1 - L) and its broken tip edge ([`TipEdge`]), plus
+    /// the wheel's edge relief towards the blank top and the face ends and its face-end
+    /// chamfers (45 deg: the flank recedes as far as the point lies inside the chamfer's width).
+    /// Returns the relief (m) and its derivative with respect to rho.
     #[inline]
     pub fn relief(&self, r: f64, z: f64, rho: f64) -> (f64, f64) {
         let t = self.tip_relief;
-        let (mut relief, slope) = t.at(rho - (self.worm.def.tip_radius - t.length));
+        let (mut relief, mut slope) = t.at(rho - (self.worm.def.tip_radius - t.length));
+        if self.tip_edge.radius > 0.0 {
+            let (edge, edge_slope) = self.tip_edge.at(rho);
+            relief += edge;
+            slope += edge_slope;
+        }
         let w = self.edge_relief;
         if w.amount > 0.0 {
             relief += w.at(r - (self.blank.top(z) - w.length)).0;
             relief += w.at(z.abs() - (0.5 * self.blank.face_width - w.length)).0;
+        }
+        if self.face_edge_chamfer > 0.0 {
+            relief += (z.abs() - (0.5 * self.blank.face_width - self.face_edge_chamfer)).max(0.0);
         }
         (relief, slope)
     }
@@ -190,5 +206,50 @@ impl<'a> GapEvaluator<'a> {
     /// |(P x n)_z| (MODEL §5.3), m.
     pub fn lever(point: &Vector3<f64>, normal: &Vector3<f64>) -> f64 {
         (point.x * normal.y - point.y * normal.x).abs()
+    }
+}
+
+/// The worm's broken tip edge (MODEL §2.3): in the axial section a circle of radius R tangent
+/// to the flank and to the tip cylinder. Near the tip the flank is taken as its tangent line at
+/// the tip (axial pressure angle psi there, from the thread's own profile): the circle touches
+/// it at rho_t = r_a - R (1 - sin psi), and a flank point a distance d = (rho - rho_t) / cos psi
+/// past that along the profile lies R - sqrt(R^2 - d^2) above the circle, normal to the flank
+/// (about d^2 / (2 R) near the tangent point). Exact for a straight axial profile (ZA); for a
+/// curved one the tangent line's error over the edge's few tenths of a millimetre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipEdge {
+    /// R, m (0: sharp).
+    pub radius: f64,
+    /// rho_t, the tangent point's radius from the worm axis, m.
+    pub tangent_radius: f64,
+    /// cos psi.
+    pub cos_angle: f64,
+}
+
+impl TipEdge {
+    /// The broken tip edge of radius `radius` (m) on `flank` of `worm`.
+    pub fn of(worm: &ThreadSurface, flank: Flank, radius: f64) -> Self {
+        let tip = worm.def.tip_radius;
+        let slope = worm.axial_profile(flank, tip).1.abs();
+        let psi = slope.atan();
+        Self {
+            radius,
+            tangent_radius: tip - radius * (1.0 - psi.sin()),
+            cos_angle: psi.cos(),
+        }
+    }
+
+    /// The normal relief at radius `rho` from the worm axis and its derivative with respect to
+    /// rho (0 below the tangent point), m and m/m.
+    #[inline]
+    pub fn at(&self, rho: f64) -> (f64, f64) {
+        if self.radius <= 0.0 || rho <= self.tangent_radius {
+            return (0.0, 0.0);
+        }
+        let d = (rho - self.tangent_radius) / self.cos_angle;
+        // Past the circle's top (above the tip only) the edge is all relief: hold its end.
+        let d = d.min(self.radius * (1.0 - 1e-9));
+        let root = (self.radius * self.radius - d * d).sqrt();
+        (self.radius - root, d / root / self.cos_angle)
     }
 }

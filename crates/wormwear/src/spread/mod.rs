@@ -729,7 +729,10 @@ mod tests {
         };
         let pitted = steps(&[0.0, 0.0, 0.004, 0.03]);
         assert_eq!(super::result_at(&pitted, "wear.first_pitting"), Some(2e5));
-        assert_eq!(super::result_at(&steps(&[0.0, 0.0]), "wear.first_pitting"), None);
+        assert_eq!(
+            super::result_at(&steps(&[0.0, 0.0]), "wear.first_pitting"),
+            None
+        );
         let end = super::result_at(&pitted, "wear.end.backlash_increase_m");
         assert_eq!(end, Some(3e-6));
         assert_eq!(super::result_at(&pitted, "safety.S_H"), Some(0.7));

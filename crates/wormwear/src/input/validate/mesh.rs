@@ -104,6 +104,7 @@ pub(super) struct WheelParts {
     pub(super) shaft_radius: Option<f64>,
     pub(super) bearing_positions: Option<Vec<f64>>,
     pub(super) edge_relief: Option<EdgeRelief>,
+    pub(super) face_edge_chamfer: Option<f64>,
 }
 
 impl WheelParts {
@@ -120,6 +121,7 @@ impl WheelParts {
             shaft_radius: self.shaft_radius,
             bearing_positions: self.bearing_positions,
             edge_relief: self.edge_relief.unwrap_or(EdgeRelief::SHARP),
+            face_edge_chamfer: self.face_edge_chamfer?,
         })
     }
 }
@@ -168,6 +170,19 @@ pub(super) fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
             (0.25 * b, "a quarter of wheel.face_width_mm"),
         )
     });
+    // A chamfer of at most a quarter of the face at each end (MODEL §2.3).
+    let face_edge_chamfer = match (w.face_edge_chamfer_mm, face_width) {
+        (None, _) => Some(0.0),
+        (Some(c), Some(b)) => {
+            let unit = format!(
+                "mm (at most a quarter of wheel.face_width_mm, {:.3} mm)",
+                0.25 * b / MM
+            );
+            ck.range("wheel.face_edge_chamfer_mm", c, 0.0, 0.25 * b / MM, &unit)
+                .map(|c| c * MM)
+        }
+        (Some(_), None) => None,
+    };
     if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
         if sh >= hub {
             let problem = format!(
@@ -192,6 +207,7 @@ pub(super) fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
         shaft_radius,
         bearing_positions,
         edge_relief,
+        face_edge_chamfer,
     }
 }
 

@@ -83,6 +83,7 @@ pub(super) fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<Thr
         axial_thickness: s,
         grinding_wheel: None,
         tip_relief: EdgeRelief::SHARP,
+        tip_edge_radius: 0.0,
     };
     let relief = edge_relief(
         ck,
@@ -99,6 +100,9 @@ pub(super) fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<Thr
         Some(r) => def.tip_relief = r,
         None => return None,
     }
+    if let Some(radius) = t.tip_edge_radius_mm {
+        def.tip_edge_radius = tip_edge_radius(ck, name, radius, &def, s)?;
+    }
     if profile == ProfileType::I {
         base_cylinder_below_root(ck, name, &def);
     }
@@ -107,6 +111,44 @@ pub(super) fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<Thr
         def.grinding_wheel = Some(grinding_wheel(ck, name, gw, profile, radii, alpha_n)?);
     }
     fits.then_some(def)
+}
+
+/// The broken tip edge's radius (mm in, m out; MODEL §2.3), checked: the worm's only (the
+/// hob's tip edge is the wheel's root fillet, `rating.root_fillet_radius_mm`), at least 0, and
+/// small enough that the two flanks' circles fit on the tip land (each takes
+/// R (1 - sin a_x) / cos a_x of it) and touch the flank above the root.
+fn tip_edge_radius(
+    ck: &mut Checker,
+    name: &str,
+    radius_mm: f64,
+    def: &ThreadDef,
+    s: f64,
+) -> Option<f64> {
+    let field = format!("{name}.tip_edge_radius_mm");
+    if name != "worm" {
+        ck.fail(
+            &field,
+            radius_mm,
+            "the worm's only: the hob's tip edge makes the wheel's root fillet              (rating.root_fillet_radius_mm for the root stress); remove it",
+        );
+        return None;
+    }
+    let alpha = def.axial_pressure_angle;
+    let land = s - 2.0 * (def.tip_radius - def.reference_radius) * alpha.tan();
+    let per_unit = (1.0 - alpha.sin()) / alpha.cos();
+    let by_land = 0.5 * land / per_unit;
+    let by_depth = (def.tip_radius - def.root_radius) / (1.0 - alpha.sin());
+    let most = by_land.min(by_depth);
+    let why = match by_land <= by_depth {
+        true => format!(
+            "the tip land ({:.3} mm wide) must hold both flanks' circles, each R (1 - sin a_x) /              cos a_x wide",
+            land / MM
+        ),
+        false => "the circle must touch the flank above the root".to_string(),
+    };
+    let unit = format!("mm ({why})");
+    ck.range(&field, radius_mm, 0.0, most / MM, &unit)
+        .map(|r| r * MM)
 }
 
 /// The pressure angle (deg), whether it is given in the axial plane, and the axial

@@ -1,0 +1,187 @@
+//! Edge breaks (MODEL §2.3): the worm's broken tip edge recedes from the sharp flank by the
+//! analytic circle, the wheel's face-end chamfer by its 45 deg line; a vanishing radius gives
+//! the sharp results; bad radii and chamfers are refused by name.
+
+mod common;
+
+use wormwear::geometry::{Flank, Geometry};
+use wormwear::input::{self, BendingKind, GearSet};
+use wormwear::kinematics::GapEvaluator;
+use wormwear::{Request, Source, Stage};
+
+fn design(tip_edge_radius_mm: f64, chamfer_mm: f64) -> GearSet {
+    let mut g = common::example("gear-1x40-design.toml");
+    g.worm.tip_edge_radius = tip_edge_radius_mm * 1e-3;
+    g.wheel.face_edge_chamfer = chamfer_mm * 1e-3;
+    g.bending.kind = BendingKind::None;
+    g
+}
+
+/// The normal distance from the sharp flank to the rounded edge, by construction in the axial
+/// section (x along the worm axis, rho from it): the flank's tangent line at the tip, the
+/// circle of radius R tangent to it and to the tip line rho = r_a, and from each flank point
+/// the first crossing of the circle along the flank's inward normal (a quadratic).
+#[test]
+fn the_broken_tip_edge_recedes_by_the_analytic_circle() {
+    let g = design(0.8, 0.0);
+    let geo = Geometry::build(&g).unwrap();
+    for flank in [Flank::Left, Flank::Right] {
+        let ev = GapEvaluator::for_flank(&g, &geo, flank);
+        let tip = g.worm.tip_radius;
+        let (x_tip, slope) = geo.worm.axial_profile(flank, tip);
+        // The material side: the thread's middle (x = 0) from the flank.
+        let side = if x_tip < 0.0 { 1.0 } else { -1.0 };
+        let norm = (1.0 + slope * slope).sqrt();
+        let inward = [side / norm, -side * slope / norm];
+        let r = 0.8e-3;
+        // Centre: r below the tip line, r from the flank line on the material side.
+        let c_rho = tip - r;
+        let c_x = x_tip + slope * (c_rho - tip) + side * r * norm;
+        // The tangent point: the arc runs from it to the tip; below it the flank is the line.
+        let tangent_rho = c_rho - r * inward[1];
+        let mut checked = 0;
+        for k in 1..200 {
+            let rho = tip - 1e-3 + k as f64 * 5e-6;
+            if rho > tip {
+                break;
+            }
+            let p = [x_tip + slope * (rho - tip), rho];
+            let w = [p[0] - c_x, p[1] - c_rho];
+            let wn = w[0] * inward[0] + w[1] * inward[1];
+            let disc = wn * wn - (w[0] * w[0] + w[1] * w[1] - r * r);
+            // Below the tangent point the normal line misses the circle or meets it behind.
+            let expected = match disc >= 0.0 && rho > tangent_rho {
+                true => (-wn - disc.sqrt()).max(0.0),
+                false => 0.0,
+            };
+            let (relief, _) = ev.relief(100e-3, 0.0, rho);
+            assert!(
+                (relief - expected).abs() < 1e-12 + 1e-9 * expected,
+                "{flank:?} rho {:.4} mm: {relief:e} vs {expected:e}",
+                rho * 1e3
+            );
+            checked += usize::from(expected > 0.0);
+        }
+        assert!(checked > 50, "{checked} points on the circle");
+        // The derivative with respect to rho is the relief's slope (central difference).
+        let rho = tip - 0.2e-3;
+        let h = 1e-8;
+        let numeric = (ev.relief(0.1, 0.0, rho + h).0 - ev.relief(0.1, 0.0, rho - h).0) / (2.0 * h);
+        let (_, analytic) = ev.relief(0.1, 0.0, rho);
+        assert!(
+            (numeric / analytic - 1.0).abs() < 1e-5,
+            "{numeric} vs {analytic}"
+        );
+    }
+}
+
+/// The 45 deg chamfer: the flank recedes as far as the point lies inside the chamfer's width
+/// along the wheel axis, at both face ends, and not at all outside it.
+#[test]
+fn the_face_end_chamfer_recedes_along_its_45_degree_line() {
+    let g = design(0.0, 1.5);
+    let geo = Geometry::build(&g).unwrap();
+    let ev = GapEvaluator::new(&g, &geo);
+    let half = 0.5 * g.wheel.face_width;
+    for z in [
+        -half,
+        -half + 0.5e-3,
+        -half + 1.5e-3,
+        0.0,
+        half - 1.0e-3,
+        half,
+    ] {
+        let expected = (z.abs() - (half - 1.5e-3)).max(0.0);
+        let (relief, slope) = ev.relief(100e-3, z, 28e-3);
+        assert!(
+            (relief - expected).abs() < 1e-15,
+            "z {z}: {relief} vs {expected}"
+        );
+        assert_eq!(slope, 0.0);
+    }
+}
+
+/// A radius and a chamfer of 0 are the sharp gear to the bit; as they shrink to a fraction of
+/// a micrometre the loaded analysis tends to the sharp one.
+#[test]
+fn a_vanishing_edge_break_gives_the_sharp_results() {
+    let run = |g: &GearSet| {
+        let request = Request::new([Stage::Ltca]);
+        wormwear::run(g, Source::default(), request, &mut |_| Ok(()))
+            .unwrap()
+            .ltca
+            .unwrap()
+    };
+    let mut sharp = common::example("gear-1x40-design.toml");
+    sharp.bending.kind = BendingKind::None;
+    let sharp = run(&sharp);
+    let zero = run(&design(0.0, 0.0));
+    assert_eq!(zero.pattern, sharp.pattern);
+    assert_eq!(zero.pressure_patch_max, sharp.pressure_patch_max);
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    // Measured (relative to sharp; P_patch, P_mean, efficiency): R 10 um 6.5e-5, 2.3e-4,
+    // 2.3e-5; R 1 um 8.9e-6, 5.2e-5, 4.0e-6; R 0.1 um 4.0e-6, 1.5e-6, 4.8e-7; a chamfer of
+    // 0.1 um 6.9e-3, 1.4e-4, 8.6e-6 (the face end's patch reads the edge node's micrometres).
+    for (radius_um, chamfer_um, bound) in [
+        (1.0, 0.0, [1e-4, 1e-4, 1e-5]),
+        (0.1, 0.0, [1e-5, 1e-5, 1e-6]),
+        (0.0, 0.1, [1e-2, 2e-4, 1e-5]),
+    ] {
+        let tiny = run(&design(radius_um * 1e-3, chamfer_um * 1e-3));
+        let moved = [
+            rel(tiny.pressure_patch_max, sharp.pressure_patch_max),
+            rel(tiny.mean_pressure, sharp.mean_pressure),
+            rel(tiny.mesh_efficiency, sharp.mesh_efficiency),
+        ];
+        eprintln!("R {radius_um} um, chamfer {chamfer_um} um: {moved:?}");
+        for k in 0..3 {
+            assert!(
+                moved[k] < bound[k],
+                "R {radius_um}, chamfer {chamfer_um}: {moved:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_edge_breaks_are_refused_naming_the_field() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/gear-1x40-design.toml"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let refused = |section: &str, line: &str| {
+        let edited = text.replacen(
+            &format!("[{section}]\n"),
+            &format!("[{section}]\n{line}\n"),
+            1,
+        );
+        input::load_from_str(&edited).unwrap_err().to_string()
+    };
+    let m = refused("worm", "tip_edge_radius_mm = -0.1");
+    assert!(
+        m.contains("worm.tip_edge_radius_mm") && m.contains("-0.1"),
+        "{m}"
+    );
+    // The tip land (about 3.8 mm) holds two circles of at most 3.0 mm each.
+    let m = refused("worm", "tip_edge_radius_mm = 4.0");
+    assert!(
+        m.contains("worm.tip_edge_radius_mm") && m.contains("tip land"),
+        "{m}"
+    );
+    let m = refused("hob", "tip_edge_radius_mm = 0.5");
+    assert!(
+        m.contains("hob.tip_edge_radius_mm") && m.contains("root_fillet_radius_mm"),
+        "{m}"
+    );
+    let m = refused("wheel", "face_edge_chamfer_mm = 20.0");
+    assert!(
+        m.contains("wheel.face_edge_chamfer_mm") && m.contains("quarter"),
+        "{m}"
+    );
+    let edited = text.replacen("[worm]\n", "[worm]\ntip_edge_radius_mm = 0.5\n", 1);
+    assert_eq!(
+        input::load_from_str(&edited).unwrap().worm.tip_edge_radius,
+        0.5e-3
+    );
+}
