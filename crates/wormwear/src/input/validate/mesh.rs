@@ -170,19 +170,7 @@ pub(super) fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
             (0.25 * b, "a quarter of wheel.face_width_mm"),
         )
     });
-    // A chamfer of at most a quarter of the face at each end (MODEL §2.3).
-    let face_edge_chamfer = match (w.face_edge_chamfer_mm, face_width) {
-        (None, _) => Some(0.0),
-        (Some(c), Some(b)) => {
-            let unit = format!(
-                "mm (at most a quarter of wheel.face_width_mm, {:.3} mm)",
-                0.25 * b / MM
-            );
-            ck.range("wheel.face_edge_chamfer_mm", c, 0.0, 0.25 * b / MM, &unit)
-                .map(|c| c * MM)
-        }
-        (Some(_), None) => None,
-    };
+    let face_edge_chamfer = face_edge_chamfer(ck, w.face_edge_chamfer_mm, face_width);
     if let (Some(hub), Some(sh)) = (hub_radius, shaft_radius) {
         if sh >= hub {
             let problem = format!(
@@ -208,6 +196,21 @@ pub(super) fn wheel_parts(ck: &mut Checker, w: &WheelSpec) -> WheelParts {
         bearing_positions,
         edge_relief,
         face_edge_chamfer,
+    }
+}
+
+/// The face-end chamfer's width (mm in, m out; MODEL §2.3): 0 when not given, at most a
+/// quarter of the face width `face_width` (m).
+fn face_edge_chamfer(ck: &mut Checker, given: Option<f64>, face_width: Option<f64>) -> Option<f64> {
+    match (given, face_width) {
+        (None, _) => Some(0.0),
+        (Some(c), Some(b)) => {
+            let most = 0.25 * b / MM;
+            let unit = format!("mm (at most a quarter of wheel.face_width_mm, {most:.3} mm)");
+            ck.range("wheel.face_edge_chamfer_mm", c, 0.0, most, &unit)
+                .map(|c| c * MM)
+        }
+        (Some(_), None) => None,
     }
 }
 

@@ -85,24 +85,7 @@ pub(super) fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<Thr
         tip_relief: EdgeRelief::SHARP,
         tip_edge_radius: 0.0,
     };
-    let relief = edge_relief(
-        ck,
-        &field("tip_relief_um"),
-        t.tip_relief_um,
-        &field("tip_relief_length_mm"),
-        t.tip_relief_length_mm,
-        (
-            0.5 * (ra - rf),
-            &format!("half the thread depth, {name}.tip_radius_mm - {name}.root_radius_mm"),
-        ),
-    );
-    match relief {
-        Some(r) => def.tip_relief = r,
-        None => return None,
-    }
-    if let Some(radius) = t.tip_edge_radius_mm {
-        def.tip_edge_radius = tip_edge_radius(ck, name, radius, &def, s)?;
-    }
+    tip_edges(ck, name, t, &mut def)?;
     if profile == ProfileType::I {
         base_cylinder_below_root(ck, name, &def);
     }
@@ -111,6 +94,26 @@ pub(super) fn thread(ck: &mut Checker, name: &str, t: &ThreadSpec) -> Option<Thr
         def.grinding_wheel = Some(grinding_wheel(ck, name, gw, profile, radii, alpha_n)?);
     }
     fits.then_some(def)
+}
+
+/// The tip relief and the broken tip edge of `def` from `t`, checked (None: refused).
+fn tip_edges(ck: &mut Checker, name: &str, t: &ThreadSpec, def: &mut ThreadDef) -> Option<()> {
+    let depth = def.tip_radius - def.root_radius;
+    def.tip_relief = edge_relief(
+        ck,
+        &format!("{name}.tip_relief_um"),
+        t.tip_relief_um,
+        &format!("{name}.tip_relief_length_mm"),
+        t.tip_relief_length_mm,
+        (
+            0.5 * depth,
+            &format!("half the thread depth, {name}.tip_radius_mm - {name}.root_radius_mm"),
+        ),
+    )?;
+    if let Some(radius) = t.tip_edge_radius_mm {
+        def.tip_edge_radius = tip_edge_radius(ck, name, radius, def, def.axial_thickness)?;
+    }
+    Some(())
 }
 
 /// The broken tip edge's radius (mm in, m out; MODEL §2.3), checked: the worm's only (the
