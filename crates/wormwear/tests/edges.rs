@@ -185,3 +185,31 @@ fn bad_edge_breaks_are_refused_naming_the_field() {
         0.5e-3
     );
 }
+
+/// The loaded analysis says where its cells reach the flow pressure: on the sharp design gear
+/// at 90 N m (no bending) at the worm tip's trace (0.69 % of the flank); a 1 mm tip edge
+/// radius takes the trace off the flow pressure (no cell there).
+#[test]
+fn the_flow_pressure_warning_names_where_and_the_tip_edge_removes_the_tip_trace() {
+    let warnings = |g: &GearSet| {
+        let mut g = g.clone();
+        g.conditions.torque = input::Torque::Worm(90.0);
+        let g = &g;
+        let request = Request::new([Stage::Ltca]);
+        let r = wormwear::run(g, Source::default(), request, &mut |_| Ok(())).unwrap();
+        let w = r.ltca.unwrap().warnings;
+        w.into_iter()
+            .find(|w| w.contains("reaches the flow pressure"))
+    };
+    let sharp = warnings(&design(0.0, 0.0)).expect("the sharp tip reaches the flow pressure");
+    eprintln!("sharp: {sharp}");
+    assert!(sharp.contains("at the worm tip's trace"), "{sharp}");
+    let rounded = warnings(&design(1.0, 0.0));
+    eprintln!("R 1 mm: {rounded:?}");
+    assert!(
+        rounded
+            .as_ref()
+            .is_none_or(|w| !w.contains("worm tip's trace")),
+        "{rounded:?}"
+    );
+}

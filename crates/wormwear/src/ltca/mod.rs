@@ -710,9 +710,11 @@ fn over_the_cycle(
         max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
+    let places = pattern::YieldedPlaces::of(wf, &pattern, settings.flow_pressure, &tca.tip_trace);
     warnings.extend(flow_pressure_warning(
         stats.yielded_area_fraction,
         settings.flow_pressure,
+        &places,
     ));
     warnings.extend(deflection_warning(&positions, tca, teeth));
     Ltca {

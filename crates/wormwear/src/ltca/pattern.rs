@@ -38,16 +38,92 @@ pub(super) fn deflection_warning(
 pub(super) fn flow_pressure_warning(
     yielded_area_fraction: f64,
     flow_pressure: f64,
+    place: &YieldedPlaces,
 ) -> Option<String> {
     (yielded_area_fraction > 0.0).then(|| {
         format!(
-            "{:.2} % of the active flank reaches the flow pressure {:.0} MPa (MODEL §5.7): the \
-             pressures there are the bronze's plastic limit, not an elastic solution, and the \
-             flank takes a plastic set",
+            "{:.2} % of the active flank reaches the flow pressure {:.0} MPa (MODEL §5.7), {}: \
+             the pressures there are the bronze's plastic limit, not an elastic solution, and \
+             the flank takes a plastic set",
             100.0 * yielded_area_fraction,
-            flow_pressure * 1e-6
+            flow_pressure * 1e-6,
+            place.text()
         )
     })
+}
+
+/// Where the cells at the flow pressure lie (MODEL §2.3, §5.7): their shares of the active
+/// flank at the worm tip's trace (the two rows of cells above the lowest radius the worm's
+/// flank reaches in their column), at the face ends (the first and last columns), at the blank
+/// top (the top row) and elsewhere, and the span of their radii and face positions, m.
+pub(super) struct YieldedPlaces {
+    shares: [f64; 4],
+    r: (f64, f64),
+    z: (f64, f64),
+}
+
+impl YieldedPlaces {
+    /// The places of the cells of `pattern` at `flow_pressure` on `wf`, with the worm tip's
+    /// trace `tip_trace` (per node column: z, radius; `Tca::tip_trace`).
+    pub(super) fn of(
+        wf: &WheelFlank,
+        pattern: &[f64],
+        flow_pressure: f64,
+        tip_trace: &[(f64, f64)],
+    ) -> Self {
+        let (ni, nj) = (wf.cells_height, wf.cells_face);
+        let bound = flow_pressure * (1.0 - 1e-9);
+        let active = wf.active_area();
+        let mut place = Self {
+            shares: [0.0; 4],
+            r: (f64::INFINITY, f64::NEG_INFINITY),
+            z: (f64::INFINITY, f64::NEG_INFINITY),
+        };
+        for k in (0..pattern.len()).filter(|&k| pattern[k] >= bound) {
+            let (j, i) = (k / ni, k % ni);
+            let cell = &wf.cells[k];
+            let trace = tip_trace.get(j).map_or(f64::NEG_INFINITY, |t| t.1);
+            let cell_height = (wf.node(ni, j).r - wf.node(0, j).r) / ni as f64;
+            let which = if j == 0 || j + 1 == nj {
+                1
+            } else if cell.r <= trace + 2.0 * cell_height {
+                0
+            } else if i + 1 == ni {
+                2
+            } else {
+                3
+            };
+            place.shares[which] += wf.cell_area[k] / active;
+            place.r = (place.r.0.min(cell.r), place.r.1.max(cell.r));
+            place.z = (place.z.0.min(cell.z), place.z.1.max(cell.z));
+        }
+        place
+    }
+
+    /// The places as a clause: "at the worm tip's trace 0.71 %, the face ends 0.17 %, ... (r
+    /// 94.1-109.9 mm, z -22.1-22.1 mm)".
+    fn text(&self) -> String {
+        let names = [
+            "the worm tip's trace",
+            "the face ends",
+            "the blank top",
+            "elsewhere",
+        ];
+        let parts: Vec<String> = names
+            .iter()
+            .zip(self.shares)
+            .filter(|(_, s)| *s > 0.0)
+            .map(|(n, s)| format!("{n} {:.2} %", 100.0 * s))
+            .collect();
+        format!(
+            "at {} (cell centres at r {:.1}-{:.1} mm, z {:.1} to {:.1} mm)",
+            parts.join(", "),
+            self.r.0 * 1e3,
+            self.r.1 * 1e3,
+            self.z.0 * 1e3,
+            self.z.1 * 1e3
+        )
+    }
 }
 
 /// The loaded pattern's statistics (MODEL §5.6, §5.7): the mean pressure of the loaded cells
