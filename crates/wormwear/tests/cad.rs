@@ -413,3 +413,25 @@ fn the_worm_and_the_wheel_assemble_touching_without_overlap() {
     assert!(common.abs() < 1e-3, "the parts overlap by {common} mm^3");
     assert!(distance < 1e-3, "the parts are {distance} mm apart");
 }
+
+/// The solids do not draw the edge breaks yet: a run asking for them with a broken tip edge
+/// says so (no silent sharp solid), one without says nothing.
+#[test]
+fn solids_of_a_gear_with_edge_breaks_say_they_are_drawn_sharp() {
+    let run = |radius: f64| {
+        let mut g = common::example("gear-1x40-design.toml");
+        g.worm.tip_edge_radius = radius;
+        let request = wormwear::Request {
+            cad: Some(CadRequest {
+                teeth: Some(1),
+                state: None,
+            }),
+            ..wormwear::Request::new([wormwear::Stage::Geometry])
+        };
+        let r = wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
+        assert!(r.cad.is_some());
+        r.warnings.iter().any(|w| w.contains("drawn with sharp edges"))
+    };
+    assert!(run(0.5e-3));
+    assert!(!run(0.0));
+}

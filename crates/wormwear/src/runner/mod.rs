@@ -653,6 +653,14 @@ impl<'a> Pipeline<'a> {
             };
             (from, *flank, change)
         });
+        if self.gear.worm.tip_edge_radius > 0.0 || self.gear.wheel.face_edge_chamfer > 0.0 {
+            self.warnings.push(
+                "cad: the STEP solids are drawn with sharp edges: the worm's broken tip edge \
+                 (worm.tip_edge_radius_mm) and the wheel's face chamfers (wheel.\
+                 face_edge_chamfer_mm) are in the analyses, not yet in the solids"
+                    .to_string(),
+            );
+        }
         crate::cad::solids(self.gear, geo, request, worn)
             .map(Some)
             .map_err(RunError::Cad)
