@@ -430,7 +430,9 @@ fn solids_of_a_gear_with_edge_breaks_say_they_are_drawn_sharp() {
         };
         let r = wormwear::run(&g, wormwear::Source::default(), request, &mut |_| Ok(())).unwrap();
         assert!(r.cad.is_some());
-        r.warnings.iter().any(|w| w.contains("drawn with sharp edges"))
+        r.warnings
+            .iter()
+            .any(|w| w.contains("drawn with sharp edges"))
     };
     assert!(run(0.5e-3));
     assert!(!run(0.0));

@@ -215,3 +215,38 @@ fn the_default_settings_are_narrowed_to_what_the_hob_generates() {
         );
     }
 }
+
+/// The loaded pattern's search reads the pattern the full loaded analysis reports: the shape
+/// of its best settings equals summary.json's `ltca.pattern_shape` of a run of the best gear
+/// file through the pipeline (the design gear without bending, a short budget).
+#[test]
+fn the_loaded_search_reads_the_pattern_the_loaded_analysis_reports() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/gear-1x40-design.toml"
+    );
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("model = \"fe\"", "model = \"none\"");
+    let target = Target::parse("centre_across_face=0.6").unwrap();
+    let vary = bounds(&[(SWIVEL, -0.3, 0.3)]);
+    let study = Assistant::new("design".into(), text, target, vary, Which::Loaded, 4).unwrap();
+    let outcome = study.run(&|_, _| {}, &|| false).unwrap();
+    assert!(outcome.path.len() <= 5, "{}", outcome.path.len());
+    assert!(outcome.best.objective <= outcome.start.objective);
+    let best = assistant::best_gear_text(&study, &outcome).unwrap();
+    let gear = input::load_from_str(&best).unwrap();
+    let source = wormwear::Source {
+        file: "best".into(),
+        text: best,
+    };
+    let request = wormwear::Request::new([wormwear::Stage::Ltca]);
+    let results = wormwear::run(&gear, source, request, &mut |_| Ok(())).unwrap();
+    let (tca, ltca) = (
+        results.tca.as_ref().unwrap(),
+        results.ltca.as_ref().unwrap(),
+    );
+    let wf = results.geometry.wheel_flank(tca.loaded_flank);
+    let reported = wormwear::output::ltca::LtcaSummary::new(tca, wf, ltca).pattern_shape;
+    assert_eq!(reported, outcome.best.shape);
+}
