@@ -528,6 +528,17 @@ fn import_export_import_gives_the_same_gear() {
             assert_same_gear(&first, &second);
         }
     }
+    // The edge breaks (MODEL §2.3) travel as custom attributes.
+    let (_, mut first) = imported(&zi_example());
+    first.worm.tip_edge_radius = 0.5e-3;
+    first.wheel.face_edge_chamfer = 0.8e-3;
+    let model = rexs::export::stage_model(&first, None, "2026-11-24T00:00:00Z").unwrap();
+    let text = rexs::to_string(&model, Encoding::Xml);
+    let back = rexs::parse_bytes(text.as_bytes(), "exported").unwrap();
+    let imp = import::import(&back, None, "exported").unwrap();
+    let second = input::load_from_str(&imp.text).unwrap();
+    assert_eq!(second.worm.tip_edge_radius, 0.5e-3);
+    assert_same_gear(&first, &second);
 }
 
 #[test]

@@ -257,6 +257,10 @@ fn gears(b: &mut Builder, gear: &GearSet) -> (u64, u64) {
         float("u_coordinate_on_shaft", "mm", 0.0),
         custom("axial_thickness", "mm", w.axial_thickness * MM),
     ];
+    // The broken tip edge (MODEL §2.3; REXS has no attribute for it), where given.
+    if w.tip_edge_radius > 0.0 {
+        worm_attrs.push(custom("tip_edge_radius", "mm", w.tip_edge_radius * MM));
+    }
     worm_attrs.extend(placed([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]));
     let worm = b.component("worm_gear", "worm", worm_attrs);
     let wh = &gear.wheel;
@@ -289,19 +293,26 @@ fn gears(b: &mut Builder, gear: &GearSet) -> (u64, u64) {
         ),
         float("u_coordinate_on_shaft", "mm", 0.0),
     ];
-    // Body dimensions the gear file gives (a default stays a default).
-    for (name, value) in [
-        ("rim_thickness", wh.rim_thickness),
-        ("web_thickness", wh.web_thickness),
-        ("hub_radius", wh.hub_radius),
-    ] {
-        if let Some(v) = value {
-            wheel_attrs.push(custom(name, "mm", v * MM));
-        }
-    }
+    wheel_attrs.extend(wheel_body_attributes(wh));
     wheel_attrs.extend(placed([0.0, a * MM, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]));
     let wheel = b.component("worm_wheel", "wheel", wheel_attrs);
     (worm, wheel)
+}
+
+/// The wheel's body dimensions the gear file gives (a default stays a default) and its
+/// face-end chamfer where given (MODEL §2.3; REXS has no attribute for it), as custom
+/// attributes in mm.
+fn wheel_body_attributes(wh: &crate::input::WheelBlank) -> Vec<Attribute> {
+    let chamfer = Some(wh.face_edge_chamfer).filter(|c| *c > 0.0);
+    [
+        ("rim_thickness", wh.rim_thickness),
+        ("web_thickness", wh.web_thickness),
+        ("hub_radius", wh.hub_radius),
+        ("face_edge_chamfer", chamfer),
+    ]
+    .into_iter()
+    .filter_map(|(name, value)| value.map(|v| custom(name, "mm", v * MM)))
+    .collect()
 }
 
 /// Shafts with a section each, bearings (side relations to the casing), the loads and the

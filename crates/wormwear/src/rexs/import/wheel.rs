@@ -43,6 +43,7 @@ pub(super) fn wheel_blank(
         ("rim_thickness", "rim_thickness_mm"),
         ("web_thickness", "web_thickness_mm"),
         ("hub_radius", "hub_radius_mm"),
+        ("face_edge_chamfer", "face_edge_chamfer_mm"),
     ] {
         if let Some(v) = custom(reader, c, field, Quantity::Length)? {
             out.field(name, v, &format!("{CUSTOM_PREFIX}{field}"));

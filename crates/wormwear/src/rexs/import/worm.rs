@@ -85,6 +85,15 @@ pub(super) fn worm_thread(
         worm.axial_thickness,
         &sources.thickness,
     );
+    // The broken tip edge wormwear wrote (MODEL §2.3; REXS has no attribute for it).
+    let tip_edge = custom(reader, parts.worm, "tip_edge_radius", Quantity::Length)?;
+    if let Some(r) = tip_edge {
+        out.field(
+            "tip_edge_radius_mm",
+            r,
+            &format!("{CUSTOM_PREFIX}tip_edge_radius"),
+        );
+    }
     out.note(&format!(
         "lead angle atan(z1 m_x / d_m1) = {} deg; tip relief: wormwear's default",
         Shown(worm.lead_angle_deg)
