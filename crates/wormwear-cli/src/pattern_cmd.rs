@@ -55,7 +55,7 @@ pub(crate) fn pattern(args: &PatternArgs, quiet: bool) -> Result<(), Failure> {
     if !quiet {
         eprintln!(
             "pattern: the {} pattern of {} toward {}, searching {} within {} evaluations",
-            assistant::files::which_name(study.which),
+            study.which.name(),
             study.base_file,
             assistant::target_text(&study.target),
             study

@@ -68,7 +68,7 @@ pub fn best_gear_text(assistant: &Assistant, outcome: &Outcome) -> Result<String
         "# Cutting settings found by `wormwear pattern` (MODEL §17) from {}:\n# the {} \
          pattern's target {}, objective {:.3e} (start {:.3e}).\n",
         assistant.base_file,
-        which_name(assistant.which),
+        assistant.which.name(),
         target_text(&assistant.target),
         outcome.best.objective,
         outcome.start.objective
@@ -200,14 +200,6 @@ fn analysis_files(
         source: e,
     })?;
     Ok(crate::output::write_results(&results, dir, false)?)
-}
-
-/// The name of the pattern searched for, as in pattern.json.
-pub fn which_name(which: Which) -> &'static str {
-    match which {
-        Which::NoLoad => "no-load",
-        Which::Loaded => "loaded",
-    }
 }
 
 /// A target as `name=value, ...`.

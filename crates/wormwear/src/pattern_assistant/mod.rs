@@ -71,14 +71,29 @@ pub enum PatternError {
     Output(#[from] crate::output::OutputError),
 }
 
-/// Which pattern the target is for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// Which pattern the target is for (pattern.json writes [`Which::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Which {
     /// The no-load pattern of the unloaded analysis (MODEL §4.4): a marking test.
     NoLoad,
     /// The loaded pattern of the loaded analysis (MODEL §5), with the gear file's bending.
     Loaded,
+}
+
+impl Which {
+    /// The name in pattern.json and the messages: "no-load" or "loaded".
+    pub fn name(self) -> &'static str {
+        match self {
+            Which::NoLoad => "no-load",
+            Which::Loaded => "loaded",
+        }
+    }
+}
+
+impl serde::Serialize for Which {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
 }
 
 /// A target pattern shape: the components to meet, each a share in [0, 1] (None: free).
