@@ -54,6 +54,7 @@ fn check_accepts_every_example() {
         "gear-1x40-case-c.toml",
         "gear-k-2x25.toml",
         "gear-1x40-duty-cycle.toml",
+        "gear-1x40-running-in.toml",
     ] {
         let out = bin().arg("check").arg(example(name)).output().unwrap();
         assert!(

@@ -3,6 +3,7 @@
 //! asperity contact of the mixed regime (MODEL §10).
 //! SI units throughout (m, Pa, m/s, N/m, K).
 
+use crate::geometry::{FlankField, WheelFlank};
 use crate::input::Lubricant;
 
 /// Dimensionless Moes–Venner minimum film thickness H(M, L) of a line contact (MODEL §6):
@@ -92,14 +93,99 @@ pub fn thermal_factor(lub: &Lubricant, e_prime: f64, c: &LineContact) -> f64 {
     phi.clamp(f64::MIN_POSITIVE, 1.0)
 }
 
-/// Film thickness, thermal factor and film ratio at a point of a contact line.
+/// Film thickness, thermal factor and film ratio at a point of a contact line, at the
+/// lubricant's composite roughness.
 pub fn film(lub: &Lubricant, e_prime: f64, c: &LineContact) -> Film {
+    film_over(lub, e_prime, c, lub.composite_roughness)
+}
+
+/// [`film`] over a flank point of composite roughness `roughness` (R_q, m; MODEL §6.1).
+pub fn film_over(lub: &Lubricant, e_prime: f64, c: &LineContact, roughness: f64) -> Film {
     let h_min = min_film_thickness(lub, e_prime, c);
     let thermal_factor = thermal_factor(lub, e_prime, c);
     Film {
         h_min,
         thermal_factor,
-        lambda: h_min * thermal_factor / lub.composite_roughness,
+        lambda: h_min * thermal_factor / roughness,
+    }
+}
+
+/// The composite roughness R_q (m) of every node of a flank worn `removal` deep (m, normal to
+/// the flank, on its node grid; MODEL §6.1: [`Lubricant::roughness_after`]). None where it is
+/// the lubricant's `composite_roughness` everywhere: no running-in, running in to the initial
+/// roughness, or an unworn flank.
+pub fn running_in_roughness(lub: &Lubricant, removal: Option<&FlankField>) -> Option<FlankField> {
+    lub.running_in
+        .filter(|r| r.roughness != lub.composite_roughness)?;
+    let removal = removal.filter(|f| f.values.iter().any(|&h| h > 0.0))?;
+    Some(FlankField {
+        values: removal
+            .values
+            .iter()
+            .map(|&h| lub.roughness_after(h))
+            .collect(),
+        ..removal.clone()
+    })
+}
+
+/// The composite roughness over a loaded flank (MODEL §6.1): the lubricant's, uniform, or a
+/// field on the flank's nodes ([`running_in_roughness`]).
+#[derive(Debug, Clone, Copy)]
+pub struct FlankRoughness<'a> {
+    /// R_q where there is no field, m.
+    pub uniform: f64,
+    /// R_q per node of the flank, m, and the flank.
+    pub field: Option<(&'a FlankField, &'a WheelFlank)>,
+}
+
+impl<'a> FlankRoughness<'a> {
+    /// The lubricant's uniform roughness, or `field` on the flank `wf` where given.
+    pub fn of(lub: &Lubricant, field: Option<&'a FlankField>, wf: &'a WheelFlank) -> Self {
+        Self {
+            uniform: lub.composite_roughness,
+            field: field.map(|f| (f, wf)),
+        }
+    }
+
+    /// R_q at flank point (r, z) of the reference tooth (m), linear between nodes.
+    pub fn at(&self, r: f64, z: f64) -> f64 {
+        match self.field {
+            Some((f, wf)) => f.at(wf, r, z),
+            None => self.uniform,
+        }
+    }
+
+    /// The area-weighted mean of R_q over the active flank and its smallest value there
+    /// (cell means of the nodes' values), m.
+    pub fn over_active(&self, wf: &WheelFlank) -> (f64, f64) {
+        let Some((f, _)) = self.field else {
+            return (self.uniform, self.uniform);
+        };
+        let (mut sum, mut area, mut least) = (0.0, 0.0, f64::INFINITY);
+        let cells = f.cell_means();
+        for ((v, a), _) in cells
+            .iter()
+            .zip(&wf.cell_area)
+            .zip(&wf.active)
+            .filter(|c| *c.1)
+        {
+            sum += v * a;
+            area += a;
+            least = least.min(*v);
+        }
+        if area > 0.0 {
+            (sum / area, least)
+        } else {
+            (self.uniform, self.uniform)
+        }
+    }
+
+    /// R_q at node k of the flank's grid, m.
+    pub fn node(&self, k: usize) -> f64 {
+        match self.field {
+            Some((f, _)) => f.values[k],
+            None => self.uniform,
+        }
     }
 }
 
@@ -153,6 +239,7 @@ pub(crate) mod tests {
             thermal_conductivity: 0.148,
             temperature: 333.0,
             composite_roughness: 1e-6,
+            running_in: None,
         }
     }
 

@@ -120,6 +120,7 @@ fn the_contacts_efficiency_of_the_reference_gears_beside_iso_tr_14521() {
         let ours = contacts.friction(&g.lubricant, &g.friction);
         let smooth = input::Lubricant {
             composite_roughness: 0.2e-6,
+            running_in: None,
             ..g.lubricant.clone()
         };
         let smoother = contacts.friction(&smooth, &g.friction);

@@ -532,12 +532,19 @@ fn import_export_import_gives_the_same_gear() {
     let (_, mut first) = imported(&zi_example());
     first.worm.tip_edge_radius = 0.5e-3;
     first.wheel.face_edge_chamfer = 0.8e-3;
+    // So does the running-in of the roughness (MODEL §6.1).
+    first.lubricant.running_in = Some(input::RunningIn {
+        roughness: 0.4e-6,
+        depth: 2e-6,
+    });
     let model = rexs::export::stage_model(&first, None, "2026-11-24T00:00:00Z").unwrap();
     let text = rexs::to_string(&model, Encoding::Xml);
     let back = rexs::parse_bytes(text.as_bytes(), "exported").unwrap();
     let imp = import::import(&back, None, "exported").unwrap();
     let second = input::load_from_str(&imp.text).unwrap();
     assert_eq!(second.worm.tip_edge_radius, 0.5e-3);
+    let run_in = second.lubricant.running_in.expect("the running-in travels");
+    assert!((run_in.roughness - 0.4e-6).abs() < 1e-18 && (run_in.depth - 2e-6).abs() < 1e-18);
     assert_same_gear(&first, &second);
 }
 

@@ -70,6 +70,9 @@ struct CellContact {
     pressure: f64,
     sliding_speed: f64,
     area: f64,
+    /// Composite roughness R_q at the cell's centre after the running-in of the analysis'
+    /// flank (MODEL §6.1, [`Ltca::roughness`]), m; None: the lubricant's.
+    roughness: Option<f64>,
     /// Index of the cell's slice in [`MeshContacts::lines`].
     line: usize,
     /// The loaded flank's grid cells under the strip the local cell stands for over the
@@ -133,6 +136,7 @@ impl MeshContacts {
         let film = FilmGeometry::new(tca, wf);
         let grid = FlankGrid::of(wf);
         let strips = flank::swept_strips(tca, ltca, 2.0 * std::f64::consts::PI / geo.teeth as f64);
+        let roughness = ltca.roughness.as_ref();
         // Positions are independent: on the pool, then joined in their order (on many cores
         // this part would otherwise wait for one thread, issue 55).
         let per_position: Vec<PositionContacts> = ltca
@@ -154,6 +158,7 @@ impl MeshContacts {
                         pressure: pr.pressure[k],
                         sliding_speed: sliding[k].speed,
                         area: c.cell.area(),
+                        roughness: roughness.map(|f| f.at(wf, c.r, c.z)),
                         line: of_cell[k],
                     });
                 }
@@ -189,7 +194,8 @@ impl MeshContacts {
     }
 
     /// The friction of every loaded cell with `lubricant` (its viscosity and temperature as
-    /// given) and `law`, and the mesh loss over the cycle (MODEL §13).
+    /// given; its composite roughness where the analysis' flank has not run in, MODEL §6.1)
+    /// and `law`, and the mesh loss over the cycle (MODEL §13).
     pub fn friction(&self, lubricant: &Lubricant, law: &FrictionLaw) -> MeshFriction {
         let mut position_loss = vec![0.0; self.positions];
         let (mut weighted, mut share, mut load) = (0.0, 0.0, 0.0);
@@ -242,7 +248,8 @@ impl MeshContacts {
         };
         let films = inputs.films(&self.lines);
         for c in &self.cells {
-            let f = inputs.at(c.pressure, c.sliding_speed, films[c.line]);
+            let roughness = c.roughness.unwrap_or(lubricant.composite_roughness);
+            let f = inputs.at(c.pressure, c.sliding_speed, films[c.line], roughness);
             let density = f.coefficient * c.pressure * c.sliding_speed;
             visit(c, f, density);
         }
@@ -598,6 +605,7 @@ mod tests {
                 pressure: 5e8,
                 sliding_speed: 4.0,
                 area: 1e-6,
+                roughness: None,
                 line: 0,
                 flank_cells: (0, 1),
             }],

@@ -226,8 +226,20 @@ pub struct Lubricant {
     pub thermal_conductivity: f64,
     /// Oil temperature, K.
     pub temperature: f64,
-    /// Composite RMS roughness, m.
+    /// Composite RMS roughness, m: the flank's as cut (R_q,0 of MODEL §6.1).
     pub composite_roughness: f64,
+    /// The running-in of the roughness with the wear (MODEL §6.1); None: the roughness stays
+    /// `composite_roughness` (the published model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub running_in: Option<RunningIn>,
+}
+
+/// The running-in of the composite roughness (MODEL §6.1, [`Lubricant::roughness_after`]):
+/// R_q,r the run-in roughness (m, at most the initial), h_r the running-in depth (m).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct RunningIn {
+    pub roughness: f64,
+    pub depth: f64,
 }
 
 impl Lubricant {
@@ -240,6 +252,19 @@ impl Lubricant {
             viscosity: self.viscosity * shift.exp(),
             temperature,
             ..self.clone()
+        }
+    }
+
+    /// The composite roughness R_q (m) of a flank point worn `worn_depth` deep (m, normal to
+    /// the flank; MODEL §6.1): `composite_roughness` without running-in, else
+    /// R_q,r + (R_q,0 - R_q,r) exp(-h / h_r) (exactly R_q,0 at h = 0 and where R_q,r = R_q,0).
+    pub fn roughness_after(&self, worn_depth: f64) -> f64 {
+        match self.running_in {
+            Some(r) if worn_depth > 0.0 => {
+                let decay = (-worn_depth / r.depth).exp();
+                r.roughness + (self.composite_roughness - r.roughness) * decay
+            }
+            _ => self.composite_roughness,
         }
     }
 }

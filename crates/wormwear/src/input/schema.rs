@@ -437,6 +437,14 @@ pub struct LubricantSpec {
     /// Composite RMS roughness R_q of worm and wheel, um.
     #[serde(default)]
     pub composite_roughness_um: Option<f64>,
+    /// Run-in composite roughness R_q,r, um (MODEL §6.1; at most `composite_roughness_um`):
+    /// with `running_in_depth_um`, the roughness falls toward it as the flank wears. None: no
+    /// running-in (the published model).
+    #[serde(default)]
+    pub run_in_roughness_um: Option<f64>,
+    /// Running-in depth h_r, um (MODEL §6.1): the worn depth over which the roughness runs in.
+    #[serde(default)]
+    pub running_in_depth_um: Option<f64>,
     /// "fixed" (default: the oil at `temperature_c`) or "balance": the steady sump temperature
     /// of the housing's heat balance (MODEL §13, `[housing]`); `viscosity_pa_s` then holds at
     /// `temperature_c` and follows the thermo-viscosity law.

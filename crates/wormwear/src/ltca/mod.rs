@@ -268,6 +268,10 @@ pub struct Ltca {
     pub power_balance: f64,
     /// What makes these results doubtful, with the reason.
     pub warnings: Vec<String>,
+    /// The composite roughness R_q on the loaded flank's nodes after its running-in
+    /// (MODEL §6.1), m; None: the lubricant's `composite_roughness` everywhere.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<FlankField>,
 }
 
 /// Largest departure from the power balance (T2 omega2 + P_Vz = T1 omega1, MODEL §5.2) of a
@@ -600,7 +604,8 @@ pub fn analyse_changed(
     let changed = FlankShape::new(wf, change);
     let worn = changed.as_ref().map(|c| c.worn(change.plastic_set));
     let oil = gear.lubricant.at_temperature(settings.oil_temperature);
-    let friction = position_friction((gear, geo, tca), settings, &oil);
+    let roughness = crate::lubrication::running_in_roughness(&gear.lubricant, change.removal);
+    let friction = position_friction((gear, geo, tca), settings, &oil, roughness.as_ref());
 
     let positions: Vec<PositionResult> = (0..tca.positions.len())
         .into_par_iter()
@@ -629,13 +634,16 @@ pub fn analyse_changed(
         })
         .collect::<Result<_, _>>()?;
     let ratio = geo.teeth as f64 / gear.worm.starts as f64;
-    Ok(over_the_cycle(
-        positions,
-        (wf, tca, geo.teeth, ratio),
-        settings,
-        bending,
-        rows_per_row,
-    ))
+    Ok(Ltca {
+        roughness,
+        ..over_the_cycle(
+            positions,
+            (wf, tca, geo.teeth, ratio),
+            settings,
+            bending,
+            rows_per_row,
+        )
+    })
 }
 
 /// The worm torque to balance (None: the wheel torque is given) and the wheel torque's
@@ -656,18 +664,22 @@ fn torque_targets(gear: &GearSet, settings: &LtcaSettings) -> (Option<f64>, f64)
 
 /// What the positions' friction needs (MODEL §5.2, §13) when the pressures carry the
 /// transmitted torque; None for the frictionless reading. `oil`: the lubricant at the
-/// analysis' oil temperature.
+/// analysis' oil temperature; `roughness`: the run-in roughness on the loaded flank's nodes
+/// (MODEL §6.1; None: the lubricant's).
 fn position_friction<'a>(
     (gear, geo, tca): (&'a GearSet, &'a Geometry, &Tca),
     settings: &LtcaSettings,
     oil: &'a crate::input::Lubricant,
+    roughness: Option<&'a FlankField>,
 ) -> Option<PositionFriction<'a>> {
     let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
+    let wf = geo.wheel_flank(tca.loaded_flank);
     transmitted.then(|| PositionFriction {
         gear,
         geo,
-        film: FilmGeometry::new(tca, geo.wheel_flank(tca.loaded_flank)),
+        film: FilmGeometry::new(tca, wf),
         inputs: FrictionInputs::of(gear, oil),
+        roughness: crate::lubrication::FlankRoughness::of(oil, roughness, wf),
         estimate: crate::rating::base_friction(tca.pitch_sliding_speed),
     })
 }
@@ -744,5 +756,6 @@ fn over_the_cycle(
         mesh_efficiency: wheel_torque / (ratio * worm_torque),
         power_balance,
         warnings,
+        roughness: None,
     }
 }

@@ -13,7 +13,7 @@
 use super::*;
 use crate::input::{FrictionLaw, Lubricant};
 use crate::kinematics::material_velocities;
-use crate::lubrication::LineContact;
+use crate::lubrication::{FlankRoughness, LineContact};
 use crate::traction::{central_film_thickness, local_friction, LocalFriction, PointContact};
 use std::collections::HashMap;
 
@@ -203,31 +203,40 @@ impl<'a> FrictionInputs<'a> {
     }
 
     /// The local friction at pressure `pressure` (Pa), sliding speed `sliding_speed` (m/s)
-    /// over a central film `film` (m), at the lubricant's composite roughness.
-    pub fn at(&self, pressure: f64, sliding_speed: f64, film: f64) -> LocalFriction {
+    /// over a central film `film` (m), where the composite roughness is `roughness` (R_q, m;
+    /// MODEL §6.1).
+    pub fn at(
+        &self,
+        pressure: f64,
+        sliding_speed: f64,
+        film: f64,
+        roughness: f64,
+    ) -> LocalFriction {
         let at = PointContact {
             pressure,
             sliding_speed,
             film_thickness: film,
-            roughness: self.lubricant.composite_roughness,
+            roughness,
         };
         let moduli = (self.e_prime, self.flow_pressure);
         local_friction(&at, self.lubricant, self.law, moduli)
     }
 
-    /// The local friction of every cell with pressure `pressure` (Pa), sliding `sliding` and
-    /// the film of its slice `films[of_cell[k]]` (central thickness, m).
+    /// The local friction of every cell `cells` with pressure `pressure` (Pa), sliding
+    /// `sliding`, the film of its slice `films[of_cell[k]]` (central thickness, m) and the
+    /// roughness `roughness` at its centre.
     pub fn cells(
         &self,
-        pressure: &[f64],
-        sliding: &[CellSliding],
+        (cells, pressure, sliding): (&[LocalCell], &[f64], &[CellSliding]),
         (films, of_cell): (&[f64], &[usize]),
+        roughness: &FlankRoughness,
     ) -> Vec<LocalFriction> {
-        pressure
+        cells
             .iter()
+            .zip(pressure)
             .zip(sliding)
             .zip(of_cell)
-            .map(|((&p, s), &line)| self.at(p, s.speed, films[line]))
+            .map(|(((c, &p), s), &line)| self.at(p, s.speed, films[line], roughness.at(c.r, c.z)))
             .collect()
     }
 
@@ -246,6 +255,8 @@ pub struct PositionFriction<'a> {
     pub geo: &'a Geometry,
     pub film: FilmGeometry,
     pub inputs: FrictionInputs<'a>,
+    /// The composite roughness over the loaded flank (MODEL §6.1).
+    pub roughness: FlankRoughness<'a>,
     /// A uniform friction coefficient to start the torque balance from (ISO/TR 14521's mu_0T
     /// at the pitch point's sliding speed): only the start, not the result.
     pub estimate: f64,
@@ -263,7 +274,11 @@ impl PositionFriction<'_> {
         let (lines, of_cell) = self.film.slice_lines(position, cells, pressure);
         let films = self.inputs.films(&lines);
         self.inputs
-            .cells(pressure, sliding, (&films, &of_cell))
+            .cells(
+                (cells, pressure, sliding),
+                (&films, &of_cell),
+                &self.roughness,
+            )
             .iter()
             .map(|f| f.coefficient)
             .collect()

@@ -680,22 +680,24 @@ fn references(b: &mut Builder, gear: &GearSet, stage: u64, casing: u64, worm: u6
         );
     }
     let l = &gear.lubricant;
-    let lub = b.component(
-        "lubricant",
-        &l.name,
-        vec![
-            text("name", &l.name),
-            custom("viscosity", "none", l.viscosity),
-            custom(
-                "pressure_viscosity_per_gpa",
-                "none",
-                l.pressure_viscosity * 1e9,
-            ),
-            custom("thermo_viscosity", "K", l.thermo_viscosity),
-            custom("thermal_conductivity", "W / (m K)", l.thermal_conductivity),
-            custom("composite_roughness", "mum", l.composite_roughness * 1e6),
-        ],
-    );
+    let mut attributes = vec![
+        text("name", &l.name),
+        custom("viscosity", "none", l.viscosity),
+        custom(
+            "pressure_viscosity_per_gpa",
+            "none",
+            l.pressure_viscosity * 1e9,
+        ),
+        custom("thermo_viscosity", "K", l.thermo_viscosity),
+        custom("thermal_conductivity", "W / (m K)", l.thermal_conductivity),
+        custom("composite_roughness", "mum", l.composite_roughness * 1e6),
+    ];
+    // The running-in of the roughness (MODEL §6.1), where the gear has one.
+    if let Some(r) = l.running_in {
+        attributes.push(custom("run_in_roughness", "mum", r.roughness * 1e6));
+        attributes.push(custom("running_in_depth", "mum", r.depth * 1e6));
+    }
+    let lub = b.component("lubricant", &l.name, attributes);
     for origin in [stage, casing] {
         b.relation(
             "reference",

@@ -135,6 +135,7 @@ pub fn martin_film() -> (f64, f64) {
         thermal_conductivity: 0.148,
         temperature: 333.0,
         composite_roughness: 1e-6,
+        running_in: None,
     };
     let c = crate::lubrication::LineContact {
         radius: 0.02,

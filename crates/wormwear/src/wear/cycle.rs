@@ -50,6 +50,8 @@ struct PassageWear<'a> {
     k_dry: f64,
     hardness: f64,
     film_load: FilmLoad,
+    /// The composite roughness on the flank's nodes (MODEL §6.1).
+    roughness: lubrication::FlankRoughness<'a>,
 }
 
 impl PassageWear<'_> {
@@ -117,7 +119,8 @@ impl PassageWear<'_> {
             line_load: film_line_load,
             pressure: peak,
         };
-        let fl = lubrication::film(&self.gear.lubricant, self.e_prime, &contact);
+        let rq = self.roughness.node(k);
+        let fl = lubrication::film_over(&self.gear.lubricant, self.e_prime, &contact, rq);
         let kw = lubrication::wear_coefficient(self.k_dry, fl.lambda);
         o[0] += kw / self.hardness * nc.sliding_speed * integral;
         if o[1].is_nan() || fl.lambda < o[1] {
@@ -141,7 +144,8 @@ impl PassageWear<'_> {
 /// whatever the number of positions (no aliasing), and the band follows the worn geometry
 /// (the profiles are the loaded analysis on it). Depth = (k(lambda)/H) |vg| integral(p dt),
 /// |vg| of the node at its contact moment, lambda from the interpolated line load (floored at
-/// the Hertz load of the peak pressure with [`FilmLoad::HertzPeakFloor`]).
+/// the Hertz load of the peak pressure with [`FilmLoad::HertzPeakFloor`]) over the roughness the
+/// loaded analysis ran in (MODEL §6.1, [`Ltca::roughness`]).
 pub fn per_cycle(
     gear: &GearSet,
     geo: &Geometry,
@@ -187,6 +191,7 @@ pub fn per_cycle(
         k_dry,
         hardness,
         film_load,
+        roughness: lubrication::FlankRoughness::of(&gear.lubricant, ltca.roughness.as_ref(), wf),
     };
     // Node columns are independent (each writes its own nodes): in parallel, then gathered.
     let per_column: Vec<Vec<[f64; 6]>> = columns

@@ -12,6 +12,7 @@ use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::kinematics::Tca;
 use crate::ltca::{stats, Ltca};
+use crate::lubrication::FlankRoughness;
 use std::borrow::Cow;
 
 /// What the life loop hands out after each completed state: the state (to checkpoint), the
@@ -702,6 +703,7 @@ impl<'a> LifeLoop<'a> {
         let worst_node = argmax(&state.removal.values).map(|k| &wf.nodes[k]);
         let worst_cell = argmax(&l.pattern).map(|k| &wf.cells[k]);
         let patch = (self.settings.patch_across, self.settings.patch_along);
+        let roughness = self.roughness_over_active(l);
         StepRecord {
             step: state.step,
             cycles: state.cycles,
@@ -739,11 +741,7 @@ impl<'a> LifeLoop<'a> {
             rigid_lag_rad: lag.iter().sum::<f64>() / lag.len().max(1) as f64,
             te_mean_relative_rad: te_rel_mean,
             te_p2p_relative_rad: te_rel_p2p,
-            n_li_model_cycles: crate::rating::rank_first_pitting_cycles(
-                self.sliding_speed,
-                l.mean_pressure * 1e-6,
-                self.pitting_limit * 1e-6,
-            ),
+            n_li_model_cycles: self.model_first_pitting(l),
             loaded_analyses: state.loaded_analyses_before() + substeps.max(1) * self.bins.len(),
             thinnest_tooth_m: self.limits.thinnest(&state.removal).0,
             worn_through_loaded: self
@@ -756,10 +754,28 @@ impl<'a> LifeLoop<'a> {
             max_plastic_indentation_m: l.plastic_indentation.max(),
             yielded_area_fraction: l.yielded_area_fraction,
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            roughness_mean_m: roughness.0,
+            roughness_min_m: roughness.1,
             friction: super::StateFriction::of(thermal),
             positions,
             bins: Vec::new(),
         }
+    }
+
+    /// Rank's cycles to first pitting with the loaded pattern's mean pressure (MODEL §12 k).
+    fn model_first_pitting(&self, l: &Ltca) -> Option<f64> {
+        crate::rating::rank_first_pitting_cycles(
+            self.sliding_speed,
+            l.mean_pressure * 1e-6,
+            self.pitting_limit * 1e-6,
+        )
+    }
+
+    /// The composite roughness over the active flank of analysis `l` (MODEL §6.1): mean and
+    /// smallest, m.
+    fn roughness_over_active(&self, l: &Ltca) -> (f64, f64) {
+        let lubricant = &self.bins[0].gear.lubricant;
+        FlankRoughness::of(lubricant, l.roughness.as_ref(), self.wf).over_active(self.wf)
     }
 
     /// A state in pitting phase k (ending at `end`): at its start the pits are cut (same

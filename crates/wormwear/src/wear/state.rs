@@ -247,6 +247,13 @@ pub struct StepRecord {
     /// records of earlier versions).
     #[serde(default)]
     pub equivalent_pressure_max_pa: f64,
+    /// Composite roughness R_q over the active flank once this state's wear has run it in
+    /// (MODEL §6.1): area-weighted mean and smallest, m (the lubricant's without running-in;
+    /// 0 in records of earlier versions).
+    #[serde(default)]
+    pub roughness_mean_m: f64,
+    #[serde(default)]
+    pub roughness_min_m: f64,
     /// Friction of this state's contact (MODEL §13; zeros in records of earlier versions).
     #[serde(flatten, default)]
     pub friction: StateFriction,

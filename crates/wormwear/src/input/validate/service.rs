@@ -149,6 +149,7 @@ pub(super) fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant
         100.0,
         "um",
     );
+    let running_in = running_in(ck, l, rq);
     Some(Lubricant {
         name: l
             .name
@@ -160,7 +161,48 @@ pub(super) fn lubricant(ck: &mut Checker, l: &LubricantSpec) -> Option<Lubricant
         thermal_conductivity: kf?,
         temperature: t? + 273.15,
         composite_roughness: rq? * 1e-6,
+        running_in: running_in?,
     })
+}
+
+/// The running-in of the roughness (MODEL §6.1) from `lubricant.run_in_roughness_um` and
+/// `lubricant.running_in_depth_um` (both or neither; no default: no measurement of a worm
+/// gear's running-in gives a citable pair), the run-in value at most the initial `rq` (um).
+/// Some(None): no running-in; None: refused.
+fn running_in(ck: &mut Checker, l: &LubricantSpec, rq: Option<f64>) -> Option<Option<RunningIn>> {
+    let (roughness, depth) = match (l.run_in_roughness_um, l.running_in_depth_um) {
+        (None, None) => return Some(None),
+        (Some(r), None) => {
+            let problem = "needs lubricant.running_in_depth_um (the worn depth over which the \
+                           roughness runs in, um; MODEL §6.1)";
+            ck.fail("lubricant.run_in_roughness_um", r, problem);
+            return None;
+        }
+        (None, Some(h)) => {
+            let problem = "needs lubricant.run_in_roughness_um (the run-in composite \
+                           roughness, um; MODEL §6.1)";
+            ck.fail("lubricant.running_in_depth_um", h, problem);
+            return None;
+        }
+        (Some(r), Some(h)) => (r, h),
+    };
+    let depth = ck.positive("lubricant.running_in_depth_um", depth, 10_000.0, "um");
+    let initial = rq?;
+    let roughness = match ck.positive("lubricant.run_in_roughness_um", roughness, 100.0, "um")? {
+        r if r > initial => {
+            let problem = format!(
+                "above the initial composite roughness (lubricant.composite_roughness_um = \
+                 {initial} um): running-in only smooths a flank"
+            );
+            ck.fail("lubricant.run_in_roughness_um", r, problem);
+            None
+        }
+        r => Some(r),
+    };
+    Some(Some(RunningIn {
+        roughness: roughness? * 1e-6,
+        depth: depth? * 1e-6,
+    }))
 }
 
 /// The friction law of the mixed lubrication (MODEL §13) from `[lubricant]`, with its

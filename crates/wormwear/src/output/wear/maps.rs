@@ -1,5 +1,6 @@
 //! The maps of a map state (`[wear] map_cycles`): cumulative wear, wear per cycle, film thickness
-//! and ratio, the loaded pattern, the damage, the friction, and `wheel_flank_wear.vtp` with them.
+//! and ratio, the loaded pattern, the damage, the friction, the run-in roughness, and
+//! `wheel_flank_wear.vtp` with them.
 
 use super::*;
 
@@ -12,6 +13,15 @@ pub(super) struct StateMaps<'a> {
 }
 
 impl StateMaps<'_> {
+    /// The state's record (its last).
+    fn record(&self) -> &crate::wear::StepRecord {
+        self.view
+            .state
+            .records
+            .last()
+            .expect("a state has a record")
+    }
+
     /// Map of a node field of the loaded flank (cell means, times `scale`), coloured over
     /// [0, top] or [0, its maximum], with the active flank and the worm tip's trace.
     pub(super) fn node_map(
@@ -84,19 +94,40 @@ impl StateMaps<'_> {
         }
         files.extend(self.plastic_and_pattern(suffix)?);
         files.extend(self.friction_maps(suffix)?);
+        files.extend(self.roughness_map(suffix)?);
         Ok(files)
+    }
+
+    /// The composite roughness R_q of the worn flank after its running-in (MODEL §6.1):
+    /// `wear_roughness_map` with `suffix` (None without running-in: the lubricant's, uniform).
+    fn roughness_map(&self, suffix: &str) -> Result<Option<PathBuf>, OutputError> {
+        let Some(field) = &self.view.ltca.roughness else {
+            return Ok(None);
+        };
+        let r = self.record();
+        let path = self.dir.join(format!("wear_roughness_map{suffix}.svg"));
+        self.node_map(
+            &path,
+            &format!(
+                "Composite roughness R_q at {} cycles (running-in; mean {:.3} um, least {:.3} um; \
+                 map: cell means)",
+                crate::output::cycles_label(r.cycles),
+                r.roughness_mean_m * UM,
+                r.roughness_min_m * UM
+            ),
+            field,
+            UM,
+            "R_q (um)",
+            None,
+        )?;
+        Ok(Some(path))
     }
 
     /// The friction of this state's loaded analysis (MODEL §13): `wear_friction_coefficient_map`
     /// and `wear_friction_power_map` with `suffix`.
     fn friction_maps(&self, suffix: &str) -> Result<Vec<PathBuf>, OutputError> {
         let wf = self.geo.wheel_flank(self.tca.loaded_flank);
-        let r = self
-            .view
-            .state
-            .records
-            .last()
-            .expect("a state has a record");
+        let r = self.record();
         let overlays = [
             flank_outline(wf, "active flank", 5),
             tip_trace_series(self.tca),

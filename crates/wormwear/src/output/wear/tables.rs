@@ -212,7 +212,7 @@ pub fn te_orders_table(records: &[crate::wear::StepRecord]) -> Csv {
 /// The columns of `wear_steps.csv` (units in the names) and how each reads a record.
 type StepColumn = (&'static str, fn(&crate::wear::StepRecord) -> f64);
 
-const STEP_COLUMNS: [StepColumn; 41] = [
+const STEP_COLUMNS: [StepColumn; 43] = [
     ("step", |r| r.step as f64),
     ("cycles", |r| r.cycles),
     ("step_cycles", |r| r.step_cycles),
@@ -266,6 +266,8 @@ const STEP_COLUMNS: [StepColumn; 41] = [
         r.friction.oil_temperature_k - 273.15
     }),
     ("viscosity_pa_s", |r| r.friction.viscosity_pa_s),
+    ("roughness_mean_m", |r| r.roughness_mean_m),
+    ("roughness_min_m", |r| r.roughness_min_m),
 ];
 
 /// The table of states (`wear_steps.csv`): one row per record ([`STEP_COLUMNS`]).

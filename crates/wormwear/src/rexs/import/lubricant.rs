@@ -307,6 +307,8 @@ pub(super) fn lubricant_as_written(
             "composite_roughness_um",
             Quantity::Ratio,
         ),
+        ("run_in_roughness", "run_in_roughness_um", Quantity::Ratio),
+        ("running_in_depth", "running_in_depth_um", Quantity::Ratio),
     ] {
         if let Some(v) = custom_any_unit(reader, l, name, q)? {
             out.field(key, v, &format!("{CUSTOM_PREFIX}{name}"));
