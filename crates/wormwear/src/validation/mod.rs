@@ -482,6 +482,17 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
             plan.clone(),
         ));
     }
+    // Running-in of the roughness (MODEL §6.1) as examples/gear-1x40-running-in.toml has it.
+    out.push((
+        "c-running-in".to_string(),
+        variant(c, |g| {
+            g.lubricant.running_in = Some(input::RunningIn {
+                roughness: 0.5 * g.lubricant.composite_roughness,
+                depth: 2.0 * g.lubricant.composite_roughness,
+            })
+        }),
+        plan.clone(),
+    ));
     for (id, factor) in [("c-k-half", 0.5), ("c-k-double", 2.0)] {
         out.push((
             id.to_string(),

@@ -233,6 +233,7 @@ fn sensitivity_ranking(m: &mut String, results: &Results) {
         let mut moves: Vec<(String, f64)> = [
             ("roughness 0.2 um", "c-roughness-0.2"),
             ("roughness 0.5 um", "c-roughness-0.5"),
+            ("running-in 1 -> 0.5 um", "c-running-in"),
             ("K x 0.5", "c-k-half"),
             ("K x 2", "c-k-double"),
             ("no bending", "c-no-bending"),
@@ -714,10 +715,14 @@ fn speed_table(m: &mut String, results: &Results) {
 }
 
 /// Rows of section (c): (variant, job id).
-const SENSITIVITY_ROWS: [(&str, &str); 7] = [
+const SENSITIVITY_ROWS: [(&str, &str); 8] = [
     ("default (case C)", "case-c"),
     ("composite roughness 0.2 um", "c-roughness-0.2"),
     ("composite roughness 0.5 um", "c-roughness-0.5"),
+    (
+        "running-in of the roughness, 1 -> 0.5 um over 2 um of wear (MODEL §6.1)",
+        "c-running-in",
+    ),
     ("K x 0.5", "c-k-half"),
     ("K x 2", "c-k-double"),
     ("no bending", "c-no-bending"),
