@@ -28,6 +28,8 @@ pub enum FaceKind {
     FlankRight,
     /// Tip land (worm outside cylinder, wheel blank top).
     Tip,
+    /// Edge break between a flank and the tip land (the worm's rounded tip edge, MODEL §2.3).
+    Edge,
     /// Root: fillet and root land (wheel), root cylinder between threads (worm).
     Root,
     /// Side of a wheel sector (a tooth count below the wheel's).

@@ -4,7 +4,8 @@
 //! Every worm flank is a helicoid (MODEL §2.1): the transverse section at axial position x is the
 //! section at x = 0 turned by x / (hand p_z / 2 pi). The section at x = 0 is, per thread, the two
 //! flanks from the root radius to the tip radius (polar angle -X_ax(rho) / (hand p_z / 2 pi)),
-//! the tip arc between them and the root arc to the next thread. Stations are spaced at most
+//! the tip arc between them and the root arc to the next thread; a broken tip edge (MODEL §2.3)
+//! joins a flank to the tip arc as its own face. Stations are spaced at most
 //! 1/48 turn apart, which keeps the interpolated helices within 1e-4 um of the true ones.
 
 use super::bspline::{mean_chord_params, uniform_params};
@@ -39,7 +40,8 @@ pub fn worm_part(gear: &GearSet, geo: &Geometry) -> Result<CadPart, CadError> {
         [Flank::Right, Flank::Left]
     };
     let starts = worm.starts() as usize;
-    let pieces = section_pieces((rf, ra), starts, sides, &angle)?;
+    let tops = sides.map(|flank| FlankTop::of(gear, geo, flank, screw));
+    let pieces = section_pieces((rf, ra), starts, (sides, &tops), &angle)?;
     let turns = length / (2.0 * PI * screw.abs());
     let stations = ((turns * STATIONS_PER_TURN).ceil() as usize).max(8) + 1;
     let xs: Vec<f64> = uniform_params(stations)
@@ -70,7 +72,7 @@ pub fn worm_part(gear: &GearSet, geo: &Geometry) -> Result<CadPart, CadError> {
     })?;
     let checks = checks.into_iter().map(|c| built.map_check(c)).collect();
     let pitch_angle = 2.0 * PI / starts as f64;
-    let section = section_area(rf, ra, starts, pitch_angle, angle, sides);
+    let section = section_area(rf, ra, starts, pitch_angle, angle, (sides, &tops));
     Ok(CadPart {
         built,
         checks,
@@ -79,16 +81,17 @@ pub fn worm_part(gear: &GearSet, geo: &Geometry) -> Result<CadPart, CadError> {
 }
 
 /// The pieces of the section at x = 0, counter-clockwise: per thread, flank A up from the root
-/// radius, the tip arc, flank B down, the root arc to the next thread (`angle`: the flanks'
-/// polar angle at a radius, rad).
+/// radius, its broken tip edge where it has one, the tip arc, flank B's edge and flank B down,
+/// the root arc to the next thread (`angle`: the flanks' polar angle at a radius, rad; `tops`:
+/// where each flank meets the tip land).
 fn section_pieces(
     (rf, ra): (f64, f64),
     starts: usize,
-    [a, b]: [Flank; 2],
+    ([a, b], [top_a, top_b]): ([Flank; 2], &[FlankTop; 2]),
     angle: &impl Fn(Flank, f64) -> f64,
 ) -> Result<Vec<(FaceKind, usize, Vec<Polar>)>, CadError> {
     let pitch_angle = 2.0 * PI / starts as f64;
-    let tip_width = angle(b, ra) - angle(a, ra);
+    let tip_width = top_b.tip_angle - top_a.tip_angle;
     let root_width = angle(a, rf) + pitch_angle - angle(b, rf);
     if tip_width <= 0.0 || root_width <= 0.0 {
         return Err(CadError::Build(format!(
@@ -108,17 +111,159 @@ fn section_pieces(
             .map(|i| (r, t0 + (t1 - t0) * i as f64 / (n - 1) as f64))
             .collect()
     };
+    let turned = |points: Vec<Polar>, turn: f64| -> Vec<Polar> {
+        points.into_iter().map(|(r, t)| (r, t + turn)).collect()
+    };
     let mut pieces = Vec::new();
     for thread in 0..starts {
         let turn = thread as f64 * pitch_angle;
-        let tip = arc(ra, angle(a, ra) + turn, angle(b, ra) + turn);
+        let tip = arc(ra, top_a.tip_angle + turn, top_b.tip_angle + turn);
         let next = angle(a, rf) + turn + pitch_angle;
-        pieces.push((kind(a), thread, flank(a, rf, ra, turn)));
+        pieces.push((kind(a), thread, flank(a, rf, top_a.tangent_radius, turn)));
+        if let Some(edge) = top_a.edge_points() {
+            pieces.push((FaceKind::Edge, 2 * thread, turned(edge, turn)));
+        }
         pieces.push((FaceKind::Tip, thread, tip));
-        pieces.push((kind(b), thread, flank(b, ra, rf, turn)));
+        if let Some(mut edge) = top_b.edge_points() {
+            edge.reverse();
+            pieces.push((FaceKind::Edge, 2 * thread + 1, turned(edge, turn)));
+        }
+        pieces.push((kind(b), thread, flank(b, top_b.tangent_radius, rf, turn)));
         pieces.push((FaceKind::Root, thread, arc(rf, angle(b, rf) + turn, next)));
     }
     Ok(pieces)
+}
+
+/// Points along a broken tip edge of the section.
+const EDGE_POINTS: usize = 17;
+
+/// Where a worm flank meets the tip land in the section at x = 0 (MODEL §2.3): at the tip
+/// radius (a sharp edge), or through its broken tip edge, the circle of radius R tangent to the
+/// tip line rho = r_a and to the flank's tangent line at the tip in the axial section, as the
+/// analyses' gap has it ([`crate::kinematics::TipEdge`]).
+#[derive(Debug, Clone, Copy)]
+struct FlankTop {
+    /// Radius where the flank ends (the edge's tangent point; r_a when sharp), m.
+    tangent_radius: f64,
+    /// Polar angle where the tip land starts, rad.
+    tip_angle: f64,
+    edge: Option<EdgeArc>,
+}
+
+/// A broken tip edge in the axial section (x along the worm axis, rho from it), m.
+#[derive(Debug, Clone, Copy)]
+struct EdgeArc {
+    radius: f64,
+    /// The circle's centre (x, rho), m.
+    centre: (f64, f64),
+    /// Direction angles from the centre of the tangent point on the flank and of the tip point
+    /// (the arc runs between them the short way), rad.
+    from: f64,
+    sweep: f64,
+    /// The true flank's x less its tangent line's at the tangent point, m (0 for a straight
+    /// axial profile): faded out along the arc so that it starts on the flank's own point.
+    offset: f64,
+    /// hand p_z / 2 pi: x = -screw x polar angle on a helicoid, m/rad.
+    screw: f64,
+}
+
+impl EdgeArc {
+    /// (x, rho) at t in [0, 1] from the tangent point to the tip point, m.
+    fn at(&self, t: f64) -> (f64, f64) {
+        let a = self.from + self.sweep * t;
+        let (cx, cr) = self.centre;
+        (
+            cx + self.radius * a.cos() + self.offset * (1.0 - t),
+            cr + self.radius * a.sin(),
+        )
+    }
+
+    /// d(x, rho)/dt, m.
+    fn derivative(&self, t: f64) -> (f64, f64) {
+        let a = self.from + self.sweep * t;
+        let r = self.radius * self.sweep;
+        (-r * a.sin() - self.offset, r * a.cos())
+    }
+
+    /// The section's (rho, polar angle) at t.
+    fn polar(&self, t: f64) -> Polar {
+        let (x, rho) = self.at(t);
+        (rho, -x / self.screw)
+    }
+
+    /// 1/2 integral of rho^2 dphi from the tangent point to the tip (Green's theorem's share of
+    /// the section's area, m^2), by Simpson's rule on 2000 intervals of t, dphi = -dx / screw.
+    fn area_share(&self) -> f64 {
+        let n = 2000;
+        let f = |t: f64| {
+            let (_, rho) = self.at(t);
+            -0.5 * rho * rho * self.derivative(t).0 / self.screw
+        };
+        let h = 1.0 / n as f64;
+        (0..n)
+            .map(|i| {
+                let t0 = h * i as f64;
+                h / 6.0 * (f(t0) + 4.0 * f(t0 + 0.5 * h) + f(t0 + h))
+            })
+            .sum()
+    }
+}
+
+impl FlankTop {
+    /// The top of `flank` of the gear's worm with its `worm.tip_edge_radius`; `screw` =
+    /// hand p_z / 2 pi (m/rad).
+    fn of(gear: &GearSet, geo: &Geometry, flank: Flank, screw: f64) -> Self {
+        let worm = &geo.worm;
+        let (ra, radius) = (gear.worm.tip_radius, gear.worm.tip_edge_radius);
+        let (x_tip, slope) = worm.axial_profile(flank, ra);
+        if radius <= 0.0 {
+            return Self {
+                tangent_radius: ra,
+                tip_angle: -x_tip / screw,
+                edge: None,
+            };
+        }
+        // The material side along x (toward the thread's middle, x = 0) and the circle's
+        // centre: R below the tip line, R from the flank's tangent line on that side.
+        let side = if x_tip < 0.0 { 1.0 } else { -1.0 };
+        let norm = (1.0 + slope * slope).sqrt();
+        let centre = (
+            x_tip + slope * (-radius) + side * radius * norm,
+            ra - radius,
+        );
+        let from = (side * slope / norm).atan2(-side / norm);
+        let mut sweep = 0.5 * PI - from;
+        if sweep > PI {
+            sweep -= 2.0 * PI;
+        } else if sweep < -PI {
+            sweep += 2.0 * PI;
+        }
+        let tangent_radius = centre.1 + radius * from.sin();
+        let line_x = x_tip + slope * (tangent_radius - ra);
+        let edge = EdgeArc {
+            radius,
+            centre,
+            from,
+            sweep,
+            offset: worm.axial_profile(flank, tangent_radius).0 - line_x,
+            screw,
+        };
+        Self {
+            tangent_radius,
+            tip_angle: edge.polar(1.0).1,
+            edge: Some(edge),
+        }
+    }
+
+    /// The broken edge's section points from the flank up to the tip (None: sharp).
+    fn edge_points(&self) -> Option<Vec<Polar>> {
+        let e = self.edge?;
+        Some(
+            (0..EDGE_POINTS)
+                .map(|i| e.polar(i as f64 / (EDGE_POINTS - 1) as f64))
+                .collect(),
+        )
+    }
 }
 
 /// Area of the worm's transverse section (the same at every x: a screw motion keeps areas), m^2:
@@ -131,12 +276,13 @@ fn section_area(
     starts: usize,
     pitch_angle: f64,
     angle: impl Fn(Flank, f64) -> f64,
-    [a, b]: [Flank; 2],
+    ([a, b], [top_a, top_b]): ([Flank; 2], &[FlankTop; 2]),
 ) -> f64 {
     let n = 2000;
-    let h = (ra - rf) / n as f64;
-    // 1/2 integral of rho^2 dphi up the flank, phi(rho) differentiated by central differences.
-    let up = |flank: Flank| -> f64 {
+    // 1/2 integral of rho^2 dphi up the flank to its top, phi(rho) differentiated by central
+    // differences; then up its broken edge to the tip.
+    let up = |flank: Flank, top: &FlankTop| -> f64 {
+        let h = (top.tangent_radius - rf) / n as f64;
         let f = |r: f64| {
             let d = 1e-3 * h;
             0.5 * r * r * (angle(flank, r + d) - angle(flank, r - d)) / (2.0 * d)
@@ -146,11 +292,12 @@ fn section_area(
                 let (r0, r1) = (rf + h * i as f64, rf + h * (i + 1) as f64);
                 h / 6.0 * (f(r0) + 4.0 * f(0.5 * (r0 + r1)) + f(r1))
             })
-            .sum()
+            .sum::<f64>()
+            + top.edge.map_or(0.0, |e| e.area_share())
     };
-    let tip = 0.5 * ra * ra * (angle(b, ra) - angle(a, ra));
+    let tip = 0.5 * ra * ra * (top_b.tip_angle - top_a.tip_angle);
     let root = 0.5 * rf * rf * (angle(a, rf) + pitch_angle - angle(b, rf));
-    starts as f64 * (up(a) + tip - up(b) + root)
+    starts as f64 * (up(a, top_a) + tip - up(b, top_b) + root)
 }
 
 /// The face kind of a worm flank.

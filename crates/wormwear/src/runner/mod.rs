@@ -653,11 +653,11 @@ impl<'a> Pipeline<'a> {
             };
             (from, *flank, change)
         });
-        if self.gear.worm.tip_edge_radius > 0.0 || self.gear.wheel.face_edge_chamfer > 0.0 {
+        if self.gear.wheel.face_edge_chamfer > 0.0 {
             self.warnings.push(
-                "cad: the STEP solids are drawn with sharp edges: the worm's broken tip edge \
-                 (worm.tip_edge_radius_mm) and the wheel's face chamfers (wheel.\
-                 face_edge_chamfer_mm) are in the analyses, not yet in the solids"
+                "cad: the wheel's STEP solid is drawn with sharp face edges: its face chamfers \
+                 (wheel.face_edge_chamfer_mm) are in the analyses, not yet in the solid (the \
+                 worm's broken tip edge is drawn)"
                     .to_string(),
             );
         }
