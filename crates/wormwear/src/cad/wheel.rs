@@ -1,6 +1,6 @@
 //! The wheel's CAD solid (MODEL §3): the toothed rim over the face width, all teeth or a
-//! sector, new or with a flank change (wear, pits and plastic set) applied; worm frame at wheel
-//! rotation 0, mm.
+//! sector, new or with a flank change (wear, pits and plastic set) applied, with the face-end
+//! chamfers of its flanks (MODEL §2.3); worm frame at wheel rotation 0, mm.
 //!
 //! The wheel is swept through transverse sections at evenly spaced face positions z (every node
 //! column of the flank grid is a station). In each section the reference tooth space is what the
@@ -85,6 +85,52 @@ pub struct WheelRequest<'a> {
     pub change: Option<(Flank, &'a FlankField)>,
 }
 
+/// How the drawn flanks depart from the cut ones: the request's change of one flank and the
+/// gear's 45 deg face-end chamfers on both (MODEL §2.3: `width` along z from each face end,
+/// `half` the half face width, m), normal depths into the material.
+#[derive(Debug, Clone, Copy)]
+struct Departures<'a> {
+    change: Option<(Flank, &'a FlankField)>,
+    chamfer: Chamfer,
+}
+
+/// The wheel's face-end chamfers (MODEL §2.3), m.
+#[derive(Debug, Clone, Copy)]
+struct Chamfer {
+    half: f64,
+    width: f64,
+}
+
+impl Chamfer {
+    fn of(gear: &GearSet, geo: &Geometry) -> Self {
+        Self {
+            half: 0.5 * geo.blank.face_width,
+            width: gear.wheel.face_edge_chamfer,
+        }
+    }
+
+    /// Normal depth at face position z, m: as the analyses' gap has it
+    /// ([`crate::kinematics::GapEvaluator::relief`]).
+    fn depth(&self, z: f64) -> f64 {
+        if self.width > 0.0 {
+            (z.abs() - (self.half - self.width)).max(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Departures<'_> {
+    /// Normal depth of flank `side` at (r, z) of the flank `geo` holds, m.
+    fn depth(&self, geo: &Geometry, side: Flank, r: f64, z: f64) -> f64 {
+        let change = match self.change {
+            Some((flank, field)) if flank == side => field.at(geo.wheel_flank(side), r, z),
+            _ => 0.0,
+        };
+        change + self.chamfer.depth(z)
+    }
+}
+
 /// A section of the reference tooth space at face position z, wheel body frame, m.
 struct SpaceSection {
     /// Flank points from r_low to the blank top, sides [A, B] (A at the smaller angle).
@@ -134,10 +180,14 @@ fn sampled_part(
     resolution: Resolution,
 ) -> Result<CadPart, CadError> {
     let z2 = geo.teeth as usize;
-    let (zs, bounds) = stations(&geo.blank, resolution.station_step);
+    let drawn = Departures {
+        change: request.change,
+        chamfer: Chamfer::of(gear, geo),
+    };
+    let (zs, bounds) = stations(&geo.blank, resolution.station_step, drawn.chamfer.width);
     let sections: Vec<SpaceSection> = zs
         .par_iter()
-        .map(|&z| space_section(geo, hobbing, (sides, resolution.flank_points), z, request))
+        .map(|&z| space_section(geo, hobbing, (sides, resolution.flank_points), z, drawn))
         .collect::<Result<_, _>>()?;
     let bore = bore_radius(gear, &sections)?;
     let layout = Layout {
@@ -166,7 +216,7 @@ fn sampled_part(
         (sides, &zs, &bounds, resolution.flank_points),
         &outer,
         (first, layout.tau),
-        request,
+        drawn,
         &to_worm,
     )?;
     let axis = gear.operating.wheel_to_worm(&V3::z()) - gear.operating.wheel_to_worm(&V3::zeros());
@@ -237,18 +287,34 @@ fn place(pieces: Vec<Piece>, to_worm: &impl Fn(V3<f64>) -> Point3) -> Vec<SweptF
 
 /// The stations across the face width and the indices of the band bounds: the blank top
 /// (outer cylinder clipped by the throat torus) has a kink where the two meet, |z| =
-/// sqrt(r_g^2 - (a - r_e2)^2); the faces are split there, stations evenly spaced at most
-/// `step` apart in each band. m.
-fn stations(blank: &crate::geometry::BlankLimits, step: f64) -> (Vec<f64>, Vec<usize>) {
+/// sqrt(r_g^2 - (a - r_e2)^2), and the flanks one where the face-end chamfers of width
+/// `chamfer` start, |z| = b/2 - chamfer; the faces are split there (kinks closer than half a
+/// step to another are left to it), stations evenly spaced at most `step` apart in each band. m.
+fn stations(
+    blank: &crate::geometry::BlankLimits,
+    step: f64,
+    chamfer: f64,
+) -> (Vec<f64>, Vec<usize>) {
     let half = 0.5 * blank.face_width;
     let depth = blank.centre_distance - blank.outer_radius;
-    let mut edges = vec![-half];
+    let mut kinks = Vec::new();
     if depth > 0.0 && depth < blank.gorge_radius {
-        let kink = (blank.gorge_radius.powi(2) - depth * depth).sqrt();
-        if kink < half - 0.5 * step {
-            edges.extend([-kink, kink]);
+        kinks.push((blank.gorge_radius.powi(2) - depth * depth).sqrt());
+    }
+    if chamfer > 0.0 {
+        kinks.push(half - chamfer);
+    }
+    kinks.sort_by(f64::total_cmp);
+    let mut edges = vec![-half];
+    let mut inner: Vec<f64> = Vec::new();
+    for k in kinks {
+        let clear = inner.last().is_none_or(|&l| k - l >= 0.5 * step);
+        if k < half - 0.5 * step && k > 0.25 * step && clear {
+            inner.push(k);
         }
     }
+    edges.extend(inner.iter().rev().map(|k| -k));
+    edges.extend(inner.iter().copied());
     edges.push(half);
     let (mut zs, mut bounds) = (vec![-half], vec![0]);
     for w in edges.windows(2) {
@@ -278,7 +344,7 @@ fn space_section(
     hobbing: &Hobbing,
     (sides, points): ([Flank; 2], [usize; 2]),
     z: f64,
-    request: WheelRequest,
+    drawn: Departures,
 ) -> Result<SpaceSection, CadError> {
     let top = geo.blank.top(z);
     let mut flank: [Vec<V3<f64>>; 2] = Default::default();
@@ -290,7 +356,7 @@ fn space_section(
         flank[s] = (0..n)
             .map(|i| {
                 let r = low + (top - low) * i as f64 / (n - 1) as f64;
-                flank_point(geo, hobbing, (side, i == n - 1), r, z, request)
+                flank_point(geo, hobbing, (side, i == n - 1), r, z, drawn)
             })
             .collect::<Result<_, _>>()?;
         let r_root = root_radius(hobbing, side, z, low)?;
@@ -341,13 +407,10 @@ fn flank_point(
     (side, on_top): (Flank, bool),
     r: f64,
     z: f64,
-    request: WheelRequest,
+    drawn: Departures,
 ) -> Result<V3<f64>, CadError> {
     let p = generate_point(hobbing, side, r, z)?;
-    let depth = match request.change {
-        Some((flank, field)) if flank == side => field.at(geo.wheel_flank(side), r, z),
-        _ => 0.0,
-    };
+    let depth = drawn.depth(geo, side, r, z);
     let mut n = p.normal_vec();
     n.z = 0.0;
     let shift = n * (depth / n.norm_squared());
@@ -626,7 +689,7 @@ fn fit_checks(
     (sides, zs, bounds, all_points): ([Flank; 2], &[f64], &[usize], [usize; 2]),
     outer: &[SweptFace],
     (first, tau): (i64, f64),
-    request: WheelRequest,
+    drawn: Departures,
     to_worm: &(impl Fn(V3<f64>) -> Point3 + Sync),
 ) -> Result<Vec<FitCheck>, CadError> {
     let mut checks = Vec::new();
@@ -655,7 +718,7 @@ fn fit_checks(
                     (0..points - 1)
                         .map(|i| {
                             let r = low + (top - low) * (i as f64 + 0.5) / (points - 1) as f64;
-                            let p = flank_point(geo, hobbing, (side, false), r, z, request)?;
+                            let p = flank_point(geo, hobbing, (side, false), r, z, drawn)?;
                             let p = turned(p, turn);
                             let ui = if s == 0 { points - 2 - i } else { i };
                             Ok((to_worm(p), (0.5 * (u[ui] + u[ui + 1]), v)))

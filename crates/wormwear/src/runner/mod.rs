@@ -653,14 +653,6 @@ impl<'a> Pipeline<'a> {
             };
             (from, *flank, change)
         });
-        if self.gear.wheel.face_edge_chamfer > 0.0 {
-            self.warnings.push(
-                "cad: the wheel's STEP solid is drawn with sharp face edges: its face chamfers \
-                 (wheel.face_edge_chamfer_mm) are in the analyses, not yet in the solid (the \
-                 worm's broken tip edge is drawn)"
-                    .to_string(),
-            );
-        }
         crate::cad::solids(self.gear, geo, request, worn)
             .map(Some)
             .map_err(RunError::Cad)
