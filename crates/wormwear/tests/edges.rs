@@ -213,3 +213,38 @@ fn the_flow_pressure_warning_names_where_and_the_tip_edge_removes_the_tip_trace(
         "{rounded:?}"
     );
 }
+
+/// No reported pressure sits at the flow pressure unsaid (issue 54): wherever P_max is the flow
+/// pressure, a warning says so and where — the pattern's share, or, where no cell of the loaded
+/// pattern reaches it, the local contact cells that do (the design gear with a 1 mm tip edge
+/// at 60 N m: a peak narrower than the flank grid).
+#[test]
+fn every_p_max_at_the_flow_pressure_is_warned_with_its_place() {
+    for (radius, chamfer, torque) in [(1.0, 0.0, 60.0), (1.0, 1.0, 90.0), (0.0, 0.0, 60.0)] {
+        let mut g = design(radius, chamfer);
+        g.conditions.torque = input::Torque::Worm(torque);
+        let request = Request::new([Stage::Ltca]);
+        let r = wormwear::run(&g, Source::default(), request, &mut |_| Ok(())).unwrap();
+        let l = r.ltca.unwrap();
+        let flow = g.wheel_material.hardness;
+        let said: Vec<&String> = l
+            .warnings
+            .iter()
+            .filter(|w| w.contains("flow pressure") && w.contains("r = ") || w.contains("r "))
+            .filter(|w| w.contains("flow pressure"))
+            .collect();
+        eprintln!(
+            "R {radius} mm, chamfer {chamfer} mm, {torque} N m: P_max {:.0} MPa; {said:?}",
+            l.max_pressure * 1e-6
+        );
+        if l.max_pressure >= flow * (1.0 - 1e-9) {
+            assert!(
+                !said.is_empty(),
+                "P_max at the flow pressure unsaid: {:?}",
+                l.warnings
+            );
+        } else {
+            assert!(said.is_empty(), "{said:?}");
+        }
+    }
+}

@@ -728,6 +728,12 @@ fn over_the_cycle(
         settings.flow_pressure,
         &places,
     ));
+    warnings.extend(pattern::local_flow_pressure_warning(
+        &positions,
+        (stats.yielded_area_fraction, settings.flow_pressure),
+        wf,
+        &tca.tip_trace,
+    ));
     warnings.extend(deflection_warning(&positions, tca, teeth));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),

@@ -52,6 +52,80 @@ pub(super) fn flow_pressure_warning(
     })
 }
 
+/// A warning when local contact cells reach the flow pressure although no cell of the loaded
+/// pattern does (`yielded_area_fraction` 0): a peak narrower than the global grid resolves (e.g.
+/// at the wheel's sharp blank-top edge, or where an edge break meets the flank), which P_max
+/// reports. Says how many cells at how many positions, their largest area at one position,
+/// where they lie (the places of [`YieldedPlaces`], counted in cells) and their span.
+pub(super) fn local_flow_pressure_warning(
+    positions: &[PositionResult],
+    (yielded_area_fraction, flow_pressure): (f64, f64),
+    wf: &WheelFlank,
+    tip_trace: &[(f64, f64)],
+) -> Option<String> {
+    if yielded_area_fraction > 0.0 {
+        return None;
+    }
+    let bound = flow_pressure * (1.0 - 1e-9);
+    let (mut at_positions, mut widest) = (0, 0.0f64);
+    let mut place = YieldedPlaces::empty();
+    for p in positions {
+        let at: Vec<usize> = (0..p.pressure.len())
+            .filter(|&k| p.pressure[k] >= bound)
+            .collect();
+        if at.is_empty() {
+            continue;
+        }
+        at_positions += 1;
+        widest = widest.max(at.iter().map(|&k| p.cells[k].cell.area()).sum());
+        for &k in &at {
+            let c = &p.cells[k];
+            let nj = wf.cells_face;
+            let f = (c.z - wf.z[0]) / (wf.z[nj] - wf.z[0]) * nj as f64;
+            let j = (f.max(0.0) as usize).min(nj - 1);
+            let cell_height = (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64;
+            let trace = tip_trace.get(j).map_or(f64::NEG_INFINITY, |t| t.1);
+            let top = c.r > wf.r_high[j] - cell_height;
+            place.add(
+                YieldedPlaces::which(j, nj, (c.r, trace, cell_height), top),
+                c,
+                1.0,
+            );
+        }
+    }
+    let count: f64 = place.shares.iter().sum();
+    (count > 0.0).then(|| {
+        format!(
+            "P_max is the flow pressure {:.0} MPa (MODEL §5.7) on {count} local contact cells at \
+             {at_positions} of {} positions (at most {:.3} mm^2 at one position, {:.3} % of the \
+             active flank), {}: a peak narrower than the flank grid, which the loaded pattern \
+             (P_patch, p_eq,2%) does not resolve",
+            flow_pressure * 1e-6,
+            positions.len(),
+            widest * 1e6,
+            100.0 * widest / wf.active_area(),
+            place.text_counted()
+        )
+    })
+}
+
+/// A point of the flank with its coordinates (r, z), m.
+trait HasPlace {
+    fn place(&self) -> (f64, f64);
+}
+
+impl HasPlace for crate::geometry::FlankPoint {
+    fn place(&self) -> (f64, f64) {
+        (self.r, self.z)
+    }
+}
+
+impl HasPlace for LocalCell {
+    fn place(&self) -> (f64, f64) {
+        (self.r, self.z)
+    }
+}
+
 /// Where the cells at the flow pressure lie (MODEL §2.3, §5.7): their shares of the active
 /// flank at the worm tip's trace (the two rows of cells above the lowest radius the worm's
 /// flank reaches in their column), at the face ends (the first and last columns), at the blank
@@ -74,35 +148,62 @@ impl YieldedPlaces {
         let (ni, nj) = (wf.cells_height, wf.cells_face);
         let bound = flow_pressure * (1.0 - 1e-9);
         let active = wf.active_area();
-        let mut place = Self {
-            shares: [0.0; 4],
-            r: (f64::INFINITY, f64::NEG_INFINITY),
-            z: (f64::INFINITY, f64::NEG_INFINITY),
-        };
+        let mut place = Self::empty();
         for k in (0..pattern.len()).filter(|&k| pattern[k] >= bound) {
             let (j, i) = (k / ni, k % ni);
             let cell = &wf.cells[k];
             let trace = tip_trace.get(j).map_or(f64::NEG_INFINITY, |t| t.1);
             let cell_height = (wf.node(ni, j).r - wf.node(0, j).r) / ni as f64;
-            let which = if j == 0 || j + 1 == nj {
-                1
-            } else if cell.r <= trace + 2.0 * cell_height {
-                0
-            } else if i + 1 == ni {
-                2
-            } else {
-                3
-            };
-            place.shares[which] += wf.cell_area[k] / active;
-            place.r = (place.r.0.min(cell.r), place.r.1.max(cell.r));
-            place.z = (place.z.0.min(cell.z), place.z.1.max(cell.z));
+            let which = Self::which(j, nj, (cell.r, trace, cell_height), i + 1 == ni);
+            place.add(which, cell, wf.cell_area[k] / active);
         }
         place
+    }
+
+    fn empty() -> Self {
+        Self {
+            shares: [0.0; 4],
+            r: (f64::INFINITY, f64::NEG_INFINITY),
+            z: (f64::INFINITY, f64::NEG_INFINITY),
+        }
+    }
+
+    /// The place of a point at radius r of column j (of nj; the worm tip's trace at `trace`,
+    /// rows `cell_height` high, m), `top` in the grid's top row: 0 the worm tip's trace, 1 the
+    /// face ends, 2 the blank top, 3 elsewhere.
+    fn which(j: usize, nj: usize, (r, trace, cell_height): (f64, f64, f64), top: bool) -> usize {
+        if j == 0 || j + 1 == nj {
+            1
+        } else if r <= trace + 2.0 * cell_height {
+            0
+        } else if top {
+            2
+        } else {
+            3
+        }
+    }
+
+    /// Adds `share` at place `which` for a point at (r, z) (m).
+    fn add(&mut self, which: usize, at: &impl HasPlace, share: f64) {
+        let (r, z) = at.place();
+        self.shares[which] += share;
+        self.r = (self.r.0.min(r), self.r.1.max(r));
+        self.z = (self.z.0.min(z), self.z.1.max(z));
+    }
+
+    /// [`Self::text`] with the shares counted in cells: "at the blank top (160 cells), ...".
+    fn text_counted(&self) -> String {
+        self.clause(|s| format!("({s} cell{})", if s == 1.0 { "" } else { "s" }))
     }
 
     /// The places as a clause: "at the worm tip's trace 0.71 %, the face ends 0.17 %, ... (r
     /// 94.1-109.9 mm, z -22.1-22.1 mm)".
     fn text(&self) -> String {
+        self.clause(|s| format!("{:.2} %", 100.0 * s))
+    }
+
+    /// The places with their shares as `share` writes them, and the span.
+    fn clause(&self, share: impl Fn(f64) -> String) -> String {
         let names = [
             "the worm tip's trace",
             "the face ends",
@@ -113,7 +214,7 @@ impl YieldedPlaces {
             .iter()
             .zip(self.shares)
             .filter(|(_, s)| *s > 0.0)
-            .map(|(n, s)| format!("{n} {:.2} %", 100.0 * s))
+            .map(|(n, s)| format!("{n} {}", share(s)))
             .collect();
         format!(
             "at {} (cell centres at r {:.1}-{:.1} mm, z {:.1} to {:.1} mm)",
