@@ -56,4 +56,33 @@ mod tests {
             assert!(!text.contains('{'), "{profile:?}: a placeholder left");
         }
     }
+
+    /// Every optional key the template shows commented out ("# key = value") is one the
+    /// input takes: the file with all of them uncommented loads.
+    #[test]
+    fn every_commented_key_is_accepted() {
+        let text = gear_template(ProfileType::A);
+        let mut uncommented = 0;
+        let lines: Vec<String> = text
+            .lines()
+            .map(|line| {
+                let rest = line.strip_prefix("# ").unwrap_or("");
+                let key = rest.split(" = ").next().unwrap_or("");
+                let is_key = rest.contains(" = ")
+                    && !key.is_empty()
+                    && key
+                        .chars()
+                        .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+                if is_key {
+                    uncommented += 1;
+                    rest.to_string()
+                } else {
+                    line.to_string()
+                }
+            })
+            .collect();
+        assert!(uncommented > 20, "{uncommented} keys");
+        let text = lines.join("\n");
+        super::super::load_from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    }
 }
