@@ -539,3 +539,24 @@ def test_the_pattern_assistant_equals_the_cli_and_bad_inputs_raise_naming_them(c
         wormwear.pattern(base, {"centre": 0.6}, output=tmp_path / "bad")
     with pytest.raises(wormwear.InputError, match="cutting.centre_distance_mm"):
         wormwear.pattern(base, target, vary={"cutting.centre_distanse_mm": (124.5, 125.5)}, output=tmp_path / "bad")
+
+
+def test_the_running_in_of_the_roughness_reaches_the_records_and_maps(fast_gear_file, tmp_path):
+    # MODEL §6.1: with lubricant.run_in_roughness_um and running_in_depth_um the worn flank's
+    # roughness falls (records, map); running in to the initial roughness is the published life.
+    base = wormwear.load(str(fast_gear_file))
+    run_in = base.with_(**{"lubricant.run_in_roughness_um": 0.5,
+                           "lubricant.running_in_depth_um": 2.0})
+    r = wormwear.run(run_in, ["wear"], cycles=40000, step_cycles=20000)
+    records = r.wear.records
+    assert records["roughness_mean_m"].iloc[0] == 1e-6 and records["roughness_min_m"].iloc[0] == 1e-6
+    assert 0.5e-6 <= records["roughness_min_m"].iloc[-1] < records["roughness_mean_m"].iloc[-1] < 1e-6
+    r.write(tmp_path / "run-in")
+    assert (tmp_path / "run-in" / "wear_roughness_map.svg").exists()
+    same = base.with_(**{"lubricant.run_in_roughness_um": 1.0,
+                         "lubricant.running_in_depth_um": 2.0})
+    published = wormwear.run(base, ["wear"], cycles=40000, step_cycles=20000).wear.records
+    limit = wormwear.run(same, ["wear"], cycles=40000, step_cycles=20000).wear.records
+    pd.testing.assert_frame_equal(published, limit)
+    with pytest.raises(wormwear.InputError, match="lubricant.run_in_roughness_um"):
+        base.with_(**{"lubricant.run_in_roughness_um": 2.0, "lubricant.running_in_depth_um": 2.0})
