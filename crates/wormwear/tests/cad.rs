@@ -509,15 +509,17 @@ fn flank_area_per_z(geo: &Geometry, flank: Flank, z: f64) -> f64 {
 /// its depth (|z| - (b/2 - c)) over the flank area (midpoint rule on 2 000 strips with the
 /// grid's area per unit z), to first order in c: the curvature of the flank's transverse
 /// profile adds a share of order c kappa, so the ratio lost / integral is 1 + k c, and its
-/// extrapolation from c = 0.5 and 1 mm to c = 0 is 1. The chamfered wheel is one solid for
-/// OpenCASCADE, of our volume.
+/// extrapolation from c = 1 and 2 mm to c = 0 is 1. The solids' volumes are their B-spline
+/// meshes', sampled at other stations with and without the chamfer: a few 1e-6 of the sector,
+/// 1-2 % of a 0.5 mm chamfer's loss (so that one is checked within 3 %). The chamfered wheel is
+/// one solid for OpenCASCADE, of our volume.
 #[test]
 fn the_face_chamfers_take_their_depth_times_the_flank_area_off_the_wheel() {
     let (mut g, geo) = built("gear-1x40-design.toml");
     let sharp = wheel_part(&g, &geo, teeth(3)).unwrap().volume_mm3;
     let half = 0.5 * geo.blank.face_width;
     let mut ratios = Vec::new();
-    for width in [0.5e-3, 1.0e-3] {
+    for width in [0.5e-3, 1.0e-3, 2.0e-3] {
         g.wheel.face_edge_chamfer = width;
         let part = wheel_part(&g, &geo, teeth(3)).unwrap();
         let n = 2000;
@@ -549,12 +551,13 @@ fn the_face_chamfers_take_their_depth_times_the_flank_area_off_the_wheel() {
             check_answer("chamfered wheel, 3 teeth", &part, &faces, &answer);
         }
     }
-    // The flanks' transverse curvature radii are tens of mm: c kappa is at most a few percent.
-    let limit = 2.0 * ratios[0] - ratios[1];
+    // The flanks' transverse curvature radii are tens of mm: c kappa is a few percent at most.
+    let limit = 2.0 * ratios[1] - ratios[2];
     assert!(
-        (limit - 1.0).abs() < 3e-3 && ratios.iter().all(|r| (r - 1.0).abs() < 0.03),
-        "lost / first-order integral {ratios:?}, at c -> 0 {limit}"
+        (limit - 1.0).abs() < 1e-2 && ratios.iter().all(|r| (r - 1.0).abs() < 0.04),
+        "lost / first-order integral {ratios:?} at 0.5 / 1 / 2 mm, at c -> 0 {limit}"
     );
+    assert!((ratios[0] - 1.0).abs() < 0.03, "{ratios:?}");
 }
 
 /// The corner a broken tip edge takes off one flank's thread, in the axial section: between the

@@ -288,8 +288,9 @@ fn place(pieces: Vec<Piece>, to_worm: &impl Fn(V3<f64>) -> Point3) -> Vec<SweptF
 /// The stations across the face width and the indices of the band bounds: the blank top
 /// (outer cylinder clipped by the throat torus) has a kink where the two meet, |z| =
 /// sqrt(r_g^2 - (a - r_e2)^2), and the flanks one where the face-end chamfers of width
-/// `chamfer` start, |z| = b/2 - chamfer; the faces are split there (kinks closer than half a
-/// step to another are left to it), stations evenly spaced at most `step` apart in each band. m.
+/// `chamfer` start, |z| = b/2 - chamfer; the faces are split there (the blank top's kink only
+/// where it leaves half a step to the face end and to the chamfer's), stations evenly spaced at
+/// most `step` apart in each band. m.
 fn stations(
     blank: &crate::geometry::BlankLimits,
     step: f64,
@@ -297,22 +298,19 @@ fn stations(
 ) -> (Vec<f64>, Vec<usize>) {
     let half = 0.5 * blank.face_width;
     let depth = blank.centre_distance - blank.outer_radius;
-    let mut kinks = Vec::new();
+    // The chamfer's start always (its width is the feature drawn, at most b/4 by the input's
+    // check); the blank top's kink where it leaves half a step to the face end and the chamfer.
+    let chamfer_kink = (chamfer > 0.0 && chamfer < half).then_some(half - chamfer);
+    let mut inner: Vec<f64> = chamfer_kink.into_iter().collect();
     if depth > 0.0 && depth < blank.gorge_radius {
-        kinks.push((blank.gorge_radius.powi(2) - depth * depth).sqrt());
-    }
-    if chamfer > 0.0 {
-        kinks.push(half - chamfer);
-    }
-    kinks.sort_by(f64::total_cmp);
-    let mut edges = vec![-half];
-    let mut inner: Vec<f64> = Vec::new();
-    for k in kinks {
-        let clear = inner.last().is_none_or(|&l| k - l >= 0.5 * step);
-        if k < half - 0.5 * step && k > 0.25 * step && clear {
-            inner.push(k);
+        let kink = (blank.gorge_radius.powi(2) - depth * depth).sqrt();
+        let clear = chamfer_kink.is_none_or(|c| (kink - c).abs() >= 0.5 * step);
+        if kink < half - 0.5 * step && clear {
+            inner.push(kink);
         }
     }
+    inner.sort_by(f64::total_cmp);
+    let mut edges = vec![-half];
     edges.extend(inner.iter().rev().map(|k| -k));
     edges.extend(inner.iter().copied());
     edges.push(half);
