@@ -145,18 +145,10 @@ fn a_vanishing_edge_break_gives_the_sharp_results() {
 
 #[test]
 fn bad_edge_breaks_are_refused_naming_the_field() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/gear-1x40-design.toml"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
     let refused = |section: &str, line: &str| {
-        let edited = text.replacen(
-            &format!("[{section}]\n"),
-            &format!("[{section}]\n{line}\n"),
-            1,
-        );
-        input::load_from_str(&edited).unwrap_err().to_string()
+        input::load_from_str(&common::design_with(section, line))
+            .unwrap_err()
+            .to_string()
     };
     let m = refused("worm", "tip_edge_radius_mm = -0.1");
     assert!(
@@ -179,7 +171,7 @@ fn bad_edge_breaks_are_refused_naming_the_field() {
         m.contains("wheel.face_edge_chamfer_mm") && m.contains("quarter"),
         "{m}"
     );
-    let edited = text.replacen("[worm]\n", "[worm]\ntip_edge_radius_mm = 0.5\n", 1);
+    let edited = common::design_with("worm", "tip_edge_radius_mm = 0.5");
     assert_eq!(
         input::load_from_str(&edited).unwrap().worm.tip_edge_radius,
         0.5e-3

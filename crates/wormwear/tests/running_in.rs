@@ -200,12 +200,7 @@ fn the_constant_roughness_limit_gives_the_published_records_byte_for_byte() {
 
 #[test]
 fn bad_running_in_is_refused_naming_the_field() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/gear-1x40-design.toml"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
-    let edit = |lines: &str| text.replacen("[lubricant]\n", &format!("[lubricant]\n{lines}\n"), 1);
+    let edit = |lines: &str| common::design_with("lubricant", lines);
     let refused = |lines: &str| input::load_from_str(&edit(lines)).unwrap_err().to_string();
     // The design file's composite roughness is the default 1 um unless it says otherwise.
     let m = refused("run_in_roughness_um = 1.5\nrunning_in_depth_um = 2.0");

@@ -85,3 +85,15 @@ impl Bench {
         )
     }
 }
+
+/// The design example's text with `lines` added at the start of its `[section]`.
+#[allow(dead_code)]
+pub fn design_with(section: &str, lines: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/gear-1x40-design.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    text.replacen(
+        &format!("[{section}]\n"),
+        &format!("[{section}]\n{lines}\n"),
+        1,
+    )
+}
