@@ -24,7 +24,7 @@ pub fn markdown(
     section_a(&mut m, analytic);
     section_b(&mut m, results);
     section_c_d(&mut m, results);
-    section_e(&mut m, settings, results, speeds);
+    super::friction::section_e(&mut m, settings, results, speeds);
     failures(&mut m, results);
     run_times(&mut m, results);
     m
@@ -101,13 +101,18 @@ fn efficiency_finding(m: &mut String, results: &Results) {
     }
     if let (Some(b), Some(f)) = (last("c-balance"), last("case-c")) {
         let start = first("c-balance").map_or(f64::NAN, |r| r.friction.oil_temperature_k);
+        let end = b.friction.oil_temperature_k;
+        let colder = end < f.friction.oil_temperature_k;
         let _ = writeln!(
             m,
-            "- Heat balance (e): in the study's housing case C's oil settles at {:.1} -> {:.1} C \
-             over its life instead of the fixed 60 C; the more viscous oil's thicker film ends the \
+            "- Heat balance (e): in the example's housing case C's oil settles at {:.1} -> {:.1} C \
+             over its life instead of the fixed {:.0} C; the {} viscous oil's {} film ends the \
              life at {:.0} um of backlash against {:.0} um ({:+.1} %).",
             start - 273.15,
-            b.friction.oil_temperature_k - 273.15,
+            end - 273.15,
+            f.friction.oil_temperature_k - 273.15,
+            if colder { "more" } else { "less" },
+            if colder { "thicker" } else { "thinner" },
             b.backlash_increase_m * 1e6,
             f.backlash_increase_m * 1e6,
             100.0 * (b.backlash_increase_m / f.backlash_increase_m - 1.0)
@@ -193,8 +198,12 @@ fn mesh_finding(m: &mut String, checks: &[Check]) {
     ) {
         let _ = writeln!(
             m,
-            "- Mesh: with the purely elastic law the raw P_max at the sharp edges is not a converged number ({}, 11 -> 41 cells across the line); with the default plastic limit it is ({}), and so is the patch mean (section (a); the whole study in \"Mesh convergence\").",
-            elastic.computed, plastic.computed
+            "- Mesh: with the purely elastic law the raw P_max at the sharp edges is not a converged number ({}, 11 -> 41 cells across the line); with the default plastic limit it is ({}, 21 -> 41){} (section (a); the whole study in \"Mesh convergence\").",
+            elastic.computed,
+            plastic.computed,
+            find("P_patch (0.5 x 1 mm mean) with the plastic limit").map_or(String::new(), |p| {
+                format!(", and so is the patch mean ({})", p.computed)
+            })
         );
     }
 }
@@ -805,147 +814,6 @@ fn variant_table(m: &mut String, results: &Results, base: &StepRecord, rows: &[(
             r.records.len(),
             e.loaded_analyses,
             r.seconds
-        );
-    }
-    m.push('\n');
-}
-
-/// (e) Friction, efficiency and oil temperature from the contact (MODEL §13): the speed study
-/// against ISO/TR 14521's mu_0T, the reference cases, and lives with the heat balance.
-fn section_e(
-    m: &mut String,
-    settings: &Settings,
-    results: &Results,
-    speeds: &[super::friction::SpeedPoint],
-) {
-    let _ = writeln!(
-        m,
-        "## (e) Friction, efficiency and oil temperature from the contact\n\n\
-         The contact's friction (MODEL §13: Greenwood & Tripp's asperity pressure at the central \
-         film with Hertz's contact modulus, bounded by the wheel's hardness, at boundary friction \
-         mu_b; Eyring's film shear bounded by Lambda p; the summit statistics, mu_b, tau_0 and \
-         Lambda the examples' defaults; the reference gears' roughness, 1 um, assumed) on every \
-         loaded cell; the loaded analysis carries it (MODEL §5.2).\n\n\
-         **Against ISO/TR 14521's rig-fitted mu_0T over sliding speeds** (MODEL §13 validation \
-         (1)): the 1/40 design gear and the K 2/25 gear at 60 N m on the worm, unworn, no \
-         bending, oil at 60 C; ISO's eta_z = tan(gamma) / tan(gamma + atan(mu_0T)) with its \
-         factors Y at 1. One set of inputs for every speed and both gears.\n"
-    );
-    m.push_str(&super::friction::table(speeds));
-    let _ = writeln!(
-        m,
-        "\n![mean friction over the sliding speed]({dir}/{f})\n\n\
-         ![mesh efficiency over the sliding speed]({dir}/{e})\n\n\
-         **The reference cases** (unworn, FE bending, oil at 60 C) against ISO/TR 14521 with the \
-         examples' factors Y and the published torques (wheel torque / (u x worm torque); \
-         REFERENCE_GEARS.md derived them with ISO's total efficiency):\n",
-        dir = super::FIGURES,
-        f = super::friction::FRICTION_CHART,
-        e = super::friction::EFFICIENCY_CHART,
-    );
-    reference_cases_table(m, settings, results);
-    thermal_life_table(m, results);
-}
-
-/// The reference cases' unworn friction and efficiencies beside ISO/TR 14521 and the published
-/// torques.
-fn reference_cases_table(m: &mut String, settings: &Settings, results: &Results) {
-    let _ = writeln!(
-        m,
-        "| case | mesh efficiency, contact | ISO/TR 14521 | total, contact | ISO/TR 14521 | published torques | mu contact | mu ISO |"
-    );
-    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|");
-    for (name, id, file, published) in [
-        (
-            "design",
-            "design-adaptive",
-            "gear-1x40-design.toml",
-            f64::NAN,
-        ),
-        (
-            "A",
-            "case-a",
-            "gear-1x40-case-a.toml",
-            1250.0 / (40.0 * 40.0),
-        ),
-        (
-            "B",
-            "case-b",
-            "gear-1x40-case-b.toml",
-            1375.0 / (40.0 * 44.0),
-        ),
-        (
-            "C",
-            "case-c",
-            "gear-1x40-case-c.toml",
-            1700.0 / (40.0 * 54.0),
-        ),
-    ] {
-        let Some(first) = results.get(id).and_then(|r| r.records.first()) else {
-            continue;
-        };
-        let Ok(gear) = super::example(settings, file) else {
-            continue;
-        };
-        let iso = crate::rating::rate(&gear);
-        let f = &first.friction;
-        let _ = writeln!(
-            m,
-            "| {name} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {:.4} | {:.4} |",
-            f.mesh_efficiency,
-            iso.mesh_efficiency,
-            f.total_efficiency,
-            iso.efficiency,
-            if published.is_nan() {
-                "-".to_string()
-            } else {
-                format!("{published:.3}")
-            },
-            f.friction_coefficient_mean,
-            iso.friction_coefficient
-        );
-    }
-}
-
-/// Case C and the speed study with the heat balance against the fixed 60 C: oil temperature
-/// and efficiency at the start and the end, and the final backlash of both.
-fn thermal_life_table(m: &mut String, results: &Results) {
-    let _ = writeln!(
-        m,
-        "\nWith the oil temperature from the heat balance of a forced-air housing (200 W/(m^2 K) \
-         over 1 m^2, 20 C ambient; the default housing cannot reject these losses), each wear \
-         state's viscosity drives its film and local wear coefficient:\n"
-    );
-    let _ = writeln!(
-        m,
-        "| worm speed | oil at start -> end (C) | total efficiency start -> end | backlash at the end, balance | at 60 C |"
-    );
-    let _ = writeln!(m, "|---|---|---|---|---|");
-    for (rpm, balance, fixed) in [
-        (100, "speed-100-balance", "speed-100"),
-        (600, "speed-600-balance", "speed-600"),
-        (900, "c-balance", "case-c"),
-        (1200, "speed-1200-balance", "speed-1200"),
-    ] {
-        let Some(r) = results.get(balance) else {
-            continue;
-        };
-        let (Some(s), Some(e)) = (r.records.first(), r.records.last()) else {
-            continue;
-        };
-        let fixed = results.get(fixed).and_then(last);
-        let _ = writeln!(
-            m,
-            "| {rpm} rpm | {:.1} -> {:.1} | {:.3} -> {:.3} | {:.1} um | {} |",
-            s.friction.oil_temperature_k - 273.15,
-            e.friction.oil_temperature_k - 273.15,
-            s.friction.total_efficiency,
-            e.friction.total_efficiency,
-            e.backlash_increase_m * UM,
-            fixed.map_or("-".to_string(), |f| format!(
-                "{:.1} um",
-                f.backlash_increase_m * UM
-            ))
         );
     }
     m.push('\n');
