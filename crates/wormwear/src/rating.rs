@@ -162,25 +162,20 @@ pub const UNDERLOAD_REFUSAL_MPA: f64 = 1.0;
 
 /// Why the gear's load is outside what a loaded analysis can take (None: it is not): the
 /// nominal mean Hertz stress sigma_Hm (MODEL §9) above [`OVERLOAD_REFUSAL`] times the wheel's
-/// pitting limit, or below [`UNDERLOAD_REFUSAL_MPA`]. The message names the torque field, its
+/// pitting limit, or an [`underload`] (below [`UNDERLOAD_REFUSAL_MPA`], or a worm torque whose
+/// power the no-load and seal losses take whole). The message names the torque field, its
 /// value and the torque the bound allows (sigma_Hm grows with the square root of the torque).
 pub fn implausible_load(gear: &GearSet) -> Option<String> {
     let r = rate(gear);
     let limit = gear.wheel_material.pitting_limit * 1e-6;
     let ratio = r.sigma_hm_mpa / limit;
     let (field, torque) = torque_field(gear);
-    if r.sigma_hm_mpa.is_nan() || r.sigma_hm_mpa < UNDERLOAD_REFUSAL_MPA {
+    if let Some(why) = underload(gear, &r) {
         let needed = match smallest_torque(gear) {
             Some(t) => format!("give at least about {t:.3e} N m"),
             None => "give a larger torque".into(),
         };
-        return Some(format!(
-            "{field} = {torque:e}: the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL \
-             §9) would be {:.3e} N/mm^2, below the {UNDERLOAD_REFUSAL_MPA} N/mm^2 a loaded \
-             analysis resolves (at small torques the no-load, bearing and seal losses take most \
-             of the input): {needed}",
-            r.sigma_hm_mpa.max(0.0)
-        ));
+        return Some(format!("{field} = {torque:e}: {why}: {needed}"));
     }
     // (A NaN ratio, from a p_m* outside its formula, is no refusal.)
     if ratio.is_nan() || ratio <= OVERLOAD_REFUSAL {
@@ -198,9 +193,37 @@ pub fn implausible_load(gear: &GearSet) -> Option<String> {
     ))
 }
 
-/// The smallest torque of the gear's kind (worm or wheel, N m) at which sigma_Hm reaches
-/// [`UNDERLOAD_REFUSAL_MPA`], to 1 %: doubled from the given torque until it does, then
-/// bisected (the no-load losses make T2 no power of T1). None beyond 1e9 N m.
+/// Why the load is below what a loaded analysis takes (None: it is not): a worm torque whose
+/// power the no-load and seal losses (MODEL §9, independent of the load) take whole, so that
+/// the wheel carries no torque; or the nominal mean Hertz stress sigma_Hm below
+/// [`UNDERLOAD_REFUSAL_MPA`].
+fn underload(gear: &GearSet, r: &Rating) -> Option<String> {
+    if let Torque::Worm(t) = gear.conditions.torque {
+        let (losses, input) = (
+            r.loss_churning_w + r.loss_seals_w,
+            t * gear.conditions.worm_speed,
+        );
+        if losses >= input {
+            return Some(format!(
+                "the no-load and seal losses ({losses:.3e} W at {:.0} rpm, MODEL §9) take the \
+                 whole input of {input:.3e} W, so the wheel would carry no torque",
+                gear.conditions.worm_speed * 60.0 / (2.0 * PI)
+            ));
+        }
+    }
+    (r.sigma_hm_mpa.is_nan() || r.sigma_hm_mpa < UNDERLOAD_REFUSAL_MPA).then(|| {
+        format!(
+            "the nominal mean Hertz stress (ISO/TR 14521 sigma_Hm, MODEL §9) would be {:.3e} \
+             N/mm^2, below the {UNDERLOAD_REFUSAL_MPA} N/mm^2 a loaded analysis resolves (at \
+             small torques the no-load, bearing and seal losses take most of the input)",
+            r.sigma_hm_mpa.max(0.0)
+        )
+    })
+}
+
+/// The smallest torque of the gear's kind (worm or wheel, N m) that is not an [`underload`],
+/// to 1 %: doubled from the given torque until it is not, then bisected (the no-load losses
+/// make T2 no power of T1). None beyond 1e9 N m.
 fn smallest_torque(gear: &GearSet) -> Option<f64> {
     let at = |t: f64| {
         let mut g = gear.clone();
@@ -208,7 +231,7 @@ fn smallest_torque(gear: &GearSet) -> Option<f64> {
             Torque::Worm(_) => Torque::Worm(t),
             Torque::Wheel(_) => Torque::Wheel(t),
         };
-        rate(&g).sigma_hm_mpa >= UNDERLOAD_REFUSAL_MPA
+        underload(&g, &rate(&g)).is_none()
     };
     let (_, given) = torque_field(gear);
     let mut hi = given.abs().max(1e-9);

@@ -173,6 +173,41 @@ fn a_vanishing_torque_is_refused_naming_the_smallest_torque_that_is_not() {
     }
 }
 
+#[test]
+fn a_worm_torque_whose_power_the_no_load_losses_take_is_refused_saying_so() {
+    // 1 N m on the worm at 3000 rpm is 314 W; the no-load (churning) and seal losses there,
+    // which do not fall with the load, are more (MODEL §9): the wheel would carry no torque.
+    // ISO's torque fixed point still gave a tiny T2, and the refusal named 1.734 N m, whose
+    // 545 W the same 577 W of losses still exceeded. The refusal now says so, with both powers,
+    // and names a torque whose power carries the losses and which is accepted.
+    let mut g = example("gear-1x40-design.toml");
+    g.conditions.worm_speed = 3000.0 * 2.0 * std::f64::consts::PI / 60.0;
+    g.conditions.torque = Torque::Worm(1.0);
+    let r = rating::rate(&g);
+    let losses = r.loss_churning_w + r.loss_seals_w;
+    let input = 1.0 * g.conditions.worm_speed;
+    assert!(losses > input, "{losses} W against {input} W");
+    let message = rating::implausible_load(&g).expect("refused");
+    assert!(
+        message.contains("conditions.worm_torque_nm")
+            && message.contains("take the whole input")
+            && message.contains(&format!("{input:.3e} W")),
+        "{message}"
+    );
+    let named: f64 = message
+        .split("give at least about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{message}"));
+    let power = named * g.conditions.worm_speed;
+    assert!(power > losses, "{named} N m: {power} W against {losses} W");
+    g.conditions.torque = Torque::Worm(named);
+    assert!(rating::implausible_load(&g).is_none(), "{named}");
+    g.conditions.torque = Torque::Worm(0.97 * named);
+    assert!(rating::implausible_load(&g).is_some(), "{named}");
+}
+
 /// The stress at which Rank's N_LI reaches given cycles is the formula's inverse: N_LI at that
 /// stress is those cycles, it falls as the cycles grow (exponent 1 / 4.666) and it has no
 /// value where the speed factor is not positive.
