@@ -146,6 +146,16 @@ fn ratings_outside_their_formulas_ranges_are_null_with_a_reason() {
     }
 }
 
+/// The torque (N m) a refusal names after "give at least about".
+fn named_torque(message: &str) -> f64 {
+    message
+        .split("give at least about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{message}"))
+}
+
 #[test]
 fn a_vanishing_torque_is_refused_naming_the_smallest_torque_that_is_not() {
     // Issue 58: 1e-6 N m on the worm asked for "at least about inf N m", 1 N m for 1.2e15: the
@@ -158,12 +168,7 @@ fn a_vanishing_torque_is_refused_naming_the_smallest_torque_that_is_not() {
     };
     for t in [1e-6, 1.0] {
         let message = rating::implausible_load(&with(t)).expect("refused");
-        let named: f64 = message
-            .split("give at least about ")
-            .nth(1)
-            .and_then(|rest| rest.split(' ').next())
-            .and_then(|n| n.parse().ok())
-            .unwrap_or_else(|| panic!("{message}"));
+        let named = named_torque(&message);
         assert!(named.is_finite() && named > t, "{message}");
         assert!(rating::implausible_load(&with(named)).is_none(), "{named}");
         assert!(
@@ -194,12 +199,7 @@ fn a_worm_torque_whose_power_the_no_load_losses_take_is_refused_saying_so() {
             && message.contains(&format!("{input:.3e} W")),
         "{message}"
     );
-    let named: f64 = message
-        .split("give at least about ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("{message}"));
+    let named = named_torque(&message);
     let power = named * g.conditions.worm_speed;
     assert!(power > losses, "{named} N m: {power} W against {losses} W");
     g.conditions.torque = Torque::Worm(named);
