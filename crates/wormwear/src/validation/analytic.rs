@@ -296,55 +296,49 @@ fn peak_convergence(
     };
     if let (Ok(mid), Ok(fine)) = (at(21, false), at(41, false)) {
         let test = "plastic::the_plastic_limit_makes_the_peaks_mesh_converged";
-        out.push(Check {
-            what: "1/40 (no bending), P_max with the plastic limit (default), 21 -> 41 cells across the line".into(),
-            computed: format!(
-                "{:.0} -> {:.0} MPa",
-                mid.max_pressure * 1e-6,
-                fine.max_pressure * 1e-6
-            ),
-            reference: "converged: ratio 1".into(),
-            error: relative(fine.max_pressure, mid.max_pressure),
-            bound: 0.05,
-            test: test.into(),
-        });
-        out.push(Check {
-            what: "1/40 (no bending), P_patch (0.5 x 1 mm mean) with the plastic limit, 21 -> 41 cells across the line".into(),
-            computed: format!(
-                "{:.0} -> {:.0} MPa",
-                mid.pressure_patch_max * 1e-6,
-                fine.pressure_patch_max * 1e-6
-            ),
-            reference: "converged: ratio 1".into(),
-            error: relative(fine.pressure_patch_max, mid.pressure_patch_max),
-            bound: 0.05,
-            test: test.into(),
-        });
+        out.push(refinement_check(
+            "P_max with the plastic limit (default), 21 -> 41 cells across the line",
+            (mid.max_pressure, fine.max_pressure),
+            0.05,
+            test,
+        ));
+        out.push(refinement_check(
+            "P_patch (0.5 x 1 mm mean) with the plastic limit, 21 -> 41 cells across the line",
+            (mid.pressure_patch_max, fine.pressure_patch_max),
+            0.05,
+            test,
+        ));
     }
     if let (Ok(c), Ok(f)) = (at(11, true), at(41, true)) {
         let test = "fidelity::the_patch_pressure_converges_where_the_maximum_does_not";
-        out.push(Check {
-            what: "1/40 (no bending), P_patch with the elastic law, frictionless, 11 -> 41 cells across the line".into(),
-            computed: format!(
-                "{:.0} -> {:.0} MPa",
-                c.pressure_patch_max * 1e-6,
-                f.pressure_patch_max * 1e-6
-            ),
-            reference: "converged: ratio 1".into(),
-            error: relative(f.pressure_patch_max, c.pressure_patch_max),
-            bound: 0.03,
-            test: test.into(),
-        });
-        out.push(Check {
-            what: "1/40 (no bending), raw P_max with the elastic law, frictionless, 11 -> 41 cells across the line (edge singularity: grows)".into(),
-            computed: format!("{:.0} -> {:.0} MPa", c.max_pressure * 1e-6, f.max_pressure * 1e-6),
-            reference: "converged: ratio 1".into(),
-            error: relative(f.max_pressure, c.max_pressure),
-            bound: f64::NAN,
-            test: test.into(),
-        });
+        out.push(refinement_check(
+            "P_patch with the elastic law, frictionless, 11 -> 41 cells across the line",
+            (c.pressure_patch_max, f.pressure_patch_max),
+            0.03,
+            test,
+        ));
+        out.push(refinement_check(
+            "raw P_max with the elastic law, frictionless, 11 -> 41 cells across the line (edge singularity: grows)",
+            (c.max_pressure, f.max_pressure),
+            f64::NAN,
+            test,
+        ));
     }
     out
+}
+
+/// A pressure of the 1/40 gear (no bending) under refinement, coarse -> fine (Pa), against
+/// convergence (ratio 1) with `bound` (NaN: none, it is not expected to converge) and the test
+/// that checks it.
+fn refinement_check(what: &str, (coarse, fine): (f64, f64), bound: f64, test: &str) -> Check {
+    Check {
+        what: format!("1/40 (no bending), {what}"),
+        computed: format!("{:.0} -> {:.0} MPa", coarse * 1e-6, fine * 1e-6),
+        reference: "converged: ratio 1".into(),
+        error: relative(fine, coarse),
+        bound,
+        test: test.into(),
+    }
 }
 
 /// Checks on the 1/40 gear (design case without bending: these are the contact model's
