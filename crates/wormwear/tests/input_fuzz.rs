@@ -3,12 +3,13 @@
 //! table at a time — hostile numbers, wrong types, missing and unknown keys, tables replaced
 //! by values and values by tables, deep nesting. Properties: nothing panics, and every
 //! rejection names a field (a field error with its dotted name, or a parse error that quotes
-//! the key). Runs for a bounded time (FUZZ_SECONDS, default 30) and prints how many documents
-//! it tried.
+//! the key). Tries a fixed number of documents (FUZZ_DOCUMENTS, default 2000), the same ones on
+//! every machine and run, loaded in parallel, and prints how many were accepted and rejected.
 
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
-use proptest::test_runner::TestRunner;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use rayon::prelude::*;
 use std::path::Path;
 use toml::Value;
 use wormwear::input::{self, InputError};
@@ -202,10 +203,85 @@ fn names_a_field(error: &InputError, key: &str) -> bool {
 
 #[test]
 fn mutated_gear_files_never_panic_and_every_rejection_names_a_field() {
-    let seconds: f64 = std::env::var("FUZZ_SECONDS")
+    let count: usize = std::env::var("FUZZ_DOCUMENTS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(30.0);
+        .unwrap_or(2000);
+    let start = std::time::Instant::now();
+    // Chunks of documents, each from its own seeded generator, generated and loaded on the
+    // pool; the outcomes come back in the chunks' order.
+    let chunks = count.div_ceil(CHUNK);
+    let outcomes: Vec<Outcome> = (0..chunks)
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            let documents = mutated_documents(c, CHUNK.min(count - c * CHUNK));
+            documents
+                .into_iter()
+                .map(|(text, keys)| load_outcome(&text, &keys))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let accepted = outcomes
+        .iter()
+        .filter(|o| matches!(o, Outcome::Accepted))
+        .count();
+    let unnamed: Vec<&String> = outcomes
+        .iter()
+        .filter_map(|o| match o {
+            Outcome::Unnamed(m) => Some(m),
+            _ => None,
+        })
+        .collect();
+    eprintln!(
+        "input fuzz: {} documents in {:.1} s: {accepted} accepted, {} rejected, {} rejections \
+         without a field",
+        outcomes.len(),
+        start.elapsed().as_secs_f64(),
+        outcomes.len() - accepted,
+        unnamed.len()
+    );
+    assert!(
+        outcomes.len() >= count / 2,
+        "only {} documents",
+        outcomes.len()
+    );
+    assert!(
+        accepted > 0 && accepted < outcomes.len(),
+        "{accepted} accepted"
+    );
+    let unnamed: Vec<&str> = unnamed.iter().map(|m| m.as_str()).collect();
+    assert!(unnamed.is_empty(), "{}", unnamed.join("\n"));
+}
+
+/// What loading one mutated document gave.
+enum Outcome {
+    Accepted,
+    Named,
+    /// A rejection that names none of the mutated keys: its keys and message.
+    Unnamed(String),
+}
+
+/// Loads `text`; panics (naming the document) if the loader panics.
+fn load_outcome(text: &str, keys: &[String]) -> Outcome {
+    match std::panic::catch_unwind(|| input::load_from_str(text)) {
+        Err(_) => panic!("the loader panicked on:\n{text}"),
+        Ok(Ok(_)) => Outcome::Accepted,
+        Ok(Err(e)) if keys.iter().any(|k| names_a_field(&e, k)) || names_a_field(&e, "\u{1}") => {
+            Outcome::Named
+        }
+        Ok(Err(e)) => Outcome::Unnamed(format!("keys {keys:?}: {}", cut(&e.to_string()))),
+    }
+}
+
+/// Documents per generator of the fuzz test.
+const CHUNK: usize = 50;
+
+/// `count` tries at a mutated document from the generator seeded with `chunk` (the same
+/// sequence on every run: a failure prints its document): an example with one or two
+/// mutations, the first on a path of the example, a second (on the mutated document) from the
+/// same strategy; as TOML text with the mutated keys. Tries whose document does not serialise
+/// are skipped.
+fn mutated_documents(chunk: usize, count: usize) -> Vec<(String, Vec<String>)> {
     let bases: Vec<Value> = examples().into_iter().map(Value::Table).collect();
     let all_paths: Vec<Vec<Vec<Step>>> = bases
         .iter()
@@ -221,19 +297,17 @@ fn mutated_gear_files_never_panic_and_every_rejection_names_a_field() {
         mutation(),
         1usize..3,
     );
-    // The same sequence of documents on every run (a failure prints its document).
-    let mut runner = TestRunner::deterministic();
-    let start = std::time::Instant::now();
-    let (mut tried, mut accepted, mut rejected) = (0usize, 0usize, 0usize);
-    let mut unnamed = Vec::new();
-    while start.elapsed().as_secs_f64() < seconds {
-        let (which, pick, first, count) = case.new_tree(&mut runner).unwrap().current();
+    let mut seed = [0u8; 32];
+    seed[..8].copy_from_slice(&(chunk as u64).to_le_bytes());
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &seed);
+    let mut runner = TestRunner::new_with_rng(Config::default(), rng);
+    let mut documents = Vec::with_capacity(count);
+    for _ in 0..count {
+        let (which, pick, first, mutations) = case.new_tree(&mut runner).unwrap().current();
         let mut doc = bases[which].clone();
-        // One or two mutations: the first on a path of the example, a second (on the mutated
-        // document) from the same strategy.
         let mut keys = Vec::new();
         let mut mutation = first;
-        for k in 0..count {
+        for k in 0..mutations {
             let mut found = Vec::new();
             paths(&doc, &mut Vec::new(), &mut found);
             let candidates = if k == 0 { &all_paths[which] } else { &found };
@@ -244,31 +318,11 @@ fn mutated_gear_files_never_panic_and_every_rejection_names_a_field() {
             keys.push(apply(&mut doc, &path, &mutation));
             mutation = Mutation::Scale(0.5);
         }
-        let text = match toml::to_string(&doc) {
-            Ok(t) => t,
-            Err(_) => continue,
-        };
-        tried += 1;
-        let outcome = std::panic::catch_unwind(|| input::load_from_str(&text));
-        match outcome {
-            Err(_) => panic!("the loader panicked on:\n{text}"),
-            Ok(Ok(_)) => accepted += 1,
-            Ok(Err(e)) => {
-                rejected += 1;
-                if !keys.iter().any(|k| names_a_field(&e, k)) && !names_a_field(&e, "\u{1}") {
-                    unnamed.push(format!("keys {keys:?}: {}", cut(&e.to_string())));
-                }
-            }
+        if let Ok(text) = toml::to_string(&doc) {
+            documents.push((text, keys));
         }
     }
-    eprintln!(
-        "input fuzz: {tried} documents in {:.0} s: {accepted} accepted, {rejected} rejected, \
-         {} rejections without a field",
-        start.elapsed().as_secs_f64(),
-        unnamed.len()
-    );
-    assert!(tried >= 100, "only {tried} documents");
-    assert!(unnamed.is_empty(), "{}", unnamed.join("\n"));
+    documents
 }
 
 fn cut(s: &str) -> String {
