@@ -209,7 +209,7 @@ fn relative(a: f64, b: f64) -> f64 {
 }
 
 /// Every check of section (a); the gear checks on `design` (the 1/40 design case).
-pub fn checks(design: &crate::input::GearSet) -> Vec<Check> {
+pub fn checks(design: &crate::input::GearSet, quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     for kind in [SolverKind::ConjugateGradient, SolverKind::FixedPoint] {
         let (got, hertz) = hertz_sphere(kind);
@@ -269,7 +269,7 @@ pub fn checks(design: &crate::input::GearSet) -> Vec<Check> {
         bound: 0.01,
         test: "fe::cantilever_matches_timoshenko_beam_theory".into(),
     });
-    out.extend(gear_checks(design));
+    out.extend(gear_checks(design, quick));
     out
 }
 
@@ -344,7 +344,7 @@ fn refinement_check(what: &str, (coarse, fine): (f64, f64), bound: f64, test: &s
 /// Checks on the 1/40 gear (design case without bending: these are the contact model's
 /// properties): conjugacy, the uniform angular
 /// recession (rigid lag), the backlash law of a uniform removal, the mesh-converged pressure.
-fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
+fn gear_checks(design: &crate::input::GearSet, quick: bool) -> Vec<Check> {
     let mut out = Vec::new();
     let mut g = design.clone();
     g.bending.kind = crate::input::BendingKind::None;
@@ -356,7 +356,7 @@ fn gear_checks(design: &crate::input::GearSet) -> Vec<Check> {
         return out;
     };
     out.push(uniform_removal_check(&g, &geo, &tca));
-    out.extend(recession_checks(&g, &geo, &tca));
+    out.extend(recession_checks(&g, &geo, &tca, quick));
     out
 }
 
@@ -409,6 +409,7 @@ fn recession_checks(
     g: &crate::input::GearSet,
     geo: &crate::geometry::Geometry,
     tca: &crate::kinematics::Tca,
+    quick: bool,
 ) -> Vec<Check> {
     let mut out = Vec::new();
     let wf = geo.wheel_flank(tca.loaded_flank);
@@ -436,7 +437,11 @@ fn recession_checks(
             bound: 1e-4,
             test: "fidelity::a_uniform_angular_recession_is_all_rigid_lag".into(),
         });
-        out.extend(peak_convergence(g, geo, tca, &settings));
+        // The refinement rows repeat their named tests' analyses at 41 cells across the line;
+        // the quick smoke run leaves them to those tests.
+        if !quick {
+            out.extend(peak_convergence(g, geo, tca, &settings));
+        }
         out.push(pit_depth_check(g, geo, tca, &unworn));
     }
     out

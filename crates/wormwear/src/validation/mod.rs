@@ -167,7 +167,7 @@ pub fn run(
         };
         results.insert(job.id.clone(), result);
     }
-    let analytic = analytic::checks(&example(settings, "gear-1x40-design.toml")?);
+    let analytic = analytic::checks(&example(settings, "gear-1x40-design.toml")?, settings.quick);
     progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
     let speeds = friction::over_speeds(settings)?;
     friction::charts(&speeds, &dir.join(FIGURES))?;
