@@ -329,7 +329,11 @@ fn running_in_settles_with_cells_much_finer_than_the_grid_rows() {
     // 1.11 um, the set growing without bound; the life's plastic set then grew with the cells
     // across the line, 21 -> 52 um at 11 -> 41). On rows fine enough for the cells it settles.
     use wormwear::ltca::{self, LtcaSettings};
-    let (g, geo, tca) = design();
+    // Ten positions over the pitch (the default's twenty halve the time; every position's
+    // indentation enters the set either way).
+    let (mut g, geo, _) = design();
+    g.analysis.positions = 10;
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
     let mut s = LtcaSettings::from_gear(&g);
     s.columns = 41;
     let first = ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap();
