@@ -199,9 +199,10 @@ fn contact_problem(
 
 /// Outer update of the normal wheel torque (`problem.load`) until the torque `weights . q`
 /// (the worm torque, or with friction the transmitted wheel torque) balances `target`
-/// (MODEL §5.2; None: the load is given): with the fast solver, one exact
-/// affine step on the loaded set after the first solve; the fixed-point solver (and any change
-/// of the loaded set) iterates, by secants on the (wheel torque, worm torque) pairs: with
+/// (MODEL §5.2; None: the load is given): with the fast solver, an exact affine step on the
+/// loaded set after each of the first [`AFFINE_STEPS`] solves, and where that step would change
+/// the loaded set, the next solve at the load it predicts; the fixed-point solver (and later
+/// solves) iterates by secants on the (wheel torque, worm torque) pairs: with
 /// cells at the flow pressure (MODEL §5.7) the worm torque is not proportional to the wheel
 /// torque and a plain rescaling can cycle. Returns the last solution and its worm torque,
 /// with the linear response the affine step moved along (when it did: reusable for other
@@ -238,23 +239,28 @@ fn balance_worm_torque(
             solution = Some((sol, worm));
             break;
         }
-        if it == 0 && settings.solver.kind == SolverKind::ConjugateGradient {
-            if let Some((updated, load, at)) =
-                solver::affine_load_update(problem, &sol, weights, target, &settings.solver)
-            {
-                response = Some(at);
-                problem.load = load;
-                let worm = worm_of(&updated.q);
-                let close = ((worm - target) / target).abs() < 1e-9;
-                warm = Some(updated.q.clone());
-                solution = Some((updated, worm));
-                if close {
-                    break;
+        let mut predicted = None;
+        if settings.solver.kind == SolverKind::ConjugateGradient && it < AFFINE_STEPS {
+            match solver::affine_step(problem, &sol, weights, target, &settings.solver) {
+                Ok((updated, load, at)) => {
+                    response = Some(at);
+                    problem.load = load;
+                    let worm = worm_of(&updated.q);
+                    let close = ((worm - target) / target).abs() < 1e-9;
+                    warm = Some(updated.q.clone());
+                    solution = Some((updated, worm));
+                    if close {
+                        break;
+                    }
+                    continue;
                 }
-                continue;
+                Err(load) => predicted = load.filter(|l| l.is_finite() && *l > 0.0),
             }
         }
-        let next = next_wheel_torque(previous, (problem.load, worm), target);
+        // Where the loaded set changes, the next solve is at the load the affine step predicts
+        // (few cells change near the balance), else at the secant's.
+        let next =
+            predicted.unwrap_or_else(|| next_wheel_torque(previous, (problem.load, worm), target));
         previous = Some((problem.load, worm));
         problem.load = next;
         warm = Some(sol.q.clone());
@@ -263,6 +269,10 @@ fn balance_worm_torque(
     let (sol, worm) = solution.expect("at least one solve");
     Ok((sol, worm, response))
 }
+
+/// Solves of a torque balance after which it takes an affine step on the loaded set (MODEL
+/// §5.2); later ones go by secants.
+const AFFINE_STEPS: usize = 3;
 
 /// Largest number of friction updates of a position's torque balance (MODEL §5.2).
 const FRICTION_ITERATIONS: usize = 12;

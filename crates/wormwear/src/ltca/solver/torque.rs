@@ -17,10 +17,27 @@ pub fn affine_load_update(
     target: f64,
     settings: &SolverSettings,
 ) -> Option<(Solution, f64, LoadResponse)> {
-    let response = LoadResponse::of(problem, solution, settings)?;
-    let loads = response.at_target(weights, target)?;
+    affine_step(problem, solution, weights, target, settings).ok()
+}
+
+/// [`affine_load_update`], or where the loaded set would change, the load the step predicts
+/// (its loaded set taken as holding: near the balance when few cells change; None when the
+/// response cannot be computed or the weights do not move).
+pub fn affine_step(
+    problem: &Problem,
+    solution: &Solution,
+    weights: &[f64],
+    target: f64,
+    settings: &SolverSettings,
+) -> Result<(Solution, f64, LoadResponse), Option<f64>> {
+    let response = LoadResponse::of(problem, solution, settings).ok_or(None)?;
+    let predicted = response.load_at_target(weights, target);
+    let loads = response.at_target(weights, target).ok_or(predicted)?;
     let load = loads.load;
-    Some((response.solution(problem, loads, settings)?, load, response))
+    match response.solution(problem, loads, settings) {
+        Some(s) => Ok((s, load, response)),
+        None => Err(predicted),
+    }
 }
 
 /// The solution's linear response to the load while its free loaded set holds (MODEL §5.4):
@@ -76,12 +93,7 @@ impl LoadResponse {
     /// The loads at which sum(weights . q) = target, or None when a free cell would leave the
     /// loaded set (its load turning negative or reaching its cap) or the weights do not move.
     pub fn at_target(&self, weights: &[f64], target: f64) -> Option<AffineLoads> {
-        let t0: f64 = weights.iter().zip(&self.q0).map(|(w, q)| w * q).sum();
-        let slope: f64 = weights.iter().zip(&self.v).map(|(w, x)| w * x).sum::<f64>() / self.sum_v;
-        if slope == 0.0 || !slope.is_finite() {
-            return None;
-        }
-        let load = self.load0 + (target - t0) / slope;
+        let load = self.load_at_target(weights, target)?;
         let dw = load - self.load0;
         let q: Vec<f64> = self
             .q0
@@ -95,6 +107,17 @@ impl LoadResponse {
             approach: self.approach0 + dw / self.sum_v,
         })
         .filter(|l| self.holds(&l.q, None))
+    }
+
+    /// The load at which sum(weights . q) = target along the response (its loaded set taken
+    /// as holding), or None when the weights do not move.
+    pub fn load_at_target(&self, weights: &[f64], target: f64) -> Option<f64> {
+        let t0: f64 = weights.iter().zip(&self.q0).map(|(w, q)| w * q).sum();
+        let slope: f64 = weights.iter().zip(&self.v).map(|(w, x)| w * x).sum::<f64>() / self.sum_v;
+        if slope == 0.0 || !slope.is_finite() {
+            return None;
+        }
+        Some(self.load0 + (target - t0) / slope)
     }
 
     /// Whether the free cells keep their state under `q` (given the caps of `problem`).
