@@ -8,21 +8,10 @@ use super::{residuals_at_load, Problem, Solution, SolverSettings};
 /// (the complementarity problem is then linear): with K_AA v = 1 on the loaded set A,
 /// q(W) = q0 + (W - W0) v / sum(v) and alpha(W) = alpha0 + (W - W0) / sum(v).
 /// Finds the load at which sum(weights . q) = target and returns that solution and load, with
-/// the response (reusable for other weights while its loaded set holds), or None when the
-/// loaded set would change (a load turning negative or a gap closing), or CG fails.
-pub fn affine_load_update(
-    problem: &Problem,
-    solution: &Solution,
-    weights: &[f64],
-    target: f64,
-    settings: &SolverSettings,
-) -> Option<(Solution, f64, LoadResponse)> {
-    affine_step(problem, solution, weights, target, settings).ok()
-}
-
-/// [`affine_load_update`], or where the loaded set would change, the load the step predicts
-/// (its loaded set taken as holding: near the balance when few cells change; None when the
-/// response cannot be computed or the weights do not move).
+/// the response (reusable for other weights while its loaded set holds). Where the loaded set
+/// would change (a load turning negative or a gap closing) it returns the load the step
+/// predicts with its loaded set taken as holding (near the balance when few cells change),
+/// and None when CG fails or the weights do not move.
 pub fn affine_step(
     problem: &Problem,
     solution: &Solution,
