@@ -311,6 +311,25 @@ struct Balanced {
 }
 
 impl Balanced {
+    /// The balance's solution `sol` with its friction `mu` on the cells' `sliding`: torques
+    /// under the (worm, wheel) torque weights and the friction's worm torque at the worm speed
+    /// `omega1` (rad/s).
+    fn with_friction(
+        cells: &[LocalCell],
+        sol: solver::Solution,
+        (mu, sliding): (Vec<f64>, &[CellSliding]),
+        (worm_weights, wheel_weights): (&Vec<f64>, &Vec<f64>),
+        omega1: f64,
+    ) -> Self {
+        Self {
+            worm: torque_of(worm_weights, &sol.q),
+            wheel: torque_of(wheel_weights, &sol.q),
+            friction_torque: friction_worm_torque(cells, &sol.q, (&mu, sliding), omega1),
+            solution: sol,
+            friction: mu,
+        }
+    }
+
     fn frictionless(solution: solver::Solution, worm: f64, wheel: f64, cells: usize) -> Self {
         Self {
             solution,
@@ -403,15 +422,12 @@ fn balance_with_friction(
                 }
             }
         }
-        let omega1 = friction.gear.conditions.worm_speed;
-        let friction_torque = friction_worm_torque(cells, &sol.q, (&mu, &sliding), omega1);
-        return Ok(Balanced {
-            worm: torque_of(&worm_weights, &sol.q),
-            wheel: torque_of(&wheel_weights, &sol.q),
-            solution: sol,
-            friction: mu,
-            friction_torque,
-        });
+        let (omega1, torques) = (
+            friction.gear.conditions.worm_speed,
+            (&worm_weights, &wheel_weights),
+        );
+        let with = (mu, &sliding[..]);
+        return Ok(Balanced::with_friction(cells, sol, with, torques, omega1));
     }
     unreachable!("the last friction update returns")
 }
