@@ -5,7 +5,7 @@ use std::process::Command;
 
 // The library tests' helpers (the skipped-test log).
 #[allow(dead_code)]
-#[path = "../../wormwear/tests/common/mod.rs"]
+#[path = "../../wormwear/tests/suite/common.rs"]
 mod common;
 use common::skipped;
 

@@ -80,7 +80,7 @@ impl PatternShape {
 /// across the face does not jump when the flanks change a little (the covariance of the nodes'
 /// contact moments with z over the whole flank, used before, is near zero on a conjugate flank
 /// and flipped between cutting settings 0.1 mm apart). Within a localised pattern the contact
-/// lines sweep the face from the entering side to the leaving side (tests/tca.rs).
+/// lines sweep the face from the entering side to the leaving side (tests/suite/tca.rs).
 pub fn entry_at_low_z(
     worm: &crate::geometry::ThreadSurface,
     placement: &crate::input::Placement,

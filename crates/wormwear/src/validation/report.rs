@@ -179,7 +179,7 @@ fn one_state_pressures(m: &mut String, results: &Results) {
              13.7 GPa; two solver versions agreeing to 1e-10 ended case B at P_max 2392 and \
              14 323 MPa, BENCHMARKS.md session 9); bounded by the flow pressure, every pressure \
              of case B's states agrees within 1 % between solver tolerances 1e-8 and 1e-11 \
-             (tests/plastic.rs). The backlash does not jump (largest change between two of \
+             (tests/suite/plastic.rs). The backlash does not jump (largest change between two of \
              those states {:.2} um).",
             tail.len(),
             at(0.5),

@@ -1,4 +1,4 @@
-"""Two STEP solids as OpenCASCADE (gmsh) sees them together, for tests/cad.rs.
+"""Two STEP solids as OpenCASCADE (gmsh) sees them together, for tests/suite/cad.rs.
 
 usage: step_assembly.py A.step B.step  -> prints JSON on stdout:
   {"intersection": volume common to both (mm^3), "distance": least distance between them (mm)}

@@ -1,4 +1,4 @@
-"""Reads a STEP file with OpenCASCADE (through gmsh's Python package) for tests/cad.rs.
+"""Reads a STEP file with OpenCASCADE (through gmsh's Python package) for tests/suite/cad.rs.
 
 usage: step_reader.py FILE.step REQUEST.json  -> prints JSON on stdout
 

@@ -1,7 +1,7 @@
 //! The safety table from the model (MODEL §9.1): trends with torque and required life, the
 //! application factor as a torque factor, and the rows that need an input saying so.
 
-mod common;
+use crate::common;
 
 use wormwear::input::{BendingKind, GearSet, SafetyInputs};
 use wormwear::safety::{SafetyTable, Verdict};

@@ -2,7 +2,7 @@
 //! mesh, linear in the loads, close to linear in the torque, converged under refinement inside
 //! the face, and a fillet that does not fit refused with the input named.
 
-mod common;
+use crate::common;
 
 use wormwear::bending::fe::element_stiffness;
 use wormwear::bending::fe::Elastic;

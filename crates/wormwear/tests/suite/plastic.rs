@@ -2,7 +2,7 @@
 //! against an independent bounded solver (Tamaas' KatoSaturated), a flat punch whose edge is
 //! bounded at the flow pressure at every refinement, and running-in on the gear.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 use std::process::{Command, Stdio};

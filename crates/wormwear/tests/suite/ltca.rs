@@ -41,7 +41,7 @@ fn equilibrium_and_complementarity_hold() {
     // points; with sharp edges the worm's tip edge touches too (not a conjugate point), so it
     // is checked on the relieved gear, where the edges are eased out of contact.
     // Frictionless pressures (the published reading, MODEL §5.2), so that T2 = u T1; the
-    // transmitted torque's balances are tests/torque_balance.rs'.
+    // transmitted torque's balances are tests/suite/torque_balance.rs'.
     for (mut g, conjugate_only) in [
         (example("gear-1x40-design.toml"), false),
         (relieved("gear-1x40-design.toml"), true),

@@ -2,8 +2,7 @@
 //! sum against a hand computation from each bin's equivalent pressures, the wear of a frozen
 //! flank linear in the shares, and the spectrum's file input.
 
-mod common;
-use common::example;
+use crate::common::example;
 use wormwear::input::{self, BendingKind, GearSet, StepControl, WearPlan};
 use wormwear::{Request, Source, Stage};
 

@@ -2,7 +2,7 @@
 //! the friction's power is the power of its moments about the two axes (energy), no friction
 //! leaves no loss, and the contact's efficiency beside ISO/TR 14521's.
 
-mod common;
+use crate::common;
 
 use wormwear::friction::{heat_balance, MeshContacts};
 use wormwear::geometry::{Geometry, WheelFlank};
@@ -233,7 +233,7 @@ fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
 /// factors Y at 1: mu_0T itself). Prints the table of VALIDATION.md (e); asserts the physics
 /// that does not depend on the constants: the friction falls with the sliding speed as
 /// ISO's does (the film grows), the asperities' share falls with it, and the torques carry
-/// the contact's own efficiency. Run: cargo test --release --test friction -- --ignored
+/// the contact's own efficiency. Run: cargo test --release -p wormwear --test suite friction:: -- --ignored
 #[test]
 #[ignore]
 fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {

@@ -2,7 +2,7 @@
 //! analytic circle, the wheel's face-end chamfer by its 45 deg line; a vanishing radius gives
 //! the sharp results; bad radii and chamfers are refused by name.
 
-mod common;
+use crate::common;
 
 use wormwear::geometry::{Flank, Geometry};
 use wormwear::input::{self, BendingKind, GearSet};

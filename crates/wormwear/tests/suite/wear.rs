@@ -1,8 +1,7 @@
 //! Wear over life (MODEL §7): per-cycle Archard wear on the flank, its convergence with the
 //! number of positions, consistency of the Archard law with the geometry frozen, backlash.
 
-mod common;
-use common::{example, Bench};
+use crate::common::{example, Bench};
 use wormwear::geometry::Geometry;
 use wormwear::input::{FilmLoad, GearSet};
 use wormwear::kinematics;

@@ -2,8 +2,8 @@
 //! own run-in roughness; a run-in flank rubs less; the constant-roughness limit gives the
 //! published model's records byte for byte; bad inputs are refused by name.
 
-mod common;
-use common::{example, Bench};
+use crate::common;
+use crate::common::{example, Bench};
 use wormwear::friction::MeshContacts;
 use wormwear::geometry::FlankField;
 use wormwear::input::{self, BendingKind, FilmLoad, GearSet, RunningIn, TorqueBalance};

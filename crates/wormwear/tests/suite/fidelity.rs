@@ -1,9 +1,9 @@
 //! The published model is the default (MODEL §12 g-m), each refinement an option: tests of
 //! every restored choice against an independent truth, and of every option on and off.
 
-mod common;
+use crate::common;
 
-use common::example;
+use crate::common::example;
 use std::f64::consts::PI;
 use wormwear::geometry::Geometry;
 use wormwear::input::{FilmLoad, GearSet, Phase, PitDepth};

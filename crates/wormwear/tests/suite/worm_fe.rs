@@ -2,8 +2,7 @@
 //! (volume), shaft bending against Timoshenko beam theory, the glued seam, interpolation of the
 //! bending coefficients off the fit grid, reciprocity.
 
-mod common;
-use common::example;
+use crate::common::example;
 use std::f64::consts::PI;
 use wormwear::bending::fe::{element_volume, Elastic, Load};
 use wormwear::bending::worm_mesh::{

@@ -2,8 +2,7 @@
 //! the disk cache (reused when unchanged, never stale), the LTCA with bending against the LTCA
 //! without it; heavier studies (1/40, 7 vs 13 width points) are ignored tests, run by hand.
 
-mod common;
-use common::example;
+use crate::common::example;
 use wormwear::bending::model::{build_in, cache_key, Origin};
 use wormwear::bending::worm_deflection::compliance_in;
 use wormwear::geometry::Geometry;

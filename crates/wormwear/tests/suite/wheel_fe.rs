@@ -1,8 +1,7 @@
 //! Finite-element model of the wheel sector built from the generated flanks: geometry
 //! (volume), convergence of the tooth compliance, CalculiX on the same mesh.
 
-mod common;
-use common::example;
+use crate::common::example;
 use std::f64::consts::PI;
 use wormwear::bending::fe::{element_volume, solve, Elastic, Load};
 use wormwear::bending::wheel_mesh::{sector_mesh, SectorMesh, SectorMeshSettings};

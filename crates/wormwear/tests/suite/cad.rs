@@ -5,9 +5,9 @@
 //! (gmsh's Python package) reading the STEP files: one solid, our volume, our face areas, and
 //! the flank grid's envelope points on its surfaces.
 
-mod common;
+use crate::common;
 
-use common::{example, skipped};
+use crate::common::{example, skipped};
 use wormwear::cad::section_solid::FaceKind;
 use wormwear::cad::wheel::{wheel_part, WheelRequest};
 use wormwear::cad::worm::worm_part;
@@ -379,7 +379,7 @@ fn the_worn_wheel_shows_the_asked_map_state_or_the_last_with_a_warning() {
 }
 
 /// Heavy (about a minute: OpenCASCADE's boolean intersection of B-spline solids): run with
-/// `cargo test -p wormwear --test cad -- --ignored`.
+/// `cargo test -p wormwear --test suite cad:: -- --ignored`.
 #[test]
 #[ignore]
 fn the_worm_and_the_wheel_assemble_touching_without_overlap() {

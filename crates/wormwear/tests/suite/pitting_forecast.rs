@@ -3,8 +3,8 @@
 //! at the curve's life; a cell worn faster than it is damaged never pits) are the unit tests of
 //! `wormwear::pitting`.
 
-mod common;
-use common::Bench;
+use crate::common;
+use crate::common::Bench;
 use wormwear::input::{GearSet, Phase, Pitting};
 use wormwear::wear;
 

@@ -2,7 +2,7 @@
 //! results: torsion and thrust of the fixed-end segment, a Timoshenko cantilever with a rigid
 //! hub arm, a propped cantilever (statically indeterminate) derived by compatibility.
 
-mod common;
+use crate::common;
 use std::f64::consts::PI;
 use wormwear::bending::wheel_shaft::WheelShaft;
 

@@ -4,7 +4,7 @@
 //! efficiency of a screw with uniform friction, T1 -> T2 -> T1, and the mesh loss under a finer
 //! contact mesh.
 
-mod common;
+use crate::common;
 
 use wormwear::friction::MeshContacts;
 use wormwear::input::{BendingKind, FrictionLaw, GearSet, Torque, TorqueBalance};
