@@ -281,12 +281,20 @@ pub fn solve(
     }
 }
 
-/// Starting point: the given one if usable, else the load spread over the cells whose initial
-/// separation is within a small band of the smallest.
+/// Starting point: the given one if usable (scaled to the problem's load; cells at their caps
+/// kept there and the others scaled to the rest, where they leave a rest), else the load
+/// spread over the cells whose initial separation is within a small band of the smallest.
 fn initial(problem: &Problem, warm: Option<&[f64]>) -> Vec<f64> {
     let n = problem.len();
     if let Some(w) = warm {
         if w.len() == n && w.iter().any(|&v| v > 0.0) {
+            if let Some(start) = problem
+                .upper
+                .as_ref()
+                .and_then(|cap| capped_start(w, cap, problem.load))
+            {
+                return start;
+            }
             let s: f64 = w.iter().sum();
             return w.iter().map(|&v| v.max(0.0) * problem.load / s).collect();
         }
@@ -314,6 +322,37 @@ fn initial(problem: &Problem, warm: Option<&[f64]>) -> Vec<f64> {
         .iter()
         .map(|&c| if c { problem.load / count as f64 } else { 0.0 })
         .collect()
+}
+
+/// The warm start `w` at the load `load` with its cells at their caps `cap` kept there and the
+/// others scaled to the rest; None where no cell is capped or the capped ones carry the load.
+fn capped_start(w: &[f64], cap: &[f64], load: f64) -> Option<Vec<f64>> {
+    let held = |i: usize| at_cap(w[i], cap[i]);
+    let capped: f64 = (0..w.len()).filter(|&i| held(i)).map(|i| cap[i]).sum();
+    let free: f64 = (0..w.len())
+        .filter(|&i| !held(i))
+        .map(|i| w[i].max(0.0))
+        .sum();
+    if capped == 0.0 || free <= 0.0 || capped >= load {
+        return None;
+    }
+    let scale = (load - capped) / free;
+    Some(
+        (0..w.len())
+            .map(|i| {
+                if held(i) {
+                    cap[i]
+                } else {
+                    w[i].max(0.0) * scale
+                }
+            })
+            .collect(),
+    )
+}
+
+/// Whether a cell's load `q` sits at its cap `cap` (to round-off), N m.
+fn at_cap(q: f64, cap: f64) -> bool {
+    q > 0.0 && q >= cap * (1.0 - 1e-12)
 }
 
 /// Refuses bounds that let the reachable cells carry no more than the load.

@@ -2,7 +2,8 @@
 //! flow-pressure bounds of the plastic contact (MODEL §5.7).
 
 use super::{
-    active_set, check_capacity, initial, Problem, Solution, SolverError, SolverKind, SolverSettings,
+    active_set, at_cap, check_capacity, initial, Problem, Solution, SolverError, SolverKind,
+    SolverSettings,
 };
 
 /// Polonsky-Keer conjugate gradient, with optional caps q <= c (elastic-perfectly-plastic
@@ -34,36 +35,20 @@ pub(super) fn conjugate_gradient(
         };
     };
     check_capacity(problem, cap)?;
-    let mut fixed = vec![false; n];
+    // A warm start's cells at their caps start fixed there (a warm start from a capped
+    // solution otherwise first solved the elastic problem without them, 100-170 iterations,
+    // and then the capped one); a fixed cell whose gap opens is freed as from any start.
+    let mut fixed: Vec<bool> = match warm.filter(|w| w.len() == n) {
+        Some(w) => (0..n).map(|i| at_cap(w[i], cap[i])).collect(),
+        None => vec![false; n],
+    };
     let mut q = q0;
     let mut iterations = 0;
     for _ in 0..200 {
-        // Loads for this pass: fixed cells at their caps, the others scaled to the rest.
-        for i in 0..n {
-            if fixed[i] {
-                q[i] = cap[i];
-            }
-        }
-        let rest = problem.load - (0..n).filter(|&i| fixed[i]).map(|i| cap[i]).sum::<f64>();
-        let free: f64 = (0..n).filter(|&i| !fixed[i]).map(|i| q[i]).sum();
-        if rest <= 0.0 {
+        if !pass_loads(problem, cap, &fixed, &mut q) {
             // Too many fixed: free the one with the largest gap... or all, and retry.
             fixed.iter_mut().for_each(|f| *f = false);
             continue;
-        }
-        if free > 0.0 {
-            for i in 0..n {
-                if !fixed[i] {
-                    q[i] *= rest / free;
-                }
-            }
-        } else {
-            let open: Vec<usize> = (0..n)
-                .filter(|&i| !fixed[i] && problem.separation[i].is_finite())
-                .collect();
-            for &i in &open {
-                q[i] = rest / open.len() as f64;
-            }
         }
         let pk_budget = (settings.max_iterations / 10).max(1);
         let mut sol = solve_with_fixed(problem, settings, q.clone(), &fixed, pk_budget)?;
@@ -88,6 +73,34 @@ pub(super) fn conjugate_gradient(
     Err(SolverError::Invalid(
         "the plastic (capped) set of the contact did not settle in 200 passes".into(),
     ))
+}
+
+/// Loads for a pass of [`conjugate_gradient`]'s outer active set: the `fixed` cells at their
+/// caps, the others scaled to the rest of the load (spread evenly over the reachable ones when
+/// they carry none). False, with `q` unchanged, where the fixed cells' caps take the whole load.
+fn pass_loads(problem: &Problem, cap: &[f64], fixed: &[bool], q: &mut [f64]) -> bool {
+    let n = q.len();
+    let rest = problem.load - (0..n).filter(|&i| fixed[i]).map(|i| cap[i]).sum::<f64>();
+    if rest <= 0.0 {
+        return false;
+    }
+    for i in (0..n).filter(|&i| fixed[i]) {
+        q[i] = cap[i];
+    }
+    let free: f64 = (0..n).filter(|&i| !fixed[i]).map(|i| q[i]).sum();
+    if free > 0.0 {
+        for i in (0..n).filter(|&i| !fixed[i]) {
+            q[i] *= rest / free;
+        }
+    } else {
+        let open: Vec<usize> = (0..n)
+            .filter(|&i| !fixed[i] && problem.separation[i].is_finite())
+            .collect();
+        for &i in &open {
+            q[i] = rest / open.len() as f64;
+        }
+    }
+    true
 }
 
 /// The problem with the cells `fixed` held at their loads in `q0` (the capped cells of
