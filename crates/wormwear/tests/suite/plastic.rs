@@ -207,6 +207,53 @@ fn both_solvers_carry_the_bound_and_agree() {
 }
 
 #[test]
+fn a_warm_start_at_the_bound_reaches_the_cold_solution_at_any_load() {
+    // A warm start holds its cells at the bound fixed there and frees those whose gaps open:
+    // from its own solution the solve is immediate, and from a solution at another load (up,
+    // where more cells reach the bound; down, where some leave it) it reaches the cold solve's
+    // loads, with the bounded complementarity.
+    let (cells, elastic, p0, _) = sphere(24, 2.8);
+    let settings = SolverSettings {
+        kind: SolverKind::ConjugateGradient,
+        tolerance: 1e-11,
+        max_iterations: 200_000,
+    };
+    let problem = bounded(&elastic, &cells, 0.7 * p0);
+    let base = solve(&problem, &settings, None).unwrap();
+    let again = solve(&problem, &settings, Some(&base.q)).unwrap();
+    let differ = |a: &Solution, b: &Solution| {
+        a.q.iter()
+            .zip(&b.q)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(differ(&base, &again) < 1e-9 * problem.load);
+    assert!(
+        again.residuals.iterations <= 3,
+        "{} iterations from the solution itself",
+        again.residuals.iterations
+    );
+    for factor in [1.4, 0.9, 0.4] {
+        let other = Problem {
+            load: factor * problem.load,
+            ..problem.clone()
+        };
+        let cold = solve(&other, &settings, None).unwrap();
+        let warm = solve(&other, &settings, Some(&base.q)).unwrap();
+        assert_bounded_complementarity(&warm, &cells, 0.7 * p0, other.load);
+        eprintln!(
+            "load x {factor}: {} cells at the bound (from {}), {} iterations warm, {} cold",
+            warm.residuals.capped,
+            base.residuals.capped,
+            warm.residuals.iterations,
+            cold.residuals.iterations
+        );
+        assert_eq!(warm.residuals.capped, cold.residuals.capped);
+        assert!(differ(&cold, &warm) < 1e-8 * other.load, "load x {factor}");
+    }
+}
+
+#[test]
 fn a_flat_punch_edge_is_bounded_at_the_flow_pressure_at_every_refinement() {
     // A rigid flat square punch (half side c, the cells exactly covering it) on the bronze at a
     // mean pressure of 0.5 p_Y: the elastic edge pressure is singular (as 1 / sqrt of the
