@@ -264,20 +264,36 @@ fn balance_worm_torque(
                     }
                     continue;
                 }
-                Err(load) => predicted = load.filter(|l| l.is_finite() && *l > 0.0),
+                Err(loads) => {
+                    predicted = loads.filter(|l| l.load.is_finite() && l.load > 0.0);
+                }
             }
         }
         // Where the loaded set changes, the next solve is at the load the affine step predicts
-        // (few cells change near the balance), else at the secant's.
-        let next =
-            predicted.unwrap_or_else(|| next_wheel_torque(previous, (problem.load, worm), target));
+        // (few cells change near the balance), from its loads (those leaving the set cut at
+        // zero and at their caps), else at the secant's from this solution.
+        let (next, start) = match predicted {
+            Some(loads) => (loads.load, within_bounds(loads.q, problem)),
+            None => (
+                next_wheel_torque(previous, (problem.load, worm), target),
+                sol.q.clone(),
+            ),
+        };
         previous = Some((problem.load, worm));
-        problem.load = next;
-        warm = Some(sol.q.clone());
+        (problem.load, warm) = (next, Some(start));
         solution = Some((sol, worm));
     }
     let (sol, worm) = solution.expect("at least one solve");
     Ok((sol, worm, response))
+}
+
+/// The loads `q` (N m) cut at zero and at `problem`'s caps.
+fn within_bounds(mut q: Vec<f64>, problem: &Problem) -> Vec<f64> {
+    for (i, v) in q.iter_mut().enumerate() {
+        let cap = problem.upper.as_ref().map_or(f64::INFINITY, |u| u[i]);
+        *v = v.clamp(0.0, cap);
+    }
+    q
 }
 
 /// Where a torque balance starts: the warm start's loads for its first solve, or that solve's

@@ -9,19 +9,23 @@ use super::{residuals_at_load, Problem, Solution, SolverSettings};
 /// q(W) = q0 + (W - W0) v / sum(v) and alpha(W) = alpha0 + (W - W0) / sum(v).
 /// Finds the load at which sum(weights . q) = target and returns that solution and load, with
 /// the response (reusable for other weights while its loaded set holds). Where the loaded set
-/// would change (a load turning negative or a gap closing) it returns the load the step
-/// predicts with its loaded set taken as holding (near the balance when few cells change),
-/// and None when CG fails or the weights do not move.
+/// would change (a load turning negative or a gap closing) it returns the loads the step
+/// predicts with its loaded set taken as holding (near the balance when few cells change;
+/// loads below zero among them), and None when CG fails or the weights do not move.
 pub fn affine_step(
     problem: &Problem,
     solution: &Solution,
     weights: &[f64],
     target: f64,
     settings: &SolverSettings,
-) -> Result<(Solution, f64, LoadResponse), Option<f64>> {
+) -> Result<(Solution, f64, LoadResponse), Option<AffineLoads>> {
     let response = LoadResponse::of(problem, solution, settings).ok_or(None)?;
-    let predicted = response.load_at_target(weights, target);
-    let loads = response.at_target(weights, target).ok_or(predicted)?;
+    let predicted = response
+        .load_at_target(weights, target)
+        .map(|load| response.loads_at(load));
+    let Some(loads) = response.at_target(weights, target) else {
+        return Err(predicted);
+    };
     let load = loads.load;
     match response.solution(problem, loads, settings) {
         Some(s) => Ok((s, load, response)),
@@ -83,6 +87,12 @@ impl LoadResponse {
     /// loaded set (its load turning negative or reaching its cap) or the weights do not move.
     pub fn at_target(&self, weights: &[f64], target: f64) -> Option<AffineLoads> {
         let load = self.load_at_target(weights, target)?;
+        Some(self.loads_at(load)).filter(|l| self.holds(&l.q, None))
+    }
+
+    /// The loads along the response at the load `load` (N m), its loaded set taken as holding
+    /// (loads may turn negative).
+    pub fn loads_at(&self, load: f64) -> AffineLoads {
         let dw = load - self.load0;
         let q: Vec<f64> = self
             .q0
@@ -90,12 +100,11 @@ impl LoadResponse {
             .zip(&self.v)
             .map(|(q, x)| q + dw * x / self.sum_v)
             .collect();
-        Some(AffineLoads {
+        AffineLoads {
             q,
             load,
             approach: self.approach0 + dw / self.sum_v,
-        })
-        .filter(|l| self.holds(&l.q, None))
+        }
     }
 
     /// The load at which sum(weights . q) = target along the response (its loaded set taken
