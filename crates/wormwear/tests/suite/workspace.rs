@@ -4,6 +4,7 @@
 //! compiled again with everything above it (faer, the wormwear library): about two minutes of
 //! the test command on the 2-core box, which the house's 15-minute budget does not hold.
 
+use crate::common::skipped;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
@@ -11,7 +12,12 @@ use std::process::Command;
 /// Each package's enabled features as `cargo tree` resolves them for `args`: "name version"
 /// -> "feature,feature", or None where cargo cannot be run here (then the check is skipped).
 fn resolved_features(args: &[&str]) -> Option<BTreeMap<String, String>> {
-    let cargo = std::env::var_os("CARGO")?;
+    const TEST: &str =
+        "workspace::the_python_module_builds_its_dependencies_with_the_test_builds_features";
+    let Some(cargo) = std::env::var_os("CARGO") else {
+        skipped(TEST, "not run by cargo (no CARGO in the environment)");
+        return None;
+    };
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let out = Command::new(cargo)
         .current_dir(root)
@@ -28,10 +34,11 @@ fn resolved_features(args: &[&str]) -> Option<BTreeMap<String, String>> {
         .output()
         .ok()?;
     if !out.status.success() {
-        eprintln!(
-            "SKIPPED: cargo tree failed: {}",
+        let reason = format!(
+            "cargo tree failed: {}",
             String::from_utf8_lossy(&out.stderr)
         );
+        skipped(TEST, reason.trim());
         return None;
     }
     let text = String::from_utf8(out.stdout).unwrap();
