@@ -4,8 +4,11 @@
 use super::{conjugate_gradient, initial, Problem, Solution, SolverError, SolverSettings};
 
 /// The screened solve's candidates: the cells the warm start loads and this many times as many
-/// of the others, those with the smallest gaps under the warm start.
-pub(super) const SCREEN_EXTRA: usize = 1;
+/// of the others, those with the smallest gaps under the warm start. Half as many: on the
+/// design life a second pass (a cell outside penetrating) came in 1 of 727 solves, and the
+/// candidates stayed below half the band in nearly all (with as many, a third of the solves
+/// fell back to the whole band; BENCHMARKS.md session 40).
+pub(super) const SCREEN_EXTRA: f64 = 0.5;
 
 /// The warm-started solve on a screened set of cells: the loaded set moves little from one
 /// wear state to the next (MODEL §7.5), so PK runs on the cells the warm start loads or nearly
@@ -30,7 +33,7 @@ pub(super) fn screened_passes(
     problem: &Problem,
     settings: &SolverSettings,
     warm: &[f64],
-    extra: usize,
+    extra: f64,
 ) -> Result<(Solution, usize), SolverError> {
     let n = problem.len();
     let e = &problem.separation;
@@ -55,7 +58,11 @@ pub(super) fn screened_passes(
             .collect()
     };
     let mut inside: Vec<bool> = q.iter().map(|&v| v > 0.0).collect();
-    add_closest(&mut inside, &gaps(&u, sum / count as f64), extra * count);
+    add_closest(
+        &mut inside,
+        &gaps(&u, sum / count as f64),
+        (extra * count as f64).ceil() as usize,
+    );
     screened_from(problem, settings, q, inside)
 }
 
