@@ -127,8 +127,6 @@ impl Sample {
 /// centroid gives way to its line crossing in a passage ([`Sample::centre_beside`]).
 pub(crate) const NEGLIGIBLE_LOAD: f64 = 1e-6;
 
-impl Sample {}
-
 /// The band's instants on each node column of the loaded flank `wf` (index j = 0..=nj), from
 /// the loaded analysis' positions: unsorted; `tau` is the wheel's tooth pitch angle, rad.
 pub(crate) fn band_samples(
