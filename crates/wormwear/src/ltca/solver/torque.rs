@@ -174,7 +174,7 @@ fn unit_load_response(
     let set: Vec<usize> = (0..problem.len()).filter(|&i| active[i]).collect();
     let restricted = problem.restrict(&set);
     let m = set.len();
-    let preconditioner = BlockPreconditioner::new(&restricted, &vec![true; m]);
+    let preconditioner = BlockPreconditioner::new(&restricted);
     let mut w = vec![0.0; m];
     let mut r = vec![1.0; m];
     let mut z = vec![0.0; m];
@@ -244,20 +244,20 @@ fn gaps_if_the_set_holds(
     Some(gap)
 }
 
-/// Block-Jacobi preconditioner: Cholesky factors of each contact block restricted to a set of
-/// unknowns (identity where a factorisation fails).
+/// Block-Jacobi preconditioner: Cholesky factors of each contact block (identity where a
+/// factorisation fails).
 pub(super) struct BlockPreconditioner {
     parts: Vec<(Vec<usize>, Option<faer::linalg::solvers::Llt<f64>>)>,
 }
 
 impl BlockPreconditioner {
-    fn new(problem: &Problem, set: &[bool]) -> Self {
+    fn new(problem: &Problem) -> Self {
         use rayon::prelude::*;
         let parts = problem
             .blocks
             .par_iter()
             .map(|b| {
-                let idx: Vec<usize> = (b.start..b.start + b.size).filter(|&i| set[i]).collect();
+                let idx: Vec<usize> = (b.start..b.start + b.size).collect();
                 let rows: Vec<&[f64]> = idx.iter().map(|&i| b.row(i - b.start)).collect();
                 let m = faer::Mat::from_fn(idx.len(), idx.len(), |r, c| rows[r][idx[c] - b.start]);
                 let llt = (!idx.is_empty())
@@ -269,7 +269,7 @@ impl BlockPreconditioner {
         Self { parts }
     }
 
-    /// z = M^-1 r on the set (r outside the set is ignored, z there is 0).
+    /// z = M^-1 r.
     fn apply(&self, r: &[f64], z: &mut [f64]) {
         use faer::linalg::solvers::Solve;
         z.iter_mut().for_each(|v| *v = 0.0);
