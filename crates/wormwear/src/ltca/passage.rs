@@ -1,8 +1,8 @@
 //! The loaded band's passage over the wheel flank (MODEL §5.6, §7.2): on each node column of
 //! the global grid, the pressure profiles across the contact line of every (position, tooth),
 //! as instants of the reference tooth's engagement (tooth k at wheel rotation theta2 is the
-//! reference tooth at theta2 + sigma k tau). Between consecutive instants the band is moved
-//! continuously from one centroid to the next with its shape blended: the per-cycle wear
+//! reference tooth at theta2 + sigma k tau). Between consecutive instants each instant's band
+//! moves with the contact line, their shapes blended: the per-cycle wear
 //! integrates the pressure over that passage, the loaded pattern takes its maximum, so neither
 //! depends on where the positions happen to fall.
 
@@ -11,14 +11,12 @@ use crate::geometry::WheelFlank;
 use crate::kinematics::Tca;
 
 /// One instant of the contact band's passage over a node column: the pressure profile across
-/// the line (cell centres' radii, ascending, and pressures), its centroid, line load and the
+/// the line (cell centres' radii, ascending, and pressures), its line crossing, line load and the
 /// band's curvature.
 #[derive(Debug, Clone)]
 pub(crate) struct Sample {
     /// Time of the reference tooth, as driven wheel rotation (sigma theta2_ref), rad.
     pub(crate) time: f64,
-    /// Pressure centroid (the TCA line crossing when unloaded), m.
-    pub(crate) centre: f64,
     /// The contact line's crossing of the node column (the band's middle), m.
     pub(crate) line: f64,
     pub(crate) profile: Vec<(f64, f64)>,
@@ -104,28 +102,7 @@ impl Sample {
             _ => 0.0,
         }
     }
-
-    /// Where the band of this instant is taken to sit in a passage with the instant `other`
-    /// (m): its pressure centroid, drawn to its line crossing as its load vanishes beside the
-    /// other's, (W c + w0 r_line) / (W + w0) with w0 = [`NEGLIGIBLE_LOAD`] times the larger
-    /// line load. The centroid of a vanishing load is wherever its last loaded cells happen to
-    /// be (one edge cell at 1e-12 of the load, or none): taken as such, the passage's path, and
-    /// the wear of the nodes it sweeps, jumped with a load at round-off level (BENCHMARKS.md
-    /// session 40); this is continuous in the loads and the centroid itself for loads above a
-    /// thousandth of the other's (to 1e-3 of a cell's offset).
-    pub(crate) fn centre_beside(&self, other: &Sample) -> f64 {
-        let reference = NEGLIGIBLE_LOAD * self.line_load.max(other.line_load);
-        if reference <= 0.0 || !reference.is_finite() {
-            return self.centre;
-        }
-        let load = self.line_load.max(0.0);
-        (load * self.centre + reference * self.line) / (load + reference)
-    }
 }
-
-/// The line load, as a share of the other instant's, below which an instant's pressure
-/// centroid gives way to its line crossing in a passage ([`Sample::centre_beside`]).
-pub(crate) const NEGLIGIBLE_LOAD: f64 = 1e-6;
 
 /// The band's instants on each node column of the loaded flank `wf` (index j = 0..=nj), from
 /// the loaded analysis' positions: unsorted; `tau` is the wheel's tooth pitch angle, rad.
@@ -292,8 +269,6 @@ fn sample_of(
     last_column: usize,
 ) -> Sample {
     let load: f64 = cells.iter().map(|c| c.pressure * c.width).sum();
-    let moment: f64 = cells.iter().map(|c| c.r * c.pressure * c.width).sum();
-    let centre = if load > 0.0 { moment / load } else { line.r };
     let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
         (Some(a), Some(b)) => {
             let spacing = if b.column > a.column {
@@ -322,7 +297,6 @@ fn sample_of(
     Sample {
         half_width,
         time,
-        centre,
         line: line.r,
         extend_low,
         extend_high,
@@ -335,13 +309,15 @@ fn sample_of(
     }
 }
 
-/// The band's passage between two instants a, b of one engagement on a node column: the band
-/// translates from c_a to c_b (their centroids, [`Sample::centre_beside`]) while its shape
-/// blends from a's to b's.
+/// The band's passage between two instants a, b of one engagement on a node column: each
+/// instant's band moves with the contact line, from its crossing c_a to c_b, while the shape
+/// blends from a's to b's. A band keeps its offset from its line: an edge contact below the line
+/// (the worm's tip edge at the end of an engagement) stays near the edge, where moving it from
+/// one pressure centroid to the next swept it over the rows between (BENCHMARKS.md session 41).
 pub(crate) struct Passage<'a> {
     pub(crate) a: &'a Sample,
     pub(crate) b: &'a Sample,
-    /// Where each instant's band sits ([`Sample::centre_beside`]), m.
+    /// The instants' contact line crossings, m.
     ca: f64,
     cb: f64,
     /// The radii the band covers on the way, m.
@@ -358,7 +334,7 @@ impl<'a> Passage<'a> {
         if b.time - a.time > 1.5 * dt || (a.line_load <= 0.0 && b.line_load <= 0.0) {
             return None;
         }
-        let (ca, cb) = (a.centre_beside(b), b.centre_beside(a));
+        let (ca, cb) = (a.line, b.line);
         let reach = a.reach_about(ca).max(b.reach_about(cb));
         let width = (2.0 * reach).max(1e-9);
         Some(Passage {
@@ -491,7 +467,6 @@ mod tests {
     fn sample(profile: Vec<(f64, f64)>) -> Sample {
         Sample {
             time: 0.0,
-            centre: 0.1,
             line: 0.1,
             profile,
             plastic: Vec::new(),
@@ -533,12 +508,10 @@ mod tests {
                 .collect(),
         );
         b.line_load = b.profile.iter().map(|p| p.1 * width).sum();
-        b.centre = b.profile.iter().map(|p| p.0 * p.1 * width).sum::<f64>() / b.line_load;
         b.time = 1.0;
         if load > 0.0 {
             a.line_load = load * b.line_load;
             a.profile[10].1 = a.line_load / width;
-            a.centre = a.profile[10].0;
         }
         let passage = Passage::between(&a, &b, 1.0).expect("b is loaded");
         nodes
@@ -553,10 +526,9 @@ mod tests {
 
     #[test]
     fn a_passage_is_continuous_as_one_instant_s_load_vanishes() {
-        // The centroid of a vanishing load sits wherever its last loaded cell is (here the
-        // band's edge, 0.5 mm from the line): the passage must tend to the unloaded instant's
-        // (centred on its line) as that load goes to zero, not jump with a load at round-off
-        // level; and an instant with a real share of the load keeps its centroid.
+        // A vanishing load on the band's edge cell (0.5 mm from the line): the passage must
+        // tend to the unloaded instant's as that load goes to zero, not jump with a load at
+        // round-off level (the centroid of such a load sits wherever its last loaded cell is).
         let nodes: Vec<f64> = (0..21).map(|k| 0.0995 + 5e-5 * k as f64).collect();
         let unloaded = passage_integrals(0.0, &nodes);
         let scale = unloaded.iter().copied().fold(0.0, f64::max);
@@ -572,11 +544,30 @@ mod tests {
                 "load {tiny:e}: {worst:e} of {scale:e}"
             );
         }
-        let mut a = sample(vec![(0.1, 0.0), (0.1005, 1e8)]);
-        a.line_load = 1e4;
-        a.centre = 0.1005;
-        let mut b = sample(vec![(0.1, 5e8)]);
-        b.line_load = 5e4;
-        assert!((a.centre_beside(&b) - 0.1005).abs() < 1e-5 * 5e-4);
+    }
+
+    #[test]
+    fn an_edge_contact_below_its_line_is_not_swept_over_the_rows_between() {
+        // Instant a: a band on its line at 100 mm; instant b: the line 0.25 mm lower and the
+        // load on one edge cell 2.2 mm below it (the worm's tip edge at an engagement's end).
+        // Moving with the lines, b's edge load travels 0.25 mm about the edge: a row 1 mm above
+        // the edge and 1 mm below a's band gets nothing; the rows the edge does pass get it.
+        let cells: Vec<f64> = (0..5).map(|k| 0.0998 + 1e-4 * k as f64).collect();
+        let mut a = sample(cells.iter().map(|&r| (r, 5e8)).collect());
+        a.line_load = 5e8 * 5e-4;
+        let mut b = sample(vec![(0.09755, 1e9), (0.0983, 0.0)]);
+        b.line = 0.09975;
+        b.line_load = 1e9 * 1e-4;
+        b.time = 1.0;
+        let passage = Passage::between(&a, &b, 1.0).expect("both loaded");
+        let integral = |r: f64| {
+            (0..passage.steps)
+                .map(|m| passage.pressure(r, (m as f64 + 0.5) / passage.steps as f64))
+                .sum::<f64>()
+                / passage.steps as f64
+        };
+        assert_eq!(integral(0.09875), 0.0);
+        assert!(integral(0.0976) > 1e8, "{}", integral(0.0976));
+        assert!(integral(0.1) > 1e8);
     }
 }
