@@ -142,6 +142,14 @@ pub struct WearSpec {
     /// sub-steps, um (default 5; 0 disables).
     #[serde(default)]
     pub max_substep_wear_um: Option<f64>,
+    /// How a step's removal follows from the wear per cycle: "explicit" (default, the
+    /// published step) or "stabilised" (MODEL §7.3, `wear::stabilised`).
+    #[serde(default)]
+    pub step_scheme: Option<String>,
+    /// Error control of adaptive steps: largest local error of a step as a share of the wear
+    /// so far (default 0: off).
+    #[serde(default)]
+    pub step_tolerance: Option<f64>,
     /// Phase schedule (MODEL §8): wear and pitting phases, each until a number of cycles.
     #[serde(default)]
     pub phases: Vec<PhaseSpec>,

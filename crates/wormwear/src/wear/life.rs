@@ -1,11 +1,13 @@
 //! The life loop (MODEL §7.1, §7.5): wear steps with the geometry updated, the step control, the
-//! phases of the schedule, pitting between steps, the maps' states, and the checks that a plan can
-//! end and that a life does not stall.
+//! phases of the schedule, pitting between steps, the maps' states, and the check that a life
+//! does not stall (that a plan can end: [`super::limits`]).
 
 use super::spectrum::{spectrum_cycle_wear, spectrum_node_loads, BinRecord, BinStart};
+use super::stabilised::{self, stabilised_removal, NodeResponse};
 use super::{
     cut_pits, forecast, per_cycle, pit_depths, pitted_fraction, Backlash, CycleWear, Phase,
-    Pitting, PositionState, StepControl, StepRecord, WearError, WearLimits, WearPlan, WearState,
+    Pitting, PositionState, StepControl, StepRecord, StepScheme, WearError, WearLimits, WearPlan,
+    WearState,
 };
 use crate::friction::{heat_balance_from, MeshContacts, Thermal};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
@@ -51,7 +53,7 @@ pub fn simulate(
     on_state: &mut dyn FnMut(&StepView) -> Result<(), WearError>,
 ) -> Result<WearState, WearError> {
     fit_to_flank(&mut state, geo.wheel_flank(tca.loaded_flank))?;
-    check_plan_can_end(gear, life)?;
+    super::check_plan_can_end(gear, life)?;
     let life_loop = LifeLoop::new(gear, geo, tca, settings, bending, life)?;
     let mut step_cycles = state.records.last().map_or(0.0, |r| r.step_cycles);
     let mut substeps = state.records.last().map_or(0, |r| r.substeps);
@@ -61,6 +63,7 @@ pub fn simulate(
     state.records.retain(|r| r.step < state.step);
     let mut stalled = 0;
     let mut analysis = life_loop.analyse_state(&state)?;
+    let mut probes = life_loop.measure_response(&mut state, &analysis)?;
     loop {
         let a = analysis;
         life_loop.start_forecast_phase(&mut state, &a.loads);
@@ -73,6 +76,7 @@ pub fn simulate(
             (step_cycles, substeps),
         );
         record.bins = life_loop.bin_records(&a);
+        record.loaded_analyses += std::mem::take(&mut probes);
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
         state.stopped = life_loop.limits.passed(&record);
@@ -205,58 +209,13 @@ fn stalled_steps(stalled: usize, before: f64, state: &WearState) -> Result<usize
     Ok(stalled)
 }
 
+/// The largest removal of an error-controlled life's first step, and of the first after a
+/// pitting phase, where no estimate exists yet (the published adaptive step's, MODEL §7.3), m.
+pub const FIRST_CONTROLLED_REMOVAL: f64 = 4e-6;
+
 /// Consecutive steps that may leave the cycles where they were (a pitting phase's cut pits
 /// take none) before a life is stopped as stalled.
 const MAX_STALLED_STEPS: usize = 50;
-
-/// Most loaded analyses a life plan may need (a case B life needs ~2 700).
-pub const MAX_ANALYSES: f64 = 200_000.0;
-
-/// Refuses a plan whose step count has no practical bound: fixed steps of `life / step`
-/// states, or adaptive steps and sub-steps so small that wearing down to the standard's
-/// pointed-tip limit (MODEL §9 (a)), which no life passes, would take more than
-/// [`MAX_ANALYSES`] loaded analyses.
-pub fn check_plan_can_end(gear: &GearSet, life: &WearPlan) -> Result<(), WearError> {
-    let limit = crate::rating::rate(gear).wear_limit_pointed_tip_m;
-    let (what, count) = match life.step {
-        StepControl::Cycles(c) => (
-            format!(
-                "fixed steps of {c:e} cycles over {:e} cycles",
-                life.life_cycles
-            ),
-            life.life_cycles / c,
-        ),
-        StepControl::MaxRemoval(d) => (
-            format!(
-                "adaptive steps of {:e} um up to the pointed-tip wear limit of {:.3} mm",
-                d * 1e6,
-                limit * 1e3
-            ),
-            limit / d,
-        ),
-    };
-    let guard = life.max_substep_removal;
-    let (what, count) = if guard > 0.0 && limit / guard > count {
-        (
-            format!(
-                "sub-steps of at most {:e} um (max_substep_wear_um) up to the pointed-tip wear \
-                 limit of {:.3} mm",
-                guard * 1e6,
-                limit * 1e3
-            ),
-            limit / guard,
-        )
-    } else {
-        (what, count)
-    };
-    if count > MAX_ANALYSES {
-        return Err(WearError::Plan(format!(
-            "up to {count:.3e} loaded analyses could be needed ({what}), more than \
-             {MAX_ANALYSES:e}: use larger steps or a shorter life"
-        )));
-    }
-    Ok(())
-}
 
 /// What the life loop of [`simulate`] works with, and its named steps.
 struct LifeLoop<'a> {
@@ -490,6 +449,7 @@ impl<'a> LifeLoop<'a> {
         let (l, cw, loads) = (&a.ltca, &a.cycle, &a.loads);
         let end = match phase {
             Some((k, Phase::Pitting { .. }, end)) => {
+                state.rates_before = None;
                 let advanced = self.pitting_step(state, l, cw, loads, k, end);
                 return Ok((advanced, 1));
             }
@@ -508,12 +468,7 @@ impl<'a> LifeLoop<'a> {
                 left = left.min(n);
             }
         }
-        let rate = cw.depth.max();
-        let step_cycles = match self.life.step {
-            StepControl::Cycles(c) => c.min(left),
-            StepControl::MaxRemoval(d) if rate > 0.0 => (d / rate).min(left),
-            StepControl::MaxRemoval(_) => left,
-        };
+        let step_cycles = self.step_cycles(state, cw).min(left);
         let target = state.cycles + step_cycles;
         let substeps = self.wear_step(state, cw.clone(), step_cycles)?;
         // The sub-steps' sum lands on the step's end, and a step to a phase's end on that
@@ -525,6 +480,70 @@ impl<'a> LifeLoop<'a> {
         };
         loads.advance(&mut state.damage, step_cycles, true);
         Ok((step_cycles, substeps))
+    }
+
+    /// The cycles of a wear step from `state` at the wear per cycle `cw` (MODEL §7.3): fixed,
+    /// or removing at most the adaptive step's depth at the fastest node, and with the error
+    /// control (`wear::stabilised`) the last step's cycles grown or cut by its error estimate
+    /// (a first step, or the first after a pitting phase, removes at most
+    /// [`FIRST_CONTROLLED_REMOVAL`]). Sets the rates the next step's estimate starts from.
+    fn step_cycles(&self, state: &mut WearState, cw: &CycleWear) -> f64 {
+        let rate = cw.depth.max();
+        let patch = (self.settings.patch_across, self.settings.patch_along);
+        let now = stabilised::RateMeasures::of(&cw.depth, self.wf, patch);
+        let before = state.rates_before.replace(now);
+        let cap = match self.life.step {
+            StepControl::Cycles(c) => return c,
+            StepControl::MaxRemoval(d) if rate > 0.0 => d / rate,
+            StepControl::MaxRemoval(_) => return f64::INFINITY,
+        };
+        let tolerance = self.life.step_tolerance;
+        if tolerance <= 0.0 {
+            return cap;
+        }
+        // This state's record (the step that led here): a step's copy holds it last.
+        let last = state
+            .records
+            .last()
+            .filter(|r| r.step == state.step)
+            .map_or(0.0, |r| r.step_cycles);
+        let worn = stabilised::RateMeasures::of(&state.removal, self.wf, patch);
+        before
+            .and_then(|b| stabilised::controlled_cycles(last, (&b, &now), &worn, tolerance))
+            .unwrap_or(FIRST_CONTROLLED_REMOVAL / rate)
+            .min(cap)
+    }
+
+    /// The stabilised step's measured response of the wear to a node-scale removal
+    /// (`wear::stabilised`), on the life's first state `a` of `state`, unless the state has it
+    /// or the step is the explicit one. Returns the loaded analyses it took.
+    fn measure_response(
+        &self,
+        state: &mut WearState,
+        a: &StateAnalysis,
+    ) -> Result<usize, WearError> {
+        if self.life.scheme != StepScheme::Stabilised || state.node_response.is_some() {
+            return Ok(0);
+        }
+        let along = |height: bool| -> Result<Vec<f64>, WearError> {
+            let pattern = stabilised::probe_pattern(&state.removal, height);
+            let mut probe = state.clone();
+            for (h, d) in probe.removal.values.iter_mut().zip(&pattern) {
+                *h += d;
+            }
+            let b = self.analyse_state(&probe)?;
+            Ok(stabilised::response(
+                &a.cycle.depth,
+                &b.cycle.depth,
+                &pattern,
+            ))
+        };
+        let response = NodeResponse {
+            rows_per_m: along(true)?,
+            columns_per_m: along(false)?,
+        };
+        state.node_response = Some(response);
+        Ok(2 * self.bins.len())
     }
 
     /// Phase at some cycles: (index, phase, end); None after the schedule (wear).
@@ -850,8 +869,14 @@ impl<'a> LifeLoop<'a> {
             } else {
                 remaining
             };
-            for (h, dh) in state.removal.values.iter_mut().zip(&rate_map.depth.values) {
-                *h += dc * dh;
+            let removal = match (self.life.scheme, &state.node_response) {
+                (StepScheme::Stabilised, Some(r)) => {
+                    stabilised_removal(&rate_map.depth, self.wf, dc, r)
+                }
+                _ => rate_map.depth.values.iter().map(|dh| dc * dh).collect(),
+            };
+            for (h, dh) in state.removal.values.iter_mut().zip(&removal) {
+                *h += dh;
             }
             state.cycles += dc;
             remaining -= dc;

@@ -1,7 +1,10 @@
 //! The wear limits a life is checked against (MODEL §9 (a), (d)): the mean flank loss from the
 //! backlash increase, and the tooth left behind each node (a pointed tip).
 
-use super::{cycles_label, node_lever, node_pattern_pressure, LifeStop, StepRecord, WearPlan};
+use super::{
+    cycles_label, node_lever, node_pattern_pressure, LifeStop, StepControl, StepRecord, WearError,
+    WearPlan,
+};
 use crate::geometry::{FlankField, Geometry, WheelFlank};
 use crate::input::GearSet;
 use crate::kinematics::Tca;
@@ -180,4 +183,53 @@ fn tooth_thickness(geo: &Geometry, loaded: crate::geometry::Flank) -> Vec<f64> {
             delta * node_lever(wf, k)
         })
         .collect()
+}
+
+/// Most loaded analyses a life plan may need (a case B life needs ~2 700).
+pub const MAX_ANALYSES: f64 = 200_000.0;
+
+/// Refuses a plan whose step count has no practical bound: fixed steps of `life / step`
+/// states, or adaptive steps and sub-steps so small that wearing down to the standard's
+/// pointed-tip limit (MODEL §9 (a)), which no life passes, would take more than
+/// [`MAX_ANALYSES`] loaded analyses.
+pub fn check_plan_can_end(gear: &GearSet, life: &WearPlan) -> Result<(), WearError> {
+    let limit = crate::rating::rate(gear).wear_limit_pointed_tip_m;
+    let (what, count) = match life.step {
+        StepControl::Cycles(c) => (
+            format!(
+                "fixed steps of {c:e} cycles over {:e} cycles",
+                life.life_cycles
+            ),
+            life.life_cycles / c,
+        ),
+        StepControl::MaxRemoval(d) => (
+            format!(
+                "adaptive steps of {:e} um up to the pointed-tip wear limit of {:.3} mm",
+                d * 1e6,
+                limit * 1e3
+            ),
+            limit / d,
+        ),
+    };
+    let guard = life.max_substep_removal;
+    let (what, count) = if guard > 0.0 && limit / guard > count {
+        (
+            format!(
+                "sub-steps of at most {:e} um (max_substep_wear_um) up to the pointed-tip wear \
+                 limit of {:.3} mm",
+                guard * 1e6,
+                limit * 1e3
+            ),
+            limit / guard,
+        )
+    } else {
+        (what, count)
+    };
+    if count > MAX_ANALYSES {
+        return Err(WearError::Plan(format!(
+            "up to {count:.3e} loaded analyses could be needed ({what}), more than \
+             {MAX_ANALYSES:e}: use larger steps or a shorter life"
+        )));
+    }
+    Ok(())
 }

@@ -23,15 +23,17 @@ pub mod forecast;
 mod life;
 mod limits;
 pub mod spectrum;
+mod stabilised;
 mod state;
 
 pub use backlash::*;
 pub use cycle::*;
 pub use life::*;
 pub use limits::*;
+pub use stabilised::{stabilised_removal, NodeResponse, RateMeasures};
 pub use state::*;
 
-pub use crate::input::{LifeStop, Phase, Pitting, StepControl, WearPlan};
+pub use crate::input::{LifeStop, Phase, Pitting, StepControl, StepScheme, WearPlan};
 
 /// A number of cycles for titles and messages: "180 000" below a million (thin groups of
 /// three digits), "1.25 million" above.

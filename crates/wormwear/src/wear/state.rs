@@ -51,6 +51,14 @@ pub struct WearState {
     /// spectrum, whose one analysis starts from `band_factor` and `warm`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bin_starts: Vec<super::spectrum::BinStart>,
+    /// The wear's measured response to a node-scale removal, on the life's first state (the
+    /// stabilised step's, `super::stabilised`; None: not measured, the explicit step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node_response: Option<super::NodeResponse>,
+    /// The wear per cycle's measures where the last wear step started (the error control's,
+    /// `super::stabilised`; None: no wear step yet, or the last step a pitting phase's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rates_before: Option<super::RateMeasures>,
 }
 
 impl WearState {
@@ -96,6 +104,8 @@ impl WearState {
             damage: Vec::new(),
             found_phases: Vec::new(),
             bin_starts: Vec::new(),
+            node_response: None,
+            rates_before: None,
         }
     }
 

@@ -288,6 +288,34 @@ fn wear_and_rating_sections_are_checked() {
         &error_of(&text),
         &["wear.max_substep_wear_um = 1e-300", "or 0: off"],
     );
+    // The step scheme and the error control (`wear::stabilised`).
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_wear_um = 4.0\nstep_scheme = \"implicit\"",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.step_scheme = \"implicit\"", "\"explicit\"", "\"stabilised\""],
+    );
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_cycles = 10000\nstep_tolerance = 0.01",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &["wear.step_tolerance = 0.01", "wear.step_wear_um"],
+    );
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_wear_um = 24.0\nstep_tolerance = 2",
+    );
+    assert_mentions(&error_of(&text), &["wear.step_tolerance = 2", "[0.0001, 0.5]"]);
     let text = set(
         &set(&design(), "wear", "step_wear_um", "step_cycles = 1"),
         "wear",

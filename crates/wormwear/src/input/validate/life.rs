@@ -14,6 +14,7 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         phases.retain(|p| matches!(p, Phase::Wear { .. }));
     }
     let guard = substep_guard(ck, w.max_substep_wear_um);
+    let (scheme, tolerance) = step_scheme(ck, w, step);
     if let (Some(life), Some(StepControl::Cycles(c))) = (life, step) {
         if let Some(problem) = fixed_steps_problem(life, c) {
             ck.fail("wear.step_cycles", Number(c), problem);
@@ -26,6 +27,8 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         life_cycles: life?,
         step: step?,
         max_substep_removal: guard? * 1e-6,
+        scheme: scheme?,
+        step_tolerance: tolerance?,
         phases,
         pitting: pitting?,
         pitting_onset_share: onset? * 1e-2,
@@ -59,6 +62,42 @@ fn pitting_onset(ck: &mut Checker, given: Option<f64>, pitting: Option<Pitting>)
             "%",
         ),
     }
+}
+
+/// The step scheme (`wear.step_scheme`, "explicit" by default or "stabilised") and the error
+/// control of adaptive steps (`wear.step_tolerance`, a share, 0 to 0.5, default 0: off; refused
+/// with fixed steps).
+fn step_scheme(
+    ck: &mut Checker,
+    w: &WearSpec,
+    step: Option<StepControl>,
+) -> (Option<StepScheme>, Option<f64>) {
+    let scheme = match w.step_scheme.as_deref() {
+        None | Some("explicit") => Some(StepScheme::Explicit),
+        Some("stabilised") => Some(StepScheme::Stabilised),
+        Some(other) => {
+            ck.fail(
+                "wear.step_scheme",
+                format!("\"{other}\""),
+                "\"explicit\" (the published step) or \"stabilised\"",
+            );
+            None
+        }
+    };
+    let tolerance = match (w.step_tolerance, step) {
+        (Some(t), Some(StepControl::Cycles(_))) if t != 0.0 => {
+            ck.fail(
+                "wear.step_tolerance",
+                t,
+                "the error control sets adaptive steps: give wear.step_wear_um (its largest \
+                 step), not wear.step_cycles",
+            );
+            None
+        }
+        (Some(t), _) if t != 0.0 => ck.range("wear.step_tolerance", t, 1e-4, 0.5, ""),
+        _ => Some(0.0),
+    };
+    (scheme, tolerance)
 }
 
 /// The largest removal of a wear sub-step (`wear.max_substep_wear_um`, um, default 5; 0: off).

@@ -324,22 +324,7 @@ impl LifeWriter {
             }
         }
         self.records_written = Some(state.records.len());
-        let checkpoint = CheckpointOut {
-            step: state.step,
-            cycles: state.cycles,
-            removal: &state.removal,
-            plastic_set: &state.plastic_set,
-            pitted_phases: &state.pitted_phases,
-            pitted: &state.pitted,
-            band_factor: state.band_factor,
-            warm: state.warm.as_ref(),
-            damage: &state.damage,
-            found_phases: &state.found_phases,
-            bin_starts: &state.bin_starts,
-            record_count: state.records.len(),
-            records_sha256: self.records_digest.hex(),
-            inputs: self.inputs.as_ref(),
-        };
+        let checkpoint = CheckpointOut::of(state, self.records_digest.hex(), self.inputs.as_ref());
         let text = crate::integrity::seal(&checkpoint).map_err(|e| OutputError::Encode {
             what: CHECKPOINT.into(),
             message: e.to_string(),

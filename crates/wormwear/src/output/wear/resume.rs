@@ -20,12 +20,45 @@ pub(super) struct CheckpointOut<'a> {
     pub(super) found_phases: &'a [crate::wear::Phase],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     pub(super) bin_starts: &'a [crate::wear::spectrum::BinStart],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) node_response: Option<&'a crate::wear::NodeResponse>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) rates_before: Option<&'a crate::wear::RateMeasures>,
     pub(super) record_count: usize,
     /// SHA-256 of the first `record_count` lines of [`RECORDS`] as written (each with its
     /// newline): the records are sealed with the checkpoint.
     pub(super) records_sha256: String,
     /// The inputs the states were computed with ([`life_inputs`]).
     pub(super) inputs: Option<&'a serde_json::Value>,
+}
+
+impl<'a> CheckpointOut<'a> {
+    /// The checkpoint of `state`, whose records as written have the digest `records_sha256`,
+    /// computed with `inputs`.
+    pub(super) fn of(
+        state: &'a crate::wear::WearState,
+        records_sha256: String,
+        inputs: Option<&'a serde_json::Value>,
+    ) -> Self {
+        Self {
+            step: state.step,
+            cycles: state.cycles,
+            removal: &state.removal,
+            plastic_set: &state.plastic_set,
+            pitted_phases: &state.pitted_phases,
+            pitted: &state.pitted,
+            band_factor: state.band_factor,
+            warm: state.warm.as_ref(),
+            damage: &state.damage,
+            found_phases: &state.found_phases,
+            bin_starts: &state.bin_starts,
+            node_response: state.node_response.as_ref(),
+            rates_before: state.rates_before.as_ref(),
+            record_count: state.records.len(),
+            records_sha256,
+            inputs,
+        }
+    }
 }
 
 /// The checkpoint as read; `records` inline is the earlier format (still read).
@@ -50,6 +83,10 @@ pub(super) struct CheckpointIn {
     pub(super) found_phases: Vec<crate::wear::Phase>,
     #[serde(default)]
     pub(super) bin_starts: Vec<crate::wear::spectrum::BinStart>,
+    #[serde(default)]
+    pub(super) node_response: Option<crate::wear::NodeResponse>,
+    #[serde(default)]
+    pub(super) rates_before: Option<crate::wear::RateMeasures>,
     #[serde(default)]
     pub(super) record_count: Option<usize>,
     #[serde(default)]
@@ -189,6 +226,8 @@ pub fn read_resume(
             damage: c.damage,
             found_phases: c.found_phases,
             bin_starts: c.bin_starts,
+            node_response: c.node_response,
+            rates_before: c.rates_before,
         },
         c.inputs,
     )))

@@ -1,0 +1,447 @@
+//! The stabilised wear step and the error control of adaptive steps (MODEL §7.3; issue 55).
+//!
+//! The published step is explicit: a node removes the step's cycles times its wear per cycle on
+//! the frozen geometry. A node worn deeper than its neighbours carries less pressure and wears
+//! slower, so the flank's roughness at the grid's scale decays; an explicit step that removes
+//! more than about twice the contact's local elastic approach overshoots it and roughens the
+//! flank instead (MODEL §7.3: "steps removing about 10 um made the published computation
+//! unstable"; BENCHMARKS.md session 37). The stabilised step takes that node-scale response at
+//! the step's end: with w the wear per cycle and dC the step's cycles,
+//!
+//!   (M + dC L) dh = dC M w,
+//!
+//! M the nodes' areas (a quarter of each cell's at its corners: the worn volume is sum M dh,
+//! `FlankField::integral`), L the graph Laplacian of the flank's grid whose edge (k, l) along the
+//! height (along the face) weighs beta_rows min(w_k, w_l) (M_k + M_l) / 8 (beta_columns ...). beta is the wear's response to the
+//! removal, measured on the life's first state ([`NodeResponse`]): the change of the wear per
+//! cycle under a removal alternating from row to row (column to column), per unit removal and
+//! unit wear, 1/m. An alternating removal is then damped exactly as its measured response
+//! says (L's eigenvalue for it is beta w), a uniform one not at all (L 1 = 0: a step wears the
+//! same as the explicit one wherever the wear is even), and smooth variations over many nodes
+//! little. L is symmetric with zero column sums, so the step removes the explicit step's worn
+//! volume exactly; an edge to a node the contact never reaches weighs 0, so no
+//! wear moves onto it; (M + dC L) is an M-matrix, so no node's removal is negative. As dC -> 0
+//! the step tends to the explicit one (first order, as the explicit step itself).
+//!
+//! The error control sets adaptive steps from the change of the wear per cycle over the last
+//! step: the step's local error is about dC / 2 times the change of the rate (the explicit
+//! step against the trapezoidal rule) on two converged measures, the worn volume and the
+//! largest patch-mean wear ([`RateMeasures`]); the next step is the last one times
+//! sqrt(tolerance / error), within half and twice it, and never beyond the adaptive step's
+//! largest removal.
+
+use crate::geometry::{FlankField, WheelFlank};
+
+/// The wear's response to a node-scale removal, measured (module doc): at each node, the
+/// per-cycle wear's decrease per unit removal, as a share of the wear per cycle, for a removal
+/// alternating along the flank's height (`rows`) and along its face (`columns`), 1/m.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct NodeResponse {
+    pub rows_per_m: Vec<f64>,
+    pub columns_per_m: Vec<f64>,
+}
+
+/// The amplitude of the probe's alternating removal, m: small against the contact's elastic
+/// approach (~10 um), large against the solver's tolerance.
+pub(crate) const PROBE_REMOVAL: f64 = 1e-6;
+
+/// Nodes whose wear per cycle is at least this share of the largest take part in the
+/// response's median (the loaded pattern, not its fringe).
+const PROBE_SHARE: f64 = 0.2;
+
+/// The probe's removal pattern on the grid of `field`: +-[`PROBE_REMOVAL`], alternating from row
+/// to row (`along_height`) or from column to column, m.
+pub(crate) fn probe_pattern(field: &FlankField, along_height: bool) -> Vec<f64> {
+    let rows = field.cells_height + 1;
+    (0..field.values.len())
+        .map(|k| {
+            let index = if along_height { k % rows } else { k / rows };
+            if index % 2 == 0 {
+                PROBE_REMOVAL
+            } else {
+                -PROBE_REMOVAL
+            }
+        })
+        .collect()
+}
+
+/// At each node, -(w1 - w0) / (pattern w0): the per-cycle wear's response to the removal
+/// `pattern` (m), as a share of the wear, 1/m; 0 where it is not positive (no damping rather
+/// than a negative one: a node the removal unloads, or one at the flow pressure, whose load
+/// does not follow its depth). A node the contact barely loads when measured (below
+/// [`PROBE_SHARE`] of the largest wear) takes the median of the others.
+pub(crate) fn response(w0: &FlankField, w1: &FlankField, pattern: &[f64]) -> Vec<f64> {
+    let largest = w0.max();
+    let measured: Vec<Option<f64>> = w0
+        .values
+        .iter()
+        .zip(&w1.values)
+        .zip(pattern)
+        .map(|((w, w1), d)| {
+            let share = -(w1 - w) / (d * w);
+            (largest > 0.0 && *w >= PROBE_SHARE * largest && share.is_finite())
+                .then(|| share.max(0.0))
+        })
+        .collect();
+    let mut shares: Vec<f64> = measured.iter().flatten().copied().collect();
+    shares.sort_by(f64::total_cmp);
+    let median = shares.get(shares.len() / 2).copied().unwrap_or(0.0);
+    measured.iter().map(|m| m.unwrap_or(median)).collect()
+}
+
+/// The stabilised step's removal (module doc) of `cycles` cycles at the wear per cycle `w`
+/// (m per cycle on the nodes of the flank `wf`), m per node.
+pub fn stabilised_removal(
+    w: &FlankField,
+    wf: &WheelFlank,
+    cycles: f64,
+    response: &NodeResponse,
+) -> Vec<f64> {
+    removal_on(w, &node_areas(wf), cycles, response)
+}
+
+/// [`stabilised_removal`] on nodes of the given areas (m^2).
+fn removal_on(w: &FlankField, areas: &[f64], cycles: f64, response: &NodeResponse) -> Vec<f64> {
+    let explicit: Vec<f64> = w.values.iter().map(|x| cycles * x).collect();
+    let edges = edges(w, areas, cycles, response);
+    if edges.is_empty() {
+        return explicit;
+    }
+    let b: Vec<f64> = explicit.iter().zip(areas).map(|(x, m)| x * m).collect();
+    conjugate_gradient(areas, &edges, &b)
+}
+
+/// The nodes' areas M (module doc): a quarter of each adjacent cell's, m^2.
+fn node_areas(wf: &WheelFlank) -> Vec<f64> {
+    let rows = wf.cells_height + 1;
+    let mut areas = vec![0.0; wf.nodes.len()];
+    for j in 0..wf.cells_face {
+        for i in 0..wf.cells_height {
+            let quarter = 0.25 * wf.cell_area[j * wf.cells_height + i];
+            for k in [
+                j * rows + i,
+                j * rows + i + 1,
+                (j + 1) * rows + i,
+                (j + 1) * rows + i + 1,
+            ] {
+                areas[k] += quarter;
+            }
+        }
+    }
+    areas
+}
+
+/// The weighted edges (k, l, weight) of dC L (module doc), on the nodes' `areas`.
+fn edges(
+    w: &FlankField,
+    areas: &[f64],
+    cycles: f64,
+    response: &NodeResponse,
+) -> Vec<(usize, usize, f64)> {
+    let rows = w.cells_height + 1;
+    let columns = w.cells_face + 1;
+    let v = &w.values;
+    let mut edges = Vec::new();
+    let mut add = |k: usize, l: usize, beta: &[f64]| {
+        let damping = (beta[k] * v[k]).min(beta[l] * v[l]).max(0.0);
+        let weight = cycles * damping * (areas[k] + areas[l]) / 8.0;
+        if weight > 0.0 {
+            edges.push((k, l, weight));
+        }
+    };
+    for j in 0..columns {
+        for i in 0..rows {
+            let k = j * rows + i;
+            if i + 1 < rows {
+                add(k, k + 1, &response.rows_per_m);
+            }
+            if j + 1 < columns {
+                add(k, k + rows, &response.columns_per_m);
+            }
+        }
+    }
+    edges
+}
+
+/// y = (M + dC L) x for the nodes' areas and the edges of [`edges`].
+fn apply(areas: &[f64], edges: &[(usize, usize, f64)], x: &[f64], y: &mut [f64]) {
+    for ((y, x), m) in y.iter_mut().zip(x).zip(areas) {
+        *y = m * x;
+    }
+    for &(k, l, weight) in edges {
+        let d = weight * (x[k] - x[l]);
+        y[k] += d;
+        y[l] -= d;
+    }
+}
+
+/// Solves (M + dC L) x = b (symmetric positive definite) by conjugate gradients from
+/// x = M^-1 b, to 1e-13 of b.
+fn conjugate_gradient(areas: &[f64], edges: &[(usize, usize, f64)], b: &[f64]) -> Vec<f64> {
+    let n = b.len();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
+    let mut x: Vec<f64> = b
+        .iter()
+        .zip(areas)
+        .map(|(b, m)| if *m > 0.0 { b / m } else { 0.0 })
+        .collect();
+    let mut ax = vec![0.0; n];
+    apply(areas, edges, &x, &mut ax);
+    let mut r: Vec<f64> = b.iter().zip(&ax).map(|(b, a)| b - a).collect();
+    let mut p = r.clone();
+    let mut rr = dot(&r, &r);
+    let target = 1e-26 * dot(b, b);
+    let mut ap = vec![0.0; n];
+    for _ in 0..10 * n {
+        if rr <= target {
+            break;
+        }
+        apply(areas, edges, &p, &mut ap);
+        let alpha = rr / dot(&p, &ap);
+        for k in 0..n {
+            x[k] += alpha * p[k];
+            r[k] -= alpha * ap[k];
+        }
+        let next = dot(&r, &r);
+        let beta = next / rr;
+        rr = next;
+        for k in 0..n {
+            p[k] = r[k] + beta * p[k];
+        }
+    }
+    x
+}
+
+/// The converged measures whose change over a step the error control reads: the worn volume
+/// of one flank (m^3) and the largest patch-mean wear (m), or their rates per cycle.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RateMeasures {
+    pub volume: f64,
+    pub patch: f64,
+}
+
+impl RateMeasures {
+    /// The measures of a field on the flank `wf` (a removal, m, or a wear per cycle), with
+    /// the pressure patch's size across and along (m).
+    pub(crate) fn of(field: &FlankField, wf: &WheelFlank, patch: (f64, f64)) -> Self {
+        Self {
+            volume: field.integral(wf),
+            patch: field.patch_mean_max(wf, patch.0, patch.1),
+        }
+    }
+}
+
+/// The next adaptive step's cycles under the error control (module doc): `last` the last
+/// step's cycles, `before` and `now` the rates at its start and end, `worn` the measures of the
+/// wear so far; None without an estimate (no wear yet).
+pub(crate) fn controlled_cycles(
+    last: f64,
+    (before, now): (&RateMeasures, &RateMeasures),
+    worn: &RateMeasures,
+    tolerance: f64,
+) -> Option<f64> {
+    let share = |rate_before: f64, rate_now: f64, worn: f64| {
+        (worn > 0.0).then(|| 0.5 * last * (rate_now - rate_before).abs() / worn)
+    };
+    let error = share(before.volume, now.volume, worn.volume)?
+        .max(share(before.patch, now.patch, worn.patch).unwrap_or(0.0));
+    let factor = if error > 0.0 {
+        (tolerance / error).sqrt().clamp(0.5, 2.0)
+    } else {
+        2.0
+    };
+    (last > 0.0).then_some(last * factor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A field on a grid of `height` x `face` cells from its values by node (i, j).
+    fn field(height: usize, face: usize, value: impl Fn(usize, usize) -> f64) -> FlankField {
+        let rows = height + 1;
+        FlankField {
+            cells_height: height,
+            cells_face: face,
+            values: (0..rows * (face + 1))
+                .map(|k| value(k % rows, k / rows))
+                .collect(),
+        }
+    }
+
+    /// Node areas varying smoothly over the grid (m^2).
+    fn areas(w: &FlankField) -> Vec<f64> {
+        (0..w.values.len())
+            .map(|k| 1e-7 * (1.0 + 0.3 * (k as f64 * 0.37).sin()))
+            .collect()
+    }
+
+    /// A response of 2e5 / m along the height and 4e5 / m along the face at every node.
+    fn even_response(w: &FlankField) -> NodeResponse {
+        NodeResponse {
+            rows_per_m: vec![2e5; w.values.len()],
+            columns_per_m: vec![4e5; w.values.len()],
+        }
+    }
+
+    /// A worn patch with node-scale roughness, zero outside rows 3..=12 and columns 2..=20
+    /// (m per cycle).
+    fn rough_patch() -> FlankField {
+        field(16, 24, |i, j| {
+            if (3..=12).contains(&i) && (2..=20).contains(&j) {
+                1e-9 * (1.0 + 0.5 * ((i * 7 + j * 3) % 5) as f64 / 4.0)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    #[test]
+    fn an_even_wear_is_stepped_as_the_explicit_step_does() {
+        let w = field(10, 12, |_, _| 3e-10);
+        let removal = removal_on(&w, &areas(&w), 8e4, &even_response(&w));
+        for x in removal {
+            assert!((x - 8e4 * 3e-10).abs() <= 1e-12 * 8e4 * 3e-10, "{x:e}");
+        }
+    }
+
+    #[test]
+    fn the_step_removes_the_explicit_worn_volume_and_nothing_where_no_contact_passes() {
+        let w = rough_patch();
+        let m = areas(&w);
+        let cycles = 3e4;
+        let removal = removal_on(&w, &m, cycles, &even_response(&w));
+        let volume: f64 = removal.iter().zip(&m).map(|(x, m)| x * m).sum();
+        let explicit: f64 = w.values.iter().zip(&m).map(|(x, m)| cycles * x * m).sum();
+        assert!(
+            (volume - explicit).abs() <= 1e-11 * explicit,
+            "{volume:e} {explicit:e}"
+        );
+        for (x, w) in removal.iter().zip(&w.values) {
+            assert!(*x >= 0.0);
+            if *w == 0.0 {
+                assert_eq!(*x, 0.0);
+            }
+        }
+        // It smooths: the largest removal falls, the smallest in the patch rises.
+        let inside = |v: &[f64]| -> (f64, f64) {
+            let ws = w
+                .values
+                .iter()
+                .zip(v)
+                .filter(|(w, _)| **w > 0.0)
+                .map(|(_, x)| *x);
+            ws.clone()
+                .fold((f64::INFINITY, 0.0), |(lo, hi), x| (lo.min(x), hi.max(x)))
+        };
+        let explicit_removal: Vec<f64> = w.values.iter().map(|x| cycles * x).collect();
+        let (lo, hi) = inside(&removal);
+        let (lo0, hi0) = inside(&explicit_removal);
+        assert!(
+            hi < hi0 && lo > lo0,
+            "{lo:e} {hi:e} against {lo0:e} {hi0:e}"
+        );
+    }
+
+    #[test]
+    fn two_nodes_part_as_the_analytic_damping_says() {
+        // Two nodes of equal area m, one edge of weight a = dC beta min(w) m / 4: (m + a) x1 -
+        // a x2 = m dC w1 and its mirror, so x1 - x2 = dC (w1 - w2) / (1 + 2 a / m), and
+        // x1 + x2 = dC (w1 + w2).
+        let w = field(1, 0, |i, _| if i == 0 { 4e-10 } else { 3e-10 });
+        let m = vec![2e-7, 2e-7];
+        let cycles = 5e4;
+        let x = removal_on(&w, &m, cycles, &even_response(&w));
+        let a_over_m = cycles * 2e5 * 3e-10 / 4.0;
+        let expected = cycles * 1e-10 / (1.0 + 2.0 * a_over_m);
+        assert!(((x[0] - x[1]) - expected).abs() <= 1e-12 * expected);
+        assert!(((x[0] + x[1]) - cycles * 7e-10).abs() <= 1e-12 * cycles * 7e-10);
+    }
+
+    #[test]
+    fn the_step_tends_to_the_explicit_one_to_first_order() {
+        let w = rough_patch();
+        let m = areas(&w);
+        let gap = |cycles: f64| {
+            let x = removal_on(&w, &m, cycles, &even_response(&w));
+            x.iter()
+                .zip(&w.values)
+                .map(|(x, w)| (x - cycles * w).abs())
+                .fold(0.0, f64::max)
+                / (cycles * w.max())
+        };
+        let (coarse, fine) = (gap(100.0), gap(50.0));
+        assert!(
+            coarse > 0.0 && (coarse / fine - 2.0).abs() < 0.05,
+            "{coarse:e} {fine:e}"
+        );
+    }
+
+    #[test]
+    fn the_measured_response_is_the_wear_change_per_unit_removal_and_wear() {
+        let w0 = rough_patch();
+        let pattern = probe_pattern(&w0, true);
+        let beta = 3e5;
+        let mut w1 = w0.clone();
+        for (w, d) in w1.values.iter_mut().zip(&pattern) {
+            *w *= 1.0 - beta * d;
+        }
+        // Every loaded node's own response; the unloaded ones take the loaded ones' median.
+        for (r, w) in response(&w0, &w1, &pattern).iter().zip(&w0.values) {
+            assert!((r - beta).abs() <= 1e-6 * beta, "{r:e} at w {w:e}");
+        }
+        // Alternating from row to row along the height.
+        assert_eq!(pattern[0], -pattern[1]);
+        assert_eq!(pattern[0], pattern[17]);
+        // A node whose wear does not fall where it is worn deeper (at the flow pressure) gets
+        // no damping, not a negative one; nor do nodes with no response.
+        let loaded = w0.values.iter().position(|w| *w > 0.0).unwrap();
+        let mut capped = w1.clone();
+        capped.values[loaded] = w0.values[loaded] * (1.0 + beta * pattern[loaded]);
+        let r = response(&w0, &capped, &pattern);
+        assert_eq!(r[loaded], 0.0);
+        assert!((r[loaded + 1] - beta).abs() <= 1e-6 * beta);
+        assert!(response(&w0, &w0, &pattern).iter().all(|r| *r == 0.0));
+    }
+
+    #[test]
+    fn the_error_control_grows_steady_steps_and_cuts_changing_ones() {
+        let worn = RateMeasures {
+            volume: 1e-9,
+            patch: 1e-5,
+        };
+        let rate = RateMeasures {
+            volume: 1e-14,
+            patch: 1e-10,
+        };
+        let steady = controlled_cycles(1e4, (&rate, &rate), &worn, 0.01);
+        assert_eq!(steady, Some(2e4));
+        // A volume rate that changed by 4e-15 over 1e4 cycles: error 1e4 / 2 * 4e-15 / 1e-9 =
+        // 0.02, twice the tolerance: the step shrinks by sqrt(0.5).
+        let faster = RateMeasures {
+            volume: 1.4e-14,
+            ..rate
+        };
+        let cut = controlled_cycles(1e4, (&rate, &faster), &worn, 0.01).unwrap();
+        assert!((cut - 1e4 * 0.5f64.sqrt()).abs() < 1e-6, "{cut}");
+        // Within half and twice the last step.
+        let tiny = controlled_cycles(1e4, (&rate, &faster), &worn, 1e-6).unwrap();
+        assert_eq!(tiny, 5e3);
+        // The patch's change counts too (4e-11 of 1e-5 over 1e4 cycles: the same 0.02).
+        let patch = RateMeasures {
+            patch: 1.4e-10,
+            ..rate
+        };
+        let by_patch = controlled_cycles(1e4, (&rate, &patch), &worn, 0.01).unwrap();
+        assert!((by_patch - 1e4 * 0.5f64.sqrt()).abs() < 1e-6, "{by_patch}");
+        let unworn = RateMeasures {
+            volume: 0.0,
+            patch: 0.0,
+        };
+        assert_eq!(
+            controlled_cycles(1e4, (&rate, &faster), &unworn, 0.01),
+            None
+        );
+        assert_eq!(controlled_cycles(0.0, (&rate, &rate), &worn, 0.01), None);
+    }
+}
