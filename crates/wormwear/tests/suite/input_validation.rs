@@ -297,7 +297,11 @@ fn wear_and_rating_sections_are_checked() {
     );
     assert_mentions(
         &error_of(&text),
-        &["wear.step_scheme = \"implicit\"", "\"explicit\"", "\"stabilised\""],
+        &[
+            "wear.step_scheme = \"implicit\"",
+            "\"explicit\"",
+            "\"stabilised\"",
+        ],
     );
     let text = set(
         &design(),
@@ -315,7 +319,10 @@ fn wear_and_rating_sections_are_checked() {
         "step_wear_um",
         "step_wear_um = 24.0\nstep_tolerance = 2",
     );
-    assert_mentions(&error_of(&text), &["wear.step_tolerance = 2", "[0.0001, 0.5]"]);
+    assert_mentions(
+        &error_of(&text),
+        &["wear.step_tolerance = 2", "[0.0001, 0.5]"],
+    );
     let text = set(
         &set(&design(), "wear", "step_wear_um", "step_cycles = 1"),
         "wear",
