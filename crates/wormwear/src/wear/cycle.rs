@@ -138,9 +138,8 @@ impl PassageWear<'_> {
 /// Wear of one mesh cycle from the loaded analysis (MODEL §7.1-7.2), on the loaded flank.
 ///
 /// Between two consecutive instants a, b of the reference tooth on a node column, the loaded
-/// band is taken to translate from its centroid c_a to c_b (a vanishing load's drawn to its line
-/// crossing, continuous in the loads) while its shape blends from p_a to
-/// p_b; the time integral of the pressure at every node follows by quadrature over the
+/// band of each instant moves with its contact line, from its crossing c_a to c_b, while its
+/// shape blends from p_a to p_b (an edge contact off the line stays near its edge); the time integral of the pressure at every node follows by quadrature over the
 /// interval (sub-steps of at most a tenth of the band width). The passage is thus resolved
 /// whatever the number of positions (no aliasing), and the band follows the worn geometry
 /// (the profiles are the loaded analysis on it). Depth = (k(lambda)/H) |vg| integral(p dt),

@@ -6,7 +6,7 @@
 //! column the loaded analysis gives, at every (position, tooth), the pressure profile across
 //! the line; tooth k at wheel rotation theta2 is the reference tooth at theta2 + sigma k tau,
 //! so these profiles are the history of the reference tooth over its whole engagement. Between
-//! consecutive instants the band is moved continuously from one centroid to the next (its
+//! consecutive instants each instant's band moves continuously with its contact line (its
 //! shape blended), and the time integral of the pressure at each node is taken by quadrature:
 //! the passage is resolved whatever the number of positions (sampling p only at the positions
 //! would alias, MODEL §7.2), and since the profiles come from the loaded analysis on the worn
