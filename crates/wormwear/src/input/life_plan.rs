@@ -193,7 +193,8 @@ pub struct WearPlan {
     /// How a step's removal follows from the wear per cycle.
     pub scheme: StepScheme,
     /// Error control of adaptive steps: the largest local error of a step, as a share of the
-    /// worn volume and of the largest patch-mean wear so far (0: off; `wear::stabilised`).
+    /// worn volume, the largest patch-mean wear and the backlash so far (0: off;
+    /// `wear::stabilised`).
     pub step_tolerance: f64,
     /// Phase schedule (empty: wear all along).
     pub phases: Vec<Phase>,

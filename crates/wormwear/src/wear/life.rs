@@ -490,8 +490,16 @@ impl<'a> LifeLoop<'a> {
     fn step_cycles(&self, state: &mut WearState, cw: &CycleWear) -> f64 {
         let rate = cw.depth.max();
         let patch = (self.settings.patch_across, self.settings.patch_along);
-        let now = stabilised::RateMeasures::of(&cw.depth, self.wf, patch);
-        let before = state.rates_before.replace(now);
+        // This state's record (the step that led here): a step's copy holds it last.
+        let record = state.records.last().filter(|r| r.step == state.step);
+        let last = record.map_or(0.0, |r| r.step_cycles);
+        let mut now = stabilised::RateMeasures::of(&cw.depth, self.wf, patch);
+        now.backlash_increase = record.map_or(0.0, |r| r.backlash_increase_m);
+        let before = state.rates_before.take();
+        now.backlash = before
+            .filter(|_| last > 0.0)
+            .map(|b| (now.backlash_increase - b.backlash_increase) / last);
+        state.rates_before = Some(now);
         let cap = match self.life.step {
             StepControl::Cycles(c) => return c,
             StepControl::MaxRemoval(d) if rate > 0.0 => d / rate,
@@ -501,13 +509,8 @@ impl<'a> LifeLoop<'a> {
         if tolerance <= 0.0 {
             return cap;
         }
-        // This state's record (the step that led here): a step's copy holds it last.
-        let last = state
-            .records
-            .last()
-            .filter(|r| r.step == state.step)
-            .map_or(0.0, |r| r.step_cycles);
-        let worn = stabilised::RateMeasures::of(&state.removal, self.wf, patch);
+        let mut worn = stabilised::RateMeasures::of(&state.removal, self.wf, patch);
+        worn.backlash = Some(now.backlash_increase);
         before
             .and_then(|b| stabilised::controlled_cycles(last, (&b, &now), &worn, tolerance))
             .unwrap_or(FIRST_CONTROLLED_REMOVAL / rate)

@@ -33,8 +33,9 @@
 //!
 //! The error control sets adaptive steps from the change of the wear per cycle over the last
 //! step: the step's local error is about dC / 2 times the change of the rate (the explicit
-//! step against the trapezoidal rule) on two converged measures, the worn volume and the
-//! largest patch-mean wear ([`RateMeasures`]); the next step is the last one times
+//! step against the trapezoidal rule) on three converged measures, the worn volume, the
+//! largest patch-mean wear and the backlash ([`RateMeasures`]; the backlash's rate over the last
+//! step and the one before); the next step is the last one times
 //! sqrt(tolerance / error), within half and twice it, and never beyond the adaptive step's
 //! largest removal.
 
@@ -227,11 +228,21 @@ fn conjugate_gradient(areas: &[f64], edges: &[(usize, usize, f64)], b: &[f64]) -
 }
 
 /// The converged measures whose change over a step the error control reads: the worn volume
-/// of one flank (m^3) and the largest patch-mean wear (m), or their rates per cycle.
+/// of one flank (m^3), the largest patch-mean wear (m) and the backlash increase (m), or their
+/// rates per cycle.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RateMeasures {
     pub volume: f64,
     pub patch: f64,
+    /// The backlash increase's rate over the step that led to this state (m per cycle; None:
+    /// no step yet), or, for the wear so far, the backlash increase (m). The backlash is the
+    /// least worn contact's at each position, not a sum over the flank: in the running-in it
+    /// rises twice as fast at its end as at its start while the worn volume's rate holds.
+    #[serde(default)]
+    pub backlash: Option<f64>,
+    /// The backlash increase at this state, m (the next step's rate starts from it).
+    #[serde(default)]
+    pub backlash_increase: f64,
 }
 
 impl RateMeasures {
@@ -241,6 +252,8 @@ impl RateMeasures {
         Self {
             volume: field.integral(wf),
             patch: field.patch_mean_max(wf, patch.0, patch.1),
+            backlash: None,
+            backlash_increase: 0.0,
         }
     }
 }
@@ -257,8 +270,13 @@ pub(crate) fn controlled_cycles(
     let share = |rate_before: f64, rate_now: f64, worn: f64| {
         (worn > 0.0).then(|| 0.5 * last * (rate_now - rate_before).abs() / worn)
     };
+    let backlash = match (before.backlash, now.backlash, worn.backlash) {
+        (Some(b), Some(n), Some(w)) => share(b, n, w).unwrap_or(0.0),
+        _ => 0.0,
+    };
     let error = share(before.volume, now.volume, worn.volume)?
-        .max(share(before.patch, now.patch, worn.patch).unwrap_or(0.0));
+        .max(share(before.patch, now.patch, worn.patch).unwrap_or(0.0))
+        .max(backlash);
     let factor = if error > 0.0 {
         (tolerance / error).sqrt().clamp(0.5, 2.0)
     } else {
@@ -423,10 +441,14 @@ mod tests {
         let worn = RateMeasures {
             volume: 1e-9,
             patch: 1e-5,
+            backlash: Some(1e-5),
+            backlash_increase: 1e-5,
         };
         let rate = RateMeasures {
             volume: 1e-14,
             patch: 1e-10,
+            backlash: Some(1e-10),
+            backlash_increase: 1e-5,
         };
         let steady = controlled_cycles(1e4, (&rate, &rate), &worn, 0.01);
         assert_eq!(steady, Some(2e4));
@@ -448,9 +470,29 @@ mod tests {
         };
         let by_patch = controlled_cycles(1e4, (&rate, &patch), &worn, 0.01).unwrap();
         assert!((by_patch - 1e4 * 0.5f64.sqrt()).abs() < 1e-6, "{by_patch}");
+        // The backlash's change counts too; without a rate over the last step, not at all.
+        let backlash = RateMeasures {
+            backlash: Some(1.4e-10),
+            ..rate
+        };
+        let by_backlash = controlled_cycles(1e4, (&rate, &backlash), &worn, 0.01).unwrap();
+        assert!(
+            (by_backlash - 1e4 * 0.5f64.sqrt()).abs() < 1e-6,
+            "{by_backlash}"
+        );
+        let unknown = RateMeasures {
+            backlash: None,
+            ..rate
+        };
+        assert_eq!(
+            controlled_cycles(1e4, (&unknown, &backlash), &worn, 0.01),
+            Some(2e4)
+        );
         let unworn = RateMeasures {
             volume: 0.0,
             patch: 0.0,
+            backlash: Some(0.0),
+            backlash_increase: 0.0,
         };
         assert_eq!(
             controlled_cycles(1e4, (&rate, &faster), &unworn, 0.01),
