@@ -486,9 +486,19 @@ impl<'a> LifeLoop<'a> {
     /// or removing at most the adaptive step's depth at the fastest node, and with the error
     /// control (`wear::stabilised`) the last step's cycles grown or cut by its error estimate
     /// (a first step, or the first after a pitting phase, removes at most
-    /// [`FIRST_CONTROLLED_REMOVAL`]). Sets the rates the next step's estimate starts from.
+    /// [`FIRST_CONTROLLED_REMOVAL`]); with it, sets the rates the next step's estimate starts
+    /// from (without it the state holds none).
     fn step_cycles(&self, state: &mut WearState, cw: &CycleWear) -> f64 {
         let rate = cw.depth.max();
+        let cap = match self.life.step {
+            StepControl::Cycles(c) => return c,
+            StepControl::MaxRemoval(d) if rate > 0.0 => d / rate,
+            StepControl::MaxRemoval(_) => return f64::INFINITY,
+        };
+        let tolerance = self.life.step_tolerance;
+        if tolerance <= 0.0 {
+            return cap;
+        }
         let patch = (self.settings.patch_across, self.settings.patch_along);
         // This state's record (the step that led here): a step's copy holds it last.
         let record = state.records.last().filter(|r| r.step == state.step);
@@ -500,15 +510,6 @@ impl<'a> LifeLoop<'a> {
             .filter(|_| last > 0.0)
             .map(|b| (now.backlash_increase - b.backlash_increase) / last);
         state.rates_before = Some(now);
-        let cap = match self.life.step {
-            StepControl::Cycles(c) => return c,
-            StepControl::MaxRemoval(d) if rate > 0.0 => d / rate,
-            StepControl::MaxRemoval(_) => return f64::INFINITY,
-        };
-        let tolerance = self.life.step_tolerance;
-        if tolerance <= 0.0 {
-            return cap;
-        }
         let mut worn = stabilised::RateMeasures::of(&state.removal, self.wf, patch);
         worn.backlash = Some(now.backlash_increase);
         before

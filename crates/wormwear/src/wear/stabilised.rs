@@ -11,11 +11,12 @@
 //!   (M + theta dC L) dh = dC M w,
 //!
 //! M the nodes' areas (a quarter of each cell's at its corners: the worn volume is sum M dh,
-//! `FlankField::integral`), L the graph Laplacian of the flank's grid whose edge (k, l) along the
-//! height (along the face) weighs beta_rows min(w_k, w_l) (M_k + M_l) / 8 (beta_columns ...). beta is the wear's response to the
-//! removal, measured on the life's first state ([`NodeResponse`]), and theta = [`THETA`]: the change of the wear per
-//! cycle under a removal alternating from row to row (column to column), per unit removal and
-//! unit wear, 1/m. An alternating removal is then damped exactly as its measured response
+//! `FlankField::integral`), theta = [`THETA`], and L the graph Laplacian of the flank's grid
+//! whose edge (k, l) along the height weighs min(beta_k w_k, beta_l w_l) (M_k + M_l) / 8, with
+//! beta the rows' response (along the face, the columns'). beta is the wear's response to the
+//! removal, measured at each node on the life's first state ([`NodeResponse`]): the change of
+//! the wear per cycle under a removal alternating from row to row (column to column), per unit
+//! removal and unit wear, 1/m. An alternating removal is then damped exactly as its measured response
 //! says (L's eigenvalue for it is beta w), a uniform one not at all (L 1 = 0: a step wears the
 //! same as the explicit one wherever the wear is even), and smooth variations over many nodes
 //! little. L is symmetric with zero column sums, so the step removes the explicit step's worn
@@ -51,7 +52,8 @@ pub struct NodeResponse {
 }
 
 /// The share of the node-scale response taken at the step's end (module doc). Against explicit
-/// 1 um steps, with 24 um steps and the error control at 0.01 (BENCHMARKS.md session 42): the
+/// 1 um steps, with 24 um steps and the error control at 0.01 before it read the backlash
+/// (BENCHMARKS.md session 42): the
 /// design gear's final patch-mean / one-node wear at 1e6 cycles -1.75 / -4.2 % at 1, -1.6 /
 /// -3.3 % at 0.6; case B's backlash over its life within 1.7 % at 1, 2.5 % at 0.6 (drifting up).
 pub const THETA: f64 = 1.0;
