@@ -303,6 +303,22 @@ fn wear_and_rating_sections_are_checked() {
             "\"stabilised\"",
         ],
     );
+    // The stability guard guards the explicit step (5 um by default); the stabilised step
+    // needs none (off by default, as given otherwise).
+    let guard = |lines: &str| {
+        let text = set(&design(), "wear", "step_wear_um", lines);
+        input::load_from_str(&text)
+            .unwrap()
+            .wear
+            .unwrap()
+            .max_substep_removal
+    };
+    assert_eq!(guard("step_wear_um = 24.0"), 5.0 * 1e-6);
+    assert_eq!(guard("step_wear_um = 24.0\nstep_scheme = \"stabilised\""), 0.0);
+    assert_eq!(
+        guard("step_wear_um = 24.0\nstep_scheme = \"stabilised\"\nmax_substep_wear_um = 8"),
+        8.0 * 1e-6
+    );
     let text = set(
         &design(),
         "wear",

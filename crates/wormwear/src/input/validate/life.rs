@@ -13,8 +13,8 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
     if pitting == Some(Pitting::Off) {
         phases.retain(|p| matches!(p, Phase::Wear { .. }));
     }
-    let guard = substep_guard(ck, w.max_substep_wear_um);
     let (scheme, tolerance) = step_scheme(ck, w, step);
+    let guard = substep_guard(ck, w.max_substep_wear_um, scheme);
     if let (Some(life), Some(StepControl::Cycles(c))) = (life, step) {
         if let Some(problem) = fixed_steps_problem(life, c) {
             ck.fail("wear.step_cycles", Number(c), problem);
@@ -100,9 +100,16 @@ fn step_scheme(
     (scheme, tolerance)
 }
 
-/// The largest removal of a wear sub-step (`wear.max_substep_wear_um`, um, default 5; 0: off).
-fn substep_guard(ck: &mut Checker, given: Option<f64>) -> Option<f64> {
-    match given.unwrap_or(5.0) {
+/// The largest removal of a wear sub-step (`wear.max_substep_wear_um`, um; 0: off): by
+/// default 5 um with the explicit step, whose stability it guards (MODEL §7.3), and off with
+/// the stabilised one, which is stable without it (a guard would split its large steps into
+/// sub-steps of the explicit step's size and undo what it saves).
+fn substep_guard(ck: &mut Checker, given: Option<f64>, scheme: Option<StepScheme>) -> Option<f64> {
+    let default = match scheme {
+        Some(StepScheme::Stabilised) => 0.0,
+        _ => 5.0,
+    };
+    match given.unwrap_or(default) {
         0.0 => Some(0.0),
         v => ck.range(
             "wear.max_substep_wear_um",
