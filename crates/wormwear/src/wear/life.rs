@@ -107,13 +107,15 @@ pub fn simulate(
                     next.step += 1;
                     let stalled = stalled_steps(stalled, before, &next)?;
                     let analysis = life_loop.analyse_state(&next)?;
-                    Ok::<_, WearError>((steps, stalled, analysis))
+                    let probes = life_loop.measure_response(&mut next, &analysis)?;
+                    Ok::<_, WearError>((steps, stalled, analysis, probes))
                 })());
             });
             on_state(&view)
         });
         written?;
-        ((step_cycles, substeps), stalled, analysis) = stepped.expect("the scope ran the step")?;
+        ((step_cycles, substeps), stalled, analysis, probes) =
+            stepped.expect("the scope ran the step")?;
         next.records = std::mem::take(&mut state.records);
         state = next;
     }
@@ -519,15 +521,25 @@ impl<'a> LifeLoop<'a> {
     }
 
     /// The stabilised step's measured response of the wear to a node-scale removal
-    /// (`wear::stabilised`), on the life's first state `a` of `state`, unless the state has it
-    /// or the step is the explicit one. Returns the loaded analyses it took.
+    /// (`wear::stabilised`), on the state `a` of `state`: on the life's first state, and again
+    /// where the flank has changed since ([`NodeResponse::is_due`]); none with the explicit step.
+    /// Returns the loaded analyses it took.
     fn measure_response(
         &self,
         state: &mut WearState,
         a: &StateAnalysis,
     ) -> Result<usize, WearError> {
-        if self.life.scheme != StepScheme::Stabilised || state.node_response.is_some() {
+        if self.life.scheme != StepScheme::Stabilised {
             return Ok(0);
+        }
+        let (removal, pitted) = (
+            state.removal.max(),
+            state.pitted.iter().filter(|p| **p).count(),
+        );
+        if let Some(r) = &state.node_response {
+            if !r.is_due(removal, pitted) {
+                return Ok(0);
+            }
         }
         let along = |height: bool| -> Result<Vec<f64>, WearError> {
             let pattern = stabilised::probe_pattern(&state.removal, height);
@@ -545,6 +557,8 @@ impl<'a> LifeLoop<'a> {
         let response = NodeResponse {
             rows_per_m: along(true)?,
             columns_per_m: along(false)?,
+            measured_at_removal_m: removal,
+            measured_pitted_nodes: pitted,
         };
         state.node_response = Some(response);
         Ok(2 * self.bins.len())

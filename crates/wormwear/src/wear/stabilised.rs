@@ -11,10 +11,11 @@
 //!   (M + theta dC L) dh = dC M w,
 //!
 //! M the nodes' areas (a quarter of each cell's at its corners: the worn volume is sum M dh,
-//! `FlankField::integral`), theta = [`THETA`], and L the graph Laplacian of the flank's grid
+//! `FlankField::integral`), theta per edge ([`theta`]), and L the graph Laplacian of the flank's grid
 //! whose edge (k, l) along the height weighs min(beta_k w_k, beta_l w_l) (M_k + M_l) / 8, with
 //! beta the rows' response (along the face, the columns'). beta is the wear's response to the
-//! removal, measured at each node on the life's first state ([`NodeResponse`]): the change of
+//! removal, measured at each node on the life's first state, and again after each pitting
+//! phase's cut and every [`REMEASURE_WEAR`] of wear ([`NodeResponse`]): the change of
 //! the wear per cycle under a removal alternating from row to row (column to column), per unit
 //! removal and unit wear, 1/m. An alternating removal is then damped exactly as its measured response
 //! says (L's eigenvalue for it is beta w), a uniform one not at all (L 1 = 0: a step wears the
@@ -28,10 +29,14 @@
 //! of response z = dC beta w evolves as e' = e (1 - (1 - theta) z) / (1 + theta z): the explicit
 //! step (theta = 0) overshoots beyond z = 2 and grows; theta = 1 damps every z (e' -> 0) but
 //! biases the worn pattern's real peaks low by about dC^2 J w / 2 per step, as the explicit step
-//! biases them high; theta = 1/2 is second order in that part but leaves the finest roughness
-//! oscillating (e' -> -e). [`THETA`] = 1: measured, the residual roughness of theta = 0.6
-//! (e' -> -0.67 e) raised case B's worn volume by 2 % over its life.
-//!
+//! biases them high (measured: case B's and the design's one-node wear -2 to -4 %, case C's patch
+//! wear -3.6 %); theta = 1/2, the trapezoidal rule on the response (second order: with a wear
+//! rate linear in the removal the step is that rule exactly), leaves the roughness of z > 2
+//! oscillating (e' -> -e as z grows; theta = 0.6 raised case B's worn volume by 2 % over its
+//! life, BENCHMARKS.md session 42). [`theta`] takes 1/2 up to z = 2 and 1 - 1/z beyond, the
+//! least theta for which e' >= 0: the roughness the trapezoidal rule would flip is removed in
+//! one step (e' = 0) and the smooth part keeps the second order wherever the step is small.
+
 //! The error control sets adaptive steps from the change of the wear per cycle over the last
 //! step: the step's local error is about dC / 2 times the change of the rate (the explicit
 //! step against the trapezoidal rule) on three converged measures, the worn volume, the
@@ -44,19 +49,52 @@ use crate::geometry::{FlankField, WheelFlank};
 
 /// The wear's response to a node-scale removal, measured (module doc): at each node, the
 /// per-cycle wear's decrease per unit removal, as a share of the wear per cycle, for a removal
-/// alternating along the flank's height (`rows`) and along its face (`columns`), 1/m.
+/// alternating along the flank's height (`rows`) and along its face (`columns`), 1/m; with the
+/// flank it was measured on (its largest removal, m, and its pitted nodes), which says when it
+/// is measured again ([`NodeResponse::is_due`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NodeResponse {
     pub rows_per_m: Vec<f64>,
     pub columns_per_m: Vec<f64>,
+    /// The flank's largest removal when measured, m (checkpoints of session 42: 0).
+    #[serde(default)]
+    pub measured_at_removal_m: f64,
+    /// The flank's pitted nodes when measured.
+    #[serde(default)]
+    pub measured_pitted_nodes: usize,
 }
 
-/// The share of the node-scale response taken at the step's end (module doc). Against explicit
-/// 1 um steps, with 24 um steps and the error control at 0.01 before it read the backlash
-/// (BENCHMARKS.md session 42): the
-/// design gear's final patch-mean / one-node wear at 1e6 cycles -1.75 / -4.2 % at 1, -1.6 /
-/// -3.3 % at 0.6; case B's backlash over its life within 1.7 % at 1, 2.5 % at 0.6 (drifting up).
-pub const THETA: f64 = 1.0;
+/// Wear after which the node response is measured again, m: the response is the contact's at
+/// the grid's scale, and it changes as the flank wears into a new shape (case B's life, 2.3 mm
+/// of wear with its response measured on the unworn flank only: backlash 2.4 % above explicit
+/// 1 um steps by its end; measured again every 200 um and after each pitting phase's cut:
+/// 1.4 %, for 7 more loaded analyses; BENCHMARKS.md session 43).
+pub const REMEASURE_WEAR: f64 = 200e-6;
+
+impl NodeResponse {
+    /// Whether the response no longer describes a flank whose largest removal is `removal`
+    /// (m) with `pitted_nodes` pitted nodes: the flank has worn [`REMEASURE_WEAR`] since, or pits
+    /// were cut (their edges respond as no worn flank does).
+    pub fn is_due(&self, removal: f64, pitted_nodes: usize) -> bool {
+        removal - self.measured_at_removal_m > REMEASURE_WEAR
+            || pitted_nodes != self.measured_pitted_nodes
+    }
+}
+
+/// The share theta of the node-scale response taken at the step's end, for a step whose
+/// node-scale response is `z` = dC beta w (module doc): the trapezoidal rule's 1/2 where it
+/// damps that roughness without oscillating (z <= 2), else 1 - 1/z, which removes it in one step
+/// (amplification 0) where the trapezoidal rule would flip its sign. Against explicit 1 um
+/// steps (BENCHMARKS.md session 43), 24 um steps with the error control at 0.003: the design
+/// gear's final patch-mean / one-node wear at 1e6 cycles -0.17 / -0.76 % (theta = 1: -0.65 /
+/// -1.72 %).
+pub fn theta(z: f64) -> f64 {
+    if z > 2.0 {
+        1.0 - 1.0 / z
+    } else {
+        0.5
+    }
+}
 
 /// The amplitude of the probe's alternating removal, m: small against the contact's elastic
 /// approach (~10 um), large against the solver's tolerance.
@@ -161,7 +199,8 @@ fn edges(
     let mut edges = Vec::new();
     let mut add = |k: usize, l: usize, beta: &[f64]| {
         let damping = (beta[k] * v[k]).min(beta[l] * v[l]).max(0.0);
-        let weight = THETA * cycles * damping * (areas[k] + areas[l]) / 8.0;
+        let z = cycles * damping;
+        let weight = theta(z) * z * (areas[k] + areas[l]) / 8.0;
         if weight > 0.0 {
             edges.push((k, l, weight));
         }
@@ -315,6 +354,8 @@ mod tests {
         NodeResponse {
             rows_per_m: vec![2e5; w.values.len()],
             columns_per_m: vec![4e5; w.values.len()],
+            measured_at_removal_m: 0.0,
+            measured_pitted_nodes: 0,
         }
     }
 
@@ -379,17 +420,75 @@ mod tests {
 
     #[test]
     fn two_nodes_part_as_the_analytic_damping_says() {
-        // Two nodes of equal area m, one edge of weight a = theta dC beta min(w) m / 4:
+        // Two nodes of equal area m, one edge of weight a = theta(z) z m / 4, z = dC beta min(w):
         // (m + a) x1 - a x2 = m dC w1 and its mirror, so x1 - x2 = dC (w1 - w2) / (1 + 2 a / m),
         // and x1 + x2 = dC (w1 + w2).
         let w = field(1, 0, |i, _| if i == 0 { 4e-10 } else { 3e-10 });
         let m = vec![2e-7, 2e-7];
-        let cycles = 5e4;
-        let x = removal_on(&w, &m, cycles, &even_response(&w));
-        let a_over_m = THETA * cycles * 2e5 * 3e-10 / 4.0;
-        let expected = cycles * 1e-10 / (1.0 + 2.0 * a_over_m);
-        assert!(((x[0] - x[1]) - expected).abs() <= 1e-12 * expected);
-        assert!(((x[0] + x[1]) - cycles * 7e-10).abs() <= 1e-12 * cycles * 7e-10);
+        // z = 0.6 (theta 1/2) and 3 (theta 2/3).
+        for cycles in [1e4, 5e4] {
+            let x = removal_on(&w, &m, cycles, &even_response(&w));
+            let z = cycles * 2e5 * 3e-10;
+            let a_over_m = theta(z) * z / 4.0;
+            let expected = cycles * 1e-10 / (1.0 + 2.0 * a_over_m);
+            assert!(((x[0] - x[1]) - expected).abs() <= 1e-12 * expected);
+            assert!(((x[0] + x[1]) - cycles * 7e-10).abs() <= 1e-12 * cycles * 7e-10);
+        }
+    }
+
+    #[test]
+    fn node_scale_roughness_decays_without_changing_sign_and_vanishes_beyond_z_2() {
+        // A flank rough from row to row by e, whose wear responds to it (w = wbar (1 -+ beta e)),
+        // no response along the face: each column a chain whose middle rows see the infinite
+        // chain's node-scale mode. After a step e' = e (1 - (1 - theta) z) / (1 + theta z):
+        // the trapezoidal rule's (1 - z / 2) / (1 + z / 2) up to z = 2, 0 beyond.
+        let (wbar, beta, e) = (1e-9, 2e5, 1e-12);
+        let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let w = field(60, 2, |i, _| wbar * (1.0 - beta * e * sign(i)));
+        let m = vec![1e-7; w.values.len()];
+        let response = NodeResponse {
+            rows_per_m: vec![beta; w.values.len()],
+            columns_per_m: vec![0.0; w.values.len()],
+            measured_at_removal_m: 0.0,
+            measured_pitted_nodes: 0,
+        };
+        for z in [0.2, 1.0, 1.9, 2.0, 3.0, 10.0] {
+            let cycles = z / (beta * wbar);
+            let x = removal_on(&w, &m, cycles, &response);
+            let middle = 30;
+            let rough = 0.5 * (x[middle] - x[middle + 1]) * sign(middle);
+            let after = e + rough;
+            let zmin = z * (1.0 - beta * e);
+            let t = theta(zmin);
+            let expected = e * (1.0 - (1.0 - t) * z) / (1.0 + t * zmin);
+            assert!(
+                after >= -1e-6 * e,
+                "z {z}: e' {after:e} flips the roughness"
+            );
+            assert!(
+                (after - expected).abs() <= 1e-6 * e,
+                "z {z}: e' {after:e}, expected {expected:e}"
+            );
+            if z >= 2.0 {
+                assert!(after.abs() <= 1e-6 * e, "z {z}: e' {after:e}");
+            } else {
+                let trapezoid = e * (1.0 - z / 2.0) / (1.0 + z / 2.0);
+                assert!((after - trapezoid).abs() <= 1e-6 * e, "z {z}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_response_is_measured_again_after_its_wear_or_new_pits() {
+        let response = NodeResponse {
+            measured_at_removal_m: 150e-6,
+            measured_pitted_nodes: 12,
+            ..even_response(&rough_patch())
+        };
+        assert!(!response.is_due(150e-6, 12));
+        assert!(!response.is_due(150e-6 + 0.99 * REMEASURE_WEAR, 12));
+        assert!(response.is_due(150e-6 + 1.01 * REMEASURE_WEAR, 12));
+        assert!(response.is_due(150e-6, 13));
     }
 
     #[test]

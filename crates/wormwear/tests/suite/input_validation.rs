@@ -314,7 +314,10 @@ fn wear_and_rating_sections_are_checked() {
             .max_substep_removal
     };
     assert_eq!(guard("step_wear_um = 24.0"), 5.0 * 1e-6);
-    assert_eq!(guard("step_wear_um = 24.0\nstep_scheme = \"stabilised\""), 0.0);
+    assert_eq!(
+        guard("step_wear_um = 24.0\nstep_scheme = \"stabilised\""),
+        0.0
+    );
     assert_eq!(
         guard("step_wear_um = 24.0\nstep_scheme = \"stabilised\"\nmax_substep_wear_um = 8"),
         8.0 * 1e-6
