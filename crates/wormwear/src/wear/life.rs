@@ -523,7 +523,8 @@ impl<'a> LifeLoop<'a> {
     /// The stabilised step's measured response of the wear to a node-scale removal
     /// (`wear::stabilised`), on the state `a` of `state`: on the life's first state, and again
     /// where the flank has changed since ([`NodeResponse::is_due`]); none with the explicit step.
-    /// Returns the loaded analyses it took.
+    /// Returns the loaded analyses it took (a run resumed at the state it was measured on counts
+    /// them again, so that the state's record is the uninterrupted run's).
     fn measure_response(
         &self,
         state: &mut WearState,
@@ -536,9 +537,14 @@ impl<'a> LifeLoop<'a> {
             state.removal.max(),
             state.pitted.iter().filter(|p| **p).count(),
         );
+        let probes = 2 * self.bins.len();
         if let Some(r) = &state.node_response {
             if !r.is_due(removal, pitted) {
-                return Ok(0);
+                return Ok(if r.measured_at_step == state.step {
+                    probes
+                } else {
+                    0
+                });
             }
         }
         let along = |height: bool| -> Result<Vec<f64>, WearError> {
@@ -559,9 +565,10 @@ impl<'a> LifeLoop<'a> {
             columns_per_m: along(false)?,
             measured_at_removal_m: removal,
             measured_pitted_nodes: pitted,
+            measured_at_step: state.step,
         };
         state.node_response = Some(response);
-        Ok(2 * self.bins.len())
+        Ok(probes)
     }
 
     /// Phase at some cycles: (index, phase, end); None after the schedule (wear).

@@ -62,6 +62,10 @@ pub struct NodeResponse {
     /// The flank's pitted nodes when measured.
     #[serde(default)]
     pub measured_pitted_nodes: usize,
+    /// The state (its step) it was measured on: a run resumed there counts the measurement's
+    /// analyses in that state's record, as the uninterrupted run did.
+    #[serde(default)]
+    pub measured_at_step: usize,
 }
 
 /// Wear after which the node response is measured again, m: the response is the contact's at
@@ -356,6 +360,7 @@ mod tests {
             columns_per_m: vec![4e5; w.values.len()],
             measured_at_removal_m: 0.0,
             measured_pitted_nodes: 0,
+            measured_at_step: 0,
         }
     }
 
@@ -451,6 +456,7 @@ mod tests {
             columns_per_m: vec![0.0; w.values.len()],
             measured_at_removal_m: 0.0,
             measured_pitted_nodes: 0,
+            measured_at_step: 0,
         };
         for z in [0.2, 1.0, 1.9, 2.0, 3.0, 10.0] {
             let cycles = z / (beta * wbar);
@@ -483,6 +489,7 @@ mod tests {
         let response = NodeResponse {
             measured_at_removal_m: 150e-6,
             measured_pitted_nodes: 12,
+            measured_at_step: 7,
             ..even_response(&rough_patch())
         };
         assert!(!response.is_due(150e-6, 12));

@@ -404,6 +404,37 @@ fn a_resumed_stabilised_life_with_error_control_gives_the_results_of_an_uninterr
 }
 
 #[test]
+fn a_resumed_stabilised_life_measures_its_response_again_after_a_cut_as_an_uninterrupted_one() {
+    // Pits cut on the first state (a pitting phase first, limit 700 MPa): the response is
+    // measured on the first state and again on the state after the cut (two loaded analyses
+    // each), which is where the run is interrupted and resumed.
+    let bench = Bench::new(&example("gear-1x40-design.toml"));
+    use wormwear::input::Phase;
+    let plan = wear::WearPlan {
+        scheme: wear::StepScheme::Stabilised,
+        step_tolerance: 0.01,
+        phases: vec![
+            Phase::Pitting {
+                until: 10_000.0,
+                pressure_limit: Some(700e6),
+                margin: 0.0,
+            },
+            Phase::Wear { until: 30_000.0 },
+        ],
+        ..plan(30_000.0, wear::StepControl::MaxRemoval(24e-6), 0.0)
+    };
+    let straight = resumes_exactly(&bench, &plan);
+    let r = &straight.records;
+    assert!(r[1].pitted_area_fraction > 0.0 && r[0].pitted_area_fraction == 0.0);
+    // State 0: its analysis and two probes; state 1 (the cut, same cycles): one and two more.
+    assert_eq!(r[0].loaded_analyses, 3);
+    assert_eq!(r[1].loaded_analyses, 6);
+    let response = straight.node_response.as_ref().unwrap();
+    assert_eq!(response.measured_at_step, 1);
+    assert!(response.measured_pitted_nodes > 0);
+}
+
+#[test]
 fn a_stabilised_step_removes_the_explicit_worn_volume_smoothed_at_the_grid_s_scale() {
     // One step of 30 000 cycles from the unworn design gear, explicit and stabilised
     // (`wear::stabilised`): the same worn volume to round-off, a lower largest removal, and
