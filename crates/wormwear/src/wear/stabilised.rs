@@ -11,8 +11,8 @@
 //!   (M + theta dC L) dh = dC M w,
 //!
 //! M the nodes' areas (a quarter of each cell's at its corners: the worn volume is sum M dh,
-//! `FlankField::integral`), theta per edge ([`theta`]), and L the graph Laplacian of the flank's grid
-//! whose edge (k, l) along the height weighs min(beta_k w_k, beta_l w_l) (M_k + M_l) / 8, with
+//! `FlankField::integral`), theta per edge ([`theta`]), and L the graph Laplacian of the
+//! flank's grid whose edge (k, l) along the height weighs min(beta_k w_k, beta_l w_l) (M_k + M_l) / 8, with
 //! beta the rows' response (along the face, the columns'). beta is the wear's response to the
 //! removal, measured at each node on the life's first state, and again after each pitting
 //! phase's cut and every [`REMEASURE_WEAR`] of wear ([`NodeResponse`]): the change of
@@ -29,14 +29,15 @@
 //! of response z = dC beta w evolves as e' = e (1 - (1 - theta) z) / (1 + theta z): the explicit
 //! step (theta = 0) overshoots beyond z = 2 and grows; theta = 1 damps every z (e' -> 0) but
 //! biases the worn pattern's real peaks low by about dC^2 J w / 2 per step, as the explicit step
-//! biases them high (measured: case B's and the design's one-node wear -2 to -4 %, case C's patch
-//! wear -3.6 %); theta = 1/2, the trapezoidal rule on the response (second order: with a wear
-//! rate linear in the removal the step is that rule exactly), leaves the roughness of z > 2
+//! biases them high (measured at tolerance 0.003: the design's and case B's one-node wear -1.7
+//! and -6.7 %, case C's patch wear away from its pits -3.6 %); theta = 1/2, the trapezoidal
+//! rule on the response (second order: with a wear rate linear in the removal the step is that
+//! rule exactly), leaves the roughness of z > 2
 //! oscillating (e' -> -e as z grows; theta = 0.6 raised case B's worn volume by 2 % over its
 //! life, BENCHMARKS.md session 42). [`theta`] takes 1/2 up to z = 2 and 1 - 1/z beyond, the
 //! least theta for which e' >= 0: the roughness the trapezoidal rule would flip is removed in
 //! one step (e' = 0) and the smooth part keeps the second order wherever the step is small.
-
+//!
 //! The error control sets adaptive steps from the change of the wear per cycle over the last
 //! step: the step's local error is about dC / 2 times the change of the rate (the explicit
 //! step against the trapezoidal rule) on three converged measures, the worn volume, the
