@@ -1050,6 +1050,17 @@ fn resume_with_other_inputs_or_a_shorter_life_is_refused_and_names_the_differenc
     map.remove(wormwear::integrity::CHECKSUM);
     std::fs::write(&path, wormwear::integrity::seal(&checkpoint).unwrap()).unwrap();
     refused(&design, &resume, "no record of the inputs");
+    // A sealed checkpoint of another build (its program stamp differs): its states may be
+    // another model's, refused and named.
+    let mut other_build: serde_json::Value = serde_json::from_str(&sound).unwrap();
+    let map = other_build.as_object_mut().unwrap();
+    assert_eq!(map["inputs"]["program"], wormwear::PROGRAM);
+    map["inputs"]["program"] = serde_json::Value::from("0.1.0+0000000000000000");
+    map.remove(wormwear::integrity::CHECKSUM);
+    std::fs::write(&path, wormwear::integrity::seal(&other_build).unwrap()).unwrap();
+    let err = refused(&design, &resume, "another build of wormwear");
+    assert!(err.contains("0.1.0+0000000000000000"), "{err}");
+    assert!(err.contains(wormwear::PROGRAM), "{err}");
     // A changed checkpoint (a digit of the cycles flipped, the JSON still valid), one without
     // its checksum (an earlier version's): "cannot read", nothing written.
     let flipped = sound.replacen("\"cycles\":10000", "\"cycles\":19000", 1);

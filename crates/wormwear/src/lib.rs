@@ -51,6 +51,17 @@ pub mod wear;
 
 pub use runner::{Event, Request, Results, RunError, Source, Stage};
 
+/// The program that computes: the release version and a digest of the library's sources
+/// (`build.rs`), e.g. "0.1.0+3f2a...". Results kept for reuse — a life's checkpoint
+/// ([`output::wear::life_inputs`]), a sweep's finished variants, the validation study's runs —
+/// are reused only by the same program: any change to the model's code may change them, and
+/// the release version alone does not move with it.
+pub const PROGRAM: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    "+",
+    env!("WORMWEAR_SOURCE_STAMP")
+);
+
 /// Runs the stages `request` asks for on a validated gear (MODEL §0), reporting progress to
 /// `on_event` (an error from it stops the run); every stage runs the ones it needs first and
 /// is skipped when nothing asked for needs it.

@@ -271,6 +271,7 @@ pub fn summary_values(
         "file": input_file.display().to_string(),
         "title": gear.title,
         "program_version": env!("CARGO_PKG_VERSION"),
+        "program": crate::PROGRAM,
         "gear": validated,
     });
     let geometry =

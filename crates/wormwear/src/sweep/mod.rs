@@ -644,12 +644,12 @@ pub fn variant_document(base: &toml::Table, variant: &Variant) -> Result<toml::T
 }
 
 /// The fingerprint of a variant's inputs: its gear document, the settings and the program
-/// version (SHA-256, hex).
+/// ([`crate::PROGRAM`]: a variant finished by another build is run again) (SHA-256, hex).
 fn fingerprint(document_text: &str, settings: &Settings) -> String {
     let settings = serde_json::to_string(settings).unwrap_or_default();
     crate::integrity::digest_text(&format!(
         "{}\n{settings}\n{document_text}",
-        env!("CARGO_PKG_VERSION")
+        crate::PROGRAM
     ))
 }
 

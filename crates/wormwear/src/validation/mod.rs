@@ -191,10 +191,12 @@ fn run_path(dir: &Path, id: &str) -> PathBuf {
     dir.join("runs").join(format!("{id}.json"))
 }
 
-/// The job's key: its inputs as JSON text.
+/// The job's key: its inputs as JSON text, with the program that ran it ([`crate::PROGRAM`]:
+/// a run kept by another build is run again).
 fn key(job: &Job) -> String {
     serde_json::json!({
         "version": STUDY_VERSION,
+        "program": crate::PROGRAM,
         "gear": job.gear,
         "plan": job.plan,
     })

@@ -106,7 +106,9 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<WearState>, OutputError> {
 /// The inputs that shape a life's results: the gear set without its title, its remarks and
 /// its life plan, and the plan without where the life ends (its length and the wear limit it
 /// stops at: a resume may extend a life).
-/// Stored in the checkpoint, compared on resume ([`input_changes`]).
+/// With them the program that computes them ([`crate::PROGRAM`]): a checkpoint of another
+/// build may hold states of another model. Stored in the checkpoint, compared on resume
+/// ([`input_changes`]).
 pub fn life_inputs(gear: &GearSet, plan: &WearPlan) -> serde_json::Value {
     let mut g = serde_json::to_value(gear).unwrap_or(serde_json::Value::Null);
     if let Some(map) = g.as_object_mut() {
@@ -120,7 +122,7 @@ pub fn life_inputs(gear: &GearSet, plan: &WearPlan) -> serde_json::Value {
             map.remove(key);
         }
     }
-    serde_json::json!({ "gear": g, "plan": p })
+    serde_json::json!({ "gear": g, "plan": p, "program": crate::PROGRAM })
 }
 
 /// Where two [`life_inputs`] differ: one line per differing leaf, `path: old -> new` (dotted
@@ -284,7 +286,23 @@ pub fn resume_state(dir: &Path, gear: &GearSet, plan: &WearPlan) -> Result<WearS
             checkpoint.display()
         )));
     };
-    let changes = input_changes(&stored, &life_inputs(gear, plan));
+    let now = life_inputs(gear, plan);
+    if stored.get("program") != now.get("program") {
+        let shown = |v: Option<&serde_json::Value>| {
+            v.and_then(|v| v.as_str())
+                .unwrap_or("an earlier version")
+                .to_string()
+        };
+        return Err(ResumeError::Refused(format!(
+            "--resume: {} was computed by another build of wormwear ({}; this one is {}): its \
+             states may come from another model; finish the life with that build, or run \
+             without --resume into a new directory",
+            checkpoint.display(),
+            shown(stored.get("program")),
+            shown(now.get("program"))
+        )));
+    }
+    let changes = input_changes(&stored, &now);
     if !changes.is_empty() {
         let shown: Vec<&str> = changes.iter().take(12).map(String::as_str).collect();
         let more = changes.len().saturating_sub(shown.len());
