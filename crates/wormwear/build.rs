@@ -2,15 +2,22 @@
 //! kept for reuse (a life's checkpoint, a sweep's variants, the validation study's runs) are
 //! reused only by the program that computed them (`wormwear::PROGRAM`).
 //!
-//! The digest is FNV-1a (64 bit) over every file under `src/`, in the order of their paths,
-//! each as its path relative to `src/` (with `/`), a zero byte, its bytes and a zero byte: the
-//! same sources give the same stamp on every machine and toolchain.
+//! The digest is FNV-1a (64 bit) over every file under `src/` but hidden ones, in the order
+//! of their paths, each as its path relative to `src/` (with `/`), a zero byte, its bytes and a
+//! zero byte: the same sources give the same stamp on every machine and toolchain.
 
 use std::path::{Path, PathBuf};
 
 fn files_under(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
     for entry in std::fs::read_dir(dir)? {
         let path = entry?.path();
+        // (Hidden files, such as an editor's swap files, are no part of the program.)
+        if path
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+        {
+            continue;
+        }
         if path.is_dir() {
             files_under(&path, out)?;
         } else {
