@@ -21,6 +21,9 @@ pub struct ComparedRun {
     pub differences: Option<Vec<String>>,
     /// The life's (cycles, backlash increase um, largest flank loss um), if it ran.
     pub life: Vec<(f64, f64, f64)>,
+    /// The worn volume of one flank at the life's end, mm^3 (None: no life, or a table
+    /// without it).
+    pub worn_volume_mm3: Option<f64>,
 }
 
 /// A key result of every run: label, unit and value per run (None where it is absent).
@@ -124,6 +127,7 @@ const KEYS: &[(&str, &str, &str, f64)] = &[
     ("rating/pitting_safety", "S_H (ISO/TR 14521)", "", 1.0),
     ("wear/life_cycles", "Simulated life", "wheel cycles", 1.0),
     ("wear/states", "Wear states", "", 1.0),
+    ("wear/loaded_analyses", "Loaded analyses of the life", "", 1.0),
 ];
 
 /// The value at a slash-separated path of summary.json, times `factor` (an oil temperature
@@ -142,11 +146,11 @@ fn value_at(summary: &Value, path: &str, factor: f64) -> Option<f64> {
 }
 
 /// The life of a run from its wear_steps.csv: (cycles, backlash increase um, patch-mean
-/// largest flank loss um); empty without a life.
-fn life_of(dir: &Path) -> Vec<(f64, f64, f64)> {
+/// largest flank loss um), empty without a life, and the worn volume at its end (mm^3).
+fn life_of(dir: &Path) -> (Vec<(f64, f64, f64)>, Option<f64>) {
     let Ok(text) = crate::files::read_text(&dir.join("wear_steps.csv"), crate::files::RESULT_LIMIT)
     else {
-        return Vec::new();
+        return (Vec::new(), None);
     };
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
@@ -156,8 +160,10 @@ fn life_of(dir: &Path) -> Vec<(f64, f64, f64)> {
         column("backlash_increase_m"),
         column("wear_patch_max_m"),
     ) else {
-        return Vec::new();
+        return (Vec::new(), None);
     };
+    let volume = column("worn_volume_m3");
+    let mut end_volume = None;
     let life: Vec<(f64, f64, f64)> = lines
         .filter_map(|line| {
             let f: Vec<&str> = line.split(',').collect();
@@ -166,15 +172,65 @@ fn life_of(dir: &Path) -> Vec<(f64, f64, f64)> {
                     .and_then(|s| s.parse::<f64>().ok())
                     .filter(|v| v.is_finite())
             };
-            Some((get(c)?, get(b)? * 1e6, get(w)? * 1e6))
+            let point = (get(c)?, get(b)? * 1e6, get(w)? * 1e6);
+            end_volume = volume.and_then(get).map(|v| v * 1e9);
+            Some(point)
         })
         .collect();
-    // A life's cycles rise from state to state; a table where they do not is no life.
-    if life.windows(2).any(|p| p[1].0 <= p[0].0) {
-        return Vec::new();
+    // A life's cycles never fall from state to state (a pitting phase's cut is a state at the
+    // cycles of the one before); a table where they do is no life.
+    if life.windows(2).any(|p| p[1].0 < p[0].0) {
+        return (Vec::new(), None);
     }
-    life
+    (life, end_volume)
 }
+
+/// The largest departure of each run's backlash increase from the first run's, % of the
+/// first's (MODEL §7: the reference comparison of a step control against fine steps): at
+/// [`DEPARTURE_POINTS`] cycles evenly over the lives' common span, each curve interpolated
+/// linearly between its states, where the first run's increase is at least 1 % of its largest
+/// there (a ratio of two near-zero increases says nothing). 0 for the first run; None for a
+/// run without a life or without such a point.
+fn backlash_departure(runs: &[ComparedRun]) -> Vec<Option<f64>> {
+    let first = &runs[0].life;
+    let interpolate = |life: &[(f64, f64, f64)], c: f64| -> Option<f64> {
+        let k = life.partition_point(|p| p.0 < c);
+        match (k.checked_sub(1).map(|i| life[i]), life.get(k)) {
+            (_, Some(b)) if b.0 == c => Some(b.1),
+            (Some(a), Some(b)) => Some(a.1 + (b.1 - a.1) * (c - a.0) / (b.0 - a.0)),
+            _ => None,
+        }
+    };
+    runs.iter()
+        .enumerate()
+        .map(|(k, run)| {
+            let (start, end) = (first.first()?.0, first.last()?.0.min(run.life.last()?.0));
+            let points: Vec<f64> = (1..=DEPARTURE_POINTS)
+                .map(|i| start + (end - start) * i as f64 / DEPARTURE_POINTS as f64)
+                .collect();
+            let reference: Vec<Option<f64>> =
+                points.iter().map(|&c| interpolate(first, c)).collect();
+            let largest = reference.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let departures: Vec<f64> = points
+                .iter()
+                .zip(&reference)
+                .filter_map(|(&c, r)| {
+                    let r = r.filter(|r| largest > 0.0 && r.abs() >= 0.01 * largest)?;
+                    Some(100.0 * (interpolate(&run.life, c)? / r - 1.0))
+                })
+                .collect();
+            if k == 0 {
+                return (!departures.is_empty()).then_some(0.0);
+            }
+            departures
+                .into_iter()
+                .max_by(|a, b| a.abs().total_cmp(&b.abs()))
+        })
+        .collect()
+}
+
+/// Points of the lives' common span at which [`backlash_departure`] compares the backlash.
+const DEPARTURE_POINTS: usize = 40;
 
 /// Reads the runs of `dirs` and gathers their key results: the table's rows, the life's end
 /// (backlash increase, largest flank loss) and each safety of the safety table.
@@ -224,8 +280,11 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
                 let (a, b) = (first["input"].get("gear")?, summary["input"].get("gear")?);
                 Some(super::wear::input_changes(a, b))
             }),
-            life: life_of(dir),
+            life: Vec::new(),
+            worn_volume_mm3: None,
         });
+        let run = runs.last_mut().expect("just pushed");
+        (run.life, run.worn_volume_mm3) = life_of(dir);
         summaries.push(summary);
     }
     let mut rows: Vec<KeyResult> = KEYS
@@ -239,19 +298,29 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
                 .collect(),
         })
         .collect();
-    rows.push(life_end_row(
-        &runs,
-        "Backlash increase at the life's end",
-        |l| l.1,
-    ));
-    rows.push(life_end_row(
-        &runs,
-        "Largest flank loss at the life's end",
-        |l| l.2,
-    ));
+    rows.extend(life_rows(&runs));
     rows.extend(safety_rows(&summaries));
     rows.retain(|r| r.values.iter().any(Option::is_some));
     Ok(Comparison { runs, rows })
+}
+
+/// The lives' rows: the backlash increase, largest flank loss and worn volume at their ends,
+/// and each backlash's departure from the first run's.
+fn life_rows(runs: &[ComparedRun]) -> Vec<KeyResult> {
+    vec![
+        life_end_row(runs, "Backlash increase at the life's end", |l| l.1),
+        life_end_row(runs, "Largest flank loss at the life's end", |l| l.2),
+        KeyResult {
+            quantity: "Worn volume of a flank at the life's end".into(),
+            unit: "mm^3".into(),
+            values: runs.iter().map(|r| r.worn_volume_mm3).collect(),
+        },
+        KeyResult {
+            quantity: "Backlash departure from the first run".into(),
+            unit: "%".into(),
+            values: backlash_departure(runs),
+        },
+    ]
 }
 
 fn life_end_row(
@@ -458,6 +527,67 @@ fn html(c: &Comparison, charts: &[PathBuf]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn run_with(life: Vec<(f64, f64, f64)>) -> ComparedRun {
+        ComparedRun {
+            label: String::new(),
+            dir: PathBuf::new(),
+            title: String::new(),
+            differences: None,
+            life,
+            worn_volume_mm3: None,
+        }
+    }
+
+    #[test]
+    fn the_backlash_departure_is_the_largest_relative_difference_over_the_common_life() {
+        // The first run's backlash rises linearly to 100 um at 1e6 cycles in 11 states; the
+        // second follows it 2 % higher in 3 states (exact between them: both are linear) and
+        // ends at 0.8e6; the third is 5 % lower up to 0.5e6 and 1 % lower after, with a state
+        // at 0.5e6; the fourth has no life. Points where the first's increase is below 1 %
+        // of its largest are left out (the second's 0-cycle state is 1 um, not 0: 2 % higher
+        // there would read +inf).
+        let first: Vec<(f64, f64, f64)> =
+            (0..=10).map(|i| (i as f64 * 1e5, i as f64 * 10.0, 0.0)).collect();
+        let second = vec![(0.0, 0.0, 0.0), (0.4e6, 40.8, 0.0), (0.8e6, 81.6, 0.0)];
+        let third = vec![
+            (0.0, 0.0, 0.0),
+            (0.5e6, 47.5, 0.0),
+            (0.5e6 + 1.0, 49.50099, 0.0),
+            (1e6, 99.0, 0.0),
+        ];
+        let runs = [first, second, third, Vec::new()].map(run_with);
+        let d = backlash_departure(&runs);
+        assert_eq!(d[0], Some(0.0));
+        assert!((d[1].unwrap() - 2.0).abs() < 1e-9, "{d:?}");
+        assert!((d[2].unwrap() + 5.0).abs() < 1e-9, "{d:?}");
+        assert_eq!(d[3], None);
+        // The same run against itself departs by nothing.
+        let same = [runs[1].clone(), runs[1].clone()];
+        assert_eq!(backlash_departure(&same), vec![Some(0.0), Some(0.0)]);
+    }
+
+    #[test]
+    fn a_life_with_a_pitting_cut_is_a_life_and_one_whose_cycles_fall_is_not() {
+        // A pitting phase's cut is a state at the cycles of the state before it: the table
+        // must still read as a life (before, the lives with pitting phases lost their rows
+        // and curves in the comparison).
+        let dir = tempfile::tempdir().unwrap();
+        let table = |rows: &[(f64, f64)]| {
+            let mut t = "step,cycles,wear_patch_max_m,worn_volume_m3,backlash_increase_m\n".to_string();
+            for (k, (c, b)) in rows.iter().enumerate() {
+                t.push_str(&format!("{k},{c},{},{},{b}\n", 2.0 * b, 1e-9 * c));
+            }
+            std::fs::write(dir.path().join("wear_steps.csv"), t).unwrap();
+        };
+        table(&[(0.0, 0.0), (1e5, 1e-6), (1e5, 1e-6), (2e5, 3e-6)]);
+        let (life, volume) = life_of(dir.path());
+        assert_eq!(life.len(), 4);
+        assert_eq!(life[3], (2e5, 3.0, 6.0));
+        assert_eq!(volume, Some(2e5 * 1e-9 * 1e9));
+        table(&[(0.0, 0.0), (1e5, 1e-6), (0.5e5, 1e-6)]);
+        assert_eq!(life_of(dir.path()), (Vec::new(), None));
+    }
 
     #[test]
     fn numbers_read_as_an_engineer_writes_them() {
