@@ -47,6 +47,9 @@ pub struct SpeedPoint {
     /// ISO/TR 14521's mu_0T and the worm-driving efficiency it gives.
     pub iso_friction: f64,
     pub iso_efficiency: f64,
+    /// ISO/TR 14521's mesh efficiency with the gear file's factors Y (`[rating]`; 1 where it
+    /// gives none): the same gear's rating.
+    pub iso_efficiency_with_factors: f64,
 }
 
 /// The study's points, gear by gear in [`SPEED_STUDY`]'s order (with `settings.quick` the
@@ -86,6 +89,7 @@ pub fn over_speeds(settings: &Settings) -> Result<Vec<SpeedPoint>, ValidationErr
                 torque_efficiency: l.mesh_efficiency,
                 iso_friction: mu0,
                 iso_efficiency: gamma.tan() / (gamma + mu0.atan()).tan(),
+                iso_efficiency_with_factors: iso.mesh_efficiency,
             });
         }
     }
@@ -96,12 +100,14 @@ pub fn over_speeds(settings: &Settings) -> Result<Vec<SpeedPoint>, ValidationErr
 pub fn table(points: &[SpeedPoint]) -> String {
     let mut m = String::from(
         "| gear | worm speed (rpm) | v_g (m/s) | mu contact | asperity share | eta_z contact | \
-         mu_0T ISO | eta_z ISO (mu_0T) | difference (points) |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+         mu_0T ISO | eta_z ISO (mu_0T) | difference (points) | eta_z ISO (the gear's Y) | \
+         difference (points) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for p in points {
         m.push_str(&format!(
-            "| {} | {:.0} | {:.2} | {:.4} | {:.3} | {:.3} | {:.4} | {:.3} | {:+.1} |\n",
+            "| {} | {:.0} | {:.2} | {:.4} | {:.3} | {:.3} | {:.4} | {:.3} | {:+.1} | {:.3} | \
+             {:+.1} |\n",
             p.gear,
             p.worm_speed_rpm,
             p.sliding_speed,
@@ -110,7 +116,9 @@ pub fn table(points: &[SpeedPoint]) -> String {
             p.mesh_efficiency,
             p.iso_friction,
             p.iso_efficiency,
-            100.0 * (p.mesh_efficiency - p.iso_efficiency)
+            100.0 * (p.mesh_efficiency - p.iso_efficiency),
+            p.iso_efficiency_with_factors,
+            100.0 * (p.mesh_efficiency - p.iso_efficiency_with_factors)
         ));
     }
     m
@@ -193,7 +201,10 @@ pub(super) fn section_e(
          **Against ISO/TR 14521's rig-fitted mu_0T over sliding speeds** (MODEL §13 validation \
          (1)): the 1/40 design gear and the K 2/25 gear at 60 N m on the worm, unworn, no \
          bending, oil at 60 C; ISO's eta_z = tan(gamma) / tan(gamma + atan(mu_0T)) with its \
-         factors Y at 1. One set of inputs for every speed and both gears.\n"
+         factors Y at 1, and ISO's mesh efficiency with the gear file's factors Y (the 1/40 \
+         gear's: Y_S 0.894 of the standard, Y_W 0.95 and Y_R 0.88 assumed, the same as the \
+         reference cases'; the K gear gives none, so 1). One set of inputs for every speed and \
+         both gears.\n"
     );
     m.push_str(&table(speeds));
     let _ = writeln!(
