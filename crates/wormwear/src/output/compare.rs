@@ -127,7 +127,12 @@ const KEYS: &[(&str, &str, &str, f64)] = &[
     ("rating/pitting_safety", "S_H (ISO/TR 14521)", "", 1.0),
     ("wear/life_cycles", "Simulated life", "wheel cycles", 1.0),
     ("wear/states", "Wear states", "", 1.0),
-    ("wear/loaded_analyses", "Loaded analyses of the life", "", 1.0),
+    (
+        "wear/loaded_analyses",
+        "Loaded analyses of the life",
+        "",
+        1.0,
+    ),
 ];
 
 /// The value at a slash-separated path of summary.json, times `factor` (an oil temperature
@@ -210,7 +215,10 @@ fn backlash_departure(runs: &[ComparedRun]) -> Vec<Option<f64>> {
                 .collect();
             let reference: Vec<Option<f64>> =
                 points.iter().map(|&c| interpolate(first, c)).collect();
-            let largest = reference.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let largest = reference
+                .iter()
+                .flatten()
+                .fold(0.0_f64, |m, v| m.max(v.abs()));
             let departures: Vec<f64> = points
                 .iter()
                 .zip(&reference)
@@ -547,8 +555,9 @@ mod tests {
         // at 0.5e6; the fourth has no life. Points where the first's increase is below 1 %
         // of its largest are left out (the second's 0-cycle state is 1 um, not 0: 2 % higher
         // there would read +inf).
-        let first: Vec<(f64, f64, f64)> =
-            (0..=10).map(|i| (i as f64 * 1e5, i as f64 * 10.0, 0.0)).collect();
+        let first: Vec<(f64, f64, f64)> = (0..=10)
+            .map(|i| (i as f64 * 1e5, i as f64 * 10.0, 0.0))
+            .collect();
         let second = vec![(0.0, 0.0, 0.0), (0.4e6, 40.8, 0.0), (0.8e6, 81.6, 0.0)];
         let third = vec![
             (0.0, 0.0, 0.0),
@@ -574,7 +583,8 @@ mod tests {
         // and curves in the comparison).
         let dir = tempfile::tempdir().unwrap();
         let table = |rows: &[(f64, f64)]| {
-            let mut t = "step,cycles,wear_patch_max_m,worn_volume_m3,backlash_increase_m\n".to_string();
+            let mut t =
+                "step,cycles,wear_patch_max_m,worn_volume_m3,backlash_increase_m\n".to_string();
             for (k, (c, b)) in rows.iter().enumerate() {
                 t.push_str(&format!("{k},{c},{},{},{b}\n", 2.0 * b, 1e-9 * c));
             }

@@ -647,10 +647,7 @@ pub fn variant_document(base: &toml::Table, variant: &Variant) -> Result<toml::T
 /// ([`crate::PROGRAM`]: a variant finished by another build is run again) (SHA-256, hex).
 fn fingerprint(document_text: &str, settings: &Settings) -> String {
     let settings = serde_json::to_string(settings).unwrap_or_default();
-    crate::integrity::digest_text(&format!(
-        "{}\n{settings}\n{document_text}",
-        crate::PROGRAM
-    ))
+    crate::integrity::digest_text(&format!("{}\n{settings}\n{document_text}", crate::PROGRAM))
 }
 
 /// A finished variant as stored in its folder (sealed).
