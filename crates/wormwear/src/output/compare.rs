@@ -276,6 +276,7 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
             .filter(|d| d.file_name() == dir.file_name())
             .count()
             > 1;
+        let (life, worn_volume_mm3) = life_of(dir);
         runs.push(ComparedRun {
             label: if clash {
                 format!("{name} ({})", k + 1)
@@ -288,11 +289,9 @@ pub fn compare(dirs: &[PathBuf]) -> Result<Comparison, CompareError> {
                 let (a, b) = (first["input"].get("gear")?, summary["input"].get("gear")?);
                 Some(super::wear::input_changes(a, b))
             }),
-            life: Vec::new(),
-            worn_volume_mm3: None,
+            life,
+            worn_volume_mm3,
         });
-        let run = runs.last_mut().expect("just pushed");
-        (run.life, run.worn_volume_mm3) = life_of(dir);
         summaries.push(summary);
     }
     let mut rows: Vec<KeyResult> = KEYS
