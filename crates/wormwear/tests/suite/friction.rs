@@ -253,6 +253,14 @@ fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
             assert!(pair[1].friction < pair[0].friction, "{pair:?}");
             assert!(pair[1].asperity_share < pair[0].asperity_share, "{pair:?}");
         }
+        for p in gear.iter().filter(|p| p.gear == "gear-k-2x25") {
+            // The K gear's file gives no factors Y: the rating's efficiency is mu_0T's own
+            // (two computations of ISO's efficiency, the rating's and the study's closed form).
+            assert!(
+                (p.iso_efficiency_with_factors - p.iso_efficiency).abs() < 1e-9,
+                "{p:?}"
+            );
+        }
         for p in gear {
             // The torques the loaded analysis carries are the contact's own efficiency.
             assert!(
