@@ -150,9 +150,13 @@ pub use super::ltca::MAX_PRESSURE_DEFINITION;
 /// The per-state results that still change by more than 5 % with the mesh (issue 39's
 /// convergence study, VALIDATION.md "Mesh convergence"): largest values at one node of the
 /// worn worm-tip trace or the wheel's tip edge (the peak wear's converged counterpart is
-/// `wear_patch_max_m`). Listed in the wear summary as `mesh_dependent`; no other stage reads
-/// them (the pitting forecast reads the damage field's share at its onset, the step control
-/// the largest per-cycle wear as a step size).
+/// `wear_patch_max_m`), the worn flank's largest equivalent pressure below it (MODEL §8.1: it
+/// reads that node's pressures; the unworn one is converged), and the worn pattern's mean
+/// pressure P_mean with Rank's N_LI from it (case C: 5 % between 40 and 80 positions, and the
+/// default level 31 % below the finer ones once the band has widened). Listed in the wear
+/// summary as `mesh_dependent`; no other stage reads them (the pitting forecast reads the
+/// damage field's share at its onset, the step control the largest per-cycle wear as a step
+/// size, the safety table the unworn analysis).
 pub const MESH_DEPENDENT: &[&str] = &[
     "max_wear_m",
     "max_plastic_set_m",
@@ -160,6 +164,9 @@ pub const MESH_DEPENDENT: &[&str] = &[
     "max_damage",
     "yielded_area_fraction",
     "pressure_patch_max_pa (worn states)",
+    "equivalent_pressure_max_pa (worn states)",
+    "mean_pressure_pa (worn states)",
+    "n_li_model_cycles (worn states)",
 ];
 
 /// Writes every file of a finished life ([`crate::runner::Life`]) at once, as [`LifeWriter`]
