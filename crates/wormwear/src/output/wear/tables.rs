@@ -455,3 +455,19 @@ pub fn node_table(
     }
     csv
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_mesh_dependent_field_is_a_column_of_the_states_table() {
+        // `mesh_dependent` names fields of the per-state records (a qualifier in brackets, such
+        // as "(worn states)", after the name): each must be a column readers can find.
+        let names: Vec<&str> = STEP_COLUMNS.iter().map(|c| c.0).collect();
+        for entry in super::super::MESH_DEPENDENT {
+            let field = entry.split(" (").next().unwrap();
+            assert!(names.contains(&field), "{entry}: no such column");
+        }
+    }
+}
