@@ -212,8 +212,8 @@ enum Command {
         /// Directory of the reference cases.
         #[arg(long, default_value = "examples")]
         examples: PathBuf,
-        /// Smoke run: lives cut to a hundredth, no bending, section (a) without its
-        /// mesh-refinement rows.
+        /// Smoke run: lives cut to a hundredth, no bending, one job per table (not its
+        /// variants), section (a) without its mesh-refinement rows.
         #[arg(long)]
         quick: bool,
     },

@@ -569,6 +569,11 @@ pub struct AnalysisSpec {
     /// line load (widened automatically when the load reaches the band edge).
     #[serde(default = "default_band_factor")]
     pub contact_band_factor: f64,
+    /// LTCA: how the band grows where the contact reaches its edge: "widen" (default: every
+    /// slice's cells widened together) or "extend" (the slices reached get more cells of the
+    /// same width on that side; MODEL §5.1).
+    #[serde(default)]
+    pub contact_band_growth: Option<String>,
     /// LTCA: contact law, "plastic" (default: pressures bounded by the wheel's flow pressure,
     /// the interference there kept as running-in, MODEL §5.7) or "elastic" (no bound, the
     /// published reading, MODEL §12 i).
@@ -657,6 +662,7 @@ impl Default for AnalysisSpec {
             contact_slice_step: default_slice_step(),
             contact_columns: default_contact_columns(),
             contact_band_factor: default_band_factor(),
+            contact_band_growth: None,
             contact: None,
             flow_pressure_mpa: None,
             contact_pressure_cap_mpa: None,

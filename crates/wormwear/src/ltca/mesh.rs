@@ -129,6 +129,25 @@ pub(super) struct Slice {
     pub(super) r_line: f64,
     /// The line's vector over the slice extent (worm frame), None at flank ends.
     pub(super) line_step: Option<Vector3<f64>>,
+    /// Cells added below and above the base band (band growth by extension, MODEL §5.1).
+    pub(super) extension: (usize, usize),
+}
+
+impl Slice {
+    /// The first and last column of the slice's band: the base band's `columns` from
+    /// [`LtcaSettings::column_offset`], and its extension's below and above.
+    fn columns(&self, settings: &LtcaSettings) -> (usize, usize) {
+        let (below, above) = self.extension;
+        let offset = settings.column_offset();
+        (offset - below, offset + settings.columns.max(1) - 1 + above)
+    }
+
+    /// Where a column's cell centre lies across the line from the line crossing, in cell
+    /// widths (the base band's cells centred on the crossing).
+    fn across(column: usize, settings: &LtcaSettings) -> f64 {
+        let nc = settings.columns.max(1) as f64;
+        column as f64 - settings.column_offset() as f64 - 0.5 * (nc - 1.0)
+    }
 }
 
 /// The contact lines of one position (MODEL §5.1), to follow a tooth's line from one node
@@ -190,8 +209,13 @@ impl<'a> PositionLines<'a> {
     }
 }
 
+/// The cells each slice's band has grown by below and above its base band, by (tooth, node
+/// column) (band growth by extension, MODEL §5.1; empty: none).
+pub(super) type Extensions = std::collections::HashMap<(i32, usize), (usize, usize)>;
+
 /// Builds the local mesh of one position with band half-width `band` (m) (MODEL §5.1):
-/// every `slice_step`-th node column crossed by a tooth's contact line is a slice.
+/// every `slice_step`-th node column crossed by a tooth's contact line is a slice, grown by
+/// `extensions`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn local_mesh(
     tca: &Tca,
@@ -202,6 +226,7 @@ pub(super) fn local_mesh(
     n: usize,
     band: f64,
     worn: Option<Worn>,
+    extensions: &Extensions,
 ) -> Vec<LocalCell> {
     let tau = 2.0 * PI / teeth as f64;
     let step = settings.slice_step.max(1);
@@ -244,6 +269,10 @@ pub(super) fn local_mesh(
             } else {
                 lines.direction(line.tooth, line.slice).map(|d| d * base_dz)
             },
+            extension: extensions
+                .get(&(line.tooth, line.slice))
+                .copied()
+                .unwrap_or((0, 0)),
         });
     }
     // Slices in parallel, in their order (on many cores idle threads help the positions
@@ -327,7 +356,8 @@ pub(super) fn worn_minimum(
 }
 
 /// The cells of one slice: `columns` cells of width 2 band / columns along the flank's
-/// radial direction, centred on the line crossing.
+/// radial direction, centred on the line crossing, and the slice's extension's cells of the
+/// same width beyond them.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn slice_cells(
     slice: &Slice,
@@ -341,17 +371,15 @@ pub(super) fn slice_cells(
     worn: Option<Worn>,
     tip_floor: &[f64],
 ) -> Vec<LocalCell> {
-    let pos = tca.positions[n];
-    let nc = settings.columns.max(1);
-    let ds = 2.0 * band / nc as f64;
-    let z = slice.z;
+    let (pos, z) = (tca.positions[n], slice.z);
+    let ds = 2.0 * band / settings.columns.max(1) as f64;
     let (lo, hi) = wf.radial_range_at(z);
     let (_, slope) = wf.theta_at(slice.r_line, z);
     let drds = 1.0 / (1.0 + (slice.r_line * slope).powi(2)).sqrt();
-    let mut cells = Vec::with_capacity(nc);
-    for k in 0..nc {
-        let s = (k as f64 - 0.5 * (nc as f64 - 1.0)) * ds;
-        let r = slice.r_line + s * drds;
+    let (first, last) = slice.columns(settings);
+    let mut cells = Vec::with_capacity(last + 1 - first);
+    for column in first..=last {
+        let r = slice.r_line + Slice::across(column, settings) * ds * drds;
         if r < lo || r > hi {
             continue;
         }
@@ -392,7 +420,9 @@ pub(super) fn slice_cells(
             tooth: slice.tooth,
             tooth_index: slice.tooth_index,
             slice: slice.base,
-            column: k,
+            column,
+            band_first: first,
+            band_last: last,
             r,
             z,
             half_dz: slice.half_dz,

@@ -67,6 +67,8 @@ pub struct LtcaSettings {
     pub columns: usize,
     /// Half-width of the band across the line, in Hertz half-widths at the mean line load.
     pub band_factor: f64,
+    /// How the band grows where the contact reaches its edge (MODEL §5.1).
+    pub band_growth: crate::input::BandGrowth,
     /// Flow pressure p_Y of the wheel's surface: the largest contact pressure, cells at it
     /// are in plastic flow (MODEL §5.7), Pa; infinite: the purely elastic contact.
     pub flow_pressure: f64,
@@ -87,12 +89,33 @@ pub struct LtcaSettings {
 }
 
 impl LtcaSettings {
+    /// Most cells a slice's band may grow by on each side when it extends, in bands' worth
+    /// of cells (`columns` each): up to seven times the base band in all (MODEL §5.1).
+    pub const EXTENSION_BANDS: usize = 3;
+
+    /// The column index of a slice's first base cell: 0 when the band widens, room for the
+    /// largest extension below it when it extends (so that a cell's column names the same
+    /// place across the line whatever its slice's extension).
+    pub fn column_offset(&self) -> usize {
+        match self.band_growth {
+            crate::input::BandGrowth::Widen => 0,
+            crate::input::BandGrowth::Extend => Self::EXTENSION_BANDS * self.columns.max(1),
+        }
+    }
+
+    /// The column that aligns the slices across the line where the band grows by extension
+    /// ([`max_patch_pressure`]'s offset); None where it widens.
+    pub fn aligned_columns(&self) -> Option<usize> {
+        (self.band_growth == crate::input::BandGrowth::Extend).then(|| self.column_offset())
+    }
+
     pub fn from_gear(gear: &GearSet) -> Self {
         let a = &gear.analysis;
         Self {
             slice_step: a.contact_slice_step,
             columns: a.contact_columns,
             band_factor: a.contact_band_factor,
+            band_growth: a.contact_band_growth,
             flow_pressure: a.contact.pressure_bound(),
             patch_across: a.pressure_patch_across,
             patch_along: a.pressure_patch_along,
@@ -121,9 +144,14 @@ pub struct LocalCell {
     /// Tooth index k and its index in the TCA's tooth list.
     pub tooth: i32,
     pub tooth_index: usize,
-    /// Slice (node column) and column across the line.
+    /// Slice (node column) and column across the line (ascending radii; with the band grown
+    /// by extension, the first base column is [`LtcaSettings::column_offset`]).
     pub slice: usize,
     pub column: usize,
+    /// The first and last column of the cell's slice band (cells outside the flank are not
+    /// made: a band cut by the flank has no cell at its end column).
+    pub band_first: usize,
+    pub band_last: usize,
     /// Flank coordinates (reference tooth), m.
     pub r: f64,
     pub z: f64,
@@ -481,7 +509,9 @@ pub fn analyse_with(
 /// Loads of a loaded analysis to start the next one's solver from (consecutive wear states
 /// differ by micrometres, so their solutions are close): per position, the loaded cells as
 /// (tooth, slice, column) and their unknown q = force x lever, N m. A start only: the result
-/// is the converged solution whatever the start (to the solver's tolerance).
+/// is the converged solution whatever the start (to the solver's tolerance); where the band
+/// grows by extension it also gives each slice's extent to start from (its loaded cells and
+/// one more each side: the same loaded cells, so the same contact, with fewer solves).
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WarmStart {
     pub positions: Vec<Vec<(i32, u32, u32, f64)>>,
@@ -491,17 +521,7 @@ impl WarmStart {
     /// The start for `cells` of position n: the load of the same (tooth, slice, column), 0 for
     /// a cell the previous analysis did not load; None when nothing matches.
     fn for_cells(&self, n: usize, cells: &[LocalCell]) -> Option<Vec<f64>> {
-        let known = self.positions.get(n)?;
-        let q: Vec<f64> = cells
-            .iter()
-            .map(|c| {
-                let key = (c.tooth, c.slice as u32, c.column as u32);
-                known
-                    .binary_search_by(|e| (e.0, e.1, e.2).cmp(&key))
-                    .map_or(0.0, |k| known[k].3)
-            })
-            .collect();
-        q.iter().any(|&v| v > 0.0).then_some(q)
+        position::start_for(self.positions.get(n)?, cells)
     }
 }
 
@@ -718,8 +738,9 @@ fn over_the_cycle(
     // The largest local cell (the published P_max): the pattern's cell centres read the
     // profiles between cell centres, which can only be lower.
     let max_pressure = positions.iter().map(|p| p.max_pressure).fold(0.0, f64::max);
+    let (across, along) = (settings.patch_across, settings.patch_along);
     let pressure_patch_max =
-        max_patch_pressure(&positions, settings.patch_across, settings.patch_along);
+        max_patch_pressure(&positions, across, along, settings.aligned_columns());
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
     let places = pattern::YieldedPlaces::of(wf, &pattern, settings.flow_pressure, &tca.tip_trace);

@@ -147,7 +147,7 @@ pub(crate) fn band_samples(
                     };
                     cells.sort_by(|a, b| a.r.total_cmp(&b.r));
                     let time = tca.sigma * theta2;
-                    sample_of(cells, line, time, wf, tca, runs.last_column)
+                    sample_of(cells, line, time, wf, tca)
                 })
                 .collect();
             samples.sort_by(|a, b| a.time.total_cmp(&b.time));
@@ -168,8 +168,6 @@ struct CellRuns {
     tail: Vec<usize>,
     teeth: usize,
     columns: usize,
-    /// The largest cell column seen.
-    last_column: usize,
 }
 
 impl CellRuns {
@@ -188,7 +186,6 @@ impl CellRuns {
             tail: vec![Self::NONE; np * teeth * (nj + 1)],
             teeth,
             columns: nj + 1,
-            last_column: 0,
         };
         for (at, pr) in positions.iter().enumerate() {
             let cells = &pr.cells;
@@ -202,10 +199,6 @@ impl CellRuns {
                 {
                     end += 1;
                 }
-                table.last_column = cells[k..end]
-                    .iter()
-                    .map(|c| c.column)
-                    .fold(table.last_column, usize::max);
                 let key = table.key(pr.position, c.tooth_index, c.slice);
                 table.runs.push((at, k, end, Self::NONE));
                 let run = table.runs.len() - 1;
@@ -233,6 +226,7 @@ impl CellRuns {
                     pressure: pr.pressure[i],
                     width: 2.0 * c.cell.half_nu,
                     column: c.column,
+                    band: (c.band_first, c.band_last),
                     plastic: pr.plastic_depth.get(i).copied().unwrap_or(0.0),
                     equivalent: pr
                         .equivalent
@@ -253,20 +247,20 @@ struct ProfileCell {
     pressure: f64,
     width: f64,
     column: usize,
+    /// The first and last column of its slice's band.
+    band: (usize, usize),
     plastic: f64,
     equivalent: (f64, f64),
 }
 
 /// One instant of the band on a node column from its cells across the line (ascending radii)
-/// at the contact line `line` of the reference tooth's time `time` (rad); `last_column` the
-/// band's last column index.
+/// at the contact line `line` of the reference tooth's time `time` (rad).
 fn sample_of(
     cells: Vec<ProfileCell>,
     line: &crate::kinematics::SliceContact,
     time: f64,
     wf: &WheelFlank,
     tca: &Tca,
-    last_column: usize,
 ) -> Sample {
     let load: f64 = cells.iter().map(|c| c.pressure * c.width).sum();
     let (_, extend_low, extend_high) = match (cells.first(), cells.last()) {
@@ -278,12 +272,12 @@ fn sample_of(
             };
             let j = line.slice;
             let floor = tca.tip_trace[j].1.max(wf.r_low[j]);
-            let low = if a.column > 0 {
+            let low = if a.column > a.band.0 {
                 (a.r - floor).max(0.5 * spacing)
             } else {
                 0.5 * spacing
             };
-            let high = if b.column < last_column {
+            let high = if b.column < b.band.1 {
                 (wf.r_high[j] - b.r).max(0.5 * spacing)
             } else {
                 0.5 * spacing

@@ -494,12 +494,22 @@ pub(super) fn plastic_rows_per_row(wf: &WheelFlank, settings: &LtcaSettings, ban
 /// line from the band's first column, z) with their widths 2 half_nu and 2 half_dz; pressure is
 /// zero outside the cells. The largest mean has a window end on a cell boundary in each
 /// direction, which is where the candidates are taken.
-pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64) -> f64 {
+///
+/// `offset`: with the band grown by extension, the column of the slices' first base cell
+/// ([`LtcaSettings::column_offset`]): a slice's cells then start across the line where that
+/// column puts them, so that slices extended by different counts stay aligned (None: every
+/// slice's first cell starts at 0).
+pub fn max_patch_pressure(
+    positions: &[PositionResult],
+    across: f64,
+    along: f64,
+    offset: Option<usize>,
+) -> f64 {
     positions
         .par_iter()
         .map(|p| {
             // (across lo, across hi, z lo, z hi, pressure) of the loaded cells, per tooth.
-            let across_start = across_starts(&p.cells);
+            let across_start = across_starts(&p.cells, offset);
             let mut teeth: std::collections::BTreeMap<usize, Vec<[f64; 5]>> = Default::default();
             for ((c, &pr), &x) in p.cells.iter().zip(&p.pressure).zip(&across_start) {
                 if pr <= 0.0 {
@@ -523,8 +533,9 @@ pub fn max_patch_pressure(positions: &[PositionResult], across: f64, along: f64)
 
 /// Where each cell starts across the contact line, m: the widths 2 half_nu of the cells before
 /// it in its slice (same tooth and slice, lower columns), so that the cells of a slice tile the
-/// band without overlap even where their widths differ from column to column.
-fn across_starts(cells: &[LocalCell]) -> Vec<f64> {
+/// band without overlap even where their widths differ from column to column; a slice's first
+/// cell at 0, or with `offset` at its column's distance from that base column.
+fn across_starts(cells: &[LocalCell], offset: Option<usize>) -> Vec<f64> {
     let mut order: Vec<usize> = (0..cells.len()).collect();
     order.sort_by_key(|&k| (cells[k].tooth_index, cells[k].slice, cells[k].column));
     let mut start = vec![0.0; cells.len()];
@@ -537,7 +548,9 @@ fn across_starts(cells: &[LocalCell]) -> Vec<f64> {
         x = if same_slice {
             x + 2.0 * cells[order[n - 1]].cell.half_nu
         } else {
-            0.0
+            offset.map_or(0.0, |o| {
+                (cells[k].column as f64 - o as f64) * 2.0 * cells[k].cell.half_nu
+            })
         };
         start[k] = x;
     }

@@ -3,6 +3,7 @@
 //! the wheel torque that closes the worm-torque equilibrium.
 
 use super::*;
+use crate::input::BandGrowth;
 
 /// The positions' mean worm and wheel torques (N m), the power balance
 /// (wheel torque / ratio + friction's worm torque) / worm torque - 1 (0 where the normal
@@ -36,7 +37,8 @@ pub(super) fn torque_balance(
 /// The loaded contact at position n (MODEL §5.2-5.4): the local mesh in a band around the
 /// contact lines, the problem on it, the solve with the wheel torque updated until the worm
 /// torque balances (with `friction`, the friction tractions' moments included: the
-/// transmitted torque), and the band widened (up to four times) while load reaches its edge.
+/// transmitted torque), and the band grown while load reaches its edge (widened up to four
+/// times, or the slices reached extended, MODEL §5.1).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_position(
     geo: &Geometry,
@@ -56,8 +58,11 @@ pub(super) fn solve_position(
 ) -> Result<PositionResult, LtcaError> {
     let mut band = band0;
     let mut widenings = 0;
+    let mut extensions = seeded_extensions(seed, n, settings);
+    // The last solve's loads, to start the next solve on an extended band from.
+    let mut restart: Option<Vec<CellLoad>> = None;
     loop {
-        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, worn);
+        let cells = local_mesh(tca, ev, wf, settings, geo.teeth, n, band, worn, &extensions);
         if cells.is_empty() {
             return Err(LtcaError::NoContact(n));
         }
@@ -70,40 +75,31 @@ pub(super) fn solve_position(
             });
         }
         // The previous analysis' loads on the same cells (the first mesh only: a widened band
-        // puts other points under the same indices).
-        let warm: Option<Vec<f64>> = seed
-            .filter(|_| widenings == 0)
-            .and_then(|s| s.for_cells(n, &cells));
-        let (mut problem, weights, sign) =
-            contact_problem(&cells, pair, settings, bending, wheel_torque_guess)
-                .ok_or(LtcaError::TorqueSign(n))?;
-        let balanced = match friction {
-            None => {
-                let start = Start { warm, first: None };
-                let (sol, worm, _) =
-                    balance_worm_torque(&mut problem, &weights, settings, worm_torque, start, n)?;
-                let wheel = problem.load;
-                Balanced::frictionless(sol, worm, wheel, cells.len())
-            }
-            Some(f) => {
-                let target = (worm_torque, wheel_torque_guess);
-                balance_with_friction(&mut problem, &cells, sign, (settings, f), target, warm, n)?
-            }
+        // puts other points under the same indices); on an extended band, the last solve's
+        // (an extension keeps every cell where it was).
+        let warm: Option<Vec<f64>> = match &restart {
+            Some(loads) => start_for(loads, &cells),
+            None => seed
+                .filter(|_| widenings == 0)
+                .and_then(|s| s.for_cells(n, &cells)),
         };
-        if at_band_edge(&cells, &balanced.solution.q, settings.columns) && widenings < 4 {
-            band *= 1.6;
-            widenings += 1;
-            continue;
+        let targets = (worm_torque, wheel_torque_guess);
+        let model = (pair, settings, bending, friction);
+        let (balanced, load) = balance_on(&cells, model, targets, warm, n)?;
+        let q = &balanced.solution.q;
+        match settings.band_growth {
+            BandGrowth::Widen if at_band_edge(&cells, q) && widenings < 4 => {
+                band *= 1.6;
+                widenings += 1;
+                continue;
+            }
+            BandGrowth::Extend if extend_reached_slices(&cells, q, settings, &mut extensions) => {
+                restart = Some(cell_loads_by_key(&cells, q));
+                continue;
+            }
+            _ => {}
         }
-        let mut result = position_result(
-            n,
-            tca,
-            ev,
-            settings,
-            cells,
-            &balanced.solution,
-            problem.load,
-        );
+        let mut result = position_result(n, tca, ev, settings, cells, &balanced.solution, load);
         let worm = balanced.worm;
         result.worm_torque = worm;
         result.wheel_torque = balanced.wheel;
@@ -114,6 +110,41 @@ pub(super) fn solve_position(
         result.band_widenings = widenings;
         return Ok(result);
     }
+}
+
+/// The solve on one local mesh (MODEL §5.2-5.4): the problem on `cells` under the elastic
+/// pair, settings, bending and friction of `model`, balanced to the (worm torque, wheel torque
+/// estimate) `targets` (N m) from `warm`; with the wheel torque it carries, N m.
+#[allow(clippy::type_complexity)]
+fn balance_on(
+    cells: &[LocalCell],
+    (pair, settings, bending, friction): (
+        &ElasticPair,
+        &LtcaSettings,
+        Option<&dyn BendingModel>,
+        Option<&PositionFriction>,
+    ),
+    (worm_torque, wheel_torque_guess): (Option<f64>, f64),
+    warm: Option<Vec<f64>>,
+    n: usize,
+) -> Result<(Balanced, f64), LtcaError> {
+    let (mut problem, weights, sign) =
+        contact_problem(cells, pair, settings, bending, wheel_torque_guess)
+            .ok_or(LtcaError::TorqueSign(n))?;
+    let balanced = match friction {
+        None => {
+            let start = Start { warm, first: None };
+            let (sol, worm, _) =
+                balance_worm_torque(&mut problem, &weights, settings, worm_torque, start, n)?;
+            let wheel = problem.load;
+            Balanced::frictionless(sol, worm, wheel, cells.len())
+        }
+        Some(f) => {
+            let target = (worm_torque, wheel_torque_guess);
+            balance_with_friction(&mut problem, cells, sign, (settings, f), target, warm, n)?
+        }
+    };
+    Ok((balanced, problem.load))
 }
 
 /// The ranges (start, size) of the teeth's cells (cells are grouped by tooth in mesh order).
@@ -529,13 +560,107 @@ fn cell_pressures(cells: &[LocalCell], q: &[f64], flow_pressure: f64) -> Vec<f64
         .collect()
 }
 
-/// Whether load reaches the first or last of the `columns` cells across the line.
-fn at_band_edge(cells: &[LocalCell], q: &[f64], columns: usize) -> bool {
+/// Whether a cell at its slice band's first or last column carries load (above 1e-6 of the
+/// largest cell's).
+fn at_edge(c: &LocalCell, q: f64, qmax: f64) -> bool {
+    q > 1e-6 * qmax && (c.column == c.band_first || c.column == c.band_last)
+}
+
+/// Whether load reaches the first or last cell across the line of any slice.
+fn at_band_edge(cells: &[LocalCell], q: &[f64]) -> bool {
     let qmax = q.iter().copied().fold(0.0, f64::max);
-    cells
+    cells.iter().zip(q).any(|(c, &q)| at_edge(c, q, qmax))
+}
+
+/// Band growth by extension (MODEL §5.1): every slice whose load reaches its band's first or
+/// last cell gets half a band's worth of cells (of the same width) more on that side, up to
+/// [`LtcaSettings::EXTENSION_BANDS`] bands' worth; whether any slice grew.
+fn extend_reached_slices(
+    cells: &[LocalCell],
+    q: &[f64],
+    settings: &LtcaSettings,
+    extensions: &mut Extensions,
+) -> bool {
+    let columns = settings.columns.max(1);
+    let (step, limit) = (columns.div_ceil(2), LtcaSettings::EXTENSION_BANDS * columns);
+    let qmax = q.iter().copied().fold(0.0, f64::max);
+    let mut grew = false;
+    for (c, &load) in cells.iter().zip(q) {
+        if !at_edge(c, load, qmax) {
+            continue;
+        }
+        let e = extensions.entry((c.tooth, c.slice)).or_default();
+        let side = if c.column == c.band_first {
+            &mut e.0
+        } else {
+            &mut e.1
+        };
+        // Once per slice and side in a pass (the edge cell is the slice's one cell there).
+        let before = if c.column == c.band_first {
+            settings.column_offset() - c.band_first
+        } else {
+            c.band_last + 1 - settings.column_offset() - columns
+        };
+        if *side == before && before < limit {
+            *side = (before + step).min(limit);
+            grew = true;
+        }
+    }
+    grew
+}
+
+/// With the band grown by extension, the extensions that hold the previous analysis' loaded
+/// cells of position n (from `seed`) and one cell more on each side: consecutive wear states
+/// differ by micrometres, so a worn contact's extent is known before it is solved again
+/// (empty without a seed, or where the band widens).
+fn seeded_extensions(seed: Option<&WarmStart>, n: usize, settings: &LtcaSettings) -> Extensions {
+    let mut extensions = Extensions::new();
+    let Some(loads) = seed.and_then(|s| s.positions.get(n)) else {
+        return extensions;
+    };
+    if settings.band_growth != BandGrowth::Extend {
+        return extensions;
+    }
+    let (offset, columns) = (settings.column_offset(), settings.columns.max(1));
+    let limit = LtcaSettings::EXTENSION_BANDS * columns;
+    for &(tooth, slice, column, _) in loads {
+        let column = column as usize;
+        let below = (offset + 1).saturating_sub(column).min(limit);
+        let above = (column + 2).saturating_sub(offset + columns).min(limit);
+        let e = extensions.entry((tooth, slice as usize)).or_default();
+        *e = (e.0.max(below), e.1.max(above));
+    }
+    extensions
+}
+
+/// A solve's loads q (N m) by (tooth, slice, column), sorted: a start for the same cells.
+pub(super) type CellLoad = (i32, u32, u32, f64);
+
+/// The loaded cells of `cells` under `q` as [`CellLoad`]s, sorted by key.
+pub(super) fn cell_loads_by_key(cells: &[LocalCell], q: &[f64]) -> Vec<CellLoad> {
+    let mut loads: Vec<CellLoad> = cells
         .iter()
         .zip(q)
-        .any(|(c, &q)| q > 1e-6 * qmax && (c.column == 0 || c.column == columns - 1))
+        .filter(|(_, &q)| q > 0.0)
+        .map(|(c, &q)| (c.tooth, c.slice as u32, c.column as u32, q))
+        .collect();
+    loads.sort_by_key(|e| (e.0, e.1, e.2));
+    loads
+}
+
+/// The start for `cells` from sorted `known` loads: the load of the same (tooth, slice,
+/// column), 0 for a cell without one; None when nothing matches.
+pub(super) fn start_for(known: &[CellLoad], cells: &[LocalCell]) -> Option<Vec<f64>> {
+    let q: Vec<f64> = cells
+        .iter()
+        .map(|c| {
+            let key = (c.tooth, c.slice as u32, c.column as u32);
+            known
+                .binary_search_by(|e| (e.0, e.1, e.2).cmp(&key))
+                .map_or(0.0, |k| known[k].3)
+        })
+        .collect();
+    q.iter().any(|&v| v > 0.0).then_some(q)
 }
 
 /// The position's result from the solution at wheel torque `wheel_torque` (N m): forces,

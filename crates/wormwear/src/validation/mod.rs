@@ -41,8 +41,8 @@ pub enum ValidationError {
 pub struct Settings {
     /// The directory of the reference cases (`examples/`).
     pub examples: PathBuf,
-    /// Smoke run: lives cut to a hundredth, no bending, no million-cycle studies (checks the
-    /// machinery, not the model).
+    /// Smoke run: lives cut to a hundredth, no bending, no million-cycle studies, one job per
+    /// table (checks the machinery, not the model).
     pub quick: bool,
 }
 
@@ -352,8 +352,27 @@ pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     for (id, g, plan) in variants(&c, scaled_life(&c, scale)) {
         push_job(&mut jobs, &id, g, Some(plan));
     }
+    if settings.quick {
+        jobs.retain(|j| QUICK_JOBS.contains(&j.id.as_str()));
+    }
     Ok(jobs)
 }
+
+/// The smoke run's jobs: one per table of the document (its machinery, not its variants).
+const QUICK_JOBS: [&str; 12] = [
+    "unworn-design",
+    "design-30000",
+    "design-adaptive",
+    "case-a",
+    "case-b",
+    "case-c",
+    "case-b-wear-only",
+    "case-c-forecast",
+    "speed-600",
+    "c-balance",
+    "c-roughness-0.2",
+    "c-elastic",
+];
 
 /// A gear's life plan (180 000 cycles when the file has none) with its life and phases
 /// scaled by `scale` (the quick study's hundredth).
@@ -548,4 +567,29 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         },
     ));
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_quick_job_is_a_job_of_the_study() {
+        // A renamed job would silently leave its table out of the smoke run.
+        let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+        let settings = |quick| Settings {
+            examples: examples.clone(),
+            quick,
+        };
+        let ids = |quick| -> Vec<String> {
+            jobs(&settings(quick))
+                .unwrap()
+                .into_iter()
+                .map(|j| j.id)
+                .collect()
+        };
+        let (full, quick) = (ids(false), ids(true));
+        assert_eq!(quick.len(), QUICK_JOBS.len(), "{quick:?}");
+        assert!(quick.iter().all(|id| full.contains(id)));
+    }
 }

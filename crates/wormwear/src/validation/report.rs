@@ -46,8 +46,8 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
          REFERENCE_GEARS.md, only the observed phases, so section (b) compares behaviours and \
          the phases, not curves.\n",
         if settings.quick {
-            " with `--quick` (lives cut to a hundredth, no bending, section (a) without its mesh-refinement \
-             rows: a smoke run, not a validation)"
+            " with `--quick` (lives cut to a hundredth, no bending, one job per table, section (a) \
+             without its mesh-refinement rows: a smoke run, not a validation)"
         } else {
             ""
         }

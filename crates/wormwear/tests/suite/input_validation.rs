@@ -1004,6 +1004,16 @@ fn friction_and_heat_balance_inputs_are_checked_by_name() {
         &e,
         &["analysis.torque_balance", "frictionfree", "transmitted"],
     );
+    let e = error_of(&set(
+        &design(),
+        "analysis",
+        "flank_cells_height",
+        "flank_cells_height = 40\ncontact_band_growth = \"grow\"",
+    ));
+    assert_mentions(
+        &e,
+        &["analysis.contact_band_growth", "grow", "widen", "extend"],
+    );
     let e = error_of(&with(
         "eyring_stress_mpa = 0.0\nlimiting_shear_coefficient = -0.1",
         "",

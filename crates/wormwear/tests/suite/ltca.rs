@@ -248,6 +248,73 @@ fn refinement_changes_pmax_and_te_little() {
 }
 
 #[test]
+fn an_extended_band_carries_the_contact_of_a_band_wide_enough_with_cells_as_fine() {
+    // Band growth by extension (MODEL §5.1) keeps its cells' width: a band of one Hertz
+    // half-width with 5 cells across the line, grown on the slices whose contact reaches its
+    // edge, must carry the contact of a band 4.2 times as wide with 21 cells of the same width
+    // (the same lattice of cell centres about the same line: both counts odd), which holds it
+    // whole without growing: the same loaded cells, so the same solution to the solver's
+    // tolerance. Frictionless pressures: the friction's entrainment speed is read at a slice's
+    // first cell, which moves with the band's extent (3e-4 of the TE here, BENCHMARKS.md
+    // session 46).
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 4;
+    let mut narrow = LtcaSettings::from_gear(&g);
+    (narrow.band_factor, narrow.columns) = (1.0, 5);
+    narrow.band_growth = input::BandGrowth::Extend;
+    narrow.torque_balance = input::TorqueBalance::Frictionless;
+    let mut wide = narrow;
+    (wide.band_factor, wide.columns) = (4.2, 21);
+    let (n, w) = (run(&g, &narrow), run(&g, &wide));
+    // A next analysis starts each slice from the extent its seed loaded (a life's states): the
+    // same loaded cells, so the same contact again.
+    let geo = Geometry::build(&g).unwrap();
+    let tca = kinematics::analyse(&g, &geo).unwrap();
+    let seed = n.warm_start();
+    let again = ltca::analyse_worn(&g, &geo, &tca, &narrow, None, None, Some(&seed)).unwrap();
+    // The test's premise: the narrow band grew, the wide one held the contact as it was.
+    let grown = |l: &Ltca, s: &LtcaSettings| {
+        let base = s.column_offset()..s.column_offset() + s.columns;
+        let cells = l.positions.iter().flat_map(|p| &p.cells);
+        cells.filter(|c| !base.contains(&c.column)).count()
+    };
+    assert!(grown(&n, &narrow) > 0);
+    assert_eq!(grown(&w, &wide), 0);
+    assert!(n
+        .positions
+        .iter()
+        .chain(&w.positions)
+        .all(|p| p.band_widenings == 0));
+    let relative = |a: f64, b: f64| (a / b - 1.0).abs();
+    for (pn, pa) in n.positions.iter().zip(&again.positions) {
+        assert!(relative(pn.transmission_error, pa.transmission_error) < 1e-8);
+        assert!(relative(pn.max_pressure, pa.max_pressure) < 1e-8);
+    }
+    for (pn, pw) in n.positions.iter().zip(&w.positions) {
+        let (ln, lw): (f64, f64) = (pn.tooth_load.iter().sum(), pw.tooth_load.iter().sum());
+        eprintln!(
+            "position {}: TE {:.9e} / {:.9e} rad, P_max {:.4} / {:.4} MPa, load {:.4} / {:.4} N",
+            pn.position,
+            pn.transmission_error,
+            pw.transmission_error,
+            pn.max_pressure / 1e6,
+            pw.max_pressure / 1e6,
+            ln,
+            lw
+        );
+        assert!(relative(pn.transmission_error, pw.transmission_error) < 1e-8);
+        assert!(relative(pn.max_pressure, pw.max_pressure) < 1e-8);
+        assert!(relative(ln, lw) < 1e-8);
+    }
+    // The patch pressure reads the slices aligned by column, whatever their extension: a cell
+    // starts where its column's count of cells of its own width puts it, and the widths vary
+    // by under 1 % along a slice, so the two layouts differ by a fraction of that (2e-4 here).
+    let (pn, pw) = (n.pressure_patch_max, w.pressure_patch_max);
+    eprintln!("P_patch {:.4} / {:.4} MPa", pn / 1e6, pw / 1e6);
+    assert!(relative(pn, pw) < 1e-3);
+}
+
+#[test]
 fn conjugate_line_contact_approach_scales_as_line_contact_theory() {
     // Hob identical to the worm: line contact. For a line contact on a half-space the approach
     // grows like w (ln(L/b) + const) with b ~ w^1/2, so d ln(approach) / d ln(load) is

@@ -123,6 +123,11 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
             ("frictionless", TorqueBalance::Frictionless),
         ],
     );
+    let band_growth = ck.choice(
+        "analysis.contact_band_growth",
+        a.contact_band_growth.as_deref().unwrap_or("widen"),
+        &[("widen", BandGrowth::Widen), ("extend", BandGrowth::Extend)],
+    );
     use super::SolverKind;
     let solver = ck.choice(
         "analysis.solver",
@@ -150,6 +155,7 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
         solver: solver?,
         pressure_direction: direction?,
         torque_balance: torque_balance?,
+        contact_band_growth: band_growth?,
     })
 }
 
