@@ -544,6 +544,13 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         plan.clone(),
     ));
     out.push((
+        "c-band-extend".to_string(),
+        variant(c, |g| {
+            g.analysis.contact_band_growth = input::BandGrowth::Extend
+        }),
+        plan.clone(),
+    ));
+    out.push((
         "c-wheel-flank-pressure".to_string(),
         variant(c, |g| {
             g.analysis.pressure_direction = input::PressureDirection::WheelFlank

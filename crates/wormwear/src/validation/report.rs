@@ -740,7 +740,7 @@ const SENSITIVITY_ROWS: [(&str, &str); 8] = [
 ];
 
 /// Rows of section (d): (option and its input, job id).
-const OPTION_ROWS: [(&str, &str); 6] = [
+const OPTION_ROWS: [(&str, &str); 7] = [
     (
         "default (plastic limit at the wheel hardness, MODEL §5.7)",
         "case-c",
@@ -760,6 +760,11 @@ const OPTION_ROWS: [(&str, &str); 6] = [
     (
         "film load floored: `film_load = \"hertz-peak-floor\"`",
         "c-film-floor",
+    ),
+    (
+        "the band grows by cells of the same width where the contact reaches it: \
+         `contact_band_growth = \"extend\"`",
+        "c-band-extend",
     ),
     (
         "pressure along the wheel grid's normal (the other reading of MODEL §5.2's n_i): \
