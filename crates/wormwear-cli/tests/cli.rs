@@ -1490,6 +1490,30 @@ fn a_life_with_the_heat_balance_killed_and_resumed_ends_as_the_uninterrupted_one
 }
 
 #[test]
+fn a_life_whose_band_extends_killed_and_resumed_ends_as_the_uninterrupted_one() {
+    // With `contact_band_growth = "extend"` each analysis starts its slices' extents from the
+    // previous state's loaded cells: a state's mesh depends on the warm start its checkpoint
+    // carries, so a resumed life must restore it exactly. A band of one Hertz half-width makes
+    // every position extend. Without bending and on 8 positions (the resume is the subject).
+    let files = tempfile::tempdir().unwrap();
+    let extend = (
+        "stl_wheel_teeth = 5",
+        "stl_wheel_teeth = 5\ncontact_band_growth = \"extend\"\ncontact_band_factor = 1.0",
+    );
+    let no_bending = ("model = \"fe\"", "model = \"none\"");
+    let positions = ("positions = 20", "positions = 8");
+    let design = edited_design(
+        files.path(),
+        "extend.toml",
+        &[extend, no_bending, positions],
+    );
+    let life = ["-q", "--cycles", "30000", "--step-cycles", "10000"];
+    let whole = tempfile::tempdir().unwrap();
+    assert!(wear_into(&design, whole.path(), &life).status.success());
+    killed_after_every_state_and_resumed(&design, &life, whole.path());
+}
+
+#[test]
 fn a_resumed_finished_life_builds_the_worn_wheel_of_an_earlier_map_state() {
     // Issue 58: resuming a finished life recomputes only its last state, so `--step-state` of
     // an earlier map state warned "no map state" and built the last state's wheel. The map
