@@ -219,7 +219,15 @@ pub struct PositionResult {
     pub cells: Vec<LocalCell>,
     /// Band widenings needed (load at the band edge).
     pub band_widenings: usize,
+    /// Share of the position's load on its bands' edge cells once the band stopped growing
+    /// (0: the contact within its band; see [`Ltca::band_edge_share`]).
+    #[serde(skip)]
+    pub band_edge_share: f64,
 }
+
+/// Share of a position's load on its band's edge cells above which the contact is reported as
+/// cut by the local mesh ([`Ltca::band_edge_share`]).
+pub const BAND_EDGE_WARNING: f64 = 0.01;
 
 impl PositionResult {
     /// The mesh force on the worm at this position: the sum over the loaded cells of pressure
@@ -526,6 +534,16 @@ impl WarmStart {
 }
 
 impl Ltca {
+    /// The largest share of a position's load on its band's edge cells once the band stopped
+    /// growing (MODEL §5.1): 0 when every position's band holds its contact; above
+    /// [`BAND_EDGE_WARNING`] the contact is cut by the local mesh, and the analysis warns.
+    pub fn band_edge_share(&self) -> f64 {
+        self.positions
+            .iter()
+            .map(|p| p.band_edge_share)
+            .fold(0.0, f64::max)
+    }
+
     /// The loads of this analysis as a start for the next ([`WarmStart`]).
     pub fn warm_start(&self) -> WarmStart {
         WarmStart {
@@ -756,6 +774,7 @@ fn over_the_cycle(
         &tca.tip_trace,
     ));
     warnings.extend(deflection_warning(&positions, tca, teeth));
+    warnings.extend(band_edge_warning(&positions));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),

@@ -99,7 +99,9 @@ pub(super) fn solve_position(
             }
             _ => {}
         }
+        let edge_share = band_edge_share(&cells, q);
         let mut result = position_result(n, tca, ev, settings, cells, &balanced.solution, load);
+        result.band_edge_share = edge_share;
         let worm = balanced.worm;
         result.worm_torque = worm;
         result.wheel_torque = balanced.wheel;
@@ -566,6 +568,48 @@ fn at_edge(c: &LocalCell, q: f64, qmax: f64) -> bool {
     q > 1e-6 * qmax && (c.column == c.band_first || c.column == c.band_last)
 }
 
+/// A warning when some position's contact still reaches its band's edge once the band stopped
+/// growing, with more than [`BAND_EDGE_WARNING`] of its load there: how many positions, the
+/// largest share and where.
+pub(super) fn band_edge_warning(positions: &[PositionResult]) -> Option<String> {
+    let cut: Vec<&PositionResult> = positions
+        .iter()
+        .filter(|p| p.band_edge_share > BAND_EDGE_WARNING)
+        .collect();
+    let worst = cut
+        .iter()
+        .max_by(|a, b| a.band_edge_share.total_cmp(&b.band_edge_share))?;
+    Some(format!(
+        "contact: at {} of {} positions the contact still reaches the local band's edge after \
+         the band grew as far as it may (MODEL §5.1; at most {:.1} % of a position's load on the \
+         edge cells, position {}): the contact there is cut by the local mesh; a wider \
+         analysis.contact_band_factor holds it",
+        cut.len(),
+        positions.len(),
+        100.0 * worst.band_edge_share,
+        worst.position
+    ))
+}
+
+/// Share of the loads `q` on cells at their slice band's first or last column (above 1e-6 of
+/// the largest cell's): 0 unless the band stopped growing with its contact still reaching its
+/// edge (four widenings, the extension's limit, or the dense solver's cells).
+fn band_edge_share(cells: &[LocalCell], q: &[f64]) -> f64 {
+    let qmax = q.iter().copied().fold(0.0, f64::max);
+    let total: f64 = q.iter().sum();
+    let edge: f64 = cells
+        .iter()
+        .zip(q)
+        .filter(|(c, &q)| at_edge(c, q, qmax))
+        .map(|(_, &q)| q)
+        .sum();
+    if total > 0.0 {
+        edge / total
+    } else {
+        0.0
+    }
+}
+
 /// Whether load reaches the first or last cell across the line of any slice.
 fn at_band_edge(cells: &[LocalCell], q: &[f64]) -> bool {
     let qmax = q.iter().copied().fold(0.0, f64::max);
@@ -574,7 +618,8 @@ fn at_band_edge(cells: &[LocalCell], q: &[f64]) -> bool {
 
 /// Band growth by extension (MODEL §5.1): every slice whose load reaches its band's first or
 /// last cell gets half a band's worth of cells (of the same width) more on that side, up to
-/// [`LtcaSettings::EXTENSION_BANDS`] bands' worth; whether any slice grew.
+/// [`LtcaSettings::EXTENSION_BANDS`] bands' worth and as long as the mesh stays within
+/// [`MAX_CONTACT_CELLS`]; whether any slice grew.
 fn extend_reached_slices(
     cells: &[LocalCell],
     q: &[f64],
@@ -584,12 +629,13 @@ fn extend_reached_slices(
     let columns = settings.columns.max(1);
     let (step, limit) = (columns.div_ceil(2), LtcaSettings::EXTENSION_BANDS * columns);
     let qmax = q.iter().copied().fold(0.0, f64::max);
-    let mut grew = false;
+    let mut grown = extensions.clone();
+    let mut grew = 0;
     for (c, &load) in cells.iter().zip(q) {
         if !at_edge(c, load, qmax) {
             continue;
         }
-        let e = extensions.entry((c.tooth, c.slice)).or_default();
+        let e = grown.entry((c.tooth, c.slice)).or_default();
         let side = if c.column == c.band_first {
             &mut e.0
         } else {
@@ -603,10 +649,16 @@ fn extend_reached_slices(
         };
         if *side == before && before < limit {
             *side = (before + step).min(limit);
-            grew = true;
+            grew += step;
         }
     }
-    grew
+    // Not past the dense solver's cells: the contact stays cut, and the position says so
+    // (its band-edge share).
+    if grew == 0 || cells.len() + grew > MAX_CONTACT_CELLS {
+        return false;
+    }
+    *extensions = grown;
+    true
 }
 
 /// With the band grown by extension, the extensions that hold the previous analysis' loaded
@@ -704,6 +756,7 @@ fn position_result(
         equivalent: Vec::new(),
         cells,
         band_widenings: 0,
+        band_edge_share: 0.0,
     }
 }
 

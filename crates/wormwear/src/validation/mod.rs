@@ -491,6 +491,9 @@ fn thermal_jobs(jobs: &mut Vec<Job>, c: &GearSet, scale: f64) {
     }
 }
 
+/// A change of a gear (a variant's).
+type GearChange = fn(&mut GearSet);
+
 /// The variants of case C for (c) and (d): id, gear, plan.
 fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
     let relief = input::EdgeRelief {
@@ -538,25 +541,21 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         }),
         plan.clone(),
     ));
-    out.push((
-        "c-elastic".to_string(),
-        variant(c, |g| g.analysis.contact = input::ContactLaw::Elastic),
-        plan.clone(),
-    ));
-    out.push((
-        "c-band-extend".to_string(),
-        variant(c, |g| {
+    // Our options of the loaded analysis, one at a time.
+    let analysis_options: [(&str, GearChange); 3] = [
+        ("c-elastic", |g| {
+            g.analysis.contact = input::ContactLaw::Elastic
+        }),
+        ("c-band-extend", |g| {
             g.analysis.contact_band_growth = input::BandGrowth::Extend
         }),
-        plan.clone(),
-    ));
-    out.push((
-        "c-wheel-flank-pressure".to_string(),
-        variant(c, |g| {
+        ("c-wheel-flank-pressure", |g| {
             g.analysis.pressure_direction = input::PressureDirection::WheelFlank
         }),
-        plan.clone(),
-    ));
+    ];
+    for (id, change) in analysis_options {
+        out.push((id.to_string(), variant(c, change), plan.clone()));
+    }
     out.push((
         "c-band-pits".to_string(),
         c.clone(),

@@ -797,6 +797,8 @@ impl<'a> LifeLoop<'a> {
             max_plastic_set_m: state.plastic_set_after(l).max(),
             max_plastic_indentation_m: l.plastic_indentation.max(),
             yielded_area_fraction: l.yielded_area_fraction,
+            band_edge_share: Some(l.band_edge_share())
+                .filter(|&s| s > crate::ltca::BAND_EDGE_WARNING),
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             roughness_mean_m: roughness.0,
             roughness_min_m: roughness.1,

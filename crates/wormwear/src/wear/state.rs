@@ -253,6 +253,11 @@ pub struct StepRecord {
     /// Share of the active flank area where this state's contact reached the flow pressure.
     #[serde(default)]
     pub yielded_area_fraction: f64,
+    /// The largest share of a position's load on its local band's edge cells once the band
+    /// stopped growing, where above [`crate::ltca::BAND_EDGE_WARNING`] (the contact cut by the
+    /// local mesh, MODEL §5.1); None: every position's band held its contact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub band_edge_share: Option<f64>,
     /// Largest equivalent pressure below the flank over the pattern (MODEL §8.1), Pa (0 in
     /// records of earlier versions).
     #[serde(default)]
@@ -379,6 +384,21 @@ impl WearState {
                 "wear: from {} cycles the loaded pattern reaches flank nodes whose tooth is worn \
                  through (contact computed on material that is gone; see wear.limits)",
                 cycles_label(r.cycles)
+            ));
+        }
+        if let Some(r) = self.records.iter().find(|r| r.band_edge_share.is_some()) {
+            let worst = self
+                .records
+                .iter()
+                .filter_map(|r| r.band_edge_share)
+                .fold(0.0, f64::max);
+            w.push(format!(
+                "contact: from {} cycles some position's contact still reaches the local band's \
+                 edge after the band grew as far as it may (MODEL §5.1; at most {:.1} % of a \
+                 position's load on the edge cells): the contact there is cut by the local mesh; \
+                 a wider analysis.contact_band_factor holds it",
+                cycles_label(r.cycles),
+                100.0 * worst
             ));
         }
         w.extend(self.damage_warning(wf));

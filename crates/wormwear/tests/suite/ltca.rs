@@ -315,6 +315,42 @@ fn an_extended_band_carries_the_contact_of_a_band_wide_enough_with_cells_as_fine
 }
 
 #[test]
+fn a_band_that_cannot_hold_its_contact_says_so() {
+    // No silent cut contact (MODEL §5.1): a band of a tenth of a Hertz half-width still reaches
+    // its contact after four widenings (0.65 half-widths), and one cell grown by at most three
+    // cells a side (0.7 half-widths) likewise (elastic cells: at the flow pressure so few could
+    // not carry the torque at all); both analyses say what share of a position's
+    // load sits on the edge cells, and warn. The default band holds its contact: share 0.
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 4;
+    let default = LtcaSettings::from_gear(&g);
+    let held = run(&g, &default);
+    assert_eq!(held.band_edge_share(), 0.0);
+    let says = |l: &Ltca| {
+        l.warnings
+            .iter()
+            .any(|w| w.contains("still reaches the local band"))
+    };
+    assert!(!says(&held));
+    let mut widened = default;
+    widened.band_factor = 0.1;
+    widened.flow_pressure = f64::INFINITY;
+    let mut extended = widened;
+    extended.columns = 1;
+    extended.band_growth = input::BandGrowth::Extend;
+    for settings in [widened, extended] {
+        let cut = run(&g, &settings);
+        eprintln!(
+            "{:?}: edge share {:.3}",
+            settings.band_growth,
+            cut.band_edge_share()
+        );
+        assert!(cut.band_edge_share() > ltca::BAND_EDGE_WARNING);
+        assert!(says(&cut), "{:?}", cut.warnings);
+    }
+}
+
+#[test]
 fn conjugate_line_contact_approach_scales_as_line_contact_theory() {
     // Hob identical to the worm: line contact. For a line contact on a half-space the approach
     // grows like w (ln(L/b) + const) with b ~ w^1/2, so d ln(approach) / d ln(load) is
