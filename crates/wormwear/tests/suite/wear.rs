@@ -171,6 +171,39 @@ fn life(
 }
 
 #[test]
+fn a_life_whose_band_cannot_hold_its_contact_records_and_warns_it() {
+    // No silent cut contact (MODEL §5.1): a band of a tenth of a Hertz half-width (below the
+    // input's range, set on the validated gear; elastic cells, which can carry the torque on
+    // so few) still reaches its contact once it has grown as far as it may; every record says
+    // what share of a position's load sits on the edge cells, and the life warns. The example's band holds its
+    // contact: no share, no warning.
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.positions = 4;
+    g.bending.kind = wormwear::input::BendingKind::None;
+    let says = |geo: &Geometry, tca: &kinematics::Tca, end: &wear::WearState| {
+        let w = end.warnings(geo.wheel_flank(tca.loaded_flank));
+        w.iter()
+            .any(|w| w.contains("still reaches the local band's edge"))
+    };
+    let (geo, tca, held) = life(&g, 2000.0, wear::StepControl::Cycles(1000.0), 0.0);
+    assert!(held.records.iter().all(|r| r.band_edge_share.is_none()));
+    assert!(!says(&geo, &tca, &held));
+    g.analysis.contact_band_factor = 0.1;
+    g.analysis.contact = wormwear::input::ContactLaw::Elastic;
+    // Grown by extension, one cell and at most three more a side: the widened band's next
+    // states would widen on from the last one's band and hold the contact again.
+    g.analysis.contact_columns = 1;
+    g.analysis.contact_band_growth = wormwear::input::BandGrowth::Extend;
+    let (geo, tca, cut) = life(&g, 2000.0, wear::StepControl::Cycles(1000.0), 0.0);
+    let shares: Vec<Option<f64>> = cut.records.iter().map(|r| r.band_edge_share).collect();
+    assert!(
+        shares.iter().all(|s| s.is_some_and(|s| s > 0.01)),
+        "{shares:?}"
+    );
+    assert!(says(&geo, &tca, &cut));
+}
+
+#[test]
 fn with_the_geometry_frozen_wear_is_linear_in_cycles() {
     // One step of C and one of 2C cycles from the unworn gear (no guard): the depth doubles.
     let g = example("gear-1x40-design.toml");
