@@ -26,6 +26,7 @@ mod traction;
 use mesh::*;
 pub use orders::{mesh_order_amplitudes, TeOrders};
 pub use pattern::*;
+pub use position::CellLoad;
 use position::*;
 use traction::torque_weights;
 pub use traction::{
@@ -522,7 +523,7 @@ pub fn analyse_with(
 /// one more each side: the same loaded cells, so the same contact, with fewer solves).
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WarmStart {
-    pub positions: Vec<Vec<(i32, u32, u32, f64)>>,
+    pub positions: Vec<Vec<CellLoad>>,
 }
 
 impl WarmStart {
@@ -546,28 +547,15 @@ impl Ltca {
 
     /// The loads of this analysis as a start for the next ([`WarmStart`]).
     pub fn warm_start(&self) -> WarmStart {
+        let loads = |p: &PositionResult| -> Vec<f64> {
+            let cells = p.cells.iter().zip(&p.pressure);
+            cells.map(|(c, pr)| pr * c.cell.area() * c.lever).collect()
+        };
         WarmStart {
             positions: self
                 .positions
                 .iter()
-                .map(|p| {
-                    let mut loaded: Vec<(i32, u32, u32, f64)> = p
-                        .cells
-                        .iter()
-                        .zip(&p.pressure)
-                        .filter(|(_, &pr)| pr > 0.0)
-                        .map(|(c, &pr)| {
-                            (
-                                c.tooth,
-                                c.slice as u32,
-                                c.column as u32,
-                                pr * c.cell.area() * c.lever,
-                            )
-                        })
-                        .collect();
-                    loaded.sort_by_key(|e| (e.0, e.1, e.2));
-                    loaded
-                })
+                .map(|p| cell_loads_by_key(&p.cells, &loads(p)))
                 .collect(),
         }
     }

@@ -685,8 +685,9 @@ fn seeded_extensions(seed: Option<&WarmStart>, n: usize, settings: &LtcaSettings
     extensions
 }
 
-/// A solve's loads q (N m) by (tooth, slice, column), sorted: a start for the same cells.
-pub(super) type CellLoad = (i32, u32, u32, f64);
+/// One loaded cell of a solve: (tooth, slice, column) and its load q = force x lever (N m);
+/// a solve's are kept sorted by key, a start for the same cells.
+pub type CellLoad = (i32, u32, u32, f64);
 
 /// The loaded cells of `cells` under `q` as [`CellLoad`]s, sorted by key.
 pub(super) fn cell_loads_by_key(cells: &[LocalCell], q: &[f64]) -> Vec<CellLoad> {
