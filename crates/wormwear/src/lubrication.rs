@@ -10,18 +10,43 @@ use crate::input::Lubricant;
 /// a smooth blend of the rigid-isoviscous (2.45/M, Martin), elastic-isoviscous (2.05 M^-1/5)
 /// and elastic-piezoviscous (0.99 M^-1/8 L^3/4) asymptotes. M > 0, L >= 0.
 pub fn moes_venner(m: f64, l: f64) -> f64 {
-    // t -> 1 as L -> 0 (L^-1/4 -> infinity).
-    let t = if l > 0.0 {
-        1.0 - (-3.5 * m.powf(0.125) * l.powf(-0.25)).exp()
-    } else {
-        1.0
-    };
-    let r = (1.0 - 3.0 / (l + 4.0)).exp();
-    let s = 3.0 - (-1.0 / (2.0 * m)).exp();
-    let ep = 0.99 * m.powf(-0.125) * l.powf(0.75) * t;
-    let ei = 2.05 * m.powf(-0.2);
-    let ri = 2.45 / m;
-    ((ep.powf(r) + ei.powf(r)).powf(s / r) + ri.powf(s)).powf(1.0 / s)
+    MoesVenner::at_l(l).at(m)
+}
+
+/// [`moes_venner`] at a fixed L (its powers of L computed once): H(M, L) for any M.
+#[derive(Debug, Clone, Copy)]
+struct MoesVenner {
+    l: f64,
+    /// L^-1/4, L^3/4 and the blend's exponent r = exp(1 - 3 / (L + 4)).
+    l_quarter: f64,
+    l_three_quarters: f64,
+    r: f64,
+}
+
+impl MoesVenner {
+    fn at_l(l: f64) -> Self {
+        Self {
+            l,
+            l_quarter: l.powf(-0.25),
+            l_three_quarters: l.powf(0.75),
+            r: (1.0 - 3.0 / (l + 4.0)).exp(),
+        }
+    }
+
+    fn at(&self, m: f64) -> f64 {
+        // t -> 1 as L -> 0 (L^-1/4 -> infinity).
+        let t = if self.l > 0.0 {
+            1.0 - (-3.5 * m.powf(0.125) * self.l_quarter).exp()
+        } else {
+            1.0
+        };
+        let r = self.r;
+        let s = 3.0 - (-1.0 / (2.0 * m)).exp();
+        let ep = 0.99 * m.powf(-0.125) * self.l_three_quarters * t;
+        let ei = 2.05 * m.powf(-0.2);
+        let ri = 2.45 / m;
+        ((ep.powf(r) + ei.powf(r)).powf(s / r) + ri.powf(s)).powf(1.0 / s)
+    }
 }
 
 /// Conditions of a contact line at one point (MODEL §6).
@@ -59,38 +84,107 @@ pub fn reduced_modulus(e1: f64, v1: f64, e2: f64, v2: f64) -> f64 {
 /// The entrainment |u1 + u2| is used (the sense of rolling does not matter). Zero when there
 /// is no entrainment or no load-free solution.
 pub fn min_film_thickness(lub: &Lubricant, e_prime: f64, c: &LineContact) -> f64 {
-    let entrainment = (c.u1 + c.u2).abs();
-    if entrainment <= 0.0 || c.radius <= 0.0 || !c.radius.is_finite() {
-        return 0.0;
-    }
-    let u = lub.viscosity * entrainment / (2.0 * e_prime * c.radius);
-    let w = c.line_load.max(0.0) / (e_prime * c.radius);
-    let g = lub.pressure_viscosity * e_prime;
-    let two_u = 2.0 * u;
-    if w <= 0.0 {
-        // No load: the film is not limited by the load (the formula's M -> 0 limit diverges).
-        return f64::INFINITY;
-    }
-    let m = w * two_u.powf(-0.5);
-    let l = g * two_u.powf(0.25);
-    moes_venner(m, l) * c.radius * two_u.sqrt()
+    LineFilm::of(lub, e_prime, c).min_film_thickness(c.line_load)
 }
 
 /// Gupta's thermal reduction factor Phi_T (MODEL §6): inlet shear heating with the thermal
 /// loading L_T = eta beta* (u1 + u2)^2 / (4 K_f T^2), slide-to-roll ratio
 /// S = 2 |u1 - u2| / |u1 + u2|. Clamped to (0, 1].
 pub fn thermal_factor(lub: &Lubricant, e_prime: f64, c: &LineContact) -> f64 {
-    let sum = (c.u1 + c.u2).abs();
-    if sum <= 0.0 {
-        return 1.0;
+    LineFilm::of(lub, e_prime, c).thermal_factor(c.pressure)
+}
+
+/// The film of a contact line (MODEL §6) with what its load does not change computed once:
+/// the curvature, the rolling velocities and the lubricant set U, G, L and the thermal loading;
+/// the line load and the peak pressure then give [`min_film_thickness`] and [`thermal_factor`]
+/// (the same numbers: they are computed through it).
+#[derive(Debug, Clone, Copy)]
+pub struct LineFilm {
+    /// None without entrainment or curvature (no film: h_min = 0).
+    isothermal: Option<IsothermalFilm>,
+    /// None without entrainment (Phi_T = 1).
+    thermal: Option<ThermalLoading>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct IsothermalFilm {
+    radius: f64,
+    /// E' R, N/m.
+    load_scale: f64,
+    /// (2U)^-1/2 and (2U)^1/2.
+    two_u_inverse_root: f64,
+    two_u_root: f64,
+    moes_venner: MoesVenner,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct ThermalLoading {
+    e_prime: f64,
+    /// L_T^0.42 and the factor's denominator 1 + 0.213 (1 + 2.23 S^0.83) L_T^0.64.
+    lt_042: f64,
+    denominator: f64,
+}
+
+impl LineFilm {
+    /// The film of the contact line `c` (its `line_load` and `pressure` not read) of the
+    /// lubricant `lub` between surfaces of reduced modulus `e_prime` (Pa).
+    pub fn of(lub: &Lubricant, e_prime: f64, c: &LineContact) -> Self {
+        let entrainment = (c.u1 + c.u2).abs();
+        // (Written as the early returns they replace: a NaN speed gives a NaN film, as before.)
+        let no_entrainment = entrainment <= 0.0;
+        let no_film = no_entrainment || c.radius <= 0.0 || !c.radius.is_finite();
+        let isothermal = (!no_film).then(|| {
+            let u = lub.viscosity * entrainment / (2.0 * e_prime * c.radius);
+            let g = lub.pressure_viscosity * e_prime;
+            let two_u = 2.0 * u;
+            IsothermalFilm {
+                radius: c.radius,
+                load_scale: e_prime * c.radius,
+                two_u_inverse_root: two_u.powf(-0.5),
+                two_u_root: two_u.sqrt(),
+                moes_venner: MoesVenner::at_l(g * two_u.powf(0.25)),
+            }
+        });
+        let thermal = (!no_entrainment).then(|| {
+            let t = lub.temperature;
+            let lt = lub.viscosity * lub.thermo_viscosity * entrainment * entrainment
+                / (4.0 * lub.thermal_conductivity * t * t);
+            let s = 2.0 * (c.u1 - c.u2).abs() / entrainment;
+            ThermalLoading {
+                e_prime,
+                lt_042: lt.powf(0.42),
+                denominator: 1.0 + 0.213 * (1.0 + 2.23 * s.powf(0.83)) * lt.powf(0.64),
+            }
+        });
+        Self {
+            isothermal,
+            thermal,
+        }
     }
-    let t = lub.temperature;
-    let lt =
-        lub.viscosity * lub.thermo_viscosity * sum * sum / (4.0 * lub.thermal_conductivity * t * t);
-    let s = 2.0 * (c.u1 - c.u2).abs() / sum;
-    let phi = (1.0 - 13.2 * (c.pressure / e_prime) * lt.powf(0.42))
-        / (1.0 + 0.213 * (1.0 + 2.23 * s.powf(0.83)) * lt.powf(0.64));
-    phi.clamp(f64::MIN_POSITIVE, 1.0)
+
+    /// Isothermal minimum film thickness (Moes–Venner) under the line load `line_load` (N/m),
+    /// m; infinite without load.
+    pub fn min_film_thickness(&self, line_load: f64) -> f64 {
+        let Some(f) = &self.isothermal else {
+            return 0.0;
+        };
+        let w = line_load.max(0.0) / f.load_scale;
+        if w <= 0.0 {
+            // No load: the film is not limited by the load (the formula's M -> 0 limit diverges).
+            return f64::INFINITY;
+        }
+        let m = w * f.two_u_inverse_root;
+        f.moes_venner.at(m) * f.radius * f.two_u_root
+    }
+
+    /// Gupta's thermal reduction factor at the peak pressure `pressure` (Pa), in (0, 1].
+    pub fn thermal_factor(&self, pressure: f64) -> f64 {
+        let Some(t) = &self.thermal else {
+            return 1.0;
+        };
+        let phi = (1.0 - 13.2 * (pressure / t.e_prime) * t.lt_042) / t.denominator;
+        phi.clamp(f64::MIN_POSITIVE, 1.0)
+    }
 }
 
 /// Film thickness, thermal factor and film ratio at a point of a contact line, at the

@@ -121,15 +121,47 @@ pub fn asperity_pressure(
 /// the mean entrainment speed), times the thermal factor Phi_T. 0 without entrainment;
 /// infinite without load.
 pub fn central_film_thickness(lub: &Lubricant, e_prime: f64, line: &LineContact) -> f64 {
-    let film = lubrication::film(lub, e_prime, line);
-    if film.h_min <= 0.0 || !film.h_min.is_finite() {
-        return film.h_min;
+    CentralFilm::of(lub, e_prime, line).at(line.line_load, line.pressure)
+}
+
+/// [`central_film_thickness`] of one contact line with what its load does not change computed
+/// once (the line's curvature and speeds, the lubricant): the thickness under any line load
+/// and peak pressure (the same numbers: the function is computed through it).
+#[derive(Debug, Clone, Copy)]
+pub struct CentralFilm {
+    film: lubrication::LineFilm,
+    /// E' R, N/m.
+    load_scale: f64,
+    /// U^-0.002 and G^-0.098 of Pan & Hamrock's ratio.
+    u_factor: f64,
+    g_factor: f64,
+}
+
+impl CentralFilm {
+    /// The film of the contact line `line` (its `line_load` and `pressure` not read) of the
+    /// lubricant `lub` between surfaces of reduced modulus `e_prime` (Pa).
+    pub fn of(lub: &Lubricant, e_prime: f64, line: &LineContact) -> Self {
+        let u = lub.viscosity * (line.u1 + line.u2).abs() / (2.0 * e_prime * line.radius);
+        let g = lub.pressure_viscosity * e_prime;
+        Self {
+            film: lubrication::LineFilm::of(lub, e_prime, line),
+            load_scale: e_prime * line.radius,
+            u_factor: u.powf(-0.002),
+            g_factor: g.max(1.0).powf(-0.098),
+        }
     }
-    let u = lub.viscosity * (line.u1 + line.u2).abs() / (2.0 * e_prime * line.radius);
-    let w = line.line_load / (e_prime * line.radius);
-    let g = lub.pressure_viscosity * e_prime;
-    let ratio = 2.922 / 1.714 * w.powf(-0.038) * u.powf(-0.002) * g.max(1.0).powf(-0.098);
-    film.h_min * ratio * film.thermal_factor
+
+    /// The central film thickness (m) under the line load `line_load` (N/m) with the peak
+    /// pressure `pressure` (Pa).
+    pub fn at(&self, line_load: f64, pressure: f64) -> f64 {
+        let h_min = self.film.min_film_thickness(line_load);
+        if h_min <= 0.0 || !h_min.is_finite() {
+            return h_min;
+        }
+        let w = line_load / self.load_scale;
+        let ratio = 2.922 / 1.714 * w.powf(-0.038) * self.u_factor * self.g_factor;
+        h_min * ratio * self.film.thermal_factor(pressure)
+    }
 }
 
 /// Shear stress of the lubricant film, Pa, at pressure `pressure` (Pa), sliding speed
@@ -195,13 +227,17 @@ pub fn local_friction(
     (e_prime, flow_pressure): (f64, f64),
 ) -> LocalFriction {
     let p = at.pressure;
-    let share = if p > 0.0 {
-        let carried =
-            asperity_pressure(at.film_thickness, at.roughness, e_prime, law, flow_pressure);
-        (carried / p).min(1.0)
-    } else {
-        1.0
-    };
+    if p.is_nan() || p <= 0.0 {
+        // Nothing pressed: the asperities' share is whole and the film shears nothing
+        // (fluid_shear is 0 at p = 0: its limit Lambda p is).
+        return LocalFriction {
+            coefficient: law.boundary,
+            asperity_share: 1.0,
+            fluid_shear: 0.0,
+        };
+    }
+    let carried = asperity_pressure(at.film_thickness, at.roughness, e_prime, law, flow_pressure);
+    let share = (carried / p).min(1.0);
     let tau = fluid_shear(
         p,
         at.sliding_speed,
@@ -210,7 +246,7 @@ pub fn local_friction(
         lubricant.pressure_viscosity,
         law,
     );
-    let fluid = if p > 0.0 { tau / p } else { 0.0 };
+    let fluid = tau / p;
     LocalFriction {
         coefficient: share * law.boundary + (1.0 - share) * fluid,
         asperity_share: share,

@@ -386,20 +386,37 @@ impl FlankField {
         let columns: Vec<ColumnIntegral> = (0..=nj)
             .map(|j| ColumnIntegral::new((0..=ni).map(|i| (wf.node(i, j).r, field.node(i, j)))))
             .collect();
-        let mut best = 0.0f64;
-        for j in 0..=nj {
-            let (z0, z1) = window(wf.z[j], along, wf.z[0], wf.z[nj]);
-            // Centres on the nodes and at quarters between them.
-            for i in 0..=ni {
-                for q in 0..if i < ni { 4 } else { 1 } {
-                    let (a, b) = (wf.node(i, j).r, wf.node((i + 1).min(ni), j).r);
-                    let rc = a + (b - a) * q as f64 / 4.0;
-                    let mean_at = |k: usize| columns[k].mean(rc, across);
-                    best = best.max(face_mean(&wf.z, z0, z1, mean_at));
-                }
-            }
-        }
-        best
+        // The largest of the patches centred on each node column (a maximum: the same in any
+        // order).
+        (0..=nj)
+            .into_par_iter()
+            .map(|j| {
+                let (z0, z1) = window(wf.z[j], along, wf.z[0], wf.z[nj]);
+                let face = FaceWindow::new(&wf.z, z0, z1);
+                // Centres on the nodes and at quarters between them (ascending).
+                let centres: Vec<f64> = (0..=ni)
+                    .flat_map(|i| {
+                        let (a, b) = (wf.node(i, j).r, wf.node((i + 1).min(ni), j).r);
+                        let quarters = if i < ni { 4 } else { 1 };
+                        (0..quarters).map(move |q| a + (b - a) * q as f64 / 4.0)
+                    })
+                    .collect();
+                let means: Vec<(usize, Vec<f64>)> = face
+                    .columns()
+                    .map(|k| (k, columns[k].means(&centres, across)))
+                    .collect();
+                let mean_of = |k: usize, c: usize| {
+                    means
+                        .iter()
+                        .find(|(m, _)| *m == k)
+                        .expect("a window's column")
+                        .1[c]
+                };
+                (0..centres.len())
+                    .map(|c| face.mean(|k| mean_of(k, c)))
+                    .fold(0.0f64, f64::max)
+            })
+            .reduce(|| 0.0, f64::max)
     }
 
     /// Value at (r, z) of the flank `wf` (the field's grid): linear along the node columns in
@@ -644,34 +661,79 @@ fn window(centre: f64, width: f64, lo: f64, hi: f64) -> (f64, f64) {
     (a, a + width)
 }
 
-/// Mean over z in [z0, z1] of a quantity given on the node columns at `z` (ascending) by
-/// `at(j)`, linear between them.
-fn face_mean(z: &[f64], z0: f64, z1: f64, at: impl Fn(usize) -> f64) -> f64 {
-    if z1 <= z0 {
-        let j = z.partition_point(|&x| x < z0).min(z.len() - 1);
-        return at(j);
-    }
-    let value = |x: f64| {
-        let k = z.partition_point(|&v| v <= x).clamp(1, z.len() - 1);
-        let t = ((x - z[k - 1]) / (z[k] - z[k - 1])).clamp(0.0, 1.0);
-        (1.0 - t) * at(k - 1) + t * at(k)
-    };
-    // Trapezoids between the window's ends and the columns inside it (no allocation: one
-    // call per candidate patch).
-    let first = z.partition_point(|&x| x <= z0);
-    let mut previous = (z0, value(z0));
-    let mut area = 0.0;
-    for (j, &zj) in z.iter().enumerate().skip(first) {
-        if zj >= z1 {
-            break;
+/// The mean over z in [z0, z1] of a quantity given on the node columns at `z` (ascending),
+/// linear between them: which columns it reads and with which weights, found once for any
+/// quantity ([`Self::mean`]).
+struct FaceWindow {
+    z0: f64,
+    z1: f64,
+    /// A window of no width: the column at it.
+    point: Option<usize>,
+    /// The window's ends: the column above each (k, at least 1) and the weight t of it.
+    start: (usize, f64),
+    end: (usize, f64),
+    /// The columns inside the window and their z.
+    inside: Vec<(usize, f64)>,
+}
+
+impl FaceWindow {
+    fn new(z: &[f64], z0: f64, z1: f64) -> Self {
+        let point = (z1 <= z0).then(|| z.partition_point(|&x| x < z0).min(z.len() - 1));
+        let end_of = |x: f64| {
+            let k = z.partition_point(|&v| v <= x).clamp(1, z.len() - 1);
+            (k, ((x - z[k - 1]) / (z[k] - z[k - 1])).clamp(0.0, 1.0))
+        };
+        let first = z.partition_point(|&x| x <= z0);
+        let inside = z
+            .iter()
+            .enumerate()
+            .skip(first)
+            .take_while(|(_, &zj)| zj < z1)
+            .map(|(j, &zj)| (j, zj))
+            .collect();
+        Self {
+            z0,
+            z1,
+            point,
+            start: end_of(z0),
+            end: end_of(z1),
+            inside,
         }
-        let here = (zj, at(j));
-        area += 0.5 * (here.0 - previous.0) * (previous.1 + here.1);
-        previous = here;
     }
-    let end = (z1, value(z1));
-    area += 0.5 * (end.0 - previous.0) * (previous.1 + end.1);
-    area / (z1 - z0)
+
+    /// The columns [`Self::mean`] reads (some more than once).
+    fn columns(&self) -> impl Iterator<Item = usize> + '_ {
+        let ends = [self.start.0 - 1, self.start.0, self.end.0 - 1, self.end.0];
+        let mut all: Vec<usize> = match self.point {
+            Some(j) => vec![j],
+            None => ends
+                .into_iter()
+                .chain(self.inside.iter().map(|c| c.0))
+                .collect(),
+        };
+        all.sort_unstable();
+        all.dedup();
+        all.into_iter()
+    }
+
+    /// The mean over the window of the quantity `at(j)` on column j: trapezoids between the
+    /// window's ends and the columns inside it.
+    fn mean(&self, at: impl Fn(usize) -> f64) -> f64 {
+        if let Some(j) = self.point {
+            return at(j);
+        }
+        let value = |(k, t): (usize, f64)| (1.0 - t) * at(k - 1) + t * at(k);
+        let mut previous = (self.z0, value(self.start));
+        let mut area = 0.0;
+        for &(j, zj) in &self.inside {
+            let here = (zj, at(j));
+            area += 0.5 * (here.0 - previous.0) * (previous.1 + here.1);
+            previous = here;
+        }
+        let end = (self.z1, value(self.end));
+        area += 0.5 * (end.0 - previous.0) * (previous.1 + end.1);
+        area / (self.z1 - self.z0)
+    }
 }
 
 /// A field along one node column, linear between its nodes, with its running integral: the
@@ -694,10 +756,12 @@ impl ColumnIntegral {
 
     /// Integral from the first node to x.
     fn integral_to(&self, x: f64) -> f64 {
-        let k = self
-            .r
-            .partition_point(|&v| v <= x)
-            .clamp(1, self.r.len() - 1);
+        self.integral_at(self.r.partition_point(|&v| v <= x), x)
+    }
+
+    /// [`Self::integral_to`] with the number of nodes at or below x, `below`, known.
+    fn integral_at(&self, below: usize, x: f64) -> f64 {
+        let k = below.clamp(1, self.r.len() - 1);
         let (a, b) = (self.r[k - 1], self.r[k]);
         let d = (x - a).clamp(0.0, b - a);
         let t = if b > a { d / (b - a) } else { 0.0 };
@@ -716,5 +780,79 @@ impl ColumnIntegral {
             return self.value[0];
         }
         (self.integral_to(b) - self.integral_to(a)) / (b - a)
+    }
+
+    /// [`Self::mean`] at each of the `centres`, the nodes below each window's ends counted by
+    /// cursors (a step or two from one centre to the next when they ascend).
+    fn means(&self, centres: &[f64], width: f64) -> Vec<f64> {
+        let n = self.r.len();
+        if n < 2 {
+            return vec![self.mean(0.0, width); centres.len()];
+        }
+        let (mut below_a, mut below_b) = (0, 0);
+        let below = |cursor: &mut usize, x: f64| {
+            while *cursor < n && self.r[*cursor] <= x {
+                *cursor += 1;
+            }
+            while *cursor > 0 && self.r[*cursor - 1] > x {
+                *cursor -= 1;
+            }
+            *cursor
+        };
+        centres
+            .iter()
+            .map(|&centre| {
+                let (a, b) = window(centre, width, self.r[0], self.r[n - 1]);
+                if b <= a {
+                    return self.value[0];
+                }
+                let upper = self.integral_at(below(&mut below_b, b), b);
+                let lower = self.integral_at(below(&mut below_a, a), a);
+                (upper - lower) / (b - a)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_column_s_means_by_cursors_are_those_of_its_binary_search() {
+        // Uneven nodes, a field with a kink; centres ascending, then descending, outside the
+        // column and at its nodes: every mean the same number as `mean`'s.
+        let r: Vec<f64> = (0..12).map(|k| 0.1 + 0.01 * (k as f64).powf(1.3)).collect();
+        let column = ColumnIntegral::new(r.iter().map(|&x| (x, (x - 0.15).abs().sqrt())));
+        let mut centres: Vec<f64> = (0..60).map(|k| 0.08 + 0.0025 * k as f64).collect();
+        centres.extend(r.iter().rev());
+        centres.extend([0.3, 0.05, 0.17]);
+        for width in [0.004, 0.03, 1.0] {
+            let by_cursor = column.means(&centres, width);
+            for (c, m) in centres.iter().zip(&by_cursor) {
+                assert_eq!(m.to_bits(), column.mean(*c, width).to_bits(), "{c} {width}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_face_window_s_mean_is_the_trapezoids_of_a_linear_field() {
+        // A field linear in z has the window's mid value as its mean, wherever the window's
+        // ends fall; a window of no width reads the column at it.
+        let z: Vec<f64> = (0..9).map(|k| -0.02 + 0.005 * k as f64).collect();
+        let at = |j: usize| 3.0 + 40.0 * z[j];
+        for (z0, z1) in [
+            (-0.018, -0.004),
+            (-0.02, 0.02),
+            (0.0012, 0.0013),
+            (-0.015, -0.01),
+        ] {
+            let mean = FaceWindow::new(&z, z0, z1).mean(at);
+            assert!(
+                (mean - (3.0 + 20.0 * (z0 + z1))).abs() < 1e-12,
+                "{z0} {z1}: {mean}"
+            );
+        }
+        assert_eq!(FaceWindow::new(&z, z[4], z[4]).mean(at), at(4));
     }
 }

@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::input::BandGrowth;
+use crate::ltca::traction::SliceFilms;
 
 /// The positions' mean worm and wheel torques (N m), the power balance
 /// (wheel torque / ratio + friction's worm torque) / worm torque - 1 (0 where the normal
@@ -412,13 +413,14 @@ fn balance_with_friction(
     n: usize,
 ) -> Result<Balanced, LtcaError> {
     let sliding = cell_sliding(friction.gear, friction.geo, cells);
+    let slices = friction.slice_films(n, cells);
     let target = worm_torque.unwrap_or(wheel_torque);
     let pick = |(worm, wheel): (Vec<f64>, Vec<f64>)| match worm_torque {
         Some(_) => (worm.clone(), worm, wheel),
         None => (wheel.clone(), worm, wheel),
     };
-    let (mut mu, first) =
-        starting_friction(problem, (cells, &sliding), (settings, friction), &warm, n)?;
+    let mesh = (cells, &sliding[..], &slices);
+    let (mut mu, first) = starting_friction(problem, mesh, (settings, friction), &warm, n)?;
     let (weights, _, _) = pick(torque_weights(cells, &sliding, &mu, sign));
     let (mut sol, mut response) = rebalance(problem, &weights, settings, (target, warm), first, n)?;
     // The current loads: the solution's, or those of its response at a later target (gaps
@@ -428,7 +430,7 @@ fn balance_with_friction(
     for it in 0..FRICTION_ITERATIONS {
         let previous = moved.as_ref().map_or(&sol.q, |m| &m.q).clone();
         let pressure = cell_pressures(cells, &previous, settings.flow_pressure);
-        mu = friction.coefficients(n, cells, &sliding, &pressure);
+        mu = friction.coefficients(&slices, cells, &sliding, &pressure);
         let (weights, worm_weights, wheel_weights) =
             pick(torque_weights(cells, &sliding, &mu, sign));
         let free_weights = if worm_torque.is_some() {
@@ -529,7 +531,7 @@ fn friction_worm_torque(
 /// the balanced load by about 8 % at its first update and unloaded edge cells: a solve more.)
 fn starting_friction(
     problem: &mut Problem,
-    (cells, sliding): (&[LocalCell], &[CellSliding]),
+    (cells, sliding, slices): (&[LocalCell], &[CellSliding], &SliceFilms),
     (settings, friction): (&LtcaSettings, &PositionFriction),
     warm: &Option<Vec<f64>>,
     n: usize,
@@ -550,7 +552,10 @@ fn starting_friction(
         }
     };
     let pressure = cell_pressures(cells, &loads, settings.flow_pressure);
-    Ok((friction.coefficients(n, cells, sliding, &pressure), first))
+    Ok((
+        friction.coefficients(slices, cells, sliding, &pressure),
+        first,
+    ))
 }
 
 /// The pressure of each cell (Pa) under the loads `q` (N m), bounded by the flow pressure.

@@ -14,7 +14,9 @@ use super::*;
 use crate::input::{FrictionLaw, Lubricant};
 use crate::kinematics::material_velocities;
 use crate::lubrication::{FlankRoughness, LineContact};
-use crate::traction::{central_film_thickness, local_friction, LocalFriction, PointContact};
+use crate::traction::{
+    central_film_thickness, local_friction, CentralFilm, LocalFriction, PointContact,
+};
 use std::collections::HashMap;
 
 /// The relative curvature radius across the contact line of every (position, tooth, slice)
@@ -102,30 +104,98 @@ impl FilmGeometry {
         cells: &[LocalCell],
         pressure: &[f64],
     ) -> (Vec<LineContact>, Vec<usize>) {
-        let mut lines = Vec::new();
-        let mut of_cell = Vec::with_capacity(cells.len());
-        let mut start = 0;
-        while start < cells.len() {
-            let first = &cells[start];
-            let end = (start..cells.len())
-                .find(|&k| {
-                    cells[k].tooth_index != first.tooth_index || cells[k].slice != first.slice
-                })
-                .unwrap_or(cells.len());
-            let (u1, u2) = self.rolling_at(first.slice, first.r);
-            lines.push(LineContact {
-                radius: self.radii.at(position, first.tooth, first.slice),
-                u1,
-                u2,
+        let (ranges, of_cell) = slice_ranges(cells);
+        let lines = ranges
+            .iter()
+            .map(|&(start, end)| LineContact {
                 line_load: (start..end)
                     .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
                     .sum(),
                 pressure: (start..end).map(|k| pressure[k]).fold(0.0, f64::max),
-            });
-            of_cell.extend(std::iter::repeat_n(lines.len() - 1, end - start));
-            start = end;
-        }
+                ..self.unloaded_line(position, &cells[start])
+            })
+            .collect();
         (lines, of_cell)
+    }
+
+    /// The slices of a position's cells with their films up to the load, for
+    /// [`PositionFriction::coefficients`].
+    pub fn slice_films(
+        &self,
+        position: usize,
+        cells: &[LocalCell],
+        inputs: &FrictionInputs,
+    ) -> SliceFilms {
+        let (ranges, of_cell) = slice_ranges(cells);
+        let slices = ranges
+            .into_iter()
+            .map(|(start, end)| {
+                let line = self.unloaded_line(position, &cells[start]);
+                let film = CentralFilm::of(inputs.lubricant, inputs.e_prime, &line);
+                (start, end, film)
+            })
+            .collect();
+        SliceFilms { slices, of_cell }
+    }
+
+    /// The contact line, unloaded, of the slice whose first cell is `first`: its curvature
+    /// radius and the rolling velocities there.
+    fn unloaded_line(&self, position: usize, first: &LocalCell) -> LineContact {
+        let (u1, u2) = self.rolling_at(first.slice, first.r);
+        LineContact {
+            radius: self.radii.at(position, first.tooth, first.slice),
+            u1,
+            u2,
+            line_load: 0.0,
+            pressure: 0.0,
+        }
+    }
+}
+
+/// The slices of a position's cells (a slice's cells are consecutive: same tooth, same node
+/// column): each one's (first cell, end), and each cell's slice index.
+fn slice_ranges(cells: &[LocalCell]) -> (Vec<(usize, usize)>, Vec<usize>) {
+    let mut ranges = Vec::new();
+    let mut of_cell = Vec::with_capacity(cells.len());
+    let mut start = 0;
+    while start < cells.len() {
+        let first = &cells[start];
+        let end = (start..cells.len())
+            .find(|&k| cells[k].tooth_index != first.tooth_index || cells[k].slice != first.slice)
+            .unwrap_or(cells.len());
+        ranges.push((start, end));
+        of_cell.extend(std::iter::repeat_n(ranges.len() - 1, end - start));
+        start = end;
+    }
+    (ranges, of_cell)
+}
+
+/// A position's slices on one local mesh (MODEL §6, §13): each slice's cells (consecutive)
+/// and its contact line's central film up to its load ([`CentralFilm`]), built once per mesh
+/// and read at every update of the friction (the numbers of [`FilmGeometry::slice_lines`] and
+/// [`FrictionInputs::films`]).
+#[derive(Debug, Clone)]
+pub struct SliceFilms {
+    /// Each slice's cells (start, end) and film.
+    slices: Vec<(usize, usize, CentralFilm)>,
+    /// Each cell's slice.
+    of_cell: Vec<usize>,
+}
+
+impl SliceFilms {
+    /// The central film thickness (m) of each slice under its cells' pressures `pressure` (Pa):
+    /// its line load sum p x (width across the line) and peak pressure.
+    fn films(&self, cells: &[LocalCell], pressure: &[f64]) -> Vec<f64> {
+        self.slices
+            .iter()
+            .map(|&(start, end, film)| {
+                let line_load = (start..end)
+                    .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
+                    .sum();
+                let peak = (start..end).map(|k| pressure[k]).fold(0.0, f64::max);
+                film.at(line_load, peak)
+            })
+            .collect()
     }
 }
 
@@ -263,20 +333,25 @@ pub struct PositionFriction<'a> {
 }
 
 impl PositionFriction<'_> {
-    /// mu of each cell of position `position` under the pressures `pressure` (Pa).
+    /// The slices of position `position`'s cells `cells` with their films up to the load,
+    /// for [`Self::coefficients`] (once per local mesh).
+    pub fn slice_films(&self, position: usize, cells: &[LocalCell]) -> SliceFilms {
+        self.film.slice_films(position, cells, &self.inputs)
+    }
+
+    /// mu of each cell `cells` (their slices `slices`) under the pressures `pressure` (Pa).
     pub fn coefficients(
         &self,
-        position: usize,
+        slices: &SliceFilms,
         cells: &[LocalCell],
         sliding: &[CellSliding],
         pressure: &[f64],
     ) -> Vec<f64> {
-        let (lines, of_cell) = self.film.slice_lines(position, cells, pressure);
-        let films = self.inputs.films(&lines);
+        let films = slices.films(cells, pressure);
         self.inputs
             .cells(
                 (cells, pressure, sliding),
-                (&films, &of_cell),
+                (&films, &slices.of_cell),
                 &self.roughness,
             )
             .iter()
