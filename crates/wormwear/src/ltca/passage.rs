@@ -54,43 +54,45 @@ impl Sample {
     /// [`Sample::pressure_at`].
     pub(crate) fn equivalent_at(&self, r: f64, shift: f64) -> (f64, f64) {
         let cell = |k: usize| self.equivalent.get(k).copied().unwrap_or_default();
-        (
-            self.value_at(r, shift, |k| cell(k).0),
-            self.value_at(r, shift, |k| cell(k).1),
-        )
+        let at = self.locate(r - shift);
+        (at.read(|k| cell(k).0), at.read(|k| cell(k).1))
     }
 
     /// The value of the profile's cell k (`value(k)`) read at radius r, shifted.
     fn value_at(&self, r: f64, shift: f64, value: impl Fn(usize) -> f64) -> f64 {
-        let x = r - shift;
+        self.locate(r - shift).read(value)
+    }
+
+    /// Where radius x (m) falls on the profile: which cells a value there reads and how.
+    fn locate(&self, x: f64) -> Located {
         let p = &self.profile;
         let (Some(first), Some(last)) = (p.first(), p.last()) else {
-            return 0.0;
+            return Located::Outside;
         };
         if x < first.0 {
             return if x >= first.0 - self.extend_low {
-                value(0)
+                Located::Cell(0)
             } else {
-                0.0
+                Located::Outside
             };
         }
         if x > last.0 {
             return if x <= last.0 + self.extend_high {
-                value(p.len() - 1)
+                Located::Cell(p.len() - 1)
             } else {
-                0.0
+                Located::Outside
             };
         }
         if p.len() == 1 {
             // x is the one cell's centre.
-            return value(0);
+            return Located::Cell(0);
         }
         let k = p.partition_point(|q| q.0 <= x).clamp(1, p.len() - 1);
-        let (a, b) = ((p[k - 1].0, value(k - 1)), (p[k].0, value(k)));
-        if b.0 == a.0 {
-            return a.1.max(b.1);
+        let (a, b) = (p[k - 1].0, p[k].0);
+        if b == a {
+            return Located::Coincident(k);
         }
-        a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+        Located::Between(k, x - a, b - a)
     }
 
     /// Half extent of the profile (cells included) around the radius `centre`, m.
@@ -100,6 +102,34 @@ impl Sample {
                 .abs()
                 .max((b.0 + self.extend_high - centre).abs()),
             _ => 0.0,
+        }
+    }
+}
+
+/// Where a radius falls on a [`Sample`]'s profile ([`Sample::locate`]).
+#[derive(Debug, Clone, Copy)]
+enum Located {
+    /// Beyond the profile's ends: zero.
+    Outside,
+    /// Cell k's value (an end cell's outer half, or the one cell).
+    Cell(usize),
+    /// Between cells k - 1 and k at the same radius: the larger value.
+    Coincident(usize),
+    /// Between cells k - 1 and k: linear, at dx from k - 1 of their spacing (m).
+    Between(usize, f64, f64),
+}
+
+impl Located {
+    /// The value there of the profile's cell values `value(k)`.
+    fn read(self, value: impl Fn(usize) -> f64) -> f64 {
+        match self {
+            Located::Outside => 0.0,
+            Located::Cell(k) => value(k),
+            Located::Coincident(k) => value(k - 1).max(value(k)),
+            Located::Between(k, dx, spacing) => {
+                let (a, b) = (value(k - 1), value(k));
+                a + (b - a) * dx / spacing
+            }
         }
     }
 }
