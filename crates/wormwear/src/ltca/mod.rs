@@ -309,6 +309,11 @@ pub struct Ltca {
     /// (MODEL §6.1), m; None: the lubricant's `composite_roughness` everywhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub roughness: Option<FlankField>,
+    /// The band's instants on each node column of the loaded flank, sorted by time (MODEL
+    /// §5.6, §7.2, [`passage::band_samples`]): the loaded pattern's passages and the cycle's
+    /// wear's.
+    #[serde(skip)]
+    pub(crate) passage_samples: std::sync::Arc<Vec<Vec<passage::Sample>>>,
 }
 
 /// Largest departure from the power balance (T2 omega2 + P_Vz = T1 omega1, MODEL §5.2) of a
@@ -710,6 +715,31 @@ fn position_friction<'a>(
     })
 }
 
+/// The warnings on a cycle's loaded pattern `pattern` (Pa per cell) and its positions: the
+/// flow pressure reached (`yielded`: the yielded share of the flank and the flow pressure,
+/// Pa; MODEL §5.7), the deflections, the band's edge.
+fn pattern_warnings(
+    positions: &[PositionResult],
+    (wf, tca, teeth): (&WheelFlank, &Tca, u32),
+    pattern: &[f64],
+    (yielded_area_fraction, flow_pressure): (f64, f64),
+) -> Vec<String> {
+    let places = pattern::YieldedPlaces::of(wf, pattern, flow_pressure, &tca.tip_trace);
+    let mut warnings: Vec<String> =
+        flow_pressure_warning(yielded_area_fraction, flow_pressure, &places)
+            .into_iter()
+            .collect();
+    warnings.extend(pattern::local_flow_pressure_warning(
+        positions,
+        (yielded_area_fraction, flow_pressure),
+        wf,
+        &tca.tip_trace,
+    ));
+    warnings.extend(deflection_warning(positions, tca, teeth));
+    warnings.extend(band_edge_warning(positions));
+    warnings
+}
+
 /// The loaded analysis over the mesh cycle from its positions (MODEL §5.6, §5.7, §8.1): the
 /// swept patterns, their statistics, the torques and the warnings. `gear_set` holds the loaded
 /// flank, the TCA, the wheel's teeth and the ratio u.
@@ -723,13 +753,16 @@ fn over_the_cycle(
     let (wf, tca, teeth, ratio) = gear_set;
 
     // Loaded pattern on the global grid (MODEL §5.6), the yielded cells and the plastic
-    // indentation (MODEL §5.7); the equivalent pressure's (MODEL §8.1).
+    // indentation (MODEL §5.7); the equivalent pressure's (MODEL §8.1). The band's instants
+    // are kept for the cycle's wear (MODEL §7.2), which reads the same passages.
+    let tau = 2.0 * std::f64::consts::PI / teeth as f64;
+    let passage_samples = passage::band_samples(wf, tca, &positions, tau);
     let Swept {
         pattern,
         plastic_indentation,
         equivalent_pattern,
         equivalent_depth,
-    } = swept_pattern(wf, tca, &positions, teeth, rows_per_row);
+    } = swept_pattern(wf, tca, &passage_samples, teeth, rows_per_row);
     let equivalent_pressure_max = positions
         .iter()
         .flat_map(|p| p.equivalent.iter().map(|e| e.pressure))
@@ -749,20 +782,13 @@ fn over_the_cycle(
         max_patch_pressure(&positions, across, along, settings.aligned_columns());
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
-    let places = pattern::YieldedPlaces::of(wf, &pattern, settings.flow_pressure, &tca.tip_trace);
-    warnings.extend(flow_pressure_warning(
-        stats.yielded_area_fraction,
-        settings.flow_pressure,
-        &places,
-    ));
-    warnings.extend(pattern::local_flow_pressure_warning(
+    let yielded = (stats.yielded_area_fraction, settings.flow_pressure);
+    warnings.extend(pattern_warnings(
         &positions,
-        (stats.yielded_area_fraction, settings.flow_pressure),
-        wf,
-        &tca.tip_trace,
+        (wf, tca, teeth),
+        &pattern,
+        yielded,
     ));
-    warnings.extend(deflection_warning(&positions, tca, teeth));
-    warnings.extend(band_edge_warning(&positions));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -791,5 +817,6 @@ fn over_the_cycle(
         power_balance,
         warnings,
         roughness: None,
+        passage_samples: std::sync::Arc::new(passage_samples),
     }
 }

@@ -289,18 +289,18 @@ pub(super) struct Swept {
 /// the whole mesh cycle at each cell centre (the positions' instants and the band's continuous
 /// passage between them, [`passage`], so the pattern neither has holes between positions nor
 /// moves with their number), the largest interference of the cells at the flow pressure at
-/// each node, and the largest equivalent pressure at each cell centre with its depth.
+/// each node, and the largest equivalent pressure at each cell centre with its depth; from the
+/// band's instants on each node column `columns` ([`passage::band_samples`]).
 pub(super) fn swept_pattern(
     wf: &WheelFlank,
     tca: &Tca,
-    positions: &[PositionResult],
+    columns: &[Vec<passage::Sample>],
     teeth: u32,
     rows_per_row: usize,
 ) -> Swept {
     let (ni, nj) = (wf.cells_height, wf.cells_face);
     let tau = 2.0 * PI / teeth as f64;
     let dt = tau / tca.positions.len() as f64;
-    let columns = passage::band_samples(wf, tca, positions, tau);
     let is_slice: Vec<bool> = columns.iter().map(|c| !c.is_empty()).collect();
     let node_r = |j: usize, i: usize| wf.nodes[j * (ni + 1) + i].r;
     type Column = (Vec<f64>, Vec<f64>, Vec<(f64, f64)>);

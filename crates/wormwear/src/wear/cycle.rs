@@ -55,13 +55,12 @@ struct PassageWear<'a> {
 }
 
 impl PassageWear<'_> {
-    /// Per node of column j, from the band's instants on it: depth per cycle, lambda, film,
-    /// line load, band half-width, and the relative radius at the passage of the largest line
-    /// load (MODEL §7.2, §6).
-    fn column(&self, j: usize, samples: &mut [crate::ltca::passage::Sample]) -> Vec<[f64; 6]> {
+    /// Per node of column j, from the band's instants on it (sorted by time): depth per
+    /// cycle, lambda, film, line load, band half-width, and the relative radius at the passage
+    /// of the largest line load (MODEL §7.2, §6).
+    fn column(&self, j: usize, samples: &[crate::ltca::passage::Sample]) -> Vec<[f64; 6]> {
         let ni = self.wf.cells_height;
         let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
-        samples.sort_by(|a, b| a.time.total_cmp(&b.time));
         for pair in samples.windows(2) {
             // Consecutive instants of the same engagement only.
             let Some(passage) = Passage::between(&pair[0], &pair[1], self.dt) else {
@@ -160,7 +159,7 @@ pub fn per_cycle(
     let dt = tau / np as f64;
     // Wheel speed, rad/s: converts wheel rotation into time.
     let wheel_speed = gear.conditions.worm_speed / gear.ratio();
-    let mut columns = crate::ltca::passage::band_samples(wf, tca, &ltca.positions, tau);
+    let columns = &ltca.passage_samples;
     let e_prime = lubrication::reduced_modulus(
         gear.worm_material.youngs_modulus,
         gear.worm_material.poisson_ratio,
@@ -195,7 +194,7 @@ pub fn per_cycle(
     };
     // Node columns are independent (each writes its own nodes): in parallel, then gathered.
     let per_column: Vec<Vec<[f64; 6]>> = columns
-        .par_iter_mut()
+        .par_iter()
         .enumerate()
         .map(|(j, samples)| context.column(j, samples))
         .collect();
