@@ -162,6 +162,17 @@ impl LineFilm {
         }
     }
 
+    /// The minimum film thickness of the contact line `c` (m) where its load leaves no
+    /// formula to evaluate: 0 without entrainment or curvature, infinite without load (as
+    /// [`min_film_thickness`] gives them); None where the film is the formula's.
+    pub fn without_formula(c: &LineContact) -> Option<f64> {
+        let entrainment = (c.u1 + c.u2).abs();
+        if entrainment <= 0.0 || c.radius <= 0.0 || !c.radius.is_finite() {
+            return Some(0.0);
+        }
+        (c.line_load.max(0.0) <= 0.0).then_some(f64::INFINITY)
+    }
+
     /// Isothermal minimum film thickness (Moes–Venner) under the line load `line_load` (N/m),
     /// m; infinite without load.
     pub fn min_film_thickness(&self, line_load: f64) -> f64 {

@@ -121,7 +121,9 @@ pub fn asperity_pressure(
 /// the mean entrainment speed), times the thermal factor Phi_T. 0 without entrainment;
 /// infinite without load.
 pub fn central_film_thickness(lub: &Lubricant, e_prime: f64, line: &LineContact) -> f64 {
-    CentralFilm::of(lub, e_prime, line).at(line.line_load, line.pressure)
+    // (No film or no load: the minimum film itself, before the powers of the formula.)
+    lubrication::LineFilm::without_formula(line)
+        .unwrap_or_else(|| CentralFilm::of(lub, e_prime, line).at(line.line_load, line.pressure))
 }
 
 /// [`central_film_thickness`] of one contact line with what its load does not change computed

@@ -120,19 +120,13 @@ impl FilmGeometry {
 
     /// The slices of a position's cells with their films up to the load, for
     /// [`PositionFriction::coefficients`].
-    pub fn slice_films(
-        &self,
-        position: usize,
-        cells: &[LocalCell],
-        inputs: &FrictionInputs,
-    ) -> SliceFilms {
+    pub fn slice_films(&self, position: usize, cells: &[LocalCell]) -> SliceFilms {
         let (ranges, of_cell) = slice_ranges(cells);
         let slices = ranges
             .into_iter()
             .map(|(start, end)| {
                 let line = self.unloaded_line(position, &cells[start]);
-                let film = CentralFilm::of(inputs.lubricant, inputs.e_prime, &line);
-                (start, end, film)
+                (start, end, line, std::cell::OnceCell::new())
             })
             .collect();
         SliceFilms { slices, of_cell }
@@ -170,14 +164,14 @@ fn slice_ranges(cells: &[LocalCell]) -> (Vec<(usize, usize)>, Vec<usize>) {
     (ranges, of_cell)
 }
 
-/// A position's slices on one local mesh (MODEL §6, §13): each slice's cells (consecutive)
-/// and its contact line's central film up to its load ([`CentralFilm`]), built once per mesh
-/// and read at every update of the friction (the numbers of [`FilmGeometry::slice_lines`] and
-/// [`FrictionInputs::films`]).
+/// A position's slices on one local mesh (MODEL §6, §13): each slice's cells (consecutive),
+/// its contact line unloaded, and its central film up to the load ([`CentralFilm`], found the
+/// first time the slice carries load), built once per mesh and read at every update of the
+/// friction (the numbers of [`FilmGeometry::slice_lines`] and [`FrictionInputs::films`]).
 #[derive(Debug, Clone)]
 pub struct SliceFilms {
-    /// Each slice's cells (start, end) and film.
-    slices: Vec<(usize, usize, CentralFilm)>,
+    /// Each slice's cells (start, end), its line and its film.
+    slices: Vec<(usize, usize, LineContact, std::cell::OnceCell<CentralFilm>)>,
     /// Each cell's slice.
     of_cell: Vec<usize>,
 }
@@ -185,15 +179,21 @@ pub struct SliceFilms {
 impl SliceFilms {
     /// The central film thickness (m) of each slice under its cells' pressures `pressure` (Pa):
     /// its line load sum p x (width across the line) and peak pressure.
-    fn films(&self, cells: &[LocalCell], pressure: &[f64]) -> Vec<f64> {
+    fn films(&self, cells: &[LocalCell], pressure: &[f64], inputs: &FrictionInputs) -> Vec<f64> {
         self.slices
             .iter()
-            .map(|&(start, end, film)| {
-                let line_load = (start..end)
-                    .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
-                    .sum();
-                let peak = (start..end).map(|k| pressure[k]).fold(0.0, f64::max);
-                film.at(line_load, peak)
+            .map(|(start, end, unloaded, film)| {
+                let line = LineContact {
+                    line_load: (*start..*end)
+                        .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
+                        .sum(),
+                    pressure: (*start..*end).map(|k| pressure[k]).fold(0.0, f64::max),
+                    ..*unloaded
+                };
+                crate::lubrication::LineFilm::without_formula(&line).unwrap_or_else(|| {
+                    film.get_or_init(|| CentralFilm::of(inputs.lubricant, inputs.e_prime, &line))
+                        .at(line.line_load, line.pressure)
+                })
             })
             .collect()
     }
@@ -336,7 +336,7 @@ impl PositionFriction<'_> {
     /// The slices of position `position`'s cells `cells` with their films up to the load,
     /// for [`Self::coefficients`] (once per local mesh).
     pub fn slice_films(&self, position: usize, cells: &[LocalCell]) -> SliceFilms {
-        self.film.slice_films(position, cells, &self.inputs)
+        self.film.slice_films(position, cells)
     }
 
     /// mu of each cell `cells` (their slices `slices`) under the pressures `pressure` (Pa).
@@ -347,7 +347,7 @@ impl PositionFriction<'_> {
         sliding: &[CellSliding],
         pressure: &[f64],
     ) -> Vec<f64> {
-        let films = slices.films(cells, pressure);
+        let films = slices.films(cells, pressure, &self.inputs);
         self.inputs
             .cells(
                 (cells, pressure, sliding),
