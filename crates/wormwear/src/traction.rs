@@ -492,6 +492,45 @@ pub(crate) mod tests {
         assert_eq!(central_film_thickness(&lub, E_PRIME, &still), 0.0);
     }
 
+    #[test]
+    fn a_line_s_central_film_is_the_same_number_from_its_load_independent_factors() {
+        // One line's CentralFilm read at several loads gives the function's numbers to the bit
+        // (the friction updates read it so); the early answers (no load, no entrainment, no
+        // curvature) are the formula's limits: infinite, 0, 0.
+        let lub = oil();
+        let line = LineContact {
+            radius: 0.012,
+            u1: 3.0,
+            u2: -0.5,
+            line_load: 0.0,
+            pressure: 0.0,
+        };
+        let film = CentralFilm::of(&lub, E_PRIME, &line);
+        for (w, p) in [(1e3, 1e8), (2e5, 5e8), (3e6, 1.2e9)] {
+            let loaded = LineContact {
+                line_load: w,
+                pressure: p,
+                ..line
+            };
+            let direct = central_film_thickness(&lub, E_PRIME, &loaded);
+            assert!(direct.is_finite() && direct > 0.0);
+            assert_eq!(film.at(w, p).to_bits(), direct.to_bits(), "{w} {p}");
+        }
+        assert_eq!(central_film_thickness(&lub, E_PRIME, &line), f64::INFINITY);
+        assert_eq!(film.at(0.0, 0.0), f64::INFINITY);
+        for still in [
+            LineContact { u1: 0.5, ..line },
+            LineContact {
+                radius: 0.0,
+                line_load: 1e5,
+                ..line
+            },
+        ] {
+            assert_eq!(central_film_thickness(&lub, E_PRIME, &still), 0.0);
+            assert_eq!(CentralFilm::of(&lub, E_PRIME, &still).at(1e5, 1e8), 0.0);
+        }
+    }
+
     /// The film's traction over a smooth Hertz line contact, p = p0 sqrt(1 - (x/a)^2), by the
     /// midpoint rule on `n` strips: F / w, the friction coefficient of the contact.
     fn hertz_traction(
