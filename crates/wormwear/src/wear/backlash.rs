@@ -78,16 +78,20 @@ impl Backlash {
 
     /// Backlash per position with `removal` (m, normal) worn off the loaded flank, rad.
     pub fn per_position(&self, removal: &FlankField) -> Vec<f64> {
+        // The removal's angle at each node, the same for every position and tooth.
+        let angle: Vec<f64> = (0..self.nodes)
+            .map(|k| removal.values[k] / self.levers[k])
+            .collect();
         self.opposite
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(n, opp)| {
                 let mut best = f64::INFINITY;
                 for t in 0..self.teeth {
                     let base = (n * self.teeth + t) * self.nodes;
-                    for k in 0..self.nodes {
-                        let g = self.loaded[base + k] + removal.values[k] / self.levers[k];
-                        best = best.min(g);
+                    let loaded = &self.loaded[base..base + self.nodes];
+                    for (g, a) in loaded.iter().zip(&angle) {
+                        best = best.min(g + a);
                     }
                 }
                 best + opp
