@@ -384,6 +384,7 @@ impl FlankField {
         let field = self.with_rows(wf.cells_height);
         let (ni, nj) = (wf.cells_height, wf.cells_face);
         let columns: Vec<ColumnIntegral> = (0..=nj)
+            .into_par_iter()
             .map(|j| ColumnIntegral::new((0..=ni).map(|i| (wf.node(i, j).r, field.node(i, j)))))
             .collect();
         // The largest of the patches centred on each node column (a maximum: the same in any
