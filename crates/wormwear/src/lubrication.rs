@@ -106,6 +106,7 @@ pub struct LineFilm {
     thermal: Option<ThermalLoading>,
 }
 
+/// What the isothermal minimum film of a line (Moes–Venner) keeps of its line contact.
 #[derive(Debug, Clone, Copy)]
 struct IsothermalFilm {
     radius: f64,
@@ -117,6 +118,7 @@ struct IsothermalFilm {
     moes_venner: MoesVenner,
 }
 
+/// What Gupta's thermal factor of a line keeps of its line contact.
 #[derive(Debug, Clone, Copy)]
 struct ThermalLoading {
     e_prime: f64,

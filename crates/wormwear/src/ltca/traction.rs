@@ -107,12 +107,9 @@ impl FilmGeometry {
         let (ranges, of_cell) = slice_ranges(cells);
         let lines = ranges
             .iter()
-            .map(|&(start, end)| LineContact {
-                line_load: (start..end)
-                    .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
-                    .sum(),
-                pressure: (start..end).map(|k| pressure[k]).fold(0.0, f64::max),
-                ..self.unloaded_line(position, &cells[start])
+            .map(|&(start, end)| {
+                let unloaded = self.unloaded_line(position, &cells[start]);
+                loaded_line(&unloaded, start..end, cells, pressure)
             })
             .collect();
         (lines, of_cell)
@@ -143,6 +140,24 @@ impl FilmGeometry {
             line_load: 0.0,
             pressure: 0.0,
         }
+    }
+}
+
+/// The contact line `unloaded` of the slice of cells `range` under their pressures `pressure`
+/// (Pa): its line load sum p x (width across the line) (N/m) and its peak pressure.
+fn loaded_line(
+    unloaded: &LineContact,
+    range: std::ops::Range<usize>,
+    cells: &[LocalCell],
+    pressure: &[f64],
+) -> LineContact {
+    LineContact {
+        line_load: range
+            .clone()
+            .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
+            .sum(),
+        pressure: range.map(|k| pressure[k]).fold(0.0, f64::max),
+        ..*unloaded
     }
 }
 
@@ -183,13 +198,7 @@ impl SliceFilms {
         self.slices
             .iter()
             .map(|(start, end, unloaded, film)| {
-                let line = LineContact {
-                    line_load: (*start..*end)
-                        .map(|k| pressure[k] * 2.0 * cells[k].cell.half_nu)
-                        .sum(),
-                    pressure: (*start..*end).map(|k| pressure[k]).fold(0.0, f64::max),
-                    ..*unloaded
-                };
+                let line = loaded_line(unloaded, *start..*end, cells, pressure);
                 crate::lubrication::LineFilm::without_formula(&line).unwrap_or_else(|| {
                     film.get_or_init(|| CentralFilm::of(inputs.lubricant, inputs.e_prime, &line))
                         .at(line.line_load, line.pressure)
