@@ -402,19 +402,12 @@ impl FlankField {
                         (0..quarters).map(move |q| a + (b - a) * q as f64 / 4.0)
                     })
                     .collect();
-                let means: Vec<(usize, Vec<f64>)> = face
-                    .columns()
-                    .map(|k| (k, columns[k].means(&centres, across)))
-                    .collect();
-                let mean_of = |k: usize, c: usize| {
-                    means
-                        .iter()
-                        .find(|(m, _)| *m == k)
-                        .expect("a window's column")
-                        .1[c]
-                };
+                let read = face.columns();
+                let first = *read.start();
+                let means: Vec<Vec<f64>> =
+                    read.map(|k| columns[k].means(&centres, across)).collect();
                 (0..centres.len())
-                    .map(|c| face.mean(|k| mean_of(k, c)))
+                    .map(|c| face.mean(|k| means[k - first][c]))
                     .fold(0.0f64, f64::max)
             })
             .reduce(|| 0.0, f64::max)
@@ -702,19 +695,13 @@ impl FaceWindow {
         }
     }
 
-    /// The columns [`Self::mean`] reads (some more than once).
-    fn columns(&self) -> impl Iterator<Item = usize> + '_ {
-        let ends = [self.start.0 - 1, self.start.0, self.end.0 - 1, self.end.0];
-        let mut all: Vec<usize> = match self.point {
-            Some(j) => vec![j],
-            None => ends
-                .into_iter()
-                .chain(self.inside.iter().map(|c| c.0))
-                .collect(),
-        };
-        all.sort_unstable();
-        all.dedup();
-        all.into_iter()
+    /// The consecutive columns [`Self::mean`] reads: from below the window's start to above
+    /// its end.
+    fn columns(&self) -> std::ops::RangeInclusive<usize> {
+        match self.point {
+            Some(j) => j..=j,
+            None => self.start.0 - 1..=self.end.0,
+        }
     }
 
     /// The mean over the window of the quantity `at(j)` on column j: trapezoids between the
