@@ -2,9 +2,11 @@
 //! cache, the validation study's runs): a file that was changed after it was written (a flipped
 //! digit that keeps the JSON valid, a scaled matrix) is detected on read instead of trusted.
 //!
-//! A sealed file is a JSON object with a member `sha256`: the SHA-256 of the compact JSON text
-//! of the object without that member (keys in serde_json's order, numbers as serde_json writes
-//! them, so parsing and writing again gives the same text).
+//! A sealed file is a JSON object whose first member `sha256` is the SHA-256 of the file's text
+//! without that member: the compact JSON text as written (reformatting it counts as a change).
+//! Files of earlier versions carry the member anywhere, over the compact text of the object
+//! without it with the keys in serde_json's order (parsing and writing again gives the same
+//! text); they open too.
 
 use sha2::{Digest, Sha256};
 
@@ -55,18 +57,40 @@ impl RunningDigest {
     }
 }
 
-/// The JSON text of `value` (an object) with its checksum member added.
+/// The compact JSON text of `value` (an object) with its checksum member first. Written
+/// straight from `value`, without an intermediate JSON tree (a life seals a checkpoint at
+/// every state, issue 55).
 pub fn seal<T: serde::Serialize>(value: &T) -> Result<String, IntegrityError> {
-    let mut v = serde_json::to_value(value).map_err(|e| IntegrityError::Json(e.to_string()))?;
-    let sum = digest(&v);
-    v.as_object_mut()
-        .ok_or(IntegrityError::NotAnObject)?
-        .insert(CHECKSUM.to_string(), serde_json::Value::String(sum));
-    Ok(v.to_string())
+    let body = serde_json::to_string(value).map_err(|e| IntegrityError::Json(e.to_string()))?;
+    let members = body
+        .strip_prefix('{')
+        .filter(|_| body.ends_with('}'))
+        .ok_or(IntegrityError::NotAnObject)?;
+    let separator = if members == "}" { "" } else { "," };
+    Ok(format!(
+        "{{\"{CHECKSUM}\":\"{}\"{separator}{members}",
+        digest_text(&body)
+    ))
 }
 
-/// Parses a sealed text into `T` after checking its checksum.
+/// The checksum and the text it covers of a text sealed by [`seal`] (its first member), or
+/// None for another layout (an earlier version's).
+fn sealed_first(text: &str) -> Option<(&str, String)> {
+    let rest = text.strip_prefix(&format!("{{\"{CHECKSUM}\":\""))?;
+    let (sum, members) = (rest.get(..64)?, rest.get(64..)?);
+    let members = members
+        .strip_prefix("\",")
+        .or_else(|| members.strip_prefix('"').filter(|m| *m == "}"))?;
+    Some((sum, format!("{{{members}")))
+}
+
+/// Parses a sealed text into `T` after checking its checksum (either layout).
 pub fn open<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, IntegrityError> {
+    if let Some((sum, body)) = sealed_first(text) {
+        if digest_text(&body) == sum {
+            return serde_json::from_str(&body).map_err(|e| IntegrityError::Json(e.to_string()));
+        }
+    }
     let mut v: serde_json::Value =
         serde_json::from_str(text).map_err(|e| IntegrityError::Json(e.to_string()))?;
     let map = v.as_object_mut().ok_or(IntegrityError::NotAnObject)?;
@@ -128,5 +152,52 @@ mod tests {
             open::<Doc>("{\"step\": "),
             Err(IntegrityError::Json(_))
         ));
+    }
+
+    /// Members out of serde_json's key order (the tree's order would differ from the text's).
+    #[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+    struct Unsorted {
+        zeta: f64,
+        alpha: Vec<u32>,
+    }
+
+    #[test]
+    fn a_seal_is_the_digest_of_the_text_as_written_and_earlier_seals_still_open() {
+        let doc = Unsorted {
+            zeta: 0.1,
+            alpha: vec![3, 1],
+        };
+        let text = seal(&doc).unwrap();
+        let plain = serde_json::to_string(&doc).unwrap();
+        assert_eq!(
+            text,
+            format!("{{\"sha256\":\"{}\",{}", digest_text(&plain), &plain[1..])
+        );
+        assert_eq!(open::<Unsorted>(&text).unwrap(), doc);
+        // The text as written is what is sealed: the members reordered is a change.
+        let reordered = format!(
+            "{{\"sha256\":\"{}\",\"alpha\":[3,1],\"zeta\":0.1}}",
+            digest_text(&plain)
+        );
+        assert_eq!(open::<Unsorted>(&reordered), Err(IntegrityError::Mismatch));
+        // An earlier version's seal: the checksum over the keys in serde_json's order, the
+        // member among the others.
+        let mut tree = serde_json::to_value(&doc).unwrap();
+        let sum = digest(&tree);
+        tree.as_object_mut()
+            .unwrap()
+            .insert(CHECKSUM.into(), serde_json::Value::String(sum));
+        let earlier = tree.to_string();
+        assert!(earlier.starts_with("{\"alpha\""), "{earlier}");
+        assert_eq!(open::<Unsorted>(&earlier).unwrap(), doc);
+        let changed = earlier.replace("0.1", "0.2");
+        assert_eq!(open::<Unsorted>(&changed), Err(IntegrityError::Mismatch));
+        // An empty object, and what is not an object.
+        let empty = seal(&serde_json::json!({})).unwrap();
+        assert_eq!(
+            open::<serde_json::Value>(&empty).unwrap(),
+            serde_json::json!({})
+        );
+        assert_eq!(seal(&[1, 2]), Err(IntegrityError::NotAnObject));
     }
 }
