@@ -101,7 +101,11 @@ impl Backlash {
 
     /// Mean, min, max over positions and the linear mean at r2.
     pub fn stats(&self, removal: &FlankField) -> BacklashStats {
-        let v = self.per_position(removal);
+        self.stats_of(&self.per_position(removal))
+    }
+
+    /// [`Self::stats`] of the backlash per position `v` ([`Self::per_position`]), rad.
+    pub fn stats_of(&self, v: &[f64]) -> BacklashStats {
         let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
         BacklashStats {
             mean_rad: mean,

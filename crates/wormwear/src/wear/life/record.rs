@@ -3,7 +3,6 @@
 
 use super::{LifeLoop, StateAnalysis};
 use crate::friction::Thermal;
-use crate::geometry::FlankField;
 use crate::ltca::{stats, Ltca};
 use crate::lubrication::FlankRoughness;
 use crate::wear::spectrum::BinRecord;
@@ -40,10 +39,10 @@ impl LifeLoop<'_> {
             .collect()
     }
 
-    /// The rigid lag the flank change `change` adds at each position (rad, MODEL §12 j) and
-    /// each position's TE, TE relative to that lag, tooth loads and largest pressure.
-    fn position_states(&self, l: &Ltca, change: &FlankField) -> (Vec<f64>, Vec<PositionState>) {
-        let per_position = self.backlash.per_position(change);
+    /// The rigid lag the flank change adds at each position (rad, MODEL §12 j), from the
+    /// backlash per position on the changed flank, and each position's TE, TE relative to that
+    /// lag, tooth loads and largest pressure.
+    fn position_states(&self, l: &Ltca, per_position: &[f64]) -> (Vec<f64>, Vec<PositionState>) {
         let lag: Vec<f64> = per_position
             .iter()
             .zip(&self.initial_backlash)
@@ -75,8 +74,9 @@ impl LifeLoop<'_> {
     ) -> StepRecord {
         let wf = self.wf;
         let change = state.flank_change();
-        let (lag, positions) = self.position_states(l, &change);
-        let b = self.backlash.stats(&change);
+        let per_position = self.backlash.per_position(&change);
+        let (lag, positions) = self.position_states(l, &per_position);
+        let b = self.backlash.stats_of(&per_position);
         let (te_mean, te_p2p) = l.te_stats();
         let (te_rel_mean, te_rel_p2p) = stats(positions.iter().map(|p| p.te_relative_rad));
         let lambdas = cw.lambda.values.iter().copied().filter(|v| v.is_finite());
