@@ -65,15 +65,15 @@ pub(crate) fn relation_core(
 }
 
 /// The rows of a thread-relation term: cells grouped by `group` (tooth or thread index), each
-/// row's basis values written at columns `offset + t k .. offset + (t + 1) k` of its row of
-/// `f` (row length `stride`; t the group's rank among those present, k the basis size).
-/// Returns the groups present (sorted) and each row's column range.
+/// row's basis values in F's columns `offset + t k .. offset + (t + 1) k` (t the group's rank
+/// among those present, k the basis size), written packed at `packed[i stride + at..][..k]`
+/// (row i of rows of `stride` values, [`LowRank::packed`]). Returns the groups present (sorted)
+/// and each row's column range in F.
 pub(crate) fn relation_rows(
     basis: &Basis,
     groups: &[i64],
     coords: &[(f64, f64)],
-    f: &mut [f64],
-    stride: usize,
+    (packed, stride, at): (&mut [f64], usize, usize),
     offset: usize,
 ) -> (Vec<i64>, Vec<(usize, usize)>) {
     let mut present: Vec<i64> = groups.to_vec();
@@ -104,7 +104,7 @@ pub(crate) fn relation_rows(
         basis.eval_into(
             r.clamp(0.0, 1.0),
             hw,
-            &mut f[i * stride + a..i * stride + b],
+            &mut packed[i * stride + at..i * stride + at + k],
         );
     }
     (present, ranges)
@@ -143,12 +143,12 @@ pub(crate) fn relation_low_rank(
     let mut present: Vec<i64> = groups.to_vec();
     present.sort_unstable();
     present.dedup();
-    let rank = basis.len() * present.len();
-    let mut f = vec![0.0; groups.len() * rank];
-    let (present, rows) = relation_rows(basis, groups, coords, &mut f, rank, 0);
+    let (rank, k) = (basis.len() * present.len(), basis.len());
+    let mut packed = vec![0.0; groups.len() * k];
+    let (present, rows) = relation_rows(basis, groups, coords, (&mut packed, k, 0), 0);
     let core = cached_core(same, before, after, &present, cache);
     let ranges = rows.into_iter().map(|r| [r, (0, 0), (0, 0)]).collect();
-    LowRank::new(rank, f, core.as_ref().clone(), ranges)
+    LowRank::packed(rank, packed, k, core.as_ref().clone(), ranges)
 }
 
 #[cfg(test)]

@@ -522,8 +522,10 @@ impl BendingModel for FeBending {
         self.wheel.rigid_rotation_compliance()
     }
 
-    /// Both members' terms written straight into one F (wheel teeth, wheel hub's rigid body,
-    /// worm threads side by side; the cores block-diagonal): one allocation per position.
+    /// Both members' terms written straight into one packed F (each row: its wheel tooth's
+    /// functions, the wheel hub's rigid body, its worm thread's; the cores block-diagonal):
+    /// one allocation per position, of the non-zero values only (a dense F was zeroed, filled
+    /// and packed: memory traffic that two threads shared, issue 55).
     fn coefficients(&self, cells: &[LocalCell]) -> LowRank {
         let (wheel_groups, wheel_coords) = self.wheel.groups(cells);
         let (worm_groups, worm_coords) = self.worm.groups(cells);
@@ -537,24 +539,25 @@ impl BendingModel for FeBending {
         let hub = if self.wheel.has_shaft() { 6 } else { 0 };
         let threads = self.worm.basis.len() * count(&worm_groups);
         let rank = teeth + hub + threads;
-        let mut f = vec![0.0; cells.len() * rank];
+        let (k_wheel, k_worm) = (self.wheel.basis.len(), self.worm.basis.len());
+        let width = k_wheel + hub + k_worm;
+        let mut packed = vec![0.0; cells.len() * width];
         let (wheel_present, wheel_rows) = relation_rows(
             &self.wheel.basis,
             &wheel_groups,
             &wheel_coords,
-            &mut f,
-            rank,
+            (&mut packed, width, 0),
             0,
         );
         if hub > 0 {
-            self.wheel.write_wrenches(cells, &mut f, rank, teeth);
+            self.wheel
+                .write_wrenches(cells, &mut packed, width, k_wheel);
         }
         let (worm_present, worm_rows) = relation_rows(
             &self.worm.basis,
             &worm_groups,
             &worm_coords,
-            &mut f,
-            rank,
+            (&mut packed, width, k_wheel + hub),
             teeth + hub,
         );
         let mut core = vec![0.0; rank * rank];
@@ -579,7 +582,7 @@ impl BendingModel for FeBending {
                 [wheel_rows[i], shaft, worm_rows[i]]
             })
             .collect();
-        LowRank::new(rank, f, core, ranges)
+        LowRank::packed(rank, packed, width, core, ranges)
     }
 }
 

@@ -728,6 +728,44 @@ mod tests {
     }
 
     #[test]
+    fn a_low_rank_term_built_packed_is_the_one_built_from_its_dense_rows() {
+        // Rows on one of three "teeth" (3 columns each) plus a shared block (2 columns), as
+        // the FE bending builds them: packed straight, or dense (zeros outside the ranges,
+        // where the dense F holds garbage that must not count) and packed by `new`.
+        let (n, k, width) = (23, 11, 5);
+        let value = |a: usize, b: usize| ((a * 5 + b * 11) % 13) as f64 / 13.0 - 0.3;
+        let ranges: Vec<[(usize, usize); 3]> = (0..n)
+            .map(|i| [(3 * (i % 3), 3 * (i % 3) + 3), (9, 11), (0, 0)])
+            .collect();
+        let mut dense = vec![f64::NAN; n * k];
+        let mut packed = Vec::new();
+        for (i, r) in ranges.iter().enumerate() {
+            for &(a, b) in r {
+                for c in a..b {
+                    dense[i * k + c] = value(i, c);
+                    packed.push(value(i, c));
+                }
+            }
+        }
+        let core: Vec<f64> = (0..k * k)
+            .map(|x| {
+                value(x / k, x % k) + value(x % k, x / k) + if x % (k + 1) == 0 { 4.0 } else { 0.0 }
+            })
+            .collect();
+        let from_dense = LowRank::new(k, dense, core.clone(), ranges.clone());
+        let built_packed = LowRank::packed(k, packed, width, core, ranges);
+        let x: Vec<f64> = (0..n).map(|i| value(i, 2)).collect();
+        let (mut a, mut b) = (vec![0.25; n], vec![0.25; n]);
+        low_rank_add(&from_dense, &x, &mut a, dot);
+        low_rank_add(&built_packed, &x, &mut b, dot);
+        assert_eq!(a, b);
+        assert!(a.iter().all(|v| v.is_finite()));
+        for i in 0..n {
+            assert_eq!(from_dense.dense_row(i), built_packed.dense_row(i));
+        }
+    }
+
+    #[test]
     fn the_wide_low_rank_product_equals_the_portable_one() {
         // The AVX2 build of F C F^T x (chosen at run time) against the portable build and a
         // plain triple loop: same numbers to round-off, with row ranges, a block-sparse core

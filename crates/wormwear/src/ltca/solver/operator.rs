@@ -214,6 +214,41 @@ impl LowRank {
             }
         }
         offsets.push(values.len());
+        Self::of_packed_rows(rank, values, offsets, core, ranges)
+    }
+
+    /// The term F C F^T from F already packed (`values`: row i's values of its non-empty
+    /// ranges, one after the other, at `values[i * width..(i + 1) * width]`; every row's
+    /// ranges cover `width` columns), C (rank x rank, row-major, symmetric) and the rows'
+    /// ranges: the numbers of [`LowRank::new`] without a dense F to fill and copy.
+    pub fn packed(
+        rank: usize,
+        values: Vec<f64>,
+        width: usize,
+        core: Vec<f64>,
+        ranges: Vec<[(usize, usize); 3]>,
+    ) -> Self {
+        assert_eq!(
+            values.len(),
+            ranges.len() * width,
+            "packed rows of {width} values"
+        );
+        debug_assert!(ranges
+            .iter()
+            .all(|r| { r.iter().map(|(a, b)| b.saturating_sub(*a)).sum::<usize>() == width }));
+        let offsets = (0..=ranges.len()).map(|i| i * width).collect();
+        Self::of_packed_rows(rank, values, offsets, core, ranges)
+    }
+
+    /// The term of packed rows (row i `values[offsets[i]..offsets[i + 1]]`), its core and the
+    /// rows' ranges, with the core's runs found.
+    fn of_packed_rows(
+        rank: usize,
+        values: Vec<f64>,
+        offsets: Vec<usize>,
+        core: Vec<f64>,
+        ranges: Vec<[(usize, usize); 3]>,
+    ) -> Self {
         let core_runs = core_runs(&core, rank);
         Self {
             rank,
