@@ -337,7 +337,8 @@ impl LowRank {
             new_index[c] = j;
         }
         let rank = columns.len();
-        let mut values = Vec::new();
+        let row_length = |i: usize| self.offsets[i + 1] - self.offsets[i];
+        let mut values = Vec::with_capacity(set.iter().map(|&i| row_length(i)).sum());
         let mut offsets = Vec::with_capacity(set.len() + 1);
         let mut ranges = Vec::with_capacity(set.len());
         for &i in set {
@@ -360,15 +361,7 @@ impl LowRank {
                 core[r * rank + c] = row[cc];
             }
         }
-        let core_runs = core_runs(&core, rank);
-        LowRank {
-            rank,
-            values,
-            offsets,
-            core,
-            ranges,
-            core_runs,
-        }
+        LowRank::of_packed_rows(rank, values, offsets, core, ranges)
     }
 }
 
