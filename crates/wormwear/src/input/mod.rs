@@ -463,7 +463,6 @@ pub struct Analysis {
     /// Which torque the pressures carry (MODEL §5.2, §12 n).
     pub torque_balance: TorqueBalance,
     /// How the local band grows where the contact reaches its edge (MODEL §5.1).
-    #[serde(skip_serializing_if = "BandGrowth::is_widen")]
     pub contact_band_growth: BandGrowth,
 }
 
@@ -472,21 +471,15 @@ pub struct Analysis {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BandGrowth {
-    /// Default: every slice's band widened by 1.6 with the same cells across the line (each
-    /// cell 1.6 times wider), up to four times; a life keeps the widest band of its states.
-    #[default]
+    /// Every slice's band widened by 1.6 with the same cells across the line (each cell 1.6
+    /// times wider), up to four times; a life keeps the widest band of its states (the
+    /// default until session 50: its worn contact is resolved ever more coarsely).
     Widen,
-    /// Only the slices whose load reaches their band's first or last cell grow, on that side,
-    /// by cells of the same width (the cells keep their size; at most three bands' worth of
-    /// cells on each side); each analysis finds its own extent.
+    /// Default: only the slices whose load reaches their band's first or last cell grow, on
+    /// that side, by cells of the same width (the cells keep their size; at most three bands'
+    /// worth of cells on each side); each analysis finds its own extent.
+    #[default]
     Extend,
-}
-
-impl BandGrowth {
-    /// Whether this is the default (serialisations without the field read as it).
-    pub fn is_widen(&self) -> bool {
-        *self == BandGrowth::Widen
-    }
 }
 
 /// Which torque the loaded analysis' pressures carry (MODEL §5.2, §12 n).

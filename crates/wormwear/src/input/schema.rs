@@ -569,9 +569,9 @@ pub struct AnalysisSpec {
     /// line load (widened automatically when the load reaches the band edge).
     #[serde(default = "default_band_factor")]
     pub contact_band_factor: f64,
-    /// LTCA: how the band grows where the contact reaches its edge: "widen" (default: every
-    /// slice's cells widened together) or "extend" (the slices reached get more cells of the
-    /// same width on that side; MODEL §5.1).
+    /// LTCA: how the band grows where the contact reaches its edge: "extend" (default: the
+    /// slices reached get more cells of the same width on that side; MODEL §5.1) or "widen"
+    /// (every slice's cells widened together, the default until session 50).
     #[serde(default)]
     pub contact_band_growth: Option<String>,
     /// LTCA: contact law, "plastic" (default: pressures bounded by the wheel's flow pressure,

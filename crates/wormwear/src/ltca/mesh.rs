@@ -425,6 +425,7 @@ pub(super) fn slice_cells(
             band_last: last,
             r,
             z,
+            line_r: slice.r_line,
             half_dz: slice.half_dz,
             lever,
             wheel_centre: stat,

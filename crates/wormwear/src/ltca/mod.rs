@@ -156,6 +156,10 @@ pub struct LocalCell {
     /// Flank coordinates (reference tooth), m.
     pub r: f64,
     pub z: f64,
+    /// Radius where the slice's contact line crosses it (the base band's centre; on a worn
+    /// flank the worn gap's minimum), m: where the slice's film is entrained (MODEL §6, §13),
+    /// whatever the band's extent.
+    pub line_r: f64,
     /// Half extent of the cell's slice along the face width, m.
     pub half_dz: f64,
     /// Lever of the normal about the wheel axis |(P x n)_z|, m.

@@ -130,9 +130,10 @@ impl FilmGeometry {
     }
 
     /// The contact line, unloaded, of the slice whose first cell is `first`: its curvature
-    /// radius and the rolling velocities there.
+    /// radius and the rolling velocities where the line crosses the slice (not at its first
+    /// cell, which moves with the band's extent).
     fn unloaded_line(&self, position: usize, first: &LocalCell) -> LineContact {
-        let (u1, u2) = self.rolling_at(first.slice, first.r);
+        let (u1, u2) = self.rolling_at(first.slice, first.line_r);
         LineContact {
             radius: self.radii.at(position, first.tooth, first.slice),
             u1,

@@ -546,8 +546,8 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         ("c-elastic", |g| {
             g.analysis.contact = input::ContactLaw::Elastic
         }),
-        ("c-band-extend", |g| {
-            g.analysis.contact_band_growth = input::BandGrowth::Extend
+        ("c-band-widen", |g| {
+            g.analysis.contact_band_growth = input::BandGrowth::Widen
         }),
         ("c-wheel-flank-pressure", |g| {
             g.analysis.pressure_direction = input::PressureDirection::WheelFlank

@@ -39,7 +39,10 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
          sharp worm tip and wheel edges, the bronze's plastic limit at its hardness with \
          running-in (MODEL §5.7: no contact pressure above the wheel's flow pressure; the \
          purely elastic reading is in (d)), the film at the line load of the loaded analysis, pits 0.78 x the local Hertz half-width deep, FE \
-         bending of worm and wheel with their shafts and bearings; the contact pressure acts \
+         bending of worm and wheel with their shafts and bearings; the local band grown by \
+         cells of the same width where the contact reaches it (MODEL §5.1: several cells across \
+         the Hertz width all life long; the band widened with the same cells is in (d)); the \
+         contact pressure acts \
          along the worm flank's normal (MODEL §5.2 leaves n_i open; this reading keeps the \
          frictionless power balance, README). Section (d) shows each of our \
          refinements against it. The published work gives no measured backlash values in \
@@ -762,9 +765,10 @@ const OPTION_ROWS: [(&str, &str); 7] = [
         "c-film-floor",
     ),
     (
-        "the band grows by cells of the same width where the contact reaches it: \
-         `contact_band_growth = \"extend\"`",
-        "c-band-extend",
+        "the band widened 1.6 times with the same cells where the contact reaches it (the \
+         default until session 50; its worn contact is resolved more coarsely): \
+         `contact_band_growth = \"widen\"`",
+        "c-band-widen",
     ),
     (
         "pressure along the wheel grid's normal (the other reading of MODEL §5.2's n_i): \

@@ -125,7 +125,7 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
     );
     let band_growth = ck.choice(
         "analysis.contact_band_growth",
-        a.contact_band_growth.as_deref().unwrap_or("widen"),
+        a.contact_band_growth.as_deref().unwrap_or("extend"),
         &[("widen", BandGrowth::Widen), ("extend", BandGrowth::Extend)],
     );
     use super::SolverKind;
