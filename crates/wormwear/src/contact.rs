@@ -461,7 +461,7 @@ impl InfluenceRows {
     /// assembled before are read, not recomputed; the first sub-block is kept, and rows
     /// assembled afterwards read their near pairs inside it.
     pub fn sub_block(&self, set: &[usize]) -> std::sync::Arc<Vec<f64>> {
-        debug_assert!(set.windows(2).all(|w| w[0] < w[1]));
+        assert!(set.windows(2).all(|w| w[0] < w[1]));
         let cells: Vec<ContactCell> = set.iter().map(|&i| self.cells[i]).collect();
         let levers: Vec<f64> = set.iter().map(|&i| self.levers[i]).collect();
         let known: Vec<Option<&[f64]>> = set

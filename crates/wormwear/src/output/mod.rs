@@ -485,7 +485,7 @@ impl Csv {
     /// counts) are written as integers, the rest with 11 significant digits, and no value
     /// (NaN or infinite; null in summary.json) as `NaN`.
     pub fn row(&mut self, values: &[f64]) {
-        debug_assert_eq!(values.len(), self.columns);
+        assert_eq!(values.len(), self.columns);
         self.numbers.extend_from_slice(values);
         for (k, v) in values.iter().enumerate() {
             if k > 0 {

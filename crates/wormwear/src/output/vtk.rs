@@ -74,14 +74,14 @@ impl QuadSurface {
 
     /// Adds a point array (one value per point; NaN: no value).
     pub fn add_point_data(&mut self, name: &str, values: Vec<f64>) {
-        debug_assert_eq!(values.len(), self.points.len());
+        assert_eq!(values.len(), self.points.len());
         self.point_data.push((name.to_string(), values));
     }
 
     /// Adds a cell array (one value per quad) and the same field averaged to the points (mean
     /// of the finite values of the quads around each point), under the same name.
     pub fn add_cell_field(&mut self, name: &str, values: Vec<f64>) {
-        debug_assert_eq!(values.len(), self.cell_count());
+        assert_eq!(values.len(), self.cell_count());
         let nodal = cells_to_points(self.rows, self.cols, &values);
         self.point_data.push((name.to_string(), nodal));
         self.cell_data.push((name.to_string(), values));

@@ -104,7 +104,7 @@ impl LowerPattern {
     pub(super) fn position(&self, row: usize, col: usize) -> usize {
         let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
         let p = a + self.row_idx[a..b].partition_point(|&r| r < row);
-        debug_assert!(p < b && self.row_idx[p] == row, "entry outside the pattern");
+        assert!(p < b && self.row_idx[p] == row, "entry outside the pattern");
         p
     }
 }

@@ -208,7 +208,7 @@ impl Problem {
             });
             at += m;
         }
-        debug_assert_eq!(at, set.len(), "every unknown lies in one contact block");
+        assert_eq!(at, set.len(), "every unknown lies in one contact block");
         Problem {
             blocks,
             low_rank: self.low_rank.as_ref().map(|lr| lr.restrict(set)),

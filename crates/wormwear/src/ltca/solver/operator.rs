@@ -190,7 +190,7 @@ impl LowRank {
             ranges
         };
         // A row's ranges must not overlap (the products would count those columns twice).
-        debug_assert!(ranges.iter().all(|r| {
+        assert!(ranges.iter().all(|r| {
             (0..3).all(|a| {
                 (a + 1..3).all(|b| {
                     r[a].0 >= r[a].1 || r[b].0 >= r[b].1 || r[a].1 <= r[b].0 || r[b].1 <= r[a].0
@@ -233,7 +233,7 @@ impl LowRank {
             ranges.len() * width,
             "packed rows of {width} values"
         );
-        debug_assert!(ranges
+        assert!(ranges
             .iter()
             .all(|r| { r.iter().map(|(a, b)| b.saturating_sub(*a)).sum::<usize>() == width }));
         let offsets = (0..=ranges.len()).map(|i| i * width).collect();
