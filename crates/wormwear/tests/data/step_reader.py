@@ -48,8 +48,10 @@ def main():
         distances.append(best)
     tetrahedra = 0
     try:
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 1.0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 6.0)
+        # Coarse tetrahedra (2-10 mm): any volume mesh needs a closed, valid boundary, which
+        # is what is checked; 6 mm elements took 15 s more for the same answer.
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 2.0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 10.0)
         gmsh.model.mesh.generate(3)
         _, elements, _ = gmsh.model.mesh.getElements(3)
         tetrahedra = sum(len(e) for e in elements)

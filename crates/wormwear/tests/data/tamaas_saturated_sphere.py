@@ -26,7 +26,9 @@ surface[~inner] = -1.0  # far below any approach: never in contact
 tm.set_log_level(tm.LogLevel.error)
 model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [L, L], [N, N])
 model.E, model.nu = 1.0, 0.0
-solver = tm.KatoSaturated(model, surface, 1e-12, cap * p0)
+# Tolerance 1e-9: the pressures within 5e-5 p0 of a 1e-12 solve (measured at caps 10 and 0.6,
+# 64 cells), far below the few % of p0 the test compares, in half the time.
+solver = tm.KatoSaturated(model, surface, 1e-9, cap * p0)
 solver.max_iter = 100000
 solver.solve(load / (L * L))
 p = np.array(model.traction).reshape(N, N)[inner].reshape(n, n)

@@ -235,7 +235,7 @@ fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
 /// ISO's does (the film grows), the asperities' share falls with it, and the torques carry
 /// the contact's own efficiency. Run: cargo test --release -p wormwear --test suite friction:: -- --ignored
 #[test]
-#[ignore]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
     use wormwear::validation::{self, friction};
     let settings = validation::Settings {

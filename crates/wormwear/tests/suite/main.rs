@@ -2,7 +2,10 @@
 //! integration test file was its own binary linking the whole library (about 3 s of the 2-core
 //! box's build apiece, 33 of them), and each ran only after the one before had finished its
 //! slowest test. Run one subject with `cargo test -p wormwear --test suite plastic::`, its
-//! ignored validations with `... --test suite plastic:: -- --ignored`.
+//! ignored validations with `... --test suite plastic:: -- --ignored`. The heavy validations
+//! (`#[ignore = "heavy validation: ..."]`: refinement and tolerance studies, long lives) are
+//! left out of the test command to keep it within CI's 15 minutes; `scripts/validate-heavy`
+//! runs them all with the release profile.
 
 mod common;
 

@@ -200,6 +200,7 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
 /// factor (the "measurement") is fitted from another K and the fitted curve (life factor 1);
 /// both come back (about 45 lives).
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn k_and_the_life_factor_are_recovered_from_a_forecast_backlash_curve() {
     let bench = Bench::new(&coarse());
     let plan = forecast_plan();

@@ -368,6 +368,7 @@ fn run_in(
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn running_in_settles_with_cells_much_finer_than_the_grid_rows() {
     // MODEL §5.7: analyses repeated at the same load on the flank their plastic indentation
     // leaves must stop yielding: the set is a fixed point. With 41 cells across the line a
@@ -456,6 +457,7 @@ fn the_plastic_limit_makes_the_peaks_mesh_converged() {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn case_b_pressures_do_not_depend_on_the_solver_tolerance() {
     // Issue 39 item 5: with the elastic contact two solver versions agreeing to 1e-10 ended
     // case B at P_max 2392 and 14 323 MPa (a ridge's edge singularity). Bounded at the flow

@@ -218,6 +218,7 @@ fn with_the_geometry_frozen_wear_is_linear_in_cycles() {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn life_results_do_not_depend_on_the_wear_step() {
     // Design case, 180 000 cycles: fixed steps of 30 000, 15 000, 10 000 cycles and adaptive
     // 4 um steps (MODEL §7.3), with the default stability guard (5 um per sub-step).
@@ -304,7 +305,7 @@ fn an_adaptive_step_removes_the_step_depth_at_its_fastest_node_and_no_more() {
 /// geometry updates, i.e. loaded analyses, are what a step costs). Prints the counts and the
 /// lower bound (largest wear) / 4 um that no 4 um step control can beat.
 #[test]
-#[ignore = "two 1e6-cycle lives (~1 min); run by hand"]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn adaptive_and_fixed_steps_over_a_million_cycles() {
     let g = example("gear-1x40-design.toml");
     let count = |step| {
@@ -877,6 +878,7 @@ fn the_patch_mean_of_a_wear_ridge_is_its_analytic_mean_on_any_grid() {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_peak_wear_converges_with_the_global_grid() {
     // Issue 39: the design case without bending over 60 000 cycles (adaptive 4 um steps) on
     // the global grids 80 x 120 and 160 x 120 (the two finest levels of VALIDATION.md's study,

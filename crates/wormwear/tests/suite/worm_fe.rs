@@ -166,6 +166,7 @@ fn worm_shaft_bends_as_a_timoshenko_beam() {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
     // MODEL §5.5 step 5 at the worm's 5 x 13 points (least-squares fit on the lattice's corner
     // nodes of the zone): FE vs fitted coefficients between points midway between fit points.
