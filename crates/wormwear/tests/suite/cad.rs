@@ -289,6 +289,19 @@ fn check_answer(
 
 #[test]
 fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
+    reads_back_as_one_solid("gear-1x40-design.toml");
+}
+
+/// The same on the K 2/25 gear (another profile, two threads).
+#[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
+fn opencascade_reads_the_k_gears_solids_with_our_volume_areas_and_flank_points() {
+    reads_back_as_one_solid("gear-k-2x25.toml");
+}
+
+/// OpenCASCADE reads the wheel and the worm of the example `name` as one solid each, of our
+/// volume and face areas, with the flanks' points on its faces.
+fn reads_back_as_one_solid(name: &str) {
     if !gmsh_present() {
         skipped(
             "cad::opencascade_reads_one_solid",
@@ -296,50 +309,48 @@ fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
         );
         return;
     }
-    for name in ["gear-1x40-design.toml", "gear-k-2x25.toml"] {
-        let (g, geo) = built(name);
-        let wheel = full_wheel(&g, &geo);
-        // The reference space's flanks (tooth 0) and the grid's cell centres: envelope points
-        // of the analysis grid, which the CAD sections did not sample.
-        let faces = faces_of(&wheel, |k, i| k.is_flank() && i == 0);
-        let mut points = Vec::new();
-        for (flank, kind) in [
-            (Flank::Left, FaceKind::FlankLeft),
-            (Flank::Right, FaceKind::FlankRight),
-        ] {
-            let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
-            for c in geo.wheel_flank(flank).cells.iter().step_by(7) {
-                let p = g.operating.wheel_to_worm(&c.position()) * 1e3;
-                points.push(([p.x, p.y, p.z], on.clone()));
-            }
+    let (g, geo) = built(name);
+    let wheel = full_wheel(&g, &geo);
+    // The reference space's flanks (tooth 0) and the grid's cell centres: envelope points
+    // of the analysis grid, which the CAD sections did not sample.
+    let faces = faces_of(&wheel, |k, i| k.is_flank() && i == 0);
+    let mut points = Vec::new();
+    for (flank, kind) in [
+        (Flank::Left, FaceKind::FlankLeft),
+        (Flank::Right, FaceKind::FlankRight),
+    ] {
+        let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
+        for c in geo.wheel_flank(flank).cells.iter().step_by(7) {
+            let p = g.operating.wheel_to_worm(&c.position()) * 1e3;
+            points.push(([p.x, p.y, p.z], on.clone()));
         }
-        let answer = read_back(&wheel, &faces, &points).unwrap();
-        check_answer(&format!("{name} wheel"), &wheel, &faces, &answer);
-        // The worm: its flank faces and points of its helicoids over the body.
-        let worm = worm_part(&g, &geo).unwrap();
-        let faces = faces_of(&worm, |k, i| k.is_flank() && i == 0);
-        let (rf, ra) = (g.worm.root_radius, g.worm.tip_radius);
-        let half = 0.45 * g.bending.worm_body_length;
-        let mut points = Vec::new();
-        for (flank, kind) in [
-            (Flank::Left, FaceKind::FlankLeft),
-            (Flank::Right, FaceKind::FlankRight),
-        ] {
-            let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
-            for a in 0..13 {
-                let rho = rf + (ra - rf) * (a as f64 + 0.37) / 13.0;
-                for b in 0..40 {
-                    let p = geo.worm.flank_point(flank, rho, 0.0, 0);
-                    let x = -half + 2.0 * half * (b as f64 + 0.29) / 40.0;
-                    let phi = (x - p.x) / (geo.worm.hand_sign() * geo.worm.lead_per_rad());
-                    let q = geo.worm.flank_point(flank, rho, phi, 0) * 1e3;
-                    points.push(([q.x, q.y, q.z], on.clone()));
-                }
-            }
-        }
-        let answer = read_back(&worm, &faces, &points).unwrap();
-        check_answer(&format!("{name} worm"), &worm, &faces, &answer);
     }
+    let answer = read_back(&wheel, &faces, &points).unwrap();
+    check_answer(&format!("{name} wheel"), &wheel, &faces, &answer);
+    // The worm: its flank faces and points of its helicoids over the body.
+    let worm = worm_part(&g, &geo).unwrap();
+    let faces = faces_of(&worm, |k, i| k.is_flank() && i == 0);
+    let (rf, ra) = (g.worm.root_radius, g.worm.tip_radius);
+    let half = 0.45 * g.bending.worm_body_length;
+    let mut points = Vec::new();
+    for (flank, kind) in [
+        (Flank::Left, FaceKind::FlankLeft),
+        (Flank::Right, FaceKind::FlankRight),
+    ] {
+        let on: Vec<usize> = (0..faces.len()).filter(|&i| faces[i].0 == kind).collect();
+        for a in 0..13 {
+            let rho = rf + (ra - rf) * (a as f64 + 0.37) / 13.0;
+            for b in 0..40 {
+                let p = geo.worm.flank_point(flank, rho, 0.0, 0);
+                let x = -half + 2.0 * half * (b as f64 + 0.29) / 40.0;
+                let phi = (x - p.x) / (geo.worm.hand_sign() * geo.worm.lead_per_rad());
+                let q = geo.worm.flank_point(flank, rho, phi, 0) * 1e3;
+                points.push(([q.x, q.y, q.z], on.clone()));
+            }
+        }
+    }
+    let answer = read_back(&worm, &faces, &points).unwrap();
+    check_answer(&format!("{name} worm"), &worm, &faces, &answer);
 }
 
 #[test]

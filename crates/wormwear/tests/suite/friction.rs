@@ -210,6 +210,7 @@ fn a_life_with_the_heat_balance_holds_it_at_every_state_and_the_film_follows_the
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
     // 11, 22 and 41 cells across the contact line: the loss (a sum of mu p |v_g| S, whose
     // pressures converge as patch means, VALIDATION.md "Mesh convergence") moves by 1.1 % and

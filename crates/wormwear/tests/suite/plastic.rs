@@ -432,6 +432,7 @@ fn running_in_settles_with_cells_much_finer_than_the_grid_rows() {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_plastic_limit_makes_the_peaks_mesh_converged() {
     // MODEL §5.7: with the elastic law the largest cell pressure at the worm's tip edge grows
     // with the cells across the line (fidelity.rs); bounded, P_max and the patch pressure

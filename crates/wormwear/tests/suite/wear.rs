@@ -17,6 +17,7 @@ fn cycle(g: &GearSet) -> (Geometry, kinematics::Tca, wear::CycleWear) {
 }
 
 #[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn per_cycle_wear_converges_with_the_positions() {
     let mut g = example("gear-1x40-design.toml");
     let (geo, tca, w20) = cycle(&g);
