@@ -289,24 +289,28 @@ fn check_answer(
 
 #[test]
 fn opencascade_reads_one_solid_with_our_volume_areas_and_flank_points() {
-    reads_back_as_one_solid("gear-1x40-design.toml");
+    reads_back_as_one_solid(
+        "gear-1x40-design.toml",
+        "cad::opencascade_reads_one_solid_with_our_volume_areas_and_flank_points",
+    );
 }
 
 /// The same on the K 2/25 gear (another profile, two threads).
 #[test]
 #[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn opencascade_reads_the_k_gears_solids_with_our_volume_areas_and_flank_points() {
-    reads_back_as_one_solid("gear-k-2x25.toml");
+    reads_back_as_one_solid(
+        "gear-k-2x25.toml",
+        "cad::opencascade_reads_the_k_gears_solids_with_our_volume_areas_and_flank_points",
+    );
 }
 
 /// OpenCASCADE reads the wheel and the worm of the example `name` as one solid each, of our
-/// volume and face areas, with the flanks' points on its faces.
-fn reads_back_as_one_solid(name: &str) {
+/// volume and face areas, with the flanks' points on its faces (`test`: the name a skip is
+/// logged under).
+fn reads_back_as_one_solid(name: &str, test: &str) {
     if !gmsh_present() {
-        skipped(
-            "cad::opencascade_reads_one_solid",
-            "gmsh's Python package (OpenCASCADE) is absent",
-        );
+        skipped(test, "gmsh's Python package (OpenCASCADE) is absent");
         return;
     }
     let (g, geo) = built(name);
