@@ -72,16 +72,7 @@ impl NodeLoads {
                 })
                 .collect(),
         };
-        let ni = wf.cells_height;
-        let mut share = vec![0.0; wf.nodes.len()];
-        let total = wf.active_area();
-        for j in 0..wf.cells_face {
-            for i in 0..ni {
-                for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    share[(j + dj) * (ni + 1) + i + di] += 0.25 * wf.cell_area[j * ni + i] / total;
-                }
-            }
-        }
+        let share = node_shares(wf);
         let cells = pressure
             .iter()
             .enumerate()
@@ -209,6 +200,22 @@ impl NodeLoads {
         }
         due
     }
+}
+
+/// Share of the active flank each node stands for: a quarter of each grid cell around it
+/// (the nodes' shares sum to 1). The area a forecast's onset and the damage warning count.
+pub fn node_shares(wf: &WheelFlank) -> Vec<f64> {
+    let ni = wf.cells_height;
+    let mut share = vec![0.0; wf.nodes.len()];
+    let total = wf.active_area();
+    for j in 0..wf.cells_face {
+        for i in 0..ni {
+            for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                share[(j + dj) * (ni + 1) + i + di] += 0.25 * wf.cell_area[j * ni + i] / total;
+            }
+        }
+    }
+    share
 }
 
 /// The equivalent pressure of node k (the largest of its cells' patterns, Pa) and the depth

@@ -422,7 +422,9 @@ impl WearState {
     /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
     /// many, their share of the active flank, the largest damage, read as first pitting only
     /// where they make up its 2 % of the flank (A_p10, "Which p_eq decides"); fewer are local
-    /// damage (an edge's), said as such.
+    /// damage (an edge's), said as such. The share is the nodes' own areas
+    /// ([`forecast::node_shares`]), as a forecast's onset counts them: the cells touching a
+    /// damaged node would count a strip of nodes about twice.
     fn damage_warning(&self, wf: &WheelFlank) -> Option<String> {
         let due: Vec<usize> = (0..self.damage.len())
             .filter(|&k| self.damage[k] >= forecast::REACHED)
@@ -430,12 +432,9 @@ impl WearState {
         if due.is_empty() || self.damage.len() != wf.nodes.len() {
             return None;
         }
-        let mut pitted = vec![false; wf.nodes.len()];
-        for &k in &due {
-            pitted[k] = true;
-        }
         let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
-        let share = pitted_fraction(wf, &pitted);
+        let shares = forecast::node_shares(wf);
+        let share: f64 = due.iter().map(|&k| shares[k]).sum();
         let first = crate::pitting::FIRST_PITTING_SHARE;
         let reading = match share >= first {
             true => "first pitting (2 % of the flank or more, A_p10): the model expects pits there",

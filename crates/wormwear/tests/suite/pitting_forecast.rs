@@ -268,3 +268,39 @@ fn a_forecast_without_wear_advances_to_its_life() {
     assert!(r.windows(2).all(|w| w[1].cycles >= w[0].cycles));
     assert!(start.elapsed().as_secs() < 300);
 }
+
+#[test]
+fn the_damage_warning_counts_a_row_of_damaged_nodes_as_the_area_between_its_neighbours() {
+    // A row of nodes at damage 1.5 (height index 3 of the coarse grid, every face node). The
+    // area it stands for is half of each cell row beside it, rows 2 and 3 (a node's dual
+    // area): computed here from the cell areas, the forecast's onset share. Counting every
+    // cell that touches a damaged node would take both rows whole, twice that.
+    let g = coarse();
+    let geo = wormwear::geometry::Geometry::build(&g).unwrap();
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let ni = wf.cells_height;
+    let shares = wear::forecast::node_shares(wf);
+    assert!((shares.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    let mut state = wear::WearState::new(wf);
+    state.damage = vec![0.0; wf.nodes.len()];
+    for j in 0..=wf.cells_face {
+        state.damage[j * (ni + 1) + 3] = 1.5;
+    }
+    let rows: f64 = (0..wf.cells_face)
+        .flat_map(|j| [j * ni + 2, j * ni + 3])
+        .filter(|&c| wf.active[c])
+        .map(|c| wf.cell_area[c])
+        .sum();
+    let expected = 100.0 * 0.5 * rows / wf.active_area();
+    let warning = state
+        .warnings(wf)
+        .into_iter()
+        .find(|w| w.contains("fatigue damage of 1"))
+        .expect("a damage warning");
+    let nodes = format!("{} flank nodes", wf.cells_face + 1);
+    let share = format!("about {expected:.2} % of the active flank");
+    assert!(warning.contains(&nodes), "{warning}");
+    assert!(warning.contains(&share), "{warning} (expected {share})");
+    assert!(warning.contains("largest 1.500"), "{warning}");
+}
