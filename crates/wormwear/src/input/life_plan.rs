@@ -115,6 +115,19 @@ pub enum PittingStress {
     SurfacePressure,
 }
 
+/// How a flank node reads the stress of the fatigue damage from the grid cells around it
+/// (MODEL §8.1; `damage` and `forecast` pitting).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NodeReading {
+    /// The largest of its (up to four) cells, as the published pitting cut reads the pattern
+    /// (default): a peak one cell row wide reaches two rows of nodes at full height.
+    Largest,
+    /// The mean of its cells: the cell-centred field interpolated to the node, the stress at
+    /// the node's own place (the pit depth still the largest cell's).
+    Interpolated,
+}
+
 impl PittingStress {
     /// The sub-surface criterion of the loaded analysis (principal shear for the surface
     /// pressure, whose equivalent pressure is then only reported).
@@ -210,6 +223,8 @@ pub struct WearPlan {
     pub pit_depth: PitDepth,
     /// The stress of the fatigue damage (`damage`, `forecast`).
     pub pitting_stress: PittingStress,
+    /// How a node reads that stress from its cells (`damage`, `forecast`).
+    pub damage_node_reading: NodeReading,
     /// Cycles at which the life stops for a state whose maps are written (steps are cut
     /// there); None: the states 0, 1, 2, 4, 8, ...
     pub map_cycles: Option<Vec<f64>>,
@@ -237,6 +252,7 @@ impl WearPlan {
             film_load: FilmLoad::LoadedAnalysis,
             pit_depth: PitDepth::Hertz,
             pitting_stress: PittingStress::PrincipalShear,
+            damage_node_reading: NodeReading::Largest,
             map_cycles: None,
             stop_at: LifeStop::PointedTip,
             backlash_limit: None,

@@ -178,6 +178,10 @@ pub struct WearSpec {
     /// "principal-shear" (default, MODEL §8.1), "orthogonal-shear" or "surface-pressure".
     #[serde(default)]
     pub pitting_stress: Option<String>,
+    /// How a node of the damage reads the stress from the grid cells around it: "largest"
+    /// (default, as the published pitting cut) or "interpolated" (the mean of its cells).
+    #[serde(default)]
+    pub damage_node_reading: Option<String>,
     /// Wheel cycles at which a state is computed and its maps written (increasing; default
     /// the states 0, 1, 2, 4, 8, ...).
     #[serde(default)]

@@ -3,7 +3,8 @@
 //!
 //! Each node carries the damage law of [`crate::pitting`]: its equivalent pressure from the
 //! stress below the flank (MODEL §8.1, [`crate::subsurface`]; the largest of its cells'
-//! patterns) on the pressure–life curve, its wear per cycle, and a damaged layer as deep as
+//! patterns, or with `[wear] damage_node_reading = "interpolated"` their mean, the field at the
+//! node's place: [`node_value`]) on the pressure–life curve, its wear per cycle, and a damaged layer as deep as
 //! the maximum of that stress. With `[wear] pitting_stress = "surface-pressure"` the node
 //! reads its loaded-pattern pressure instead (as the published pits are cut) and its layer is
 //! as deep as its pit would be (0.78 a, [`super::pit_depths`]).
@@ -25,7 +26,7 @@
 
 use super::{node_cells, node_pattern_pressure, pit_depths, CycleWear};
 use crate::geometry::WheelFlank;
-use crate::input::{Endurance, PitDepth, PittingStress};
+use crate::input::{Endurance, NodeReading, PitDepth, PittingStress};
 use crate::ltca::Ltca;
 use crate::pitting::CellLoad;
 
@@ -47,24 +48,30 @@ pub struct NodeLoads {
 
 impl NodeLoads {
     /// Loads of every node from a state's loaded analysis and wear of one cycle: the stress
-    /// the damage reads (`stress`), the depth of its maximum as the damaged layer (the pits'
-    /// `rule` for the surface pressure, and where the depth is not known).
+    /// the damage reads (`stress`, each node reading its cells as `reading` says), the depth
+    /// of its maximum as the damaged layer (the pits' `rule` for the surface pressure, and
+    /// where the depth is not known).
     pub fn new(
         wf: &WheelFlank,
         l: &Ltca,
         cw: &CycleWear,
         curve: &Endurance,
-        rule: PitDepth,
-        stress: PittingStress,
+        (rule, stress, reading): (PitDepth, PittingStress, NodeReading),
     ) -> Self {
         let mut layer = pit_depths(cw, rule);
-        let pressure: Vec<f64> = match stress {
-            PittingStress::SurfacePressure => (0..wf.nodes.len())
+        let pressure: Vec<f64> = match (stress, reading) {
+            (PittingStress::SurfacePressure, NodeReading::Largest) => (0..wf.nodes.len())
                 .map(|k| node_pattern_pressure(wf, &l.pattern, k))
+                .collect(),
+            (PittingStress::SurfacePressure, NodeReading::Interpolated) => (0..wf.nodes.len())
+                .map(|k| {
+                    let cells = node_cells(wf, k).filter_map(|c| Some((*l.pattern.get(c)?, 0.0)));
+                    node_value(cells, reading).0
+                })
                 .collect(),
             _ => (0..wf.nodes.len())
                 .map(|k| {
-                    let (p, depth) = node_equivalent(wf, l, k);
+                    let (p, depth) = node_equivalent(wf, l, k, reading);
                     if depth > 0.0 {
                         layer.values[k] = depth;
                     }
@@ -218,12 +225,31 @@ pub fn node_shares(wf: &WheelFlank) -> Vec<f64> {
     share
 }
 
-/// The equivalent pressure of node k (the largest of its cells' patterns, Pa) and the depth
-/// of that cell's maximum (m; MODEL §8.1).
-pub fn node_equivalent(wf: &WheelFlank, l: &Ltca, k: usize) -> (f64, f64) {
-    node_cells(wf, k)
-        .filter_map(|c| Some((*l.equivalent_pattern.get(c)?, *l.equivalent_depth.get(c)?)))
-        .fold((0.0, 0.0), |best, v| if v.0 > best.0 { v } else { best })
+/// The equivalent pressure of node k from its cells' patterns as `reading` says (Pa) and the
+/// depth of the largest cell's maximum (m; MODEL §8.1).
+pub fn node_equivalent(wf: &WheelFlank, l: &Ltca, k: usize, reading: NodeReading) -> (f64, f64) {
+    let cells = node_cells(wf, k)
+        .filter_map(|c| Some((*l.equivalent_pattern.get(c)?, *l.equivalent_depth.get(c)?)));
+    node_value(cells, reading)
+}
+
+/// A node's value from its cells' (value, depth) pairs: the largest value, or the cells'
+/// mean (the cell-centred field interpolated to the node), with the depth of the largest
+/// cell either way; (0, 0) without cells.
+pub fn node_value(cells: impl Iterator<Item = (f64, f64)>, reading: NodeReading) -> (f64, f64) {
+    let (mut largest, mut sum, mut count) = ((0.0, 0.0), 0.0, 0usize);
+    for (value, depth) in cells {
+        if value > largest.0 {
+            largest = (value, depth);
+        }
+        sum += value;
+        count += 1;
+    }
+    match reading {
+        NodeReading::Largest => largest,
+        NodeReading::Interpolated if count > 0 => (sum / count as f64, largest.1),
+        NodeReading::Interpolated => (0.0, 0.0),
+    }
 }
 
 /// A phase of a life as it happened: kind ("wear" or "pitting"), start and end cycles, and
@@ -260,4 +286,61 @@ pub fn phase_spans(records: &[super::StepRecord]) -> Vec<PhaseSpan> {
         }
     }
     spans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The four cells around a node at (i, j) of a field f(x, y) given at cell centres
+    /// (i +- 1/2, j +- 1/2), with depth 1 mm times the value's rank.
+    fn around(f: impl Fn(f64, f64) -> f64, i: f64, j: f64) -> Vec<(f64, f64)> {
+        [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)]
+            .iter()
+            .map(|(di, dj)| (f(i + di, j + dj), 1e-3 * (i + di + 2.0 * (j + dj))))
+            .collect()
+    }
+
+    #[test]
+    fn the_interpolated_reading_is_the_field_at_the_node_and_the_largest_half_a_cell_up() {
+        // A field linear over the grid (Pa): the mean of the four cell centres is its value at
+        // the node exactly; the largest reads it half a cell up each way.
+        let f = |x: f64, y: f64| 500e6 + 12e6 * x - 5e6 * y;
+        let (i, j) = (7.0, 3.0);
+        let cells = around(f, i, j);
+        let (mean, depth) = node_value(cells.iter().copied(), NodeReading::Interpolated);
+        assert!(
+            (mean - f(i, j)).abs() < 1e-6 * f(i, j),
+            "{mean} {}",
+            f(i, j)
+        );
+        let (largest, largest_depth) = node_value(cells.iter().copied(), NodeReading::Largest);
+        assert_eq!(largest, f(i + 0.5, j - 0.5));
+        // The depth is the largest cell's under either reading.
+        assert_eq!(depth, largest_depth);
+        assert_eq!(largest_depth, 1e-3 * (i + 0.5 + 2.0 * (j - 0.5)));
+    }
+
+    #[test]
+    fn a_peak_one_cell_row_wide_reaches_two_node_rows_at_half_height_when_interpolated() {
+        // Cells of row 5 at 1 GPa, the rest at 400 MPa: the nodes of rows 5 and 6 each touch
+        // two peak cells and two others. The largest reads the peak on both node rows (twice
+        // the peak's area); the interpolation reads the mean, the field's value on the row's
+        // edges; a uniform field reads the same both ways; a node without cells reads 0.
+        let f = |x: f64, _y: f64| if (x - 5.5).abs() < 0.25 { 1e9 } else { 400e6 };
+        for i in [5.0, 6.0] {
+            let cells = around(f, i, 10.0);
+            assert_eq!(
+                node_value(cells.iter().copied(), NodeReading::Largest).0,
+                1e9
+            );
+            let mean = node_value(cells.iter().copied(), NodeReading::Interpolated).0;
+            assert!((mean - 700e6).abs() < 1e-3, "{mean}");
+        }
+        let uniform = around(|_, _| 612e6, 3.0, 4.0);
+        for reading in [NodeReading::Largest, NodeReading::Interpolated] {
+            assert_eq!(node_value(uniform.iter().copied(), reading).0, 612e6);
+            assert_eq!(node_value(std::iter::empty(), reading), (0.0, 0.0));
+        }
+    }
 }

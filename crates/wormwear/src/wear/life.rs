@@ -354,8 +354,11 @@ impl<'a> LifeLoop<'a> {
             l,
             cw,
             &life.endurance,
-            life.pit_depth,
-            life.pitting_stress,
+            (
+                life.pit_depth,
+                life.pitting_stress,
+                life.damage_node_reading,
+            ),
         )
     }
 

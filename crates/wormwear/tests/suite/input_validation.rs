@@ -247,6 +247,19 @@ fn bad_choices_and_exclusive_fields() {
         &error_of(&text),
         &["worm.grinding_wheel", "profiles K and C need"],
     );
+    let text = set(
+        &design(),
+        "wear",
+        "step_wear_um",
+        "step_wear_um = 4.0\ndamage_node_reading = \"mean\"",
+    );
+    assert_mentions(
+        &error_of(&text),
+        &[
+            "wear.damage_node_reading = \"mean\"",
+            "must be one of largest, interpolated",
+        ],
+    );
 }
 
 #[test]

@@ -21,6 +21,7 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         }
     }
     let (film_load, pit_depth, pitting_stress) = model_choices(ck, w);
+    let damage_node_reading = node_reading(ck, w);
     let map_cycles = map_cycles(ck, w.map_cycles.as_ref());
     let (stop_at, backlash_limit) = life_stop(ck, w);
     Some(WearPlan {
@@ -36,6 +37,7 @@ pub(super) fn wear_plan(ck: &mut Checker, w: &WearSpec) -> Option<WearPlan> {
         film_load: film_load?,
         pit_depth: pit_depth?,
         pitting_stress: pitting_stress?,
+        damage_node_reading: damage_node_reading?,
         map_cycles: map_cycles?,
         stop_at: stop_at?,
         backlash_limit: backlash_limit?,
@@ -152,6 +154,18 @@ fn model_choices(
         ],
     );
     (film_load, pit_depth, pitting_stress)
+}
+
+/// How a node of the fatigue damage reads the stress of the cells around it.
+fn node_reading(ck: &mut Checker, w: &WearSpec) -> Option<NodeReading> {
+    ck.choice(
+        "wear.damage_node_reading",
+        w.damage_node_reading.as_deref().unwrap_or("largest"),
+        &[
+            ("largest", NodeReading::Largest),
+            ("interpolated", NodeReading::Interpolated),
+        ],
+    )
 }
 
 /// Where the life stops: the criterion and the optional backlash limit (m).

@@ -57,6 +57,8 @@ pub struct WearSummary<'a> {
     /// The model's choices and refinements in force (MODEL §12 g, h).
     pub film_load: crate::input::FilmLoad,
     pub pit_depth: crate::input::PitDepth,
+    /// How the fatigue damage's nodes read their cells (MODEL §8.1; `max_damage` follows it).
+    pub damage_node_reading: crate::input::NodeReading,
     /// States recorded (the start, one per step, one per pit cut) and loaded analyses run
     /// (a step split by the stability guard costs one per sub-step; MODEL §7.3 counts those).
     pub states: usize,

@@ -296,6 +296,7 @@ pub fn summary_value(
         bending_model: &view.ltca.bending_model,
         film_load: plan.film_load,
         pit_depth: plan.pit_depth,
+        damage_node_reading: plan.damage_node_reading,
         states: state.records.len(),
         loaded_analyses: state.records.last().map_or(0, |r| r.loaded_analyses),
         max_pressure_definition: MAX_PRESSURE_DEFINITION,
