@@ -815,7 +815,7 @@ fn wear(
 /// The end of a life: warnings, and the result paragraph unless quiet.
 fn finish_life(results: &wormwear::Results, dir: &Path, quiet: bool) {
     let Some(life) = &results.life else { return };
-    warn_about_the_life(results, &life.end);
+    warn_about_the_life(results, life);
     if let (Some(rating), false) = (&results.rating, quiet) {
         print_life(&life.end, rating, dir);
     }
@@ -864,9 +864,10 @@ fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating
 
 /// Warnings on a finished life ([`wormwear::wear::WearState::warnings`], each tagged by
 /// its subject: wear limit, wear, pitting, contact).
-fn warn_about_the_life(results: &wormwear::Results, end: &wormwear::wear::WearState) {
+fn warn_about_the_life(results: &wormwear::Results, life: &wormwear::runner::Life) {
     let Some(tca) = &results.tca else { return };
-    for w in end.warnings(results.geometry.wheel_flank(tca.loaded_flank)) {
+    let wf = results.geometry.wheel_flank(tca.loaded_flank);
+    for w in life.end.warnings(wf, life.plan.pitting_onset_share) {
         eprintln!("warning: {w}");
     }
 }

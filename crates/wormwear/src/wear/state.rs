@@ -357,9 +357,10 @@ pub struct PositionState {
 impl WearState {
     /// What an engineer must see about this life at its last state (summary.json, stderr, the
     /// top of report.html): why it stopped early, loaded analyses off the power balance,
-    /// contact on worn-through teeth, flank nodes whose fatigue damage has reached 1 (MODEL
-    /// §8.1), and pressures at the flow pressure (MODEL §5.7).
-    pub fn warnings(&self, wf: &WheelFlank) -> Vec<String> {
+    /// contact on worn-through teeth, flank nodes whose fatigue damage has reached 1 (read as
+    /// first pitting where they make up the `onset` share of the active flank, the plan's
+    /// `pitting_onset_share`; MODEL §8.1), and pressures at the flow pressure (MODEL §5.7).
+    pub fn warnings(&self, wf: &WheelFlank, onset: f64) -> Vec<String> {
         let mut w = Vec::new();
         if let Some(why) = &self.stopped {
             w.push(format!("wear limit: {why}"));
@@ -401,7 +402,7 @@ impl WearState {
                 100.0 * worst
             ));
         }
-        w.extend(self.damage_warning(wf));
+        w.extend(self.damage_warning(wf, onset));
         if let Some(r) = self
             .records
             .last()
@@ -421,11 +422,12 @@ impl WearState {
 
     /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
     /// many, their share of the active flank, the largest damage, read as first pitting only
-    /// where they make up its 2 % of the flank (A_p10, "Which p_eq decides"); fewer are local
-    /// damage (an edge's), said as such. The share is the nodes' own areas
-    /// ([`forecast::node_shares`]), as a forecast's onset counts them: the cells touching a
-    /// damaged node would count a strip of nodes about twice.
-    fn damage_warning(&self, wf: &WheelFlank) -> Option<String> {
+    /// where they make up the `onset` share of the flank (2 %, A_p10, "Which p_eq decides";
+    /// a forecast's `pitting_onset_percent`); fewer are local damage (an edge's), said as
+    /// such. The share is the nodes' own areas ([`forecast::node_shares`]), as a forecast's
+    /// onset counts them: the cells touching a damaged node would count a strip of nodes
+    /// about twice.
+    fn damage_warning(&self, wf: &WheelFlank, onset: f64) -> Option<String> {
         let due: Vec<usize> = (0..self.damage.len())
             .filter(|&k| self.damage[k] >= forecast::REACHED)
             .collect();
@@ -435,13 +437,19 @@ impl WearState {
         let largest = due.iter().map(|&k| self.damage[k]).fold(0.0, f64::max);
         let shares = forecast::node_shares(wf);
         let share: f64 = due.iter().map(|&k| shares[k]).sum();
-        let first = crate::pitting::FIRST_PITTING_SHARE;
-        let reading = match share >= first {
-            true => "first pitting (2 % of the flank or more, A_p10): the model expects pits there",
-            false => {
-                "less than the 2 % of the flank that is first pitting (A_p10): local damage, \
-                 such as at an edge, not yet first pitting"
-            }
+        let first = match (onset - crate::pitting::FIRST_PITTING_SHARE).abs() < 1e-12 {
+            true => "2 % of the flank, A_p10".to_string(),
+            false => format!(
+                "{:.2} % of the flank, wear.pitting_onset_percent",
+                100.0 * onset
+            ),
+        };
+        let reading = match share >= onset {
+            true => format!("first pitting ({first}, or more): the model expects pits there"),
+            false => format!(
+                "less than first pitting ({first}): local damage, such as at an edge, not yet \
+                 first pitting"
+            ),
         };
         Some(format!(
             "pitting: {} flank nodes (about {:.2} % of the active flank) have reached a fatigue \

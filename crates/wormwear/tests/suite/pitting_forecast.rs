@@ -293,16 +293,29 @@ fn the_damage_warning_counts_a_row_of_damaged_nodes_as_the_area_between_its_neig
         .map(|c| wf.cell_area[c])
         .sum();
     let expected = 100.0 * 0.5 * rows / wf.active_area();
-    let warning = state
-        .warnings(wf)
-        .into_iter()
-        .find(|w| w.contains("fatigue damage of 1"))
-        .expect("a damage warning");
+    let warning = |onset: f64| {
+        state
+            .warnings(wf, onset)
+            .into_iter()
+            .find(|w| w.contains("fatigue damage of 1"))
+            .expect("a damage warning")
+    };
+    let at_two = warning(0.02);
     let nodes = format!("{} flank nodes", wf.cells_face + 1);
     let share = format!("about {expected:.2} % of the active flank");
-    assert!(warning.contains(&nodes), "{warning}");
-    assert!(warning.contains(&share), "{warning} (expected {share})");
-    assert!(warning.contains("largest 1.500"), "{warning}");
+    assert!(at_two.contains(&nodes), "{at_two}");
+    assert!(at_two.contains(&share), "{at_two} (expected {share})");
+    assert!(at_two.contains("largest 1.500"), "{at_two}");
+    // The row (about 2.5 % of the flank) is first pitting at the default 2 %, and below a
+    // forecast's onset share of 5 %: the warning reads the life's own onset.
+    assert!(expected > 2.0 && expected < 5.0, "{expected}");
+    assert!(at_two.contains("first pitting (2 % of the flank, A_p10, or more)"));
+    let at_five = warning(0.05);
+    assert!(
+        at_five
+            .contains("less than first pitting (5.00 % of the flank, wear.pitting_onset_percent)"),
+        "{at_five}"
+    );
 }
 
 #[test]

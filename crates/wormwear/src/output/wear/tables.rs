@@ -305,7 +305,7 @@ pub fn summary_value(
         pitting: plan.pitting,
         phases: crate::wear::forecast::phase_spans(&state.records),
         found_phases: &state.found_phases,
-        warnings: state.warnings(geo.wheel_flank(tca.loaded_flank)),
+        warnings: state.warnings(geo.wheel_flank(tca.loaded_flank), plan.pitting_onset_share),
         steps: state
             .records
             .iter()
