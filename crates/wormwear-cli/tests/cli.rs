@@ -1410,6 +1410,7 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
         "## (d) Our refinements against the default",
         "## (e) Friction, efficiency and oil temperature from the contact",
         "**Against ISO/TR 14521's rig-fitted mu_0T over sliding speeds**",
+        "**The film's limiting shear Lambda**",
     ] {
         assert!(text.contains(heading), "{heading} missing");
     }

@@ -171,10 +171,19 @@ pub fn run(
     progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
     let speeds = friction::over_speeds(settings)?;
     friction::charts(&speeds, &dir.join(FIGURES))?;
-    let markdown = report::markdown(settings, &results, &analytic, &speeds);
+    progress(
+        "the film's limiting shear over its window (MODEL §13, 105 unworn loaded analyses) ...",
+    );
+    let window = friction::limiting_shear_window(settings)?;
+    let markdown = report::markdown(settings, &results, &analytic, (&speeds, &window));
     let path = dir.join("VALIDATION.md");
     crate::output::write_atomic(&path, markdown.as_bytes())?;
-    let json = serde_json::json!({ "analytic": analytic, "jobs": results, "friction_over_speeds": speeds });
+    let json = serde_json::json!({
+        "analytic": analytic,
+        "jobs": results,
+        "friction_over_speeds": speeds,
+        "limiting_shear_window": window,
+    });
     crate::output::write_atomic(
         &dir.join("validation.json"),
         serde_json::to_string_pretty(&json)
@@ -212,6 +221,44 @@ fn cached(dir: &Path, job: &Job) -> Option<JobResult> {
     (r.key == key(job)).then_some(r)
 }
 
+/// A gear's unworn analysis: its geometry, TCA, bending model (from the cache when built
+/// before), loaded-analysis settings and loaded analysis.
+pub(super) struct Unworn {
+    pub geo: Geometry,
+    pub tca: crate::kinematics::Tca,
+    pub bending: Option<crate::bending::worm_model::FeBending>,
+    pub settings: crate::ltca::LtcaSettings,
+    pub ltca: crate::ltca::Ltca,
+}
+
+impl Unworn {
+    /// Runs the stages up to the unworn loaded analysis of `g`; a failure is reported as the
+    /// job `id`'s.
+    pub fn analyse(g: &GearSet, id: &str) -> Result<Self, ValidationError> {
+        let fail = |message: String| ValidationError::Job {
+            id: id.to_string(),
+            message,
+        };
+        let geo = Geometry::build(g).map_err(|e| fail(e.to_string()))?;
+        let tca = crate::kinematics::analyse(g, &geo).map_err(|e| fail(e.to_string()))?;
+        let (built, _) = crate::bending::model::build(g, &geo).map_err(|e| fail(e.to_string()))?;
+        let bending = built.map(|b| b.model);
+        let settings = crate::ltca::LtcaSettings::from_gear(g);
+        let bending_ref = bending
+            .as_ref()
+            .map(|b| b as &dyn crate::ltca::BendingModel);
+        let ltca = crate::ltca::analyse_with(g, &geo, &tca, &settings, bending_ref)
+            .map_err(|e| fail(crate::runner::error_chain(&e)))?;
+        Ok(Self {
+            geo,
+            tca,
+            bending,
+            settings,
+            ltca,
+        })
+    }
+}
+
 /// Runs one job: geometry, TCA, bending (from the cache when built before), the unworn loaded
 /// analysis, and the life when there is a plan.
 pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
@@ -221,16 +268,16 @@ pub fn run_job(job: &Job) -> Result<JobResult, ValidationError> {
     };
     let start = std::time::Instant::now();
     let g = &job.gear;
-    let geo = Geometry::build(g).map_err(|e| fail(e.to_string()))?;
-    let tca = crate::kinematics::analyse(g, &geo).map_err(|e| fail(e.to_string()))?;
-    let (built, _) = crate::bending::model::build(g, &geo).map_err(|e| fail(e.to_string()))?;
-    let bending = built.map(|b| b.model);
+    let Unworn {
+        geo,
+        tca,
+        bending,
+        settings,
+        ltca: l,
+    } = Unworn::analyse(g, &job.id)?;
     let bending_ref = bending
         .as_ref()
         .map(|b| b as &dyn crate::ltca::BendingModel);
-    let settings = crate::ltca::LtcaSettings::from_gear(g);
-    let l = crate::ltca::analyse_with(g, &geo, &tca, &settings, bending_ref)
-        .map_err(|e| fail(crate::runner::error_chain(&e)))?;
     let unworn = unworn_pattern(&geo, &tca, &l);
     let mut records = Vec::new();
     if let Some(plan) = &job.plan {

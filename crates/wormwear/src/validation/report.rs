@@ -16,7 +16,10 @@ pub fn markdown(
     settings: &Settings,
     results: &Results,
     analytic: &[Check],
-    speeds: &[super::friction::SpeedPoint],
+    friction: (
+        &[super::friction::SpeedPoint],
+        &[super::friction::LimitingShearRow],
+    ),
 ) -> String {
     let mut m = String::new();
     header(&mut m, settings, results);
@@ -24,7 +27,7 @@ pub fn markdown(
     section_a(&mut m, analytic);
     section_b(&mut m, results);
     section_c_d(&mut m, results);
-    super::friction::section_e(&mut m, settings, results, speeds);
+    super::friction::section_e(&mut m, settings, results, friction);
     failures(&mut m, results);
     run_times(&mut m, results);
     m

@@ -228,6 +228,14 @@ fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
     assert!((finest / fine - 1.0).abs() < 0.02, "{fine} W -> {finest} W");
 }
 
+/// The validation study's settings over the repository's examples (the whole study).
+fn study_settings() -> wormwear::validation::Settings {
+    wormwear::validation::Settings {
+        examples: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples"),
+        quick: false,
+    }
+}
+
 /// The contact's mean friction and mesh efficiency beside ISO/TR 14521's rig-fitted mu_0T
 /// (MODEL §9, §13 validation (1)) on the 1/40 and the K 2/25 gears, worm speeds giving sliding
 /// speeds from 0.3 to 8 m/s, one set of inputs (the examples' cited defaults; the standard's
@@ -239,10 +247,7 @@ fn the_mesh_loss_converges_as_the_local_contact_mesh_is_refined() {
 #[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
     use wormwear::validation::{self, friction};
-    let settings = validation::Settings {
-        examples: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples"),
-        quick: false,
-    };
+    let settings = study_settings();
     let points = friction::over_speeds(&settings).unwrap();
     print!("{}", friction::table(&points));
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(validation::FIGURES);
@@ -254,11 +259,16 @@ fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
             assert!(pair[1].friction < pair[0].friction, "{pair:?}");
             assert!(pair[1].asperity_share < pair[0].asperity_share, "{pair:?}");
         }
-        for p in gear.iter().filter(|p| p.gear == "gear-k-2x25") {
-            // The K gear's file gives no factors Y: the rating's efficiency is mu_0T's own
-            // (two computations of ISO's efficiency, the rating's and the study's closed form).
+        // The rating's efficiency with the gear's factors Y is the closed form at mu_0T times
+        // their product (two computations of ISO's efficiency, the rating's and the study's).
+        let file = format!("{}.toml", gear[0].gear);
+        let g = validation::example(&settings, &file).unwrap();
+        let gamma = g.worm.lead_angle();
+        for p in gear {
+            let mu = p.iso_friction * g.rating.friction_factor;
+            let closed = gamma.tan() / (gamma + mu.atan()).tan();
             assert!(
-                (p.iso_efficiency_with_factors - p.iso_efficiency).abs() < 1e-9,
+                (p.iso_efficiency_with_factors - closed).abs() < 1e-9,
                 "{p:?}"
             );
         }
@@ -269,6 +279,49 @@ fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
                 "{p:?}"
             );
         }
+    }
+}
+
+/// The speed study over the film's limiting shear Lambda (MODEL §13; VALIDATION.md (e)):
+/// prints the window table; asserts what Lambda must do whatever the reference: on every gear
+/// at every speed (and case C) the friction rises and the efficiency falls with Lambda, and at
+/// the highest speed, where the film shears at its limit on nearly all the loaded flank, the
+/// mean friction moves by the film's share of the load times the change of Lambda. Run:
+/// cargo test --release -p wormwear --test suite friction:: -- --ignored
+#[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
+fn the_film_limiting_shear_sets_the_friction_at_speed() {
+    use wormwear::validation::friction;
+    let rows = friction::limiting_shear_window(&study_settings()).unwrap();
+    print!("{}", friction::limiting_shear_table(&rows));
+    for pair in rows.windows(2) {
+        let (low, high) = (&pair[0], &pair[1]);
+        assert!(high.limiting_shear > low.limiting_shear);
+        assert!(high.case_c_efficiency < low.case_c_efficiency, "{pair:?}");
+        for (a, b) in low.points.iter().zip(&high.points) {
+            assert!(
+                b.friction > a.friction && b.mesh_efficiency < a.mesh_efficiency,
+                "{a:?} -> {b:?}"
+            );
+        }
+    }
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+    let step = last.limiting_shear - first.limiting_shear;
+    let per_gear = friction::SPEED_STUDY[0].1.len();
+    for (a, b) in first
+        .points
+        .iter()
+        .zip(&last.points)
+        .skip(per_gear - 1)
+        .step_by(per_gear)
+    {
+        let film = 1.0 - 0.5 * (a.asperity_share + b.asperity_share);
+        let ratio = (b.friction - a.friction) / (film * step);
+        eprintln!(
+            "{} at {} rpm: friction change / film share x Lambda change {ratio:.3}",
+            a.gear, a.worm_speed_rpm
+        );
+        assert!((ratio - 1.0).abs() < 0.05, "{a:?} -> {b:?}");
     }
 }
 
