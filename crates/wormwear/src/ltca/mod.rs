@@ -87,6 +87,10 @@ pub struct LtcaSettings {
     pub oil_temperature: f64,
     /// The sub-surface stress criterion of the equivalent pressure (MODEL §8.1).
     pub subsurface: SubsurfaceSettings,
+    /// How far above the worm tip's trace its rounded tip edge reaches on the wheel flank,
+    /// R (1 - sin alpha_x) with R `worm.tip_edge_radius` (MODEL §2.3), m; 0 for a sharp
+    /// edge. The warnings count a flow pressure up to there as the worm tip's.
+    pub tip_edge_height: f64,
 }
 
 impl LtcaSettings {
@@ -134,6 +138,8 @@ impl LtcaSettings {
                     .map_or(Criterion::PrincipalShear, |w| w.pitting_stress.criterion()),
                 ..SubsurfaceSettings::new(gear.wheel_material.poisson_ratio)
             },
+            tip_edge_height: gear.worm.tip_edge_radius
+                * (1.0 - gear.worm.axial_pressure_angle.sin()),
         }
     }
 }
@@ -726,9 +732,10 @@ fn pattern_warnings(
     positions: &[PositionResult],
     (wf, tca, teeth): (&WheelFlank, &Tca, u32),
     pattern: &[f64],
-    (yielded_area_fraction, flow_pressure): (f64, f64),
+    (yielded_area_fraction, flow_pressure, tip_edge_height): (f64, f64, f64),
 ) -> Vec<String> {
-    let places = pattern::YieldedPlaces::of(wf, pattern, flow_pressure, &tca.tip_trace);
+    let trace = (tca.tip_trace.as_slice(), tip_edge_height);
+    let places = pattern::YieldedPlaces::of(wf, pattern, flow_pressure, trace);
     let mut warnings: Vec<String> =
         flow_pressure_warning(yielded_area_fraction, flow_pressure, &places)
             .into_iter()
@@ -737,7 +744,7 @@ fn pattern_warnings(
         positions,
         (yielded_area_fraction, flow_pressure),
         wf,
-        &tca.tip_trace,
+        trace,
     ));
     warnings.extend(deflection_warning(positions, tca, teeth));
     warnings.extend(band_edge_warning(positions));
@@ -786,7 +793,11 @@ fn over_the_cycle(
         max_patch_pressure(&positions, across, along, settings.aligned_columns());
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
-    let yielded = (stats.yielded_area_fraction, settings.flow_pressure);
+    let yielded = (
+        stats.yielded_area_fraction,
+        settings.flow_pressure,
+        settings.tip_edge_height,
+    );
     warnings.extend(pattern_warnings(
         &positions,
         (wf, tca, teeth),

@@ -61,7 +61,7 @@ pub(super) fn local_flow_pressure_warning(
     positions: &[PositionResult],
     (yielded_area_fraction, flow_pressure): (f64, f64),
     wf: &WheelFlank,
-    tip_trace: &[(f64, f64)],
+    (tip_trace, tip_edge_height): (&[(f64, f64)], f64),
 ) -> Option<String> {
     if yielded_area_fraction > 0.0 {
         return None;
@@ -84,7 +84,9 @@ pub(super) fn local_flow_pressure_warning(
             let f = (c.z - wf.z[0]) / (wf.z[nj] - wf.z[0]) * nj as f64;
             let j = (f.max(0.0) as usize).min(nj - 1);
             let cell_height = (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64;
-            let trace = tip_trace.get(j).map_or(f64::NEG_INFINITY, |t| t.1);
+            let trace = tip_trace
+                .get(j)
+                .map_or(f64::NEG_INFINITY, |t| t.1 + tip_edge_height);
             let top = c.r > wf.r_high[j] - cell_height;
             place.add(
                 YieldedPlaces::which(j, nj, (c.r, trace, cell_height), top),
@@ -128,8 +130,9 @@ impl HasPlace for LocalCell {
 
 /// Where the cells at the flow pressure lie (MODEL §2.3, §5.7): their shares of the active
 /// flank at the worm tip's trace (the two rows of cells above the lowest radius the worm's
-/// flank reaches in their column), at the face ends (the first and last columns), at the blank
-/// top (the top row) and elsewhere, and the span of their radii and face positions, m.
+/// flank reaches in their column, above the rounded tip edge's strip where the worm has one),
+/// at the face ends (the first and last columns), at the blank top (the top row) and
+/// elsewhere, and the span of their radii and face positions, m.
 pub(super) struct YieldedPlaces {
     shares: [f64; 4],
     r: (f64, f64),
@@ -138,12 +141,13 @@ pub(super) struct YieldedPlaces {
 
 impl YieldedPlaces {
     /// The places of the cells of `pattern` at `flow_pressure` on `wf`, with the worm tip's
-    /// trace `tip_trace` (per node column: z, radius; `Tca::tip_trace`).
+    /// trace `tip_trace` (per node column: z, radius; `Tca::tip_trace`) and the height its
+    /// rounded edge reaches above it (m; `LtcaSettings::tip_edge_height`).
     pub(super) fn of(
         wf: &WheelFlank,
         pattern: &[f64],
         flow_pressure: f64,
-        tip_trace: &[(f64, f64)],
+        (tip_trace, tip_edge_height): (&[(f64, f64)], f64),
     ) -> Self {
         let (ni, nj) = (wf.cells_height, wf.cells_face);
         let bound = flow_pressure * (1.0 - 1e-9);
@@ -152,7 +156,9 @@ impl YieldedPlaces {
         for k in (0..pattern.len()).filter(|&k| pattern[k] >= bound) {
             let (j, i) = (k / ni, k % ni);
             let cell = &wf.cells[k];
-            let trace = tip_trace.get(j).map_or(f64::NEG_INFINITY, |t| t.1);
+            let trace = tip_trace
+                .get(j)
+                .map_or(f64::NEG_INFINITY, |t| t.1 + tip_edge_height);
             let cell_height = (wf.node(ni, j).r - wf.node(0, j).r) / ni as f64;
             let which = Self::which(j, nj, (cell.r, trace, cell_height), i + 1 == ni);
             place.add(which, cell, wf.cell_area[k] / active);

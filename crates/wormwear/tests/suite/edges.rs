@@ -240,3 +240,53 @@ fn every_p_max_at_the_flow_pressure_is_warned_with_its_place() {
         }
     }
 }
+
+/// The flow-pressure warnings count the worm's rounded tip edge as the worm tip's (MODEL §2.3):
+/// the strip of the wheel flank it touches reaches R (1 - sin alpha_x) above the trace of the
+/// tip's lowest radius. On the design gear with a 1 mm edge at 90 N m (no bending), the cells
+/// at the flow pressure counted "elsewhere" with the sharp edge's band (the trace's two rows)
+/// move to the tip's trace with the edge's height, none appears or vanishes, and the edge's
+/// strip holds some of them.
+#[test]
+fn the_flow_pressure_at_the_rounded_tip_edge_is_counted_as_the_worm_tips() {
+    let mut g = design(1.0, 0.0);
+    g.conditions.torque = input::Torque::Worm(90.0);
+    let geo = Geometry::build(&g).unwrap();
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let settings = wormwear::ltca::LtcaSettings::from_gear(&g);
+    let alpha = g.worm.axial_pressure_angle;
+    assert!((settings.tip_edge_height - 1e-3 * (1.0 - alpha.sin())).abs() < 1e-15);
+    // The cells the warning counts at each place: (tip trace, elsewhere, all).
+    let counts = |height: f64| {
+        let s = wormwear::ltca::LtcaSettings {
+            tip_edge_height: height,
+            ..settings
+        };
+        let l = wormwear::ltca::analyse_with(&g, &geo, &tca, &s, None).unwrap();
+        let w = l
+            .warnings
+            .into_iter()
+            .find(|w| w.contains("P_max is the flow pressure"))
+            .expect("the rounded edge's local cells reach the flow pressure");
+        let cells = |place: &str| -> usize {
+            w.split(&format!("{place} ("))
+                .nth(1)
+                .and_then(|rest| rest.split(' ').next())
+                .map_or(0, |n| n.parse().unwrap())
+        };
+        let all: usize = w
+            .split(" on ")
+            .nth(1)
+            .and_then(|rest| rest.split(' ').next())
+            .unwrap()
+            .parse()
+            .unwrap();
+        eprintln!("edge height {:.3} mm: {w}", height * 1e3);
+        (cells("the worm tip's trace"), cells("elsewhere"), all)
+    };
+    let (trace_sharp, elsewhere_sharp, all_sharp) = counts(0.0);
+    let (trace, elsewhere, all) = counts(settings.tip_edge_height);
+    assert_eq!(all, all_sharp);
+    assert!(trace > trace_sharp, "{trace} <= {trace_sharp}");
+    assert_eq!(trace - trace_sharp, elsewhere_sharp - elsewhere);
+}
