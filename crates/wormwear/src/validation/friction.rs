@@ -149,14 +149,15 @@ pub struct LimitingShearRow {
 }
 
 /// The window study: for each Lambda of [`LIMITING_SHEAR_STUDY`] (with `settings.quick` the
-/// smallest and the default), the speed study on both gears and case C unworn, the other
+/// smallest only), the speed study on both gears and case C unworn, the other
 /// inputs the examples'. Lambda is the input that sets the film's friction where the film
 /// shears at its limit (most of the loaded flank at these pressures).
 pub fn limiting_shear_window(
     settings: &Settings,
 ) -> Result<Vec<LimitingShearRow>, ValidationError> {
     let lambdas = if settings.quick {
-        vec![LIMITING_SHEAR_STUDY[0], LIMITING_SHEAR_STUDY[6]]
+        // The smoke run: the machinery on one value (the test command runs it twice).
+        vec![LIMITING_SHEAR_STUDY[0]]
     } else {
         LIMITING_SHEAR_STUDY.to_vec()
     };

@@ -171,9 +171,11 @@ pub fn run(
     progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
     let speeds = friction::over_speeds(settings)?;
     friction::charts(&speeds, &dir.join(FIGURES))?;
-    progress(
-        "the film's limiting shear over its window (MODEL §13, 105 unworn loaded analyses) ...",
-    );
+    progress(&format!(
+        "the film's limiting shear over its window (MODEL §13: the speed study and case C at \
+         {} values) ...",
+        friction::LIMITING_SHEAR_STUDY.len()
+    ));
     let window = friction::limiting_shear_window(settings)?;
     let markdown = report::markdown(settings, &results, &analytic, (&speeds, &window));
     let path = dir.join("VALIDATION.md");
