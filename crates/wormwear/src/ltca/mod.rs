@@ -725,16 +725,18 @@ fn position_friction<'a>(
     })
 }
 
-/// The warnings on a cycle's loaded pattern `pattern` (Pa per cell) and its positions: the
-/// flow pressure reached (`yielded`: the yielded share of the flank and the flow pressure,
-/// Pa; MODEL §5.7), the deflections, the band's edge.
+/// The warnings on a cycle's loaded pattern `pattern` (Pa per cell, its yielded share of the
+/// flank `yielded_area_fraction`) and its positions: the flow pressure reached (MODEL §5.7;
+/// the flow pressure and the tip edge's height from `settings`), the deflections, the band's
+/// edge.
 fn pattern_warnings(
     positions: &[PositionResult],
     (wf, tca, teeth): (&WheelFlank, &Tca, u32),
-    pattern: &[f64],
-    (yielded_area_fraction, flow_pressure, tip_edge_height): (f64, f64, f64),
+    (pattern, yielded_area_fraction): (&[f64], f64),
+    settings: &LtcaSettings,
 ) -> Vec<String> {
-    let trace = (tca.tip_trace.as_slice(), tip_edge_height);
+    let flow_pressure = settings.flow_pressure;
+    let trace = (tca.tip_trace.as_slice(), settings.tip_edge_height);
     let places = pattern::YieldedPlaces::of(wf, pattern, flow_pressure, trace);
     let mut warnings: Vec<String> =
         flow_pressure_warning(yielded_area_fraction, flow_pressure, &places)
@@ -793,16 +795,11 @@ fn over_the_cycle(
         max_patch_pressure(&positions, across, along, settings.aligned_columns());
     let (worm_torque, wheel_torque, power_balance, mut warnings) =
         torque_balance(&positions, ratio, wf, &pattern);
-    let yielded = (
-        stats.yielded_area_fraction,
-        settings.flow_pressure,
-        settings.tip_edge_height,
-    );
     warnings.extend(pattern_warnings(
         &positions,
         (wf, tca, teeth),
-        &pattern,
-        yielded,
+        (&pattern, stats.yielded_area_fraction),
+        settings,
     ));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
