@@ -315,6 +315,29 @@ fn pitting_life_cycles(
     (n_lii, n_l_i_ii, n_li_stahl)
 }
 
+/// The worm's lead angle gamma_m at its reference diameter (rad) and the sliding speed there,
+/// v_gm = pi d_m1 n1 / cos(gamma_m) (m/s; MODEL §9).
+fn lead_and_sliding_speed(gear: &GearSet) -> (f64, f64) {
+    let w = &gear.worm;
+    let d_m1 = 2.0 * w.reference_radius;
+    let gamma = (w.lead() / (PI * d_m1)).atan();
+    (gamma, d_m1 * 0.5 * gear.conditions.worm_speed / gamma.cos())
+}
+
+/// Mesh efficiency of a screw of lead angle `gamma` (rad) with the friction `mu` (worm
+/// driving, MODEL §9): eta_z = tan(gamma) / tan(gamma + atan(mu)).
+fn screw_efficiency(gamma: f64, mu: f64) -> f64 {
+    gamma.tan() / (gamma + mu.atan()).tan()
+}
+
+/// ISO/TR 14521's mesh efficiency with the base friction mu_0T alone, none of the rating's
+/// factors Y (MODEL §9): the loaded analysis' first estimate of the wheel torque (MODEL §5.2),
+/// which the rating's inputs must not move.
+pub fn base_mesh_efficiency(gear: &GearSet) -> f64 {
+    let (gamma, v_g) = lead_and_sliding_speed(gear);
+    screw_efficiency(gamma, base_friction(v_g))
+}
+
 /// Ratings for the gear's operating case with the file's factors. The wheel torque follows
 /// from the worm torque by the efficiency (fixed point: the losses depend on the output) or is
 /// given.
@@ -330,11 +353,10 @@ pub fn rate(gear: &GearSet) -> Rating {
     let a = gear.operating.centre_distance * 1e3; // mm
     let x2 = (a - 0.5 * (d_m1 + d_m2)) / m_x;
     let q1 = d_m1 / m_x;
-    let gamma = (w.lead() / (PI * d_m1 * 1e-3)).atan();
+    let (gamma, v_g) = lead_and_sliding_speed(gear);
     let n1 = gear.conditions.worm_speed * 60.0 / (2.0 * PI); // rpm
-    let v_g = d_m1 * n1 * PI / (60_000.0 * gamma.cos());
     let mu = base_friction(v_g) * factors.friction_factor;
-    let eta_z = gamma.tan() / (gamma + mu.atan()).tan();
+    let eta_z = screw_efficiency(gamma, mu);
     let losses = |t2: f64| {
         let p2 = t2 * (n1 / u) * 2.0 * PI / 60.0;
         let mesh = 0.1 * t2 * n1 / u * (1.0 / eta_z - 1.0);

@@ -387,14 +387,38 @@ pub fn root_stress(
     Ok(loaded.root_stresses(gear.worm.axial_pitch / std::f64::consts::PI)?)
 }
 
-/// Version of the root stress's cache entries: raise it when the sector, its loads or its
-/// reading change.
-const CACHE_VERSION: u32 = 3;
+/// Version of the root stress's cache entries: raise it when the sector or its reading
+/// change (the loads are in the key, [`loads_fingerprint`]).
+const CACHE_VERSION: u32 = 4;
+
+/// SHA-256 of the loads the sector takes from `ltca` (every loaded cell of every position:
+/// tooth, place r and z, area, pressure; the bits of each number): the loaded analysis'
+/// results, which the gear file alone does not fix (a change of the model's code or defaults
+/// moves them under the same gear).
+fn loads_fingerprint(ltca: &Ltca) -> String {
+    let mut digest = crate::integrity::RunningDigest::default();
+    for p in &ltca.positions {
+        digest.update(&format!("position {};", p.position));
+        for (c, &pressure) in p.cells.iter().zip(&p.pressure) {
+            if pressure > 0.0 {
+                digest.update(&format!(
+                    "{} {:x} {:x} {:x} {:x};",
+                    c.tooth,
+                    c.r.to_bits(),
+                    c.z.to_bits(),
+                    c.cell.area().to_bits(),
+                    pressure.to_bits()
+                ));
+            }
+        }
+    }
+    digest.hex()
+}
 
 /// [`root_stress`] from the cache directory `dir` when an entry of the same key is there (the
-/// whole gear, K_A and the safety inputs with it, the flank, level and fillet radius), else
-/// computed and cached; checksummed like the bending models. Cache problems never fail the
-/// run: they come back as warnings.
+/// whole gear, K_A and the safety inputs with it, the fingerprint of the loaded analysis'
+/// loads, the flank, level and fillet radius), else computed and cached; checksummed like the
+/// bending models. Cache problems never fail the run: they come back as warnings.
 pub fn root_stress_cached(
     gear: &GearSet,
     geo: &Geometry,
@@ -405,6 +429,7 @@ pub fn root_stress_cached(
     let key = serde_json::json!({
         "version": CACHE_VERSION,
         "gear": gear,
+        "loads": loads_fingerprint(ltca),
         "flank": format!("{flank:?}"),
         "level": level,
         "fillet_radius": fillet_radius,

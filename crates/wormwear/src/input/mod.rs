@@ -271,6 +271,11 @@ impl Lubricant {
     }
 }
 
+/// The default limiting shear stress over pressure Lambda of the film (MODEL §13): within
+/// the 0.009-0.027 a DGMK report measured for polyglycols, set on the level of ISO/TR 14521's
+/// rig-fitted friction with the gears' factors Y (VALIDATION.md (e)).
+pub const DEFAULT_LIMITING_SHEAR: f64 = 0.014;
+
 /// Friction of the mixed lubrication (MODEL §13), SI.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FrictionLaw {

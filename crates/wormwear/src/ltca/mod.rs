@@ -689,14 +689,15 @@ pub fn analyse_changed(
 
 /// The worm torque to balance (None: the wheel torque is given) and the wheel torque's
 /// estimate that sizes the band and starts the solve, N m: the given wheel torque, or u T1,
-/// times ISO/TR 14521's mesh efficiency when the pressures carry the transmitted torque
+/// times ISO/TR 14521's mesh efficiency at its base friction mu_0T (none of the rating's
+/// factors Y, which must not move the contact) when the pressures carry the transmitted torque
 /// (MODEL §5.2).
 fn torque_targets(gear: &GearSet, settings: &LtcaSettings) -> (Option<f64>, f64) {
     let transmitted = settings.torque_balance == crate::input::TorqueBalance::Transmitted;
     match gear.conditions.torque {
         Torque::Worm(t) if transmitted => (
             Some(t),
-            t * gear.ratio() * crate::rating::rate(gear).mesh_efficiency,
+            t * gear.ratio() * crate::rating::base_mesh_efficiency(gear),
         ),
         Torque::Worm(t) => (Some(t), t * gear.ratio()),
         Torque::Wheel(t) => (None, t),

@@ -126,7 +126,7 @@ fn unworn_friction(g: &crate::input::GearSet, id: &str) -> Result<UnwornFriction
 }
 
 /// The film's limiting shear coefficients Lambda of the window study (MODEL §13; the
-/// examples' default 0.02 among them).
+/// default [`crate::input::DEFAULT_LIMITING_SHEAR`] and the former default 0.02 among them).
 pub const LIMITING_SHEAR_STUDY: [f64; 9] =
     [0.012, 0.013, 0.014, 0.015, 0.016, 0.018, 0.02, 0.022, 0.025];
 
@@ -343,14 +343,17 @@ pub(super) fn section_e(
     m.push_str(&table(speeds));
     let _ = writeln!(
         m,
-        "\n**The film's limiting shear Lambda** (MODEL §13; the examples' default 0.02): where \
+        "\n**The film's limiting shear Lambda** (MODEL §13; the default {}, 0.02 before session 55: \
+         within the 0.009-0.027 measured for polyglycols, README, and set on ISO's level with the \
+         gears' factors Y by this study, one value for every gear and speed): where \
          the film shears at its limit Lambda p, as it does on most of the loaded flank at these \
          pressures, Lambda sets the film's friction, so it is the input that decides the level \
          of the friction at speed; the asperities decide its rise at low speed. The same study \
          at each Lambda, the other inputs the examples': on each gear the largest departure of \
          the contact's mesh efficiency from ISO's over the seven speeds (points, signed), with \
          the gear's factors Y and with Y = 1, and case C unworn (FE bending) beside ISO's with \
-         its example's factors (issue 53 asks for 3 points in each column).\n"
+         its example's factors (issue 53 asks for 3 points in each column).\n",
+        crate::input::DEFAULT_LIMITING_SHEAR
     );
     m.push_str(&limiting_shear_table(window));
     let _ = writeln!(

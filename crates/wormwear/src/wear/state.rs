@@ -475,24 +475,15 @@ pub fn pit_depths(cw: &CycleWear, rule: PitDepth) -> FlankField {
     }
 }
 
-/// Share of the active flank area around pitted nodes (cells with a pitted corner).
+/// Share of the active flank the pitted nodes stand for: each node a quarter of each grid cell
+/// around it, the area the forecast's onset counts ([`forecast::node_shares`]; MODEL §8.1).
 pub(super) fn pitted_fraction(wf: &WheelFlank, pitted: &[bool]) -> f64 {
-    let ni = wf.cells_height;
-    let mut area = 0.0;
-    for j in 0..wf.cells_face {
-        for i in 0..ni {
-            let corners = [
-                j * (ni + 1) + i,
-                j * (ni + 1) + i + 1,
-                (j + 1) * (ni + 1) + i,
-                (j + 1) * (ni + 1) + i + 1,
-            ];
-            if corners.iter().any(|&k| pitted[k]) {
-                area += wf.cell_area[j * ni + i];
-            }
-        }
-    }
-    area / wf.active_area()
+    forecast::node_shares(wf)
+        .iter()
+        .zip(pitted)
+        .filter(|(_, &p)| p)
+        .map(|(share, _)| share)
+        .sum()
 }
 
 /// Cuts the pits of a pitting phase (MODEL §8): every node whose loaded-pattern pressure (the

@@ -131,6 +131,16 @@ fn the_root_stress_is_cached_checked_and_recomputed_when_its_entry_is_damaged() 
     let other = (flank, 1, 0.8e-3);
     let (smaller, _) = root_stress_cached(&g, &geo, &ltca, other, Some(dir.path())).unwrap();
     assert_ne!(smaller.interior.stress, first.interior.stress);
+    // The same gear under other loads (a loaded analysis moved by the model's code or
+    // defaults, not by the file) is another entry, not this one's value: linear elasticity
+    // scales the stress with the loads.
+    let mut heavier = ltca.clone();
+    for p in &mut heavier.positions {
+        p.pressure.iter_mut().for_each(|x| *x *= 1.1);
+    }
+    let (scaled, _) = root_stress_cached(&g, &geo, &heavier, args, Some(dir.path())).unwrap();
+    let ratio = scaled.interior.stress / first.interior.stress;
+    assert!((ratio - 1.1).abs() < 1e-6, "{ratio}");
     // A damaged entry fails its checksum: recomputed, with a warning, to the same value.
     let path = entries[0].path();
     let text = std::fs::read_to_string(&path).unwrap();

@@ -121,9 +121,10 @@ fn t1_to_t2_to_t1_closes() {
     let bench = common::Bench::new(&g);
     let forward = analyse(&g, &bench);
     // The same contact mesh both ways: the band across the line is sized from the wheel
-    // torque's estimate (u T1 eta_z of ISO/TR 14521 when the worm torque is given), so the
-    // backward band factor is scaled by the Hertz width's square root of the load.
-    let estimate = g.ratio() * 60.0 * wormwear::rating::rate(&g).mesh_efficiency;
+    // torque's estimate (u T1 eta_z of ISO/TR 14521 at its base friction when the worm torque
+    // is given), so the backward band factor is scaled by the Hertz width's square root of the
+    // load.
+    let estimate = g.ratio() * 60.0 * wormwear::rating::base_mesh_efficiency(&g);
     let mut back = g.clone();
     back.conditions.torque = Torque::Wheel(forward.wheel_torque);
     back.analysis.contact_band_factor *= (estimate / forward.wheel_torque).sqrt();

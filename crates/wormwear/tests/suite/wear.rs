@@ -603,9 +603,11 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
         ..wear::WearPlan::with_life(60_000.0)
     };
     let mut removals = Vec::new();
+    let mut pitted = Vec::new();
     let end = bench
         .simulate(&plan, None, &mut |view| {
             removals.push(view.state.removal.clone());
+            pitted.push(view.state.pitted.clone());
             Ok(())
         })
         .unwrap();
@@ -628,6 +630,28 @@ fn pitting_phase_cuts_pits_then_lets_the_cycles_pass_without_wear() {
     assert_eq!(start[0].phase, "pitting");
     assert_eq!(start[0].pitted_area_fraction, 0.0);
     assert!(start[1].pitted_area_fraction > 0.0, "no pits above 700 MPa");
+    // The pitted share is the pitted nodes' own areas (a quarter of each cell around a node),
+    // the area a forecast's onset counts, not every cell touching a pitted node (more).
+    let wf = bench.geo.wheel_flank(bench.tca.loaded_flank);
+    let shares = wear::forecast::node_shares(wf);
+    let ni = wf.cells_height;
+    for (x, pits) in r.iter().zip(&pitted) {
+        let own: f64 = (0..pits.len())
+            .filter(|&k| pits[k])
+            .map(|k| shares[k])
+            .sum();
+        assert!((x.pitted_area_fraction - own).abs() < 1e-12, "{x:?}");
+        let touching: f64 = (0..wf.cell_area.len())
+            .filter(|c| {
+                let (j, i) = (c / ni, c % ni);
+                [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .any(|(di, dj)| pits[(j + dj) * (ni + 1) + i + di])
+            })
+            .map(|c| wf.cell_area[c] / wf.active_area())
+            .sum();
+        assert!(own == 0.0 || own < touching, "{own} {touching}");
+    }
     // No wear through the phase: the state at 40 000 cycles has the pitted geometry unchanged.
     let k20 = r.iter().position(|x| x.cycles == 20_000.0).unwrap() + 1;
     let k40 = r.iter().position(|x| x.cycles == 40_000.0).unwrap();
