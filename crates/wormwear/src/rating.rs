@@ -318,10 +318,9 @@ fn pitting_life_cycles(
 /// The worm's lead angle gamma_m at its reference diameter (rad) and the sliding speed there,
 /// v_gm = pi d_m1 n1 / cos(gamma_m) (m/s; MODEL §9).
 fn lead_and_sliding_speed(gear: &GearSet) -> (f64, f64) {
-    let w = &gear.worm;
-    let d_m1 = 2.0 * w.reference_radius;
-    let gamma = (w.lead() / (PI * d_m1)).atan();
-    (gamma, d_m1 * 0.5 * gear.conditions.worm_speed / gamma.cos())
+    let gamma = gear.worm.lead_angle();
+    let rim_speed = gear.worm.reference_radius * gear.conditions.worm_speed;
+    (gamma, rim_speed / gamma.cos())
 }
 
 /// Mesh efficiency of a screw of lead angle `gamma` (rad) with the friction `mu` (worm

@@ -82,7 +82,6 @@ fn speed_points(
             let unworn = unworn_friction(&g, &id)?;
             let iso = crate::rating::rate(&g);
             let mu0 = crate::rating::base_friction(iso.sliding_speed_m_s);
-            let gamma = g.worm.lead_angle();
             points.push(SpeedPoint {
                 gear: name.trim_end_matches(".toml").to_string(),
                 worm_speed_rpm: rpm,
@@ -92,7 +91,7 @@ fn speed_points(
                 mesh_efficiency: unworn.mesh_efficiency,
                 torque_efficiency: unworn.torque_efficiency,
                 iso_friction: mu0,
-                iso_efficiency: gamma.tan() / (gamma + mu0.atan()).tan(),
+                iso_efficiency: crate::rating::base_mesh_efficiency(&g),
                 iso_efficiency_with_factors: iso.mesh_efficiency,
             });
         }
