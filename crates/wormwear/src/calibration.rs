@@ -287,8 +287,8 @@ fn solve_life_factor(
         let records = simulate(x.exp())?;
         Ok(first_pitting(&records).map_or(10.0, |c| (c.max(1.0) / target).ln()))
     };
-    let (mut a, mut b) = (LIFE_FACTOR_RANGE.0.ln(), LIFE_FACTOR_RANGE.1.ln());
-    let (mut ya, mut yb) = (miss(a)?, miss(b)?);
+    let (a, b) = (LIFE_FACTOR_RANGE.0.ln(), LIFE_FACTOR_RANGE.1.ln());
+    let (ya, yb) = (miss(a)?, miss(b)?);
     if ya > 0.0 || yb < 0.0 {
         return Err(no_life_factor(format!(
             "the first flat part of the measured curve ({target:.4e} cycles) is outside the \
@@ -296,28 +296,14 @@ fn solve_life_factor(
             LIFE_FACTOR_RANGE.0, LIFE_FACTOR_RANGE.1
         )));
     }
-    let mut side = 0;
-    for _ in 0..60 {
-        let x = (a * yb - b * ya) / (yb - ya);
-        let y = miss(x)?;
-        if y.abs() < 1e-9 || (b - a) < 1e-4 {
-            return Ok(x.exp());
-        }
-        if y < 0.0 {
-            (a, ya) = (x, y);
-            if side == -1 {
-                yb *= 0.5;
-            }
-            side = -1;
-        } else {
-            (b, yb) = (x, y);
-            if side == 1 {
-                ya *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    Ok((0.5 * (a + b)).exp())
+    let x = crate::geometry::roots::illinois(
+        miss,
+        (a, ya),
+        (b, yb),
+        |_, y, width| y.abs() < 1e-9 || width < 1e-4,
+        60,
+    )?;
+    Ok(x.exp())
 }
 
 /// [`fit_to_backlash`] through the gear's life simulation (MODEL §10): the geometry, unloaded

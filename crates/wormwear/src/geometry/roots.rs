@@ -1,4 +1,4 @@
-//! Small, robust 1-D solvers used by the geometry (bisection, Brent maximisation).
+//! Small, robust 1-D solvers (bisection, Illinois false position, Brent maximisation).
 
 /// Root of `f` in [a, b] by bisection (f(a), f(b) of opposite signs), to absolute `tol` in x.
 /// Returns None when the bracket is invalid or `f` gives NaN.
@@ -35,6 +35,42 @@ pub fn bisect(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Option<f64> {
         }
     }
     Some(0.5 * (lo + hi))
+}
+
+/// Root of `f` between a and b (their values fa, fb given, of opposite signs) by the Illinois
+/// false position: the secant point replaces the end of its sign, and the other end's value is
+/// halved when the same end is replaced twice in a row. Stops at the point c where `done(c,
+/// f(c), the bracket's width)`, else after `iterations` at the bracket's middle; an error of `f`
+/// is passed on.
+pub fn illinois<E>(
+    mut f: impl FnMut(f64) -> Result<f64, E>,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    done: impl Fn(f64, f64, f64) -> bool,
+    iterations: usize,
+) -> Result<f64, E> {
+    let mut side = 0i8;
+    for _ in 0..iterations {
+        let c = (a * fb - b * fa) / (fb - fa);
+        let fc = f(c)?;
+        if done(c, fc, (b - a).abs()) {
+            return Ok(c);
+        }
+        if (fc < 0.0) == (fa < 0.0) {
+            (a, fa) = (c, fc);
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            (b, fb) = (c, fc);
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok(0.5 * (a + b))
 }
 
 /// Maximum of `f` on [a, b] by Brent's method (golden section with parabolic steps), to
@@ -123,6 +159,22 @@ pub fn brent_max(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> (f64, f64)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn illinois_finds_the_cube_root_from_either_sign_and_passes_errors_on() {
+        let exact = 2f64.cbrt();
+        let done = |_: f64, y: f64, width: f64| y == 0.0 || width < 1e-14;
+        for sign in [1.0, -1.0] {
+            let f = |x: f64| Ok::<f64, ()>(sign * (x * x * x - 2.0));
+            let r = illinois(f, (0.0, -2.0 * sign), (2.0, 6.0 * sign), done, 100).unwrap();
+            assert!((r - exact).abs() < 1e-12, "{r}");
+        }
+        let failing = |x: f64| if x > 0.5 { Err("no") } else { Ok(x - 1.0) };
+        assert_eq!(
+            illinois(failing, (0.0, -1.0), (2.0, 1.0), done, 100),
+            Err("no")
+        );
+    }
 
     #[test]
     fn bisect_finds_cube_root() {

@@ -159,7 +159,8 @@ impl<'a> GapEvaluator<'a> {
         )
     }
 
-    /// The Newton of [`Self::angular`] from the first evaluation (e, de, rho, thread).
+    /// The Newton of [`Self::angular`] from the first evaluation (e, de, rho, thread); where it
+    /// does not settle inside a broken tip edge, [`Self::angular_bracketed`].
     #[inline]
     fn angular_from(
         &self,
@@ -174,32 +175,102 @@ impl<'a> GapEvaluator<'a> {
         if rho > tip || de.abs() < 1e-12 {
             return f64::INFINITY;
         }
-        // e(psi - sigma delta) = 0, de/dpsi has the sign of sigma. A gap that a rotation of
-        // a tooth pitch cannot close, or a Newton that does not settle (possible inside the
-        // edge reliefs, where the relief slope can cancel the flank's), means "out of reach".
+        let point = (r, theta, z, theta2, theta1);
+        match self.newton(point, (e, de, k)) {
+            Some(delta) => delta,
+            None if self.tip_edge.radius > 0.0 => self.angular_bracketed(point, k),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// Newton on e(psi - sigma delta) = 0 on thread k from (e, de): None where a rotation of a
+    /// tooth pitch cannot close the gap or the iteration does not settle (possible inside the
+    /// edge reliefs, where the relief's slope can cancel the flank's). rad.
+    #[inline]
+    fn newton(
+        &self,
+        (r, theta, z, theta2, theta1): (f64, f64, f64, f64, f64),
+        (e, de, k): (f64, f64, f64),
+    ) -> Option<f64> {
+        // e(psi - sigma delta) = 0, de/dpsi has the sign of sigma.
         let limit = 2.0 * PI / self.ratio / self.worm.starts() as f64;
         if self.sigma * de <= 0.0 {
-            return f64::INFINITY;
+            return None;
         }
         let mut delta = e / (self.sigma * de);
         for _ in 0..12 {
             if !delta.is_finite() || delta.abs() > limit {
-                return f64::INFINITY;
+                return None;
             }
             let (e, de, _, _, _) =
                 self.linear_on(r, theta, z, theta2 - self.sigma * delta, theta1, Some(k));
             if self.sigma * de <= 0.0 {
-                return f64::INFINITY;
+                return None;
             }
             let step = e / (self.sigma * de);
             delta += step;
             // Exact near contact (1e-13 rad), 1e-9 relative for far points (a 1 mm gap to
             // about a nanometre).
             if step.abs() < 1e-13 + 1e-9 * delta.abs() {
-                return delta;
+                return Some(delta);
             }
         }
-        f64::INFINITY
+        None
+    }
+
+    /// The angular gap where the Newton does not settle inside the broken tip edge (MODEL
+    /// §2.3): its relief grows with the worm radius up to h = R (1 - sin psi), so the gap e
+    /// of the rounded flank lies between the sharp flank's e_0 and e_0 + h |axial| and its
+    /// closing rotations between the sharp flank's (e_0 = 0, where e >= 0) and the rotation
+    /// past it where e <= 0. That bracket (found by doubling a step of the sharp flank's
+    /// Newton) is narrowed by the Illinois false position to the Newton's tolerance; +infinity
+    /// where the sharp flank is out of reach or the bracket leaves a tooth pitch. rad.
+    #[cold]
+    fn angular_bracketed(&self, point: (f64, f64, f64, f64, f64), k: f64) -> f64 {
+        let (r, theta, z, theta2, theta1) = point;
+        let sharp = Self {
+            tip_edge: TipEdge {
+                radius: 0.0,
+                ..self.tip_edge
+            },
+            ..*self
+        };
+        let gap = |delta: f64| {
+            self.linear_on(r, theta, z, theta2 - self.sigma * delta, theta1, Some(k))
+                .0
+        };
+        let (e0, de0, _, _, _) = sharp.linear_on(r, theta, z, theta2, theta1, Some(k));
+        let Some(low) = sharp.newton(point, (e0, de0, k)) else {
+            return f64::INFINITY;
+        };
+        let limit = 2.0 * PI / self.ratio / self.worm.starts() as f64;
+        let (e_low, de_low, _, _, gradient) =
+            sharp.linear_on(r, theta, z, theta2 - self.sigma * low, theta1, Some(k));
+        let (mut a, mut fa) = (low, gap(low));
+        if fa <= 0.0 {
+            return a;
+        }
+        let axial = (1.0 + gradient[0].powi(2) + gradient[1].powi(2)).sqrt();
+        let height = self.tip_edge.radius * (1.0 - (1.0 - self.tip_edge.cos_angle.powi(2)).sqrt());
+        let mut step = (height * axial - e_low).max(fa) / (self.sigma * de_low);
+        let (mut b, mut fb) = (a + step, gap(a + step));
+        while fb > 0.0 {
+            (a, fa) = (b, fb);
+            step *= 2.0;
+            b = a + step;
+            if !step.is_finite() || b.abs() > limit {
+                return f64::INFINITY;
+            }
+            fb = gap(b);
+        }
+        let found = crate::geometry::roots::illinois(
+            |c| Ok::<f64, std::convert::Infallible>(gap(c)),
+            (a, fa),
+            (b, fb),
+            |c, fc, width| fc == 0.0 || width < 1e-13 + 1e-9 * c.abs(),
+            100,
+        );
+        found.unwrap_or_else(|never| match never {})
     }
 
     /// Lever arm converting an angular separation into a normal distance at a wheel point:
@@ -247,9 +318,20 @@ impl TipEdge {
             return (0.0, 0.0);
         }
         let d = (rho - self.tangent_radius) / self.cos_angle;
-        // Past the circle's top (above the tip only) the edge is all relief: hold its end.
-        let d = d.min(self.radius * (1.0 - 1e-9));
+        // The arc ends at the circle's top (tangent to the tip cylinder), reached from the
+        // flank point d = R cos psi (beyond the tip radius): past it the relief holds its end,
+        // R (1 - sin psi), with no slope, as the sharp flank's continuation past the tip does
+        // for the unrounded edge (the flank's gap a Newton may cross on its way). The slope
+        // stays bounded by 1 / (sin psi cos psi), whatever R: as R -> 0 the edge's gap tends
+        // to the sharp one uniformly.
+        let top = self.radius * self.cos_angle;
+        let d = d.min(top);
         let root = (self.radius * self.radius - d * d).sqrt();
-        (self.radius - root, d / root / self.cos_angle)
+        let slope = if d < top {
+            d / root / self.cos_angle
+        } else {
+            0.0
+        };
+        (self.radius - root, slope)
     }
 }

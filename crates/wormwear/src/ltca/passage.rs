@@ -95,6 +95,20 @@ impl Sample {
         Located::Between(k, x - a, b - a)
     }
 
+    /// The radii where the profile's reading changes its slope or jumps (its ends, first -
+    /// extend_low and last + extend_high, and its cell centres), ascending, m: between two
+    /// consecutive ones [`Sample::pressure_at`] and its kin are linear in r.
+    fn knots(&self) -> impl Iterator<Item = f64> + '_ {
+        let ends = match (self.profile.first(), self.profile.last()) {
+            (Some(a), Some(b)) => [Some(a.0 - self.extend_low), Some(b.0 + self.extend_high)],
+            _ => [None, None],
+        };
+        ends[0]
+            .into_iter()
+            .chain(self.profile.iter().map(|p| p.0))
+            .chain(ends[1])
+    }
+
     /// Half extent of the profile (cells included) around the radius `centre`, m.
     pub(crate) fn reach_about(&self, centre: f64) -> f64 {
         match (self.profile.first(), self.profile.last()) {
@@ -338,6 +352,13 @@ fn sample_of(
 /// blends from a's to b's. A band keeps its offset from its line: an edge contact below the line
 /// (the worm's tip edge at the end of an engagement) stays near the edge, where moving it from
 /// one pressure centroid to the next swept it over the rows between (BENCHMARKS.md session 41).
+///
+/// At a radius r the passage's value at the fraction s is (1 - s) A(r - s d) + s B(r + (1 - s)
+/// d), d = c_b - c_a, with A and B the instants' profiles, linear between their knots: a
+/// quadratic in s between the fractions where a knot passes r ([`Passage::pieces`]). Its
+/// maximum and its integral over the passage are taken exactly on those pieces, so neither
+/// depends on a sub-step count (which jumped with the lines' positions, and with it the
+/// pattern by up to 7 % at a node: session 56).
 pub(crate) struct Passage<'a> {
     pub(crate) a: &'a Sample,
     pub(crate) b: &'a Sample,
@@ -347,8 +368,6 @@ pub(crate) struct Passage<'a> {
     /// The radii the band covers on the way, m.
     pub(crate) lo: f64,
     pub(crate) hi: f64,
-    /// Sub-steps of the quadrature: the band moves at most a tenth of its width per step.
-    pub(crate) steps: usize,
 }
 
 impl<'a> Passage<'a> {
@@ -360,7 +379,6 @@ impl<'a> Passage<'a> {
         }
         let (ca, cb) = (a.line, b.line);
         let reach = a.reach_about(ca).max(b.reach_about(cb));
-        let width = (2.0 * reach).max(1e-9);
         Some(Passage {
             a,
             b,
@@ -368,7 +386,6 @@ impl<'a> Passage<'a> {
             cb,
             lo: ca.min(cb) - reach,
             hi: ca.max(cb) + reach,
-            steps: ((10.0 * (cb - ca).abs() / width).ceil() as usize).clamp(4, 400),
         })
     }
 
@@ -384,6 +401,102 @@ impl<'a> Passage<'a> {
         let (a, b, ca, cb) = (self.a, self.b, self.ca, self.cb);
         let c = ca + s * (cb - ca);
         (1.0 - s) * a.plastic_at(r, c - ca) + s * b.plastic_at(r, c - cb)
+    }
+
+    /// The fractions of the passage where, at radius r, a knot of a's profile (moving as r - s d)
+    /// or of b's (r + (1 - s) d) passes r, with 0 and 1, ascending, into `out`: between two
+    /// consecutive ones the passage's values at r are quadratics in s.
+    pub(crate) fn pieces(&self, r: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.push(0.0);
+        let d = self.cb - self.ca;
+        if d != 0.0 {
+            let inside = |s: f64| s > 0.0 && s < 1.0;
+            out.extend(self.a.knots().map(|x| (r - x) / d).filter(|&s| inside(s)));
+            out.extend(
+                self.b
+                    .knots()
+                    .map(|x| 1.0 - (x - r) / d)
+                    .filter(|&s| inside(s)),
+            );
+            out.sort_unstable_by(f64::total_cmp);
+        }
+        out.push(1.0);
+    }
+
+    /// The integral over the passage (s from 0 to 1) of the pressure at radius r, Pa: two-point
+    /// Gauss on each piece, exact for its quadratic.
+    pub(crate) fn pressure_integral(&self, r: f64, pieces: &mut Vec<f64>) -> f64 {
+        self.pieces(r, pieces);
+        let g = 0.5 / 3f64.sqrt();
+        pieces
+            .windows(2)
+            .map(|w| {
+                let (mid, width) = (0.5 * (w[0] + w[1]), w[1] - w[0]);
+                0.5 * width
+                    * (self.pressure(r, mid - g * width) + self.pressure(r, mid + g * width))
+            })
+            .sum()
+    }
+
+    /// The largest of `value(r, s)` over the passage's inner fractions at radius r (the limits
+    /// at its ends included, not the instants themselves), with `also(r, s)` read at the same
+    /// fraction: each piece's quadratic through its values at a quarter, a half and three
+    /// quarters of it, at its ends and at its vertex.
+    fn piece_max(
+        &self,
+        r: f64,
+        pieces: &mut Vec<f64>,
+        value: impl Fn(f64, f64) -> (f64, f64),
+    ) -> (f64, f64) {
+        self.pieces(r, pieces);
+        let mut best = (f64::NEG_INFINITY, 0.0);
+        for w in pieces.windows(2) {
+            let (mid, width) = (0.5 * (w[0] + w[1]), w[1] - w[0]);
+            let at = |u: f64| value(r, mid + u * width);
+            let (y1, y2, y3) = (at(-0.25), at(0.0), at(0.25));
+            let v = Quadratic::through(y1.0, y2.0, y3.0);
+            let u = v.argmax();
+            if v.at(u) > best.0 {
+                best = (v.at(u), Quadratic::through(y1.1, y2.1, y3.1).at(u));
+            }
+        }
+        best
+    }
+}
+
+/// A quadratic in u on [-1/2, 1/2], q(u) = c + b u + a u^2, from its values at u = -1/4, 0,
+/// 1/4.
+struct Quadratic {
+    a: f64,
+    b: f64,
+    c: f64,
+}
+
+impl Quadratic {
+    fn through(y1: f64, y2: f64, y3: f64) -> Self {
+        Self {
+            a: 8.0 * (y1 + y3 - 2.0 * y2),
+            b: 2.0 * (y3 - y1),
+            c: y2,
+        }
+    }
+
+    fn at(&self, u: f64) -> f64 {
+        self.c + u * (self.b + u * self.a)
+    }
+
+    /// Where it is largest on [-1/2, 1/2].
+    fn argmax(&self) -> f64 {
+        let vertex = if self.a < 0.0 {
+            (-self.b / (2.0 * self.a)).clamp(-0.5, 0.5)
+        } else {
+            0.5
+        };
+        [-0.5, 0.5, vertex]
+            .into_iter()
+            .max_by(|&x, &y| self.at(x).total_cmp(&self.at(y)))
+            .unwrap_or(0.5)
     }
 }
 
@@ -414,6 +527,7 @@ pub(crate) fn swept_equivalent(samples: &[Sample], radii: &[f64], dt: f64) -> Ve
     {
         return out;
     }
+    let mut pieces = Vec::new();
     for sample in samples {
         for (o, &r) in out.iter_mut().zip(radii) {
             keep(o, sample.equivalent_at(r, 0.0));
@@ -427,9 +541,10 @@ pub(crate) fn swept_equivalent(samples: &[Sample], radii: &[f64], dt: f64) -> Ve
             if r < passage.lo || r > passage.hi {
                 continue;
             }
-            for m in 1..passage.steps {
-                keep(o, passage.equivalent(r, m as f64 / passage.steps as f64));
-            }
+            keep(
+                o,
+                passage.piece_max(r, &mut pieces, |r, s| passage.equivalent(r, s)),
+            );
         }
     }
     out
@@ -443,7 +558,7 @@ pub(crate) enum Swept {
 }
 
 /// The largest pressure or plastic indentation over the band's whole passage (the instants
-/// and the sub-steps between them, [`Passage`]) at the radii `radii` of one node column, from
+/// and, exactly, the passages between them, [`Passage`]) at the radii `radii` of one node column, from
 /// its instants sorted by time; `dt` the wheel rotation between positions, rad.
 pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept) -> Vec<f64> {
     let mut out = vec![0.0f64; radii.len()];
@@ -452,9 +567,10 @@ pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept)
         return out;
     }
     let value = |passage: &Passage, r: f64, s: f64| match what {
-        Swept::Pressure => passage.pressure(r, s),
-        Swept::Plastic => passage.plastic(r, s),
+        Swept::Pressure => (passage.pressure(r, s), 0.0),
+        Swept::Plastic => (passage.plastic(r, s), 0.0),
     };
+    let mut pieces = Vec::new();
     for sample in samples {
         for (o, &r) in out.iter_mut().zip(radii) {
             let v = match what {
@@ -475,10 +591,8 @@ pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept)
             if r < passage.lo || r > passage.hi {
                 continue;
             }
-            for m in 1..passage.steps {
-                let v = value(&passage, r, m as f64 / passage.steps as f64);
-                *o = o.max(v);
-            }
+            let (v, _) = passage.piece_max(r, &mut pieces, |r, s| value(&passage, r, s));
+            *o = o.max(v);
         }
     }
     out
@@ -540,11 +654,7 @@ mod tests {
         let passage = Passage::between(&a, &b, 1.0).expect("b is loaded");
         nodes
             .iter()
-            .map(|&r| {
-                (0..passage.steps)
-                    .map(|m| passage.pressure(r, (m as f64 + 0.5) / passage.steps as f64))
-                    .sum::<f64>()
-            })
+            .map(|&r| passage.pressure_integral(r, &mut Vec::new()))
             .collect()
     }
 
@@ -584,14 +694,92 @@ mod tests {
         b.line_load = 1e9 * 1e-4;
         b.time = 1.0;
         let passage = Passage::between(&a, &b, 1.0).expect("both loaded");
-        let integral = |r: f64| {
-            (0..passage.steps)
-                .map(|m| passage.pressure(r, (m as f64 + 0.5) / passage.steps as f64))
-                .sum::<f64>()
-                / passage.steps as f64
-        };
+        let integral = |r: f64| passage.pressure_integral(r, &mut Vec::new());
         assert_eq!(integral(0.09875), 0.0);
         assert!(integral(0.0976) > 1e8, "{}", integral(0.0976));
         assert!(integral(0.1) > 1e8);
+    }
+
+    /// Two instants of a parabolic band, the second narrower, higher and `shift` further up
+    /// the column, with an edge cell held over a wider extent.
+    fn moving_band(shift: f64) -> (Sample, Sample) {
+        let cells: Vec<f64> = (0..13).map(|k| 0.0994 + 1e-4 * k as f64).collect();
+        let band = |centre: f64, half: f64, peak: f64| {
+            cells
+                .iter()
+                .map(|&r| {
+                    (
+                        r + centre - 0.1,
+                        peak * (1.0 - ((r - 0.1) / half).powi(2)).max(0.0),
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        let mut a = sample(band(0.1, 6e-4, 5e8));
+        a.line_load = 1.0;
+        a.extend_low = 3e-4;
+        let mut b = sample(band(0.1 + shift, 4e-4, 7e8));
+        b.line = 0.1 + shift;
+        b.line_load = 1.0;
+        b.time = 1.0;
+        (a, b)
+    }
+
+    #[test]
+    fn a_passage_s_maximum_and_integral_are_exact_on_its_pieces() {
+        // Against a fine sampling of the passage (1e5 steps): the pieces' maximum is at least
+        // every sample and at most a hair above the largest, their integral the samples' mean.
+        for shift in [0.0, 3.3e-5, 2.7e-4, -1.1e-3] {
+            let (a, b) = moving_band(shift);
+            let passage = Passage::between(&a, &b, 1.0).unwrap();
+            let mut pieces = Vec::new();
+            for k in 0..40 {
+                let r = passage.lo + (passage.hi - passage.lo) * (k as f64 + 0.37) / 40.0;
+                let n = 100_000;
+                let samples: Vec<f64> = (1..n)
+                    .map(|m| passage.pressure(r, m as f64 / n as f64))
+                    .collect();
+                let fine_max = samples.iter().copied().fold(0.0, f64::max);
+                let fine_mean = (0..n)
+                    .map(|m| passage.pressure(r, (m as f64 + 0.5) / n as f64))
+                    .sum::<f64>()
+                    / n as f64;
+                let (max, _) =
+                    passage.piece_max(r, &mut pieces, |r, s| (passage.pressure(r, s), 0.0));
+                let integral = passage.pressure_integral(r, &mut pieces);
+                assert!(
+                    max >= fine_max * (1.0 - 1e-12) && max <= fine_max + 1e-4 * 7e8,
+                    "shift {shift}, r {r}: {max} vs {fine_max}"
+                );
+                assert!(
+                    (integral - fine_mean).abs() <= 1e-6 * 7e8,
+                    "shift {shift}, r {r}: {integral} vs {fine_mean}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_swept_maximum_is_the_passage_s_own_at_every_line_shift() {
+        // swept_max against the instants and a fine sampling of the passage (2e4 steps), for
+        // line shifts from none to several band widths: a sampled maximum (the sub-steps'
+        // count jumping with the shift) fell short by several per cent and jumped with it.
+        let radii: Vec<f64> = (0..60).map(|k| 0.0993 + 2.5e-5 * k as f64).collect();
+        for k in 0..=30 {
+            let shift = 1e-4 * k as f64 - 1.3e-3;
+            let (a, b) = moving_band(shift);
+            let swept = swept_max(&[a.clone(), b.clone()], &radii, 1.0, Swept::Pressure);
+            let passage = Passage::between(&a, &b, 1.0).unwrap();
+            for (&r, &max) in radii.iter().zip(&swept) {
+                let n = 20_000;
+                let fine = (0..=n)
+                    .map(|m| passage.pressure(r, m as f64 / n as f64))
+                    .fold(0.0, f64::max);
+                assert!(
+                    (max - fine).abs() <= 1e-4 * 7e8,
+                    "shift {shift}, r {r}: {max} vs {fine}"
+                );
+            }
+        }
     }
 }

@@ -61,23 +61,24 @@ impl PassageWear<'_> {
     fn column(&self, j: usize, samples: &[crate::ltca::passage::Sample]) -> Vec<[f64; 6]> {
         let ni = self.wf.cells_height;
         let mut out = vec![[0.0, f64::NAN, f64::NAN, 0.0, 0.0, 0.0]; ni + 1];
+        let mut pieces = Vec::new();
         for pair in samples.windows(2) {
             // Consecutive instants of the same engagement only.
             let Some(passage) = Passage::between(&pair[0], &pair[1], self.dt) else {
                 continue;
             };
             for (i, o) in out.iter_mut().enumerate() {
-                self.node(j * (ni + 1) + i, &passage, o);
+                self.node(j * (ni + 1) + i, &passage, o, &mut pieces);
             }
         }
         out
     }
 
     /// Adds one passage over node k to its entry `o` ([`Self::column`]).
-    fn node(&self, k: usize, passage: &Passage, o: &mut [f64; 6]) {
+    fn node(&self, k: usize, passage: &Passage, o: &mut [f64; 6], pieces: &mut Vec<f64>) {
         let (a, b) = (passage.a, passage.b);
         let duration = (b.time - a.time) / self.wheel_speed;
-        let (lo, hi, steps) = (passage.lo, passage.hi, passage.steps);
+        let (lo, hi) = (passage.lo, passage.hi);
         let w = 0.5 * (a.line_load + b.line_load);
         let fill = |x: f64, y: f64| {
             if !x.is_finite() {
@@ -94,11 +95,7 @@ impl PassageWear<'_> {
         }
         let nc = &self.tca.node_contact[k];
         let (u1, u2) = self.rolling[k];
-        let mut integral = 0.0;
-        for m in 0..steps {
-            integral += passage.pressure(node.r, (m as f64 + 0.5) / steps as f64);
-        }
-        integral *= duration / steps as f64;
+        let integral = passage.pressure_integral(node.r, pieces) * duration;
         if integral <= 0.0 {
             return;
         }

@@ -103,14 +103,12 @@ fn the_face_end_chamfer_recedes_along_its_45_degree_line() {
 
 /// A radius and a chamfer of 0 are the sharp gear to the bit; as they shrink to a fraction of
 /// a micrometre the loaded analysis tends to the sharp one: the mesh-converged peak P_patch,
-/// the mean transmission error and the mesh efficiency.
+/// the mean transmission error, the mesh efficiency and the loaded pattern's mean pressure.
 ///
-/// Not P_mean (the mean of the loaded pattern's cells): since session 55 (the transmitted
-/// torque of Lambda 0.014, 6 % more load) it steps by about 1e-4 between R = 0 and any R > 0
-/// and does not tend to the sharp value (R 0.01, 0.1, 1 um: 1.03e-4, 1.01e-4, 5.6e-5). The
-/// step is a few face-end cells near the worm tip's trace (i 9, j 58-59 of the design grid:
-/// -7 to -16 % at R = 10 nm): a defect of the edge's gap near the tip, left for issue 54
-/// (the session 55 note); printed here, not asserted.
+/// P_mean reads every cell of the pattern, the face ends' edge contacts at the worm tip
+/// included: until session 56 it stepped by 1e-4 at any R > 0 (the edge's relief slope
+/// beyond the arc's top grew without bound and a Newton crossing it declared those points
+/// out of reach, moving the tip's edge contact by micrometres).
 #[test]
 fn a_vanishing_edge_break_gives_the_sharp_results() {
     let run = |g: &GearSet| {
@@ -133,31 +131,96 @@ fn a_vanishing_edge_break_gives_the_sharp_results() {
             .map(|p| p.transmission_error)
             .sum::<f64>()
     };
-    // Measured (relative to sharp; P_patch, TE, efficiency), session 55: R 1 um 5.5e-6,
-    // 3.6e-5, 5.0e-6; R 0.1 um 4.0e-6, 6.1e-6, 1.1e-7; a chamfer of 0.1 um 7.0e-3, 2.8e-4,
-    // 1.1e-6 (the face end's patch reads the edge node's micrometres).
+    // Measured (relative to sharp; P_patch, TE, efficiency, P_mean), session 56: R 1 um
+    // 5.5e-6, 3.6e-5, 5.0e-6, 1.9e-5; R 0.1 um 4.0e-6, 6.1e-6, 1.1e-7, 1.1e-5; R 0.01 um
+    // 2.5e-6, 3.4e-6, 1.2e-8, 5.0e-6; a chamfer of 0.1 um 7.0e-3, 2.8e-4, 1.1e-6, 8.4e-5 (the
+    // face end's patch reads the edge node's micrometres). P_mean falls slower than R: the
+    // edge contact's pressure at the face ends follows the edge's curvature.
     for (radius_um, chamfer_um, bound) in [
-        (1.0, 0.0, [1e-4, 1e-4, 1e-5]),
-        (0.1, 0.0, [1e-5, 1e-5, 1e-6]),
-        (0.0, 0.1, [1e-2, 1e-3, 1e-5]),
+        (1.0, 0.0, [1e-4, 1e-4, 1e-5, 5e-5]),
+        (0.1, 0.0, [1e-5, 1e-5, 1e-6, 2e-5]),
+        (0.01, 0.0, [1e-5, 1e-5, 1e-6, 1e-5]),
+        (0.0, 0.1, [1e-2, 1e-3, 1e-5, 1e-3]),
     ] {
         let tiny = run(&design(radius_um * 1e-3, chamfer_um * 1e-3));
         let moved = [
             rel(tiny.pressure_patch_max, sharp.pressure_patch_max),
             rel(te(&tiny), te(&sharp)),
             rel(tiny.mesh_efficiency, sharp.mesh_efficiency),
+            rel(tiny.mean_pressure, sharp.mean_pressure),
         ];
-        eprintln!(
-            "R {radius_um} um, chamfer {chamfer_um} um: {moved:?}; P_mean {:e}",
-            rel(tiny.mean_pressure, sharp.mean_pressure)
-        );
-        for k in 0..3 {
+        eprintln!("R {radius_um} um, chamfer {chamfer_um} um: {moved:?}");
+        for k in 0..4 {
             assert!(
                 moved[k] < bound[k],
                 "R {radius_um}, chamfer {chamfer_um}: {moved:?}"
             );
         }
     }
+}
+
+#[test]
+fn the_rounded_edge_gap_is_the_first_rotation_that_closes_it() {
+    let g = design(1.0, 0.0);
+    let geo = Geometry::build(&g).unwrap();
+    let sharp_gear = design(0.0, 0.0);
+    let sharp_geo = Geometry::build(&sharp_gear).unwrap();
+    let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
+    let ev = GapEvaluator::new(&g, &geo);
+    let sharp = GapEvaluator::new(&sharp_gear, &sharp_geo);
+    let wf = geo.wheel_flank(ev.flank);
+    let limit = 2.0 * std::f64::consts::PI / g.ratio() / geo.worm.starts() as f64;
+    let tau = limit * geo.worm.starts() as f64;
+    let (mut on_edge, mut not_monotone) = (0, 0);
+    for n in [0, 5, 10, 15] {
+        let pos = tca.positions[n];
+        for &tooth in &tca.teeth {
+            let offset = tca.sigma * tooth as f64 * tau;
+            for p in &wf.nodes {
+                let (theta, at) = (p.theta + offset, |d: f64| pos.theta2 - ev.sigma * d);
+                let delta0 = sharp.angular(p.r, theta, p.z, pos.theta2, pos.theta1);
+                let delta = ev.angular(p.r, theta, p.z, pos.theta2, pos.theta1);
+                if delta0.is_finite() {
+                    assert!(
+                        delta.is_finite(),
+                        "node r {} z {}: {delta0} sharp",
+                        p.r,
+                        p.z
+                    );
+                }
+                if !delta.is_finite() || delta <= 0.0 {
+                    continue;
+                }
+                let (e, _, rho) = ev.linear(p.r, theta, p.z, at(delta), pos.theta1);
+                assert!(e.abs() < 1e-10, "node r {} z {}: gap {e:e} left", p.r, p.z);
+                if rho < ev.tip_edge.tangent_radius {
+                    continue;
+                }
+                on_edge += 1;
+                let mut previous = f64::INFINITY;
+                for k in 0..200 {
+                    let d = delta * k as f64 / 200.0;
+                    let (e, _, _) = ev.linear(p.r, theta, p.z, at(d), pos.theta1);
+                    assert!(
+                        e > 0.0,
+                        "node r {} z {}: closed at {d} before {delta}",
+                        p.r,
+                        p.z
+                    );
+                    if e > previous {
+                        not_monotone += 1;
+                        break;
+                    }
+                    previous = e;
+                }
+            }
+        }
+    }
+    eprintln!("{on_edge} gaps closing on the edge, {not_monotone} of them not monotone");
+    assert!(
+        on_edge > 100 && not_monotone > 10,
+        "{on_edge}, {not_monotone}"
+    );
 }
 
 #[test]
@@ -197,12 +260,15 @@ fn bad_edge_breaks_are_refused_naming_the_field() {
 
 /// The loaded analysis says where its cells reach the flow pressure: on the sharp design gear
 /// at 80 N m (no bending) at the worm tip's trace (0.49 % of the flank); a 1 mm tip edge radius
-/// takes the trace off the flow pressure (no cell of the pattern there; its local cells still
-/// reach it). At 90 N m, with the transmitted torque of the contact's friction since session 55
-/// (eta_z 0.83, Lambda 0.014), a 1 mm edge keeps 0.11 % of the flank at the trace on the flow
-/// pressure: the edge break's relief is load dependent (issue 54).
+/// moves them up the flank by about the edge's height R (1 - sin alpha_x), to where its round
+/// meets the flank (0.33 % of the flank, from 0.5 mm higher).
+///
+/// Until session 56 the rounded edge's cells seemed to leave the pattern at 80 N m: the band's
+/// passage was sampled at a few sub-steps, and a peak as narrow as the round's passed between
+/// them (the pattern is the passage's exact maximum since). A 1 mm round is a contact of 1 mm
+/// radius where the flank rides onto it, over the flow pressure at a few hundred N/mm.
 #[test]
-fn the_flow_pressure_warning_names_where_and_the_tip_edge_removes_the_tip_trace() {
+fn the_flow_pressure_warning_names_where_and_the_tip_edge_moves_it_up_the_flank() {
     let warnings = |g: &GearSet| {
         let mut g = g.clone();
         g.conditions.torque = input::Torque::Worm(80.0);
@@ -213,23 +279,36 @@ fn the_flow_pressure_warning_names_where_and_the_tip_edge_removes_the_tip_trace(
         w.into_iter()
             .find(|w| w.contains("reaches the flow pressure"))
     };
+    // The lowest cell centre the warning gives, m.
+    let lowest = |w: &str| -> f64 {
+        let r: f64 = w
+            .split("cell centres at r ")
+            .nth(1)
+            .and_then(|rest| rest.split('-').next())
+            .unwrap()
+            .parse()
+            .unwrap();
+        r * 1e-3
+    };
     let sharp = warnings(&design(0.0, 0.0)).expect("the sharp tip reaches the flow pressure");
     eprintln!("sharp: {sharp}");
     assert!(sharp.contains("at the worm tip's trace"), "{sharp}");
-    let rounded = warnings(&design(1.0, 0.0));
-    eprintln!("R 1 mm: {rounded:?}");
+    let rounded = warnings(&design(1.0, 0.0)).expect("the round's contact reaches it");
+    eprintln!("R 1 mm: {rounded}");
+    assert!(rounded.contains("at the worm tip's trace"), "{rounded}");
+    let g = design(1.0, 0.0);
+    let height = g.worm.tip_edge_radius * (1.0 - g.worm.axial_pressure_angle.sin());
+    let risen = lowest(&rounded) - lowest(&sharp);
     assert!(
-        rounded
-            .as_ref()
-            .is_none_or(|w| !w.contains("worm tip's trace")),
-        "{rounded:?}"
+        risen > 0.5 * height && risen < 1.5 * height,
+        "{risen} vs the edge's height {height}"
     );
 }
 
 /// No reported pressure sits at the flow pressure unsaid (issue 54): wherever P_max is the flow
 /// pressure, a warning says so and where — the pattern's share, or, where no cell of the loaded
-/// pattern reaches it, the local contact cells that do (the design gear with a 1 mm tip edge
-/// at 60 N m: a peak narrower than the flank grid).
+/// pattern reaches it, the local contact cells that do (the sharp design gear at 60 N m: a
+/// peak narrower than the flank grid).
 #[test]
 fn every_p_max_at_the_flow_pressure_is_warned_with_its_place() {
     for (radius, chamfer, torque) in [(1.0, 0.0, 60.0), (1.0, 1.0, 90.0), (0.0, 0.0, 60.0)] {
@@ -263,7 +342,7 @@ fn every_p_max_at_the_flow_pressure_is_warned_with_its_place() {
 
 /// The flow-pressure warnings count the worm's rounded tip edge as the worm tip's (MODEL §2.3):
 /// the strip of the wheel flank it touches reaches R (1 - sin alpha_x) above the trace of the
-/// tip's lowest radius. On the design gear with a 1 mm edge at its 60 N m (no bending; the
+/// tip's lowest radius. On the design gear with a 1 mm edge at 30 N m (no bending; the
 /// local cells reach the flow pressure, no cell of the pattern does), the cells at the flow
 /// pressure counted "elsewhere" with the sharp edge's band (the trace's two rows) move to the
 /// tip's trace with the edge's height, none appears or vanishes, and the edge's strip holds
@@ -271,7 +350,7 @@ fn every_p_max_at_the_flow_pressure_is_warned_with_its_place() {
 #[test]
 fn the_flow_pressure_at_the_rounded_tip_edge_is_counted_as_the_worm_tips() {
     let mut g = design(1.0, 0.0);
-    g.conditions.torque = input::Torque::Worm(60.0);
+    g.conditions.torque = input::Torque::Worm(30.0);
     let geo = Geometry::build(&g).unwrap();
     let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
     let settings = wormwear::ltca::LtcaSettings::from_gear(&g);
