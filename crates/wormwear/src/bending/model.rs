@@ -219,7 +219,11 @@ pub fn cache_key(gear: &GearSet) -> String {
         "rotation": gear.rotation,
         "worm_elastic": [gear.worm_material.youngs_modulus, gear.worm_material.poisson_ratio],
         "wheel_elastic": [gear.wheel_material.youngs_modulus, gear.wheel_material.poisson_ratio],
-        "grid": [gear.analysis.flank_cells_height, gear.analysis.flank_cells_face],
+        "grid": [
+            gear.analysis.flank_cells_height,
+            gear.analysis.flank_cells_face,
+            gear.analysis.tip_trace_refinement,
+        ],
         "bending": gear.bending,
     });
     key.to_string()

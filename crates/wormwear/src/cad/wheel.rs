@@ -46,7 +46,7 @@ const REFINEMENTS: usize = 3;
 /// largest station spacing (m). The new flank is smooth: 17 points and 1 mm give 0.44 um on
 /// the design case, and [`wheel_part`] refines until the fit is within [`FIT_TARGET_MM`]. A
 /// flank change lives on the flank grid's nodes, linear between them: the changed flank is
-/// sampled on the grid's rows (the same radii: evenly spaced between r_low and the top) and
+/// sampled on as many rows as the grid's nominal ones, evenly spaced between r_low and the top, and
 /// the stations are as far apart as its columns.
 #[derive(Debug, Clone, Copy)]
 struct Resolution {
@@ -65,7 +65,7 @@ impl Resolution {
                 let wf = geo.wheel_flank(flank);
                 let column = geo.blank.face_width / wf.cells_face as f64;
                 let points = |side: Flank| match side == flank {
-                    true => wf.cells_height + 1,
+                    true => wf.nominal_rows + 1,
                     false => FLANK_POINTS,
                 };
                 Self {

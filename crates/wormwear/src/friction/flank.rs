@@ -9,11 +9,11 @@ use crate::geometry::WheelFlank;
 use crate::kinematics::Tca;
 use crate::ltca::Ltca;
 
-/// The node columns of a flank grid: their z and radial limits (m), and the cell rows.
+/// The node columns of a flank grid: their z and their nodes' radii (m, column by column
+/// from the foot up), and the cell rows.
 pub(super) struct FlankGrid<'a> {
     z: &'a [f64],
-    r_low: &'a [f64],
-    r_high: &'a [f64],
+    radii: Vec<f64>,
     rows: usize,
 }
 
@@ -21,18 +21,29 @@ impl<'a> FlankGrid<'a> {
     pub(super) fn of(wf: &'a WheelFlank) -> Self {
         Self {
             z: &wf.z,
-            r_low: &wf.r_low,
-            r_high: &wf.r_high,
+            radii: wf.nodes.iter().map(|n| n.r).collect(),
             rows: wf.cells_height,
         }
+    }
+
+    /// The height parameter (row index, fractional: linear in r between the column's nodes,
+    /// extended with its end rows) of radius r on node column j.
+    fn row_parameter(&self, j: usize, r: f64) -> f64 {
+        let n = self.rows + 1;
+        let c = &self.radii[j * n..(j + 1) * n];
+        let i = c
+            .partition_point(|&x| x <= r)
+            .saturating_sub(1)
+            .min(self.rows - 1);
+        i as f64 + (r - c[i]) / (c[i + 1] - c[i])
     }
 
     /// The grid cells under a strip spanning radii `r` (low, high) and z +- `half_dz` (m),
     /// with the share of the strip each takes, appended to `out`: the cell columns the strip
     /// overlaps by their overlap along z (a strip on a node column is half in the column on
-    /// each side), and in each the rows by their overlap in radius between the column's
-    /// interpolated radial limits. What lies past the grid's edges is clamped onto it, so the
-    /// shares sum to one.
+    /// each side), and in each the rows by their overlap in the height parameter, blended
+    /// linearly between the column's two node columns. What lies past the grid's edges is
+    /// clamped onto it, so the shares sum to one.
     pub(super) fn cells_under(
         &self,
         r: (f64, f64),
@@ -46,11 +57,12 @@ impl<'a> FlankGrid<'a> {
         let (a, b) = (column(z - half_dz), column(z + half_dz));
         // The strip's share in column j, spread over the column's rows by radius.
         let mut in_column = |j: usize, column_share: f64| {
-            // The column's radial limits where the strip's centre lies along it.
+            // The height parameter where the strip's centre lies along the column.
             let t = (column(z) - j as f64).clamp(0.0, 1.0);
-            let lo = self.r_low[j] + t * (self.r_low[j + 1] - self.r_low[j]);
-            let hi = self.r_high[j] + t * (self.r_high[j + 1] - self.r_high[j]);
-            let u = |r: f64| ((r - lo) / (hi - lo) * ni as f64).clamp(0.0, ni as f64);
+            let u = |r: f64| {
+                let g = (1.0 - t) * self.row_parameter(j, r) + t * self.row_parameter(j + 1, r);
+                g.clamp(0.0, ni as f64)
+            };
             let (u0, u1) = (u(r.0.min(r.1)), u(r.0.max(r.1)));
             if u1 - u0 <= 1e-9 {
                 let i = (u0.min(ni as f64 - 1e-9).floor() as usize).min(ni - 1);
@@ -205,8 +217,9 @@ mod tests {
     fn flat() -> FlankGrid<'static> {
         FlankGrid {
             z: &[-2e-3, -1e-3, 0.0, 1e-3, 2e-3],
-            r_low: &[0.0; 5],
-            r_high: &[10e-3; 5],
+            radii: (0..5)
+                .flat_map(|_| (0..=5).map(|i| 2e-3 * i as f64))
+                .collect(),
             rows: 5,
         }
     }

@@ -7,6 +7,7 @@ pub mod hobbing;
 pub mod placement;
 pub mod profile;
 pub mod roots;
+pub mod rows;
 pub mod sections;
 pub mod stl;
 pub mod thread;
@@ -114,10 +115,35 @@ impl Geometry {
             GeometryError::Wheel(m) => GeometryError::Wheel(format!("{m}; {}", blank_fit(gear))),
             other => other,
         };
-        let left = wheel::generate_flank(&hobbing, Flank::Left, &blank, cells_height, cells_face)
-            .map_err(wheel_hint)?;
-        let right = wheel::generate_flank(&hobbing, Flank::Right, &blank, cells_height, cells_face)
-            .map_err(wheel_hint)?;
+        let worm_cut = Hobbing::new(&worm, gear.operating, gear.wheel.teeth);
+        let refinement = gear.analysis.tip_trace_refinement;
+        let frame = |flank: Flank| {
+            let strip = worm_edge_strip(&worm, flank, gear);
+            let reach =
+                |z: f64, foot: f64, top: f64| worm_reach(&worm_cut, flank, z, (foot, top), strip);
+            wheel::FlankFrame::new(
+                &hobbing,
+                flank,
+                &blank,
+                (cells_height, cells_face),
+                &reach,
+                refinement,
+            )
+        };
+        let frames = [
+            frame(Flank::Left).map_err(wheel_hint)?,
+            frame(Flank::Right).map_err(wheel_hint)?,
+        ];
+        let knots: Vec<_> = frames
+            .iter()
+            .flat_map(|f| f.columns.iter().chain(&f.mids))
+            .copied()
+            .collect();
+        let plan = rows::RowPlan::of(&knots, cells_height, refinement);
+        let generate =
+            |f: &wheel::FlankFrame| wheel::generate_flank(&hobbing, f, &plan, cells_height);
+        let left = generate(&frames[0]).map_err(wheel_hint)?;
+        let right = generate(&frames[1]).map_err(wheel_hint)?;
         Ok(Self {
             worm,
             hob,
@@ -139,6 +165,64 @@ impl Geometry {
     pub fn hobbing<'a>(&'a self, gear: &GearSet) -> Hobbing<'a> {
         Hobbing::new(&self.hob, gear.cutting, self.teeth)
     }
+}
+
+/// The worm's radial height, from its tip down, of the strip its broken tip edge (MODEL §2.3:
+/// R (1 - sin psi), psi the axial profile's angle at the tip) or its tip relief (its length)
+/// sweeps on `flank`, m; 0 for a sharp, unrelieved tip.
+fn worm_edge_strip(worm: &ThreadSurface, flank: Flank, gear: &GearSet) -> f64 {
+    let edge = gear.worm.tip_edge_radius * (1.0 - worm.tip_profile_angle(flank).sin());
+    let relief = &gear.worm.tip_relief;
+    edge.max(if relief.amount > 0.0 {
+        relief.length
+    } else {
+        0.0
+    })
+}
+
+/// Where the worm at its operating placement (`worm_cut`: the worm as a hob) reaches the
+/// wheel's node column at z between its foot and top: the worm-tip trace (the lowest radius
+/// the worm's flank generates) and the top of the strip of height `strip` below the worm's tip
+/// (the wheel radius whose generating point lies at the worm radius r_a - strip), m. None
+/// where the worm does not reach the column's top.
+fn worm_reach(
+    worm_cut: &Hobbing,
+    flank: Flank,
+    z: f64,
+    (foot, top): (f64, f64),
+    strip: f64,
+) -> Option<rows::WormReach> {
+    let trace = worm_cut.radial_limits(flank, z, top).ok()?.0.max(foot);
+    if strip <= 0.0 {
+        return Some(rows::WormReach {
+            trace,
+            strip_top: trace,
+        });
+    }
+    let edge_start = worm_cut.hob.def.tip_radius - strip;
+    let above_edge = |r: f64| {
+        let e = worm_cut.envelope(flank, r, z);
+        e.kind == PointKind::Flank && e.hob_radius <= edge_start
+    };
+    let (mut lo, mut hi) = (trace, top);
+    if !above_edge(hi) {
+        return Some(rows::WormReach {
+            trace,
+            strip_top: top,
+        });
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if above_edge(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(rows::WormReach {
+        trace,
+        strip_top: hi,
+    })
 }
 
 /// Derived quantities reported by `check` and in `summary.json` (units in the names).

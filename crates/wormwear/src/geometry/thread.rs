@@ -130,6 +130,15 @@ impl ThreadSurface {
         }
     }
 
+    /// The axial profile's angle to the radial direction at the tip radius of `flank`, rad
+    /// (psi of the broken tip edge, MODEL §2.3).
+    pub fn tip_profile_angle(&self, flank: Flank) -> f64 {
+        self.axial_profile(flank, self.def.tip_radius)
+            .1
+            .abs()
+            .atan()
+    }
+
     /// Exact (untabulated) axial profile, for checks. None where the tool does not reach.
     pub fn axial_profile_exact(&self, flank: Flank, rho: f64) -> Option<(f64, f64)> {
         let (x, s) = self.generator.eval(rho)?;

@@ -439,8 +439,13 @@ pub enum SolverKind {
 /// Analysis settings (grid sizes, positions...).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Analysis {
+    /// Rows of the global flank grid's nominal height (the band at the worm-tip trace adds
+    /// its finer rows, MODEL §3.3).
     pub flank_cells_height: usize,
     pub flank_cells_face: usize,
+    /// How many times finer the rows are in the band at the worm-tip trace (1: a node row on
+    /// the trace, no finer rows; 0: evenly spaced rows).
+    pub tip_trace_refinement: usize,
     pub positions: usize,
     pub teeth_each_side: usize,
     /// Marking thickness j, m.

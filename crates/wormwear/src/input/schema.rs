@@ -545,6 +545,11 @@ pub struct AnalysisSpec {
     /// Cells of the global wheel-flank grid along the face width.
     #[serde(default = "default_grid_face")]
     pub flank_cells_face: i64,
+    /// How many times finer the grid's rows are in the band at the worm-tip trace (MODEL §3.3):
+    /// 1 puts a node row on the trace with rows of the grid's height, 0 spaces the rows evenly
+    /// from the flank's foot to its top (before session 58).
+    #[serde(default = "default_tip_trace_refinement")]
+    pub tip_trace_refinement: i64,
     /// Kinematic positions per wheel tooth pitch (MODEL §4.1).
     #[serde(default = "default_positions")]
     pub positions: i64,
@@ -636,6 +641,9 @@ fn default_grid_height() -> i64 {
 fn default_grid_face() -> i64 {
     60
 }
+fn default_tip_trace_refinement() -> i64 {
+    4
+}
 fn default_positions() -> i64 {
     20
 }
@@ -657,6 +665,7 @@ impl Default for AnalysisSpec {
         Self {
             flank_cells_height: default_grid_height(),
             flank_cells_face: default_grid_face(),
+            tip_trace_refinement: default_tip_trace_refinement(),
             positions: default_positions(),
             teeth_each_side: default_teeth_each_side(),
             marking_thickness_um: default_marking(),

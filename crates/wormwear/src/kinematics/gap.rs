@@ -301,8 +301,7 @@ impl TipEdge {
     /// The broken tip edge of radius `radius` (m) on `flank` of `worm`.
     pub fn of(worm: &ThreadSurface, flank: Flank, radius: f64) -> Self {
         let tip = worm.def.tip_radius;
-        let slope = worm.axial_profile(flank, tip).1.abs();
-        let psi = slope.atan();
+        let psi = worm.tip_profile_angle(flank);
         Self {
             radius,
             tangent_radius: tip - radius * (1.0 - psi.sin()),

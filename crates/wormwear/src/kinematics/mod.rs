@@ -327,8 +327,11 @@ fn slice_minimum(
         (wf.node(best, j).r, best_gap)
     };
     // A contact-line crossing is a proper interior minimum: finite, larger gaps on both sides.
-    let h = 0.25 * (wf.r_high[j] - wf.r_low[j]) / ni as f64;
-    let at_end = !(f(r - h) < -gap && f(r + h) < -gap) || -f(r - h) >= 1.0 || -f(r + h) >= 1.0;
+    // (a minimum on the column's end node is its end, whatever the extension beyond it says)
+    let h = 0.25 * wf.largest_row_of(j);
+    let on_end = r <= wf.node(0, j).r || r >= wf.node(ni, j).r;
+    let at_end =
+        on_end || !(f(r - h) < -gap && f(r + h) < -gap) || -f(r - h) >= 1.0 || -f(r + h) >= 1.0;
     (r, gap, at_end)
 }
 

@@ -23,7 +23,7 @@ pub(super) fn curvature_radius(
     contacts: &[NodeContact],
 ) -> f64 {
     let z = wf.z[j];
-    let h = 0.25 * (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64;
+    let h = 0.25 * wf.largest_row_of(j);
     let gap =
         |rr: f64| ev.angular(rr, wf.column_theta(j, rr).0 + offset, z, theta2, theta1) * lever;
     let (gm, g0, gp) = (gap(r - h), gap(r), gap(r + h));
@@ -31,9 +31,7 @@ pub(super) fn curvature_radius(
     let ds = (pos(r + h) - pos(r - h)).norm() / 2.0;
     let g2 = (gp - 2.0 * g0 + gm) / (ds * ds);
     // Angle between the slice and the contact line (body frame), from the nearest node.
-    let i = (((r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]) * wf.cells_height as f64).round()
-        as usize)
-        .min(wf.cells_height);
+    let i = (wf.row_parameter(j, r).round().max(0.0) as usize).min(wf.cells_height);
     let c = &contacts[j * (wf.cells_height + 1) + i];
     let slice_dir = (pos(r + h) - pos(r - h)).normalize();
     let sin_b = slice_dir

@@ -30,8 +30,15 @@ impl PatternShape {
     /// `entry_at_low_z`. None for an empty pattern.
     pub fn of(wf: &WheelFlank, in_pattern: &[bool], entry_at_low_z: bool) -> Option<Self> {
         let (ni, nj) = (wf.cells_height, wf.cells_face);
+        // A node's height fraction on its column (0 at the foot, 1 at the top; the rows are
+        // not evenly spaced at the worm-tip trace, MODEL §3.3).
+        let fraction =
+            |i: usize, j: usize| (wf.node(i, j).r - wf.r_low[j]) / (wf.r_high[j] - wf.r_low[j]);
         let (mut area, mut across, mut up) = (0.0, 0.0, 0.0);
-        let (mut j_lo, mut j_hi, mut i_lo, mut i_hi) = (usize::MAX, 0, usize::MAX, 0);
+        let (mut j_lo, mut j_hi) = (usize::MAX, 0);
+        // The lowest and highest height fraction the pattern's cells reach (their rows' edges,
+        // the mean of the cell's two node columns).
+        let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
         for j in 0..nj {
             for i in 0..ni {
                 let k = j * ni + i;
@@ -41,9 +48,14 @@ impl PatternShape {
                 let a = wf.cell_area[k];
                 area += a;
                 across += a * (j as f64 + 0.5) / nj as f64;
-                up += a * (i as f64 + 0.5) / ni as f64;
+                let centre = fraction(i, j)
+                    + fraction(i + 1, j)
+                    + fraction(i, j + 1)
+                    + fraction(i + 1, j + 1);
+                up += a * 0.25 * centre;
                 (j_lo, j_hi) = (j_lo.min(j), j_hi.max(j));
-                (i_lo, i_hi) = (i_lo.min(i), i_hi.max(i));
+                low = low.min(0.5 * (fraction(i, j) + fraction(i, j + 1)));
+                high = high.max(0.5 * (fraction(i + 1, j) + fraction(i + 1, j + 1)));
             }
         }
         if area <= 0.0 {
@@ -59,7 +71,7 @@ impl PatternShape {
             },
             centre_up_flank: up / area,
             extent_along_face: (j_hi + 1 - j_lo) as f64 / nj as f64,
-            extent_up_flank: (i_hi + 1 - i_lo) as f64 / ni as f64,
+            extent_up_flank: high - low,
             entry_side_z_mm: 1e3
                 * if entry_at_low_z {
                     z_first.min(z_last)

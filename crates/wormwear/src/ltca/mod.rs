@@ -265,7 +265,7 @@ pub struct Ltca {
     /// loaded flank, Pa.
     pub pattern: Vec<f64>,
     pub max_pressure: f64,
-    /// Mean of the non-zero pattern cells, Pa.
+    /// Mean of the non-zero pattern cells weighted by their areas, Pa.
     pub mean_pressure: f64,
     /// Contact area / active flank area.
     pub s0: f64,

@@ -83,7 +83,7 @@ pub(super) fn local_flow_pressure_warning(
             let nj = wf.cells_face;
             let f = (c.z - wf.z[0]) / (wf.z[nj] - wf.z[0]) * nj as f64;
             let j = (f.max(0.0) as usize).min(nj - 1);
-            let cell_height = (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64;
+            let cell_height = wf.largest_row_of(j);
             let trace = tip_trace
                 .get(j)
                 .map_or(f64::NEG_INFINITY, |t| t.1 + tip_edge_height);
@@ -159,7 +159,7 @@ impl YieldedPlaces {
             let trace = tip_trace
                 .get(j)
                 .map_or(f64::NEG_INFINITY, |t| t.1 + tip_edge_height);
-            let cell_height = (wf.node(ni, j).r - wf.node(0, j).r) / ni as f64;
+            let cell_height = wf.largest_row_of(j);
             let which = Self::which(j, nj, (cell.r, trace, cell_height), i + 1 == ni);
             place.add(which, cell, wf.cell_area[k] / active);
         }
@@ -234,7 +234,7 @@ impl YieldedPlaces {
 }
 
 /// The loaded pattern's statistics (MODEL §5.6, §5.7): the mean pressure of the loaded cells
-/// (Pa), the loaded share of the active flank S0, the share above the mean S1 (of the active
+/// weighted by their areas (Pa), the loaded share of the active flank S0, the share above the mean S1 (of the active
 /// flank) and S2 (of the loaded area), and the share at the flow pressure `flow_pressure`.
 pub(super) struct PatternStats {
     pub(super) mean_pressure: f64,
@@ -254,10 +254,16 @@ impl PatternStats {
             .sum();
         let loaded: Vec<usize> = (0..pattern.len()).filter(|&k| pattern[k] > 0.0).collect();
         let contact_area: f64 = loaded.iter().map(|&k| wf.cell_area[k]).sum();
-        let mean_pressure = if loaded.is_empty() {
-            0.0
+        // The mean over the loaded area (MODEL §5.6's mean of the non-zero cells, weighted by
+        // their areas: the grid's rows are finer at the worm-tip trace, MODEL §3.3).
+        let mean_pressure = if contact_area > 0.0 {
+            loaded
+                .iter()
+                .map(|&k| pattern[k] * wf.cell_area[k])
+                .sum::<f64>()
+                / contact_area
         } else {
-            loaded.iter().map(|&k| pattern[k]).sum::<f64>() / loaded.len() as f64
+            0.0
         };
         let above: f64 = loaded
             .iter()
@@ -317,11 +323,11 @@ pub(super) fn swept_pattern(
             let mid: Vec<f64> = (0..ni)
                 .map(|i| 0.5 * (node_r(j, i) + node_r(j, i + 1)))
                 .collect();
-            // The plastic set's rows (MODEL §5.7): the grid's, rows_per_row times finer.
+            // The plastic set's rows (MODEL §5.7): the grid's, rows_per_row times finer (at
+            // the same height parameter, [`FlankField::with_rows`]).
             let rows = ni * rows_per_row;
-            let (low, high) = (node_r(j, 0), node_r(j, ni));
             let fine: Vec<f64> = (0..=rows)
-                .map(|i| low + (high - low) * i as f64 / rows as f64)
+                .map(|i| wf.row_radius(j, i as f64 / rows_per_row as f64))
                 .collect();
             (
                 passage::swept_max(samples, &mid, dt, passage::Swept::Pressure),
@@ -486,9 +492,7 @@ pub(super) fn plastic_rows_per_row(wf: &WheelFlank, settings: &LtcaSettings, ban
     if !settings.flow_pressure.is_finite() {
         return 1;
     }
-    let row = (0..=wf.cells_face)
-        .map(|j| (wf.r_high[j] - wf.r_low[j]) / wf.cells_height as f64)
-        .fold(0.0, f64::max);
+    let row = wf.largest_row();
     let cell = 2.0 * band / settings.columns.max(1) as f64;
     (4.0 * row / cell).ceil().clamp(1.0, 64.0) as usize
 }

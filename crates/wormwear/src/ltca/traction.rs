@@ -70,8 +70,8 @@ pub struct FilmGeometry {
     pub radii: ContactLineRadii,
     /// (u1, u2) of every node of the loaded flank, m/s ([`Tca::rolling_velocities`]).
     rolling: Vec<(f64, f64)>,
-    r_low: Vec<f64>,
-    r_high: Vec<f64>,
+    /// Radii of the loaded flank's nodes, m (same order).
+    node_radii: Vec<f64>,
     rows: usize,
 }
 
@@ -80,18 +80,22 @@ impl FilmGeometry {
         Self {
             radii: ContactLineRadii::of(tca),
             rolling: tca.rolling_velocities(wf),
-            r_low: wf.r_low.clone(),
-            r_high: wf.r_high.clone(),
+            node_radii: wf.nodes.iter().map(|n| n.r).collect(),
             rows: wf.cells_height,
         }
     }
 
     /// Rolling velocities of the node of column `j` nearest radius `r` (m).
     fn rolling_at(&self, j: usize, r: f64) -> (f64, f64) {
-        let ni = self.rows;
-        let t = (r - self.r_low[j]) / (self.r_high[j] - self.r_low[j]);
-        let i = (t * ni as f64).round().clamp(0.0, ni as f64) as usize;
-        self.rolling[j * (ni + 1) + i]
+        let n = self.rows + 1;
+        let column = &self.node_radii[j * n..(j + 1) * n];
+        let above = column.partition_point(|&x| x < r).min(n - 1);
+        let i = if above > 0 && r - column[above - 1] <= column[above] - r {
+            above - 1
+        } else {
+            above
+        };
+        self.rolling[j * n + i]
     }
 
     /// The line contact of each slice of a position's cells (a slice's cells are consecutive:

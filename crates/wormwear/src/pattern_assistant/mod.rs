@@ -547,8 +547,15 @@ impl Assistant {
 
     /// The shape of the asked pattern of `gear`: the unloaded analysis, and the loaded one
     /// with the gear file's bending for [`Which::Loaded`].
+    ///
+    /// The grid's rows are evenly spaced here: the band at the worm-tip trace (MODEL §3.3)
+    /// changes its row counts in steps as the settings move the trace, which would make the
+    /// objective jump where the search needs it continuous.
     fn shape(&self, gear: &GearSet) -> Result<Option<PatternShape>, String> {
         let chain = |e: &dyn std::error::Error| crate::runner::error_chain(e);
+        let mut even = gear.clone();
+        even.analysis.tip_trace_refinement = 0;
+        let gear = &even;
         let geo = Geometry::build(gear).map_err(|e| chain(&e))?;
         let tca = crate::kinematics::analyse(gear, &geo).map_err(|e| chain(&e))?;
         if self.which == Which::NoLoad {

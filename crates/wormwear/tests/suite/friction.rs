@@ -357,8 +357,8 @@ fn the_friction_maps_have_no_holes_between_positions_and_follow_the_passage() {
         let tca = kinematics::analyse(&g, &geo).unwrap();
         let l = ltca::analyse(&g, &geo, &tca).unwrap();
         let friction = MeshContacts::new(&g, &geo, &tca, &l).friction(&g.lubricant, &g.friction);
-        let holes = interior_holes(&friction.flank_coefficient, height);
         let wf = geo.wheel_flank(tca.loaded_flank);
+        let holes = interior_holes(&friction.flank_coefficient, wf.cells_height);
         let on_flank = on_flank(&friction, wf);
         eprintln!(
             "{height} x {face} cells, {positions} positions: {holes} holes, mesh loss {:.1} W",

@@ -534,6 +534,19 @@ fn wear_and_rating_sections_are_checked() {
         &error_of(&text),
         &["analysis.contact = \"rigid\"", "plastic, elastic"],
     );
+    // The band at the worm-tip trace: a whole number of times finer, at most 16.
+    for bad in ["-1", "17"] {
+        let text = set(
+            &design(),
+            "analysis",
+            "positions",
+            &format!("positions = 20\ntip_trace_refinement = {bad}"),
+        );
+        assert_mentions(
+            &error_of(&text),
+            &[&format!("analysis.tip_trace_refinement = {bad}"), "[0, 16]"],
+        );
+    }
 }
 
 #[test]

@@ -448,7 +448,8 @@ fn the_loaded_pattern_has_no_holes_and_its_area_and_mean_converge() {
         g.analysis.flank_cells_face = face;
         g.analysis.positions = positions;
         let l = run(&g, &LtcaSettings::from_gear(&g));
-        let holes = interior_holes(&l.pattern, height);
+        // (the grid's rows: the nominal height and the band at the worm-tip trace, MODEL §3.3)
+        let holes = interior_holes(&l.pattern, l.pattern.len() / face);
         eprintln!(
             "{height} x {face} cells, {positions} positions: S0 {:.4}, P_mean {:.1} MPa, {holes} holes",
             l.s0,

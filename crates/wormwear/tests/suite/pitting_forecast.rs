@@ -275,7 +275,9 @@ fn the_damage_warning_counts_a_row_of_damaged_nodes_as_the_area_between_its_neig
     // area it stands for is half of each cell row beside it, rows 2 and 3 (a node's dual
     // area): computed here from the cell areas, the forecast's onset share. Counting every
     // cell that touches a damaged node would take both rows whole, twice that.
-    let g = coarse();
+    // (evenly spaced rows: a row of the band at the worm-tip trace holds a quarter of that)
+    let mut g = coarse();
+    g.analysis.tip_trace_refinement = 0;
     let geo = wormwear::geometry::Geometry::build(&g).unwrap();
     let tca = wormwear::kinematics::analyse(&g, &geo).unwrap();
     let wf = geo.wheel_flank(tca.loaded_flank);

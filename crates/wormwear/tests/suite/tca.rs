@@ -190,9 +190,22 @@ fn centre_distance_change_acts_linearly_with_the_expected_sign() {
     let measure = |d: f64| {
         let mut g = base.clone();
         g.operating.centre_distance += d;
-        let (geo, tca) = run(&g);
+        // The same wheel (its grid's band placed at the base's worm-tip trace), the worm moved.
+        let geo = Geometry::build(&base).unwrap();
+        let tca = kinematics::analyse(&g, &geo).unwrap();
         let wf = geo.wheel_flank(tca.loaded_flank);
         let ke: Vec<f64> = tca.positions.iter().map(|p| p.kinematic_error).collect();
+        // Whether each position's first contact is a line's end (an edge: the wheel's tip
+        // edge at a face end), which the interior crossings' first order does not cover.
+        let first_at_end: Vec<bool> = (0..ke.len())
+            .map(|n| {
+                tca.contact_lines
+                    .iter()
+                    .filter(|c| c.position == n)
+                    .min_by(|a, b| a.separation.total_cmp(&b.separation))
+                    .is_some_and(|c| c.at_end)
+            })
+            .collect();
         let (mut sa, mut sr) = (0.0, 0.0);
         for (k, &m) in tca.marked.iter().enumerate() {
             if m {
@@ -200,12 +213,12 @@ fn centre_distance_change_acts_linearly_with_the_expected_sign() {
                 sr += wf.cell_area[k] * wf.cells[k].r;
             }
         }
-        let mid = wf.cells_face / 2;
-        (ke, sr / sa, tca.tip_trace[mid])
+        (ke, sr / sa, first_at_end)
     };
     let (k0, _, _) = measure(0.0);
-    let (k1, _, _) = measure(da);
+    let (k1, _, edge1) = measure(da);
     let (k2, _, _) = measure(2.0 * da);
+    let mut compared = 0;
     for n in 0..k0.len() {
         let (d1, d2) = (k1[n] - k0[n], k2[n] - k0[n]);
         // The worm moves away: the wheel must turn back further to touch (more lag) ...
@@ -217,15 +230,26 @@ fn centre_distance_change_acts_linearly_with_the_expected_sign() {
             (d2 / d1 - 2.0).abs() < 0.05 * 2.0,
             "position {n}: KE not linear: {d1:e}, {d2:e}"
         );
-        // ... as the first-order sensitivity says.
+        // ... as the first-order sensitivity says, where the first contact is an interior
+        // crossing (the grid's node row on the worm-tip trace, MODEL §3.3, finds the wheel's
+        // tip edge at a face end first at one position of 20 here).
         // (3 %: the prediction uses interior line crossings only, not line ends on the worm-tip
         // reach boundary, which can be the first contact at some positions)
+        if edge1[n] {
+            continue;
+        }
+        compared += 1;
         assert!(
             (d1 / predicted[n] - 1.0).abs() < 0.03,
             "position {n}: KE shift {d1:e} vs first order {:e}",
             predicted[n]
         );
     }
+    assert!(
+        compared + 2 >= k0.len(),
+        "{compared} of {} positions compared",
+        k0.len()
+    );
 }
 
 #[test]
@@ -504,7 +528,9 @@ fn edge_reliefs_are_parabolic_and_vanish_inside() {
 #[test]
 fn the_pattern_shape_reads_its_cells_its_entry_side_and_follows_the_worm() {
     use wormwear::kinematics::pattern_shape::PatternShape;
-    let over = localised();
+    // (evenly spaced rows, so that a block of rows is its share of the height)
+    let mut over = localised();
+    over.analysis.tip_trace_refinement = 0;
     let (geo, tca) = run(&over);
     let wf = geo.wheel_flank(tca.loaded_flank);
     let (ni, nj) = (wf.cells_height, wf.cells_face);
@@ -516,7 +542,7 @@ fn the_pattern_shape_reads_its_cells_its_entry_side_and_follows_the_worm() {
         PatternShape::of(wf, &block, false).unwrap(),
     );
     assert_eq!(low.extent_along_face, 10.0 / nj as f64);
-    assert_eq!(low.extent_up_flank, 10.0 / ni as f64);
+    assert!((low.extent_up_flank - 10.0 / ni as f64).abs() < 1e-12);
     assert!(low.centre_across_face > 10.0 / nj as f64 && low.centre_across_face < 20.0 / nj as f64);
     assert!((low.centre_across_face + high.centre_across_face - 1.0).abs() < 1e-12);
     assert!(PatternShape::of(wf, &vec![false; ni * nj], true).is_none());

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 use wormwear::geometry::placement::wheel_point;
 use wormwear::geometry::wheel::generate_point;
-use wormwear::geometry::{Flank, FlankPoint, Geometry, Hobbing, WheelFlank};
+use wormwear::geometry::{Flank, FlankPoint, Geometry, Hobbing, PointKind, WheelFlank};
 use wormwear::input::{self, GearSet, Hand};
 
 const MM: f64 = 1e-3;
@@ -347,7 +347,9 @@ fn bilinear_centre_error(wf: &WheelFlank, z_max: f64) -> f64 {
 
 #[test]
 fn grid_refinement_is_consistent_and_converges() {
-    let g = example("gear-1x40-design.toml");
+    // (evenly spaced rows: the band at the worm-tip trace does not nest under refinement)
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.tip_trace_refinement = 0;
     let coarse = Geometry::build_with_grid(&g, 10, 15).unwrap();
     let fine = Geometry::build_with_grid(&g, 20, 30).unwrap();
     let finer = Geometry::build_with_grid(&g, 40, 60).unwrap();
@@ -592,4 +594,76 @@ fn a_centre_distance_changed_alone_names_the_blank_radii_that_follow_it() {
         .replace("outer_radius_mm = 110.0", "outer_radius_mm = 115.0");
     let g = input::load_from_str(&fitted).unwrap();
     assert!(Geometry::build(&g).is_ok());
+}
+
+#[test]
+fn a_node_row_lies_on_the_worm_tip_trace_and_a_finer_band_covers_the_edge() {
+    // MODEL §3.3: below the worm-tip trace the worm never touches and above it the flank
+    // wears, so the grid puts a node row on it. Checked against the worm's own envelope (the
+    // worm at its operating placement generating the wheel): at that node the worm's flank
+    // generates the point, half a band row below it the worm's tip edge does (the row lies a
+    // fiftieth of a band row inside the worm's reach, `rows::TRACE_CLEARANCE`).
+    // The band above it is four times finer and reaches past the strip the 1 mm tip edge sweeps.
+    let mut g = example("gear-1x40-design.toml");
+    g.worm.tip_edge_radius = 1.0 * MM;
+    let geo = Geometry::build(&g).unwrap();
+    let worm_cut = Hobbing::new(&geo.worm, g.operating, geo.teeth);
+    let mut checked = 0;
+    for flank in Flank::BOTH {
+        let wf = geo.wheel_flank(flank);
+        let psi = geo.worm.tip_profile_angle(flank);
+        let edge_start = geo.worm.def.tip_radius - g.worm.tip_edge_radius * (1.0 - psi.sin());
+        for j in (0..=wf.cells_face).step_by(5) {
+            let z = wf.z[j];
+            let kind = |r: f64| worm_cut.envelope(flank, r, z).kind;
+            let Some(i) =
+                (0..=wf.cells_height).find(|&i| kind(wf.node(i, j).r) == PointKind::Flank)
+            else {
+                panic!("column {j}: the worm reaches no node");
+            };
+            let nominal = (wf.r_high[j] - wf.r_low[j]) / g.analysis.flank_cells_height as f64;
+            if wf.node(i, j).r - wf.r_low[j] < 0.2 * nominal {
+                continue; // the trace within a fifth of a row of the foot: the foot is the trace
+            }
+            let r = wf.node(i, j).r;
+            let row = wf.node(i + 1, j).r - r;
+            assert_ne!(
+                kind(r - 0.5 * row),
+                PointKind::Flank,
+                "column {j}: the trace lies below node {i}"
+            );
+            assert!(
+                row < 0.3 * nominal,
+                "column {j}: band row {row:e} m of {nominal:e}"
+            );
+            // The band's last fine row lies above the edge's strip.
+            let last_fine = (i..wf.cells_height)
+                .take_while(|&k| wf.node(k + 1, j).r - wf.node(k, j).r < 0.3 * nominal)
+                .last()
+                .unwrap();
+            let top = worm_cut.envelope(flank, wf.node(last_fine + 1, j).r, z);
+            assert!(
+                top.hob_radius < edge_start,
+                "column {j}: the band ends on the edge"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 10, "{checked} columns checked");
+}
+
+#[test]
+fn without_refinement_the_rows_are_evenly_spaced_as_before() {
+    let mut g = example("gear-1x40-design.toml");
+    g.analysis.tip_trace_refinement = 0;
+    let geo = Geometry::build_with_grid(&g, 12, 10).unwrap();
+    for wf in &geo.wheel_flanks {
+        assert_eq!(wf.cells_height, 12);
+        for j in 0..=wf.cells_face {
+            let (lo, hi) = (wf.r_low[j], wf.r_high[j]);
+            for i in 0..=12 {
+                assert_eq!(wf.node(i, j).r, lo + (hi - lo) * i as f64 / 12.0);
+            }
+        }
+    }
 }

@@ -12,6 +12,12 @@ pub(super) fn analysis_settings(
 ) -> Option<Analysis> {
     let height = ck.int_range("analysis.flank_cells_height", a.flank_cells_height, 4, 400);
     let face = ck.int_range("analysis.flank_cells_face", a.flank_cells_face, 4, 400);
+    let refinement = ck.int_range(
+        "analysis.tip_trace_refinement",
+        a.tip_trace_refinement,
+        0,
+        16,
+    );
     let positions = ck.int_range("analysis.positions", a.positions, 4, 720);
     let teeth_each_side = ck.int_range("analysis.teeth_each_side", a.teeth_each_side, 1, 10);
     let marking = ck
@@ -35,6 +41,7 @@ pub(super) fn analysis_settings(
     let mut analysis = contact?;
     analysis.flank_cells_height = height? as usize;
     analysis.flank_cells_face = face? as usize;
+    analysis.tip_trace_refinement = refinement? as usize;
     analysis.positions = positions? as usize;
     analysis.teeth_each_side = teeth_each_side? as usize;
     analysis.marking_thickness = marking?;
@@ -140,6 +147,7 @@ pub(super) fn contact_settings(ck: &mut Checker, a: &AnalysisSpec) -> Option<Ana
     Some(Analysis {
         flank_cells_height: 0,
         flank_cells_face: 0,
+        tip_trace_refinement: 0,
         positions: 0,
         teeth_each_side: 0,
         marking_thickness: 0.0,
