@@ -183,8 +183,10 @@ fn analysis_files(
     file: String,
     dir: &Path,
 ) -> Result<Vec<PathBuf>, PatternError> {
-    let gear = crate::input::load_from_str(text)
+    let mut gear = crate::input::load_from_str(text)
         .map_err(|e| PatternError::Base(crate::runner::error_chain(&e)))?;
+    // On the evenly spaced rows the search reads the pattern on (`Assistant::shape`).
+    gear.analysis.tip_trace_refinement = 0;
     let stage = match which {
         Which::NoLoad => Stage::Tca,
         Which::Loaded => Stage::Ltca,
