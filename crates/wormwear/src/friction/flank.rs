@@ -5,6 +5,7 @@
 //! bands nor depend on where the positions fall. Shares sum to one: a map integrates to the
 //! mesh loss. SI units (m, rad).
 
+use crate::geometry::rows::row_parameter_on;
 use crate::geometry::WheelFlank;
 use crate::kinematics::Tca;
 use crate::ltca::Ltca;
@@ -30,12 +31,7 @@ impl<'a> FlankGrid<'a> {
     /// extended with its end rows) of radius r on node column j.
     fn row_parameter(&self, j: usize, r: f64) -> f64 {
         let n = self.rows + 1;
-        let c = &self.radii[j * n..(j + 1) * n];
-        let i = c
-            .partition_point(|&x| x <= r)
-            .saturating_sub(1)
-            .min(self.rows - 1);
-        i as f64 + (r - c[i]) / (c[i + 1] - c[i])
+        row_parameter_on(&self.radii[j * n..(j + 1) * n], |&x| x, r)
     }
 
     /// The grid cells under a strip spanning radii `r` (low, high) and z +- `half_dz` (m),

@@ -192,9 +192,65 @@ fn run(lo: f64, hi: f64, t: f64, n: usize) -> f64 {
     }
 }
 
+/// The height parameter of radius `r` (m) on one node column whose nodes' radii ascend
+/// (`radius` reads a node's): the row index, fractional between two nodes (linear in r, since
+/// the rows are evenly spaced only within each run), extended with the end rows beyond the
+/// column (MODEL §3.3).
+pub fn row_parameter_on<T>(column: &[T], radius: impl Fn(&T) -> f64, r: f64) -> f64 {
+    let rows = column.len() - 1;
+    let i = column
+        .partition_point(|p| radius(p) <= r)
+        .saturating_sub(1)
+        .min(rows - 1);
+    let (lo, hi) = (radius(&column[i]), radius(&column[i + 1]));
+    i as f64 + (r - lo) / (hi - lo)
+}
+
+/// The node of a column (as [`row_parameter_on`]) nearest radius `r`: the lower of two equally
+/// near, the end node beyond the column.
+pub fn nearest_node_on<T>(column: &[T], radius: impl Fn(&T) -> f64, r: f64) -> usize {
+    let rows = column.len() - 1;
+    let g = row_parameter_on(column, radius, r);
+    if g <= 0.0 {
+        return 0;
+    }
+    let i = (g.floor() as usize).min(rows);
+    if i < rows && g - i as f64 > 0.5 {
+        i + 1
+    } else {
+        i
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_radius_reads_its_row_between_uneven_nodes_and_its_nearest_node() {
+        let radii = [1.0, 2.0, 2.5, 4.5];
+        let at = |r| row_parameter_on(&radii, |&x| x, r);
+        let near = |r| nearest_node_on(&radii, |&x| x, r);
+        assert_eq!(at(1.0), 0.0);
+        assert_eq!(at(2.25), 1.5);
+        assert_eq!(at(3.5), 2.5);
+        assert_eq!(at(4.5), 3.0);
+        // Beyond the column, its end rows extended.
+        assert_eq!(at(0.5), -0.5);
+        assert_eq!(at(5.5), 3.5);
+        // Nearest: the lower of two equally near, the end nodes beyond.
+        assert_eq!(
+            [
+                near(0.0),
+                near(1.5),
+                near(1.6),
+                near(2.2),
+                near(3.6),
+                near(9.0)
+            ],
+            [0, 0, 1, 1, 3, 3]
+        );
+    }
 
     fn column(trace: f64, strip_top: f64) -> ColumnKnots {
         let reach = WormReach { trace, strip_top };

@@ -124,12 +124,7 @@ impl WheelFlank {
     /// §3.3; the rows are evenly spaced only within each run, `rows.rs`).
     #[inline]
     pub fn row_parameter(&self, j: usize, r: f64) -> f64 {
-        let c = self.column_nodes(j);
-        let i = c
-            .partition_point(|p| p.r <= r)
-            .saturating_sub(1)
-            .min(self.cells_height - 1);
-        i as f64 + (r - c[i].r) / (c[i + 1].r - c[i].r)
+        super::rows::row_parameter_on(self.column_nodes(j), |p| p.r, r)
     }
 
     /// Radius at height parameter g on node column j (inverse of [`Self::row_parameter`]), m.

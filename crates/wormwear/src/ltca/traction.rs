@@ -11,6 +11,7 @@
 //! film, with the curvature rule at the band's end. SI units.
 
 use super::*;
+use crate::geometry::rows::nearest_node_on;
 use crate::input::{FrictionLaw, Lubricant};
 use crate::kinematics::material_velocities;
 use crate::lubrication::{FlankRoughness, LineContact};
@@ -89,13 +90,7 @@ impl FilmGeometry {
     fn rolling_at(&self, j: usize, r: f64) -> (f64, f64) {
         let n = self.rows + 1;
         let column = &self.node_radii[j * n..(j + 1) * n];
-        let above = column.partition_point(|&x| x < r).min(n - 1);
-        let i = if above > 0 && r - column[above - 1] <= column[above] - r {
-            above - 1
-        } else {
-            above
-        };
-        self.rolling[j * n + i]
+        self.rolling[j * n + nearest_node_on(column, |&x| x, r)]
     }
 
     /// The line contact of each slice of a position's cells (a slice's cells are consecutive:
