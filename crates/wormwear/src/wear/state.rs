@@ -262,6 +262,10 @@ pub struct StepRecord {
     /// records of earlier versions).
     #[serde(default)]
     pub equivalent_pressure_max_pa: f64,
+    /// The equivalent pressure exceeded on 2 % of the active flank, p_eq,2% (MODEL §8.1: the
+    /// area of first pitting, A_p10, which S_H reads), Pa (0 in records of earlier versions).
+    #[serde(default)]
+    pub equivalent_pressure_first_pitting_pa: f64,
     /// Composite roughness R_q over the active flank once this state's wear has run it in
     /// (MODEL §6.1): area-weighted mean and smallest, m (the lubricant's without running-in;
     /// 0 in records of earlier versions).

@@ -256,6 +256,34 @@ fn rank_first_pitting_is_evaluated_with_the_model_mean_pressure() {
 }
 
 #[test]
+fn the_records_carry_the_pressure_exceeded_on_the_area_of_first_pitting() {
+    // MODEL §8.1: p_eq,2% (what S_H reads) per state. The unworn state's is the loaded
+    // analysis's own, reached by the life's runner and by the analysis alone; it lies below
+    // the largest p_eq (2 % of the flank is more than one cell) and above zero.
+    let g = design();
+    let (geo, tca) = prepared(&g);
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let (end, _) = life(
+        &g,
+        &geo,
+        &tca,
+        &WearPlan::with_life(1.0),
+        WearState::new(wf),
+    );
+    let r = &end.records[0];
+    let alone = ltca::analyse_with(&g, &geo, &tca, &LtcaSettings::from_gear(&g), None).unwrap();
+    eprintln!(
+        "p_eq,2% {:.1} MPa (analysis alone {:.1}), largest p_eq {:.1} MPa",
+        r.equivalent_pressure_first_pitting_pa / 1e6,
+        alone.equivalent_pressure_first_pitting / 1e6,
+        r.equivalent_pressure_max_pa / 1e6
+    );
+    let p = r.equivalent_pressure_first_pitting_pa;
+    assert!((p / alone.equivalent_pressure_first_pitting - 1.0).abs() < 1e-9);
+    assert!(p > 0.0 && p < r.equivalent_pressure_max_pa);
+}
+
+#[test]
 fn a_uniform_angular_recession_is_all_rigid_lag() {
     // MODEL §12 j: a flank worn by the same angle everywhere (normal depth delta x lever)
     // lags the wheel by delta and changes nothing else: the TE drops by delta at every

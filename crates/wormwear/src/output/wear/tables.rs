@@ -212,7 +212,7 @@ pub fn te_orders_table(records: &[crate::wear::StepRecord]) -> Csv {
 /// The columns of `wear_steps.csv` (units in the names) and how each reads a record.
 type StepColumn = (&'static str, fn(&crate::wear::StepRecord) -> f64);
 
-const STEP_COLUMNS: [StepColumn; 43] = [
+const STEP_COLUMNS: [StepColumn; 44] = [
     ("step", |r| r.step as f64),
     ("cycles", |r| r.cycles),
     ("step_cycles", |r| r.step_cycles),
@@ -255,6 +255,9 @@ const STEP_COLUMNS: [StepColumn; 43] = [
     ("yielded_area_fraction", |r| r.yielded_area_fraction),
     ("equivalent_pressure_max_pa", |r| {
         r.equivalent_pressure_max_pa
+    }),
+    ("equivalent_pressure_first_pitting_pa", |r| {
+        r.equivalent_pressure_first_pitting_pa
     }),
     ("friction_coefficient_mean", |r| {
         r.friction.friction_coefficient_mean

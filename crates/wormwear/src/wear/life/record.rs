@@ -137,6 +137,7 @@ impl LifeLoop<'_> {
             band_edge_share: Some(l.band_edge_share())
                 .filter(|&s| s > crate::ltca::BAND_EDGE_WARNING),
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
             roughness_mean_m: roughness.0,
             roughness_min_m: roughness.1,
             friction: crate::wear::StateFriction::of(thermal),
