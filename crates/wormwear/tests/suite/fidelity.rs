@@ -58,6 +58,12 @@ fn life(
     (end, views)
 }
 
+/// A life of one cycle from the unworn flank: its first record is the unworn state's.
+fn unworn_life(g: &GearSet, geo: &Geometry, tca: &Tca) -> WearState {
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    life(g, geo, tca, &WearPlan::with_life(1.0), WearState::new(wf)).0
+}
+
 #[test]
 fn the_examples_have_no_relief_and_the_plastic_limit_at_the_hardness() {
     // MODEL §12 i: sharp edges; the contact bounded by the bronze's flow pressure, the
@@ -226,14 +232,7 @@ fn rank_first_pitting_is_evaluated_with_the_model_mean_pressure() {
     let g = design();
     assert_eq!(g.wheel_material.pitting_limit, 520e6);
     let (geo, tca) = prepared(&g);
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let (end, _) = life(
-        &g,
-        &geo,
-        &tca,
-        &WearPlan::with_life(1.0),
-        WearState::new(wf),
-    );
+    let end = unworn_life(&g, &geo, &tca);
     let r = &end.records[0];
     let d1 = 2.0 * g.worm.reference_radius;
     let gamma = (g.worm.lead() / (PI * d1)).atan();
@@ -262,14 +261,7 @@ fn the_records_carry_the_pressure_exceeded_on_the_area_of_first_pitting() {
     // the largest p_eq (2 % of the flank is more than one cell) and above zero.
     let g = design();
     let (geo, tca) = prepared(&g);
-    let wf = geo.wheel_flank(tca.loaded_flank);
-    let (end, _) = life(
-        &g,
-        &geo,
-        &tca,
-        &WearPlan::with_life(1.0),
-        WearState::new(wf),
-    );
+    let end = unworn_life(&g, &geo, &tca);
     let r = &end.records[0];
     let alone = ltca::analyse_with(&g, &geo, &tca, &LtcaSettings::from_gear(&g), None).unwrap();
     eprintln!(
@@ -291,13 +283,7 @@ fn a_uniform_angular_recession_is_all_rigid_lag() {
     let g = design();
     let (geo, tca) = prepared(&g);
     let wf = geo.wheel_flank(tca.loaded_flank);
-    let (unworn, _) = life(
-        &g,
-        &geo,
-        &tca,
-        &WearPlan::with_life(1.0),
-        WearState::new(wf),
-    );
+    let unworn = unworn_life(&g, &geo, &tca);
     let delta = 2e-5;
     let mut state = WearState::new(wf);
     for (k, n) in wf.nodes.iter().enumerate() {

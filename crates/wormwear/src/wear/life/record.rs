@@ -90,10 +90,7 @@ impl LifeLoop<'_> {
             cycles: state.cycles,
             step_cycles,
             substeps,
-            phase: match phase {
-                Some((_, Phase::Pitting { .. }, _)) => "pitting".into(),
-                _ => "wear".into(),
-            },
+            phase: phase_name(phase),
             pitted_area_fraction: pitted_fraction(wf, &state.pitted),
             max_wear_m: state.removal.max(),
             max_wear_r_m: worst_node.map_or(f64::NAN, |n| n.r),
@@ -166,6 +163,14 @@ impl LifeLoop<'_> {
     fn initial_backlash_linear(&self) -> f64 {
         self.initial_backlash.iter().sum::<f64>() / self.initial_backlash.len().max(1) as f64
             * self.backlash.reference_radius
+    }
+}
+
+/// The name of a state's phase in its record: "pitting" or "wear".
+fn phase_name(phase: Option<(usize, Phase, f64)>) -> String {
+    match phase {
+        Some((_, Phase::Pitting { .. }, _)) => "pitting".into(),
+        _ => "wear".into(),
     }
 }
 
