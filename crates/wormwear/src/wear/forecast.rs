@@ -29,6 +29,7 @@ use crate::geometry::WheelFlank;
 use crate::input::{Endurance, NodeReading, PitDepth, PittingStress};
 use crate::ltca::Ltca;
 use crate::pitting::CellLoad;
+use crate::wear::StepRecord;
 
 /// Damage at or above which a node has reached its life (round-off of the exact step end).
 pub const REACHED: f64 = 1.0 - 1e-9;
@@ -247,6 +248,44 @@ pub fn node_value(cells: impl Iterator<Item = (f64, f64)>, reading: NodeReading)
         NodeReading::Interpolated if count > 0 => (sum / count as f64, largest.1),
         NodeReading::Interpolated => (0.0, 0.0),
     }
+}
+
+/// The area reading of first pitting (MODEL §8.1: pitting is an area, the forecast reads
+/// p_eq,2%): damage per cycle of the state of `record`, the life of its p_eq,2% on the
+/// pressure–life curve inverted (with a duty cycle each bin's at its cycle share); zero in a
+/// pitting phase, where the nodes' damage holds too.
+pub fn area_damage_rate(record: &StepRecord, curve: &Endurance) -> f64 {
+    if record.phase == "pitting" {
+        return 0.0;
+    }
+    if record.bins.is_empty() {
+        return 1.0 / curve.life(record.equivalent_pressure_first_pitting_pa);
+    }
+    record
+        .bins
+        .iter()
+        .map(|b| b.cycle_share / curve.life(b.equivalent_pressure_first_pitting_pa))
+        .sum()
+}
+
+/// The area reading's Miner sum at `cycles` after the state of `last` (none: the life's first
+/// state, 0), whose rate holds over the step (as the nodes' loads do, MODEL §7.3).
+pub fn area_damage_after(last: Option<&StepRecord>, cycles: f64, curve: &Endurance) -> f64 {
+    last.map_or(0.0, |r| {
+        r.area_damage + (cycles - r.cycles).max(0.0) * area_damage_rate(r, curve)
+    })
+}
+
+/// Cycles at which the area reading's Miner sum reaches 1 over `records` (None: not within
+/// them): within the step that crosses it, where its rate is constant.
+pub fn area_first_pitting_cycles(records: &[StepRecord], curve: &Endurance) -> Option<f64> {
+    records.windows(2).find_map(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        (b.area_damage >= REACHED).then(|| {
+            let rate = area_damage_rate(a, curve);
+            a.cycles + ((1.0 - a.area_damage) / rate).clamp(0.0, b.cycles - a.cycles)
+        })
+    })
 }
 
 /// A phase of a life as it happened: kind ("wear" or "pitting"), start and end cycles, and

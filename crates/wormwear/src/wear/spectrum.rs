@@ -37,6 +37,9 @@ pub struct BinRecord {
     pub max_pressure_pa: f64,
     pub pressure_patch_max_pa: f64,
     pub equivalent_pressure_max_pa: f64,
+    /// p_eq,2% of the bin's analysis (MODEL §8.1), Pa (0 in records of earlier versions).
+    #[serde(default)]
+    pub equivalent_pressure_first_pitting_pa: f64,
     /// Largest depth the bin wears per wheel cycle, m.
     pub max_wear_per_cycle_m: f64,
     /// Volume the bin wears per wheel cycle, m^3.
@@ -61,6 +64,7 @@ impl BinRecord {
             max_pressure_pa: l.max_pressure,
             pressure_patch_max_pa: l.pressure_patch_max,
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
+            equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
             max_wear_per_cycle_m: cw.depth.max(),
             worn_volume_per_cycle_m3: cw.depth.integral(wf),
             friction: StateFriction::of(thermal),

@@ -266,6 +266,13 @@ pub struct StepRecord {
     /// area of first pitting, A_p10, which S_H reads), Pa (0 in records of earlier versions).
     #[serde(default)]
     pub equivalent_pressure_first_pitting_pa: f64,
+    /// The area reading of first pitting (MODEL §8.1): the Miner sum over the wear steps so far
+    /// of each step's cycles over the life of p_eq,2% (of the state that starts it, each bin's
+    /// at its cycle share with a duty cycle) on the pressure–life curve; 1 is first pitting on
+    /// 2 % of the flank. Held over pitting phases, as the nodes' damage is (0 in records of
+    /// earlier versions).
+    #[serde(default)]
+    pub area_damage: f64,
     /// Composite roughness R_q over the active flank once this state's wear has run it in
     /// (MODEL §6.1): area-weighted mean and smallest, m (the lubricant's without running-in;
     /// 0 in records of earlier versions).

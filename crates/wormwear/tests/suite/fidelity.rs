@@ -276,6 +276,83 @@ fn the_records_carry_the_pressure_exceeded_on_the_area_of_first_pitting() {
 }
 
 #[test]
+fn the_area_reading_of_first_pitting_is_the_miner_sum_of_the_states_area_pressure() {
+    // MODEL §8.1: the forecast reads p_eq,2%. Each wear step adds its cycles over the life of
+    // the starting state's p_eq,2% on the pressure–life curve (written here from the curve's
+    // own power law); a pitting phase holds the sum; first pitting is where the sum reaches 1,
+    // within the step that crosses it. A curve shifted so that it is crossed in a short life.
+    let g = design();
+    let (geo, tca) = prepared(&g);
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let mut plan = WearPlan::with_life(40_000.0);
+    plan.step = wormwear::wear::StepControl::Cycles(10_000.0);
+    plan.phases = vec![
+        Phase::Wear { until: 20_000.0 },
+        Phase::Pitting {
+            until: 30_000.0,
+            pressure_limit: Some(1e12),
+            margin: 0.0,
+        },
+        Phase::Wear { until: 40_000.0 },
+    ];
+    let (p_ref, n_ref, b) = (800e6, 15_000.0, 0.176);
+    plan.endurance = wormwear::input::Endurance {
+        reference_pressure: p_ref,
+        reference_cycles: n_ref,
+        exponent: b,
+        life_factor: 1.0,
+    };
+    let (end, _) = life(&g, &geo, &tca, &plan, WearState::new(wf));
+    let records = &end.records;
+    let life_at = |p: f64| n_ref * (p / p_ref).powf(-1.0 / b);
+    let (mut sum, mut crossing) = (0.0, None);
+    for w in records.windows(2) {
+        let (a, r) = (&w[0], &w[1]);
+        let rate = match a.phase.as_str() {
+            "pitting" => 0.0,
+            _ => 1.0 / life_at(a.equivalent_pressure_first_pitting_pa),
+        };
+        if sum < 1.0 && sum + (r.cycles - a.cycles) * rate >= 1.0 {
+            crossing = Some(a.cycles + (1.0 - sum) / rate);
+        }
+        sum += (r.cycles - a.cycles) * rate;
+        eprintln!(
+            "{:>6.0} cycles, {}: p_eq,2% {:.1} MPa, sum {:.4} (record {:.4})",
+            r.cycles,
+            r.phase,
+            a.equivalent_pressure_first_pitting_pa / 1e6,
+            sum,
+            r.area_damage
+        );
+        assert!((r.area_damage - sum).abs() <= 1e-12 * sum.max(1.0));
+        if a.phase == "pitting" {
+            assert_eq!(r.area_damage, a.area_damage);
+        }
+    }
+    assert_eq!(records[0].area_damage, 0.0);
+    assert!(records.iter().any(|r| r.phase == "pitting"));
+    let first = wormwear::wear::forecast::area_first_pitting_cycles(records, &plan.endurance);
+    let (got, expected) = (first.expect("not crossed"), crossing.unwrap());
+    assert!(
+        (got / expected - 1.0).abs() < 1e-12,
+        "{got} against {expected}"
+    );
+    // Not crossed: none.
+    plan.endurance.reference_cycles = 1e9;
+    let records: Vec<_> = records
+        .iter()
+        .map(|r| wormwear::wear::StepRecord {
+            area_damage: r.area_damage * n_ref / 1e9,
+            ..r.clone()
+        })
+        .collect();
+    assert_eq!(
+        wormwear::wear::forecast::area_first_pitting_cycles(&records, &plan.endurance),
+        None
+    );
+}
+
+#[test]
 fn a_uniform_angular_recession_is_all_rigid_lag() {
     // MODEL §12 j: a flank worn by the same angle everywhere (normal depth delta x lever)
     // lags the wheel by delta and changes nothing else: the TE drops by delta at every

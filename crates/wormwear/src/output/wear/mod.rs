@@ -75,6 +75,11 @@ pub struct WearSummary<'a> {
     pub pitting: crate::input::Pitting,
     /// The phases of the life as they happened (consecutive states of one kind joined).
     pub phases: Vec<crate::wear::forecast::PhaseSpan>,
+    /// The area reading of first pitting (MODEL §8.1): where the Miner sum of the states'
+    /// p_eq,2% on the pressure–life curve (`area_damage` of the steps) reaches 1, cycles; null
+    /// where it does not within the life. Beside the forecast's nodes (`phases`), whatever
+    /// `pitting` is.
+    pub area_first_pitting_cycles: Option<f64>,
     /// The schedule a forecast found (its phases with their pressure limits; run it as a
     /// `[wear] phases` schedule to repeat the life); empty without a forecast.
     pub found_phases: &'a [crate::wear::Phase],

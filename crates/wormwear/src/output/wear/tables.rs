@@ -212,7 +212,7 @@ pub fn te_orders_table(records: &[crate::wear::StepRecord]) -> Csv {
 /// The columns of `wear_steps.csv` (units in the names) and how each reads a record.
 type StepColumn = (&'static str, fn(&crate::wear::StepRecord) -> f64);
 
-const STEP_COLUMNS: [StepColumn; 44] = [
+const STEP_COLUMNS: [StepColumn; 45] = [
     ("step", |r| r.step as f64),
     ("cycles", |r| r.cycles),
     ("step_cycles", |r| r.step_cycles),
@@ -259,6 +259,7 @@ const STEP_COLUMNS: [StepColumn; 44] = [
     ("equivalent_pressure_first_pitting_pa", |r| {
         r.equivalent_pressure_first_pitting_pa
     }),
+    ("area_damage", |r| r.area_damage),
     ("friction_coefficient_mean", |r| {
         r.friction.friction_coefficient_mean
     }),
@@ -307,6 +308,10 @@ pub fn summary_value(
         limits: LimitsSummary::new(gear, geo, tca, plan, state),
         pitting: plan.pitting,
         phases: crate::wear::forecast::phase_spans(&state.records),
+        area_first_pitting_cycles: crate::wear::forecast::area_first_pitting_cycles(
+            &state.records,
+            &plan.endurance,
+        ),
         found_phases: &state.found_phases,
         warnings: state.warnings(geo.wheel_flank(tca.loaded_flank), plan.pitting_onset_share),
         steps: state

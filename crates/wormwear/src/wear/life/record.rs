@@ -5,6 +5,7 @@ use super::{LifeLoop, StateAnalysis};
 use crate::friction::Thermal;
 use crate::ltca::{stats, Ltca};
 use crate::lubrication::FlankRoughness;
+use crate::wear::forecast;
 use crate::wear::spectrum::BinRecord;
 use crate::wear::{pitted_fraction, CycleWear, Phase, PositionState, StepRecord, WearState};
 
@@ -24,6 +25,11 @@ impl LifeLoop<'_> {
         let mut record = self.record(state, (&a.ltca, &a.thermal), &a.cycle, phase, step);
         record.bins = self.bin_records(a);
         record.loaded_analyses += probes;
+        record.area_damage = forecast::area_damage_after(
+            state.records.iter().rev().find(|r| r.step < state.step),
+            record.cycles,
+            &self.life.endurance,
+        );
         // A resumed run recomputes the state it stopped at: keep one record per step.
         state.records.retain(|r| r.step < state.step);
         state.stopped = self.limits.passed(&record);
@@ -135,6 +141,7 @@ impl LifeLoop<'_> {
                 .filter(|&s| s > crate::ltca::BAND_EDGE_WARNING),
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
+            area_damage: 0.0,
             roughness_mean_m: roughness.0,
             roughness_min_m: roughness.1,
             friction: crate::wear::StateFriction::of(thermal),
