@@ -162,8 +162,8 @@ pub use super::ltca::MAX_PRESSURE_DEFINITION;
 /// pressure P_mean with Rank's N_LI from it (case C: 5 % between 40 and 80 positions, and the
 /// default level 31 % below the finer ones once the band has widened), and the worn flank's
 /// p_eq,2% with the area reading's sum from it (case C: 530-560 MPa over 0.06-0.33e6 cycles
-/// at 11 cells across the line, 650-740 MPa at 21: the edges' plastic strips, which do not
-/// converge, make up about 2 % of the flank; VALIDATION.md, session 59). Listed in the wear
+/// at 11 cells across the line, 650-740 MPa at 21, likely the edges' running-in, which does
+/// not converge with the cells; VALIDATION.md, session 59). Listed in the wear
 /// summary as `mesh_dependent`; no other stage reads them (the pitting forecast reads the
 /// damage field's share at its onset, the step control the largest per-cycle wear as a step
 /// size, the safety table the unworn analysis).
