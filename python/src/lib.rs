@@ -358,7 +358,13 @@ impl NativeResults {
             "wear_map" => wf
                 .zip(life.and_then(|l| l.maps.last().map(|m| (l, m))))
                 .map(|(w, (_, m))| {
-                    wear::node_table(w, &m.state, &m.cycle, &m.state.plastic_set_after(&m.ltca))
+                    wear::node_table(
+                        w,
+                        &m.state,
+                        &m.cycle,
+                        &m.state.plastic_set_after(&m.ltca),
+                        &m.ltca,
+                    )
                 }),
             _ => {
                 return Err(PyValueError::new_err(format!(

@@ -194,6 +194,20 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
         header.contains(&"damage") && header.contains(&"plastic_set_m"),
         "{header:?}"
     );
+    // The nodes' equivalent pressure, each the largest of its cells': over the flank their
+    // largest is the pattern's largest, which the last record carries.
+    let column = header
+        .iter()
+        .position(|h| *h == "equivalent_pressure_pa")
+        .unwrap();
+    let largest = nodes
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(column).unwrap().parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    let record = straight.records.last().unwrap().equivalent_pressure_max_pa;
+    assert!(largest > 0.0);
+    assert!((largest / record - 1.0).abs() < 1e-9, "{largest} against {record}");
 }
 
 /// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life

@@ -266,7 +266,7 @@ impl StateMaps<'_> {
             None,
         )?;
         files.push(path);
-        let csv = node_table(wf, state, view.cycle, &plastic);
+        let csv = node_table(wf, state, view.cycle, &plastic, view.ltca);
         let path = dir.join(format!("wear_map{suffix}.csv"));
         csv.write(&path)?;
         files.push(path);

@@ -423,13 +423,16 @@ pub(super) fn backlash_series(records: &[crate::wear::StepRecord]) -> Vec<Series
 
 /// The node table of a state (`wear_map.csv`): per loaded-flank node (i up the height, j
 /// across the face) its (r, z) mm, cumulative wear m, wear per cycle m, film ratio and film
-/// thickness m, damage, and the plastic set m once the state has run in
-/// ([`WearState::plastic_set_after`], read at the nodes).
+/// thickness m, damage, the plastic set m once the state has run in
+/// ([`WearState::plastic_set_after`], read at the nodes), and the equivalent pressure of the
+/// state's analysis `l` at the node, Pa (MODEL §8.1: the largest of its cells', the damage's
+/// default node reading).
 pub fn node_table(
     wf: &crate::geometry::WheelFlank,
     state: &WearState,
     cycle: &crate::wear::CycleWear,
     plastic_set: &FlankField,
+    l: &crate::ltca::Ltca,
 ) -> Csv {
     let plastic_set = plastic_set.with_rows(wf.cells_height);
     let mut csv = Csv::new(&[
@@ -443,6 +446,7 @@ pub fn node_table(
         "film_m",
         "damage",
         "plastic_set_m",
+        "equivalent_pressure_pa",
     ]);
     for j in 0..=wf.cells_face {
         for i in 0..=wf.cells_height {
@@ -459,6 +463,13 @@ pub fn node_table(
                 cycle.film.values[k],
                 state.damage.get(k).copied().unwrap_or(0.0),
                 plastic_set.values.get(k).copied().unwrap_or(0.0),
+                crate::wear::forecast::node_equivalent(
+                    wf,
+                    l,
+                    k,
+                    crate::input::NodeReading::Largest,
+                )
+                .0,
             ]);
         }
     }
