@@ -207,7 +207,10 @@ fn a_forecast_killed_after_a_state_and_resumed_ends_as_the_uninterrupted_one() {
         .fold(0.0, f64::max);
     let record = straight.records.last().unwrap().equivalent_pressure_max_pa;
     assert!(largest > 0.0);
-    assert!((largest / record - 1.0).abs() < 1e-9, "{largest} against {record}");
+    assert!(
+        (largest / record - 1.0).abs() < 1e-9,
+        "{largest} against {record}"
+    );
 }
 
 /// MODEL §10 with a forecast: a backlash curve the program generated with a known K and life
