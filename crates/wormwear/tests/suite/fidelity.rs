@@ -337,6 +337,28 @@ fn the_area_reading_of_first_pitting_is_the_miner_sum_of_the_states_area_pressur
         (got / expected - 1.0).abs() < 1e-12,
         "{got} against {expected}"
     );
+    // A duty cycle: each bin at its share of the cycles, from its own p_eq,2%.
+    let bin = |share: f64, p: f64| wormwear::wear::spectrum::BinRecord {
+        cycle_share: share,
+        worm_torque_nm: 0.0,
+        wheel_torque_nm: 0.0,
+        max_pressure_pa: 0.0,
+        pressure_patch_max_pa: 0.0,
+        equivalent_pressure_max_pa: 0.0,
+        equivalent_pressure_first_pitting_pa: p,
+        max_wear_per_cycle_m: 0.0,
+        worn_volume_per_cycle_m3: 0.0,
+        friction: Default::default(),
+    };
+    let mut duty = records[1].clone();
+    duty.phase = "wear".into();
+    duty.bins = vec![bin(0.25, 900e6), bin(0.75, 500e6)];
+    let rate = wormwear::wear::forecast::area_damage_rate(&duty, &plan.endurance);
+    let expected = 0.25 / life_at(900e6) + 0.75 / life_at(500e6);
+    assert!(
+        (rate / expected - 1.0).abs() < 1e-12,
+        "{rate} against {expected}"
+    );
     // Not crossed: none.
     plan.endurance.reference_cycles = 1e9;
     let records: Vec<_> = records
