@@ -625,15 +625,7 @@ pub fn analyse_changed(
     let ev = GapEvaluator::new(gear, geo);
     let wf = geo.wheel_flank(tca.loaded_flank);
     let (worm_torque, wheel_torque_guess) = torque_targets(gear, settings);
-    if let Some(problem) = bending.and_then(|b| {
-        shaft_torsion_problem(
-            b.rigid_rotation_compliance(),
-            wheel_torque_guess,
-            gear.wheel.teeth,
-        )
-    }) {
-        return Err(LtcaError::ShaftTorsion(problem));
-    }
+    check_shaft_torsion(bending, wheel_torque_guess, gear.wheel.teeth)?;
     let band0 = initial_band(gear, tca, wf, settings, &pair, wheel_torque_guess);
     let rows_per_row = change
         .plastic_set
@@ -675,7 +667,7 @@ pub fn analyse_changed(
         })
         .collect::<Result<_, _>>()?;
     let ratio = geo.teeth as f64 / gear.worm.starts as f64;
-    Ok(Ltca {
+    let mut ltca = Ltca {
         roughness,
         ..over_the_cycle(
             positions,
@@ -684,7 +676,28 @@ pub fn analyse_changed(
             bending,
             rows_per_row,
         )
-    })
+    };
+    ltca.warnings.extend(tip_edge_resolution_warning(
+        gear.worm.tip_edge_radius,
+        ltca.max_pressure,
+        pair.effective_modulus,
+        loaded_cell_width(&ltca.positions),
+    ));
+    Ok(ltca)
+}
+
+/// Refuses a bending model whose shaft torsion alone would turn the wheel by more than a pitch
+/// under the wheel torque `wheel_torque` (N m) on `teeth` teeth ([`shaft_torsion_problem`]).
+fn check_shaft_torsion(
+    bending: Option<&dyn BendingModel>,
+    wheel_torque: f64,
+    teeth: u32,
+) -> Result<(), LtcaError> {
+    let compliance = bending.map_or(0.0, |b| b.rigid_rotation_compliance());
+    match bending.and(shaft_torsion_problem(compliance, wheel_torque, teeth)) {
+        Some(problem) => Err(LtcaError::ShaftTorsion(problem)),
+        None => Ok(()),
+    }
 }
 
 /// The worm torque to balance (None: the wheel torque is given) and the wheel torque's

@@ -111,6 +111,74 @@ pub(super) fn local_flow_pressure_warning(
     })
 }
 
+/// Contact cells across the line that a contact must span to count as resolved (MODEL §5.1:
+/// several cells across the Hertz width).
+pub const RESOLVED_CELLS_ACROSS: f64 = 3.0;
+
+/// The Hertz contact width (m) of the worm's broken tip edge on the wheel (MODEL §2.3): its
+/// circle of radius `radius` (m) against the flank, nearly flat beside it, at the peak
+/// pressure `pressure` (Pa), with the pair's Hertz modulus E* (Pa): 2 a = 4 R p0 / E*
+/// (Johnson 1985, §4.2: a = 2 R p0 / E* for a cylinder on a plane).
+pub fn tip_edge_contact_width(radius: f64, pressure: f64, effective_modulus: f64) -> f64 {
+    4.0 * radius * pressure / effective_modulus
+}
+
+/// A warning when the worm's broken tip edge (radius `radius`, m; 0: sharp, no warning)
+/// touches the wheel over a contact narrower than [`RESOLVED_CELLS_ACROSS`] contact cells
+/// across the line (`cell_width`, m): its Hertz width at the analysis' largest pressure
+/// `max_pressure` (Pa, at most the flow pressure), with the Hertz modulus `effective_modulus`
+/// (Pa), bounds the contact the round makes anywhere. Its strip's pressures, plastic set and
+/// equivalent pressures then read the cells, not the round, and grow as the cells are refined
+/// (VALIDATION.md, session 60).
+pub(super) fn tip_edge_resolution_warning(
+    radius: f64,
+    max_pressure: f64,
+    effective_modulus: f64,
+    cell_width: f64,
+) -> Option<String> {
+    if !(radius > 0.0 && max_pressure > 0.0 && cell_width > 0.0) {
+        return None;
+    }
+    let width = tip_edge_contact_width(radius, max_pressure, effective_modulus);
+    let resolved = RESOLVED_CELLS_ACROSS * cell_width;
+    (width < resolved).then(|| {
+        format!(
+            "the worm's broken tip edge (worm.tip_edge_radius_mm = {:.3}) touches the wheel over \
+             a Hertz width of at most 4 R P_max / E* = {:.1} um (at P_max = {:.0} MPa), less \
+             than {RESOLVED_CELLS_ACROSS:.0} contact cells across the line ({:.1} um each): \
+             the pressures, the plastic set and the equivalent pressures on the strip it \
+             sweeps read the cells, not the round, and grow as they are refined; resolving it \
+             takes cells about {:.1} um wide there, {:.0} times finer (MODEL §2.3, §5.1)",
+            radius * 1e3,
+            width * 1e6,
+            max_pressure * 1e-6,
+            cell_width * 1e6,
+            width / RESOLVED_CELLS_ACROSS * 1e6,
+            (resolved / width).ceil()
+        )
+    })
+}
+
+/// The median width across the contact line of the positions' loaded cells, m (0 when none
+/// is loaded): the width [`tip_edge_resolution_warning`] compares.
+pub(super) fn loaded_cell_width(positions: &[PositionResult]) -> f64 {
+    let mut widths: Vec<f64> = positions
+        .iter()
+        .flat_map(|p| {
+            p.cells
+                .iter()
+                .zip(&p.pressure)
+                .filter(|(_, &q)| q > 0.0)
+                .map(|(c, _)| 2.0 * c.cell.half_nu)
+        })
+        .collect();
+    if widths.is_empty() {
+        return 0.0;
+    }
+    let middle = widths.len() / 2;
+    *widths.select_nth_unstable_by(middle, f64::total_cmp).1
+}
+
 /// A point of the flank with its coordinates (r, z), m.
 trait HasPlace {
     fn place(&self) -> (f64, f64);
@@ -595,4 +663,41 @@ pub(super) fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64
     // A mean is never above the largest value it averages (the cells tile the band without
     // overlap: this only removes the sum's rounding).
     best.min(cells.iter().map(|c| c[4]).fold(0.0, f64::max))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tip_edge_s_contact_width_is_hertz_s_for_a_cylinder_on_a_plane() {
+        // Hertz (contact.rs): a = sqrt(4 w R / (pi E*)), p0 = 2 w / (pi a).
+        let (radius, modulus) = (0.5e-3, 77.9e9);
+        for line_load in [1e4, 1e5, 4e5] {
+            let a = crate::contact::hertz_half_width(line_load, radius, modulus);
+            let p0 = 2.0 * line_load / (PI * a);
+            let width = tip_edge_contact_width(radius, p0, modulus);
+            assert!(
+                (width - 2.0 * a).abs() < 1e-12 * a,
+                "{width} against {}",
+                2.0 * a
+            );
+        }
+    }
+
+    #[test]
+    fn a_round_narrower_than_three_cells_is_warned_and_a_sharp_edge_is_not() {
+        let (radius, p, modulus) = (0.5e-3, 1e9, 77.9e9);
+        // 2 a = 4 R p / E* = 25.7 um.
+        let width = tip_edge_contact_width(radius, p, modulus);
+        let warned = |cells: f64| tip_edge_resolution_warning(radius, p, modulus, cells);
+        let text = warned(180e-6).expect("a 25.7 um contact in 180 um cells");
+        assert!(text.contains("worm.tip_edge_radius_mm = 0.500"), "{text}");
+        assert!(text.contains("25.7 um"), "{text}");
+        assert!(text.contains("8.6 um wide"), "{text}");
+        assert!(text.contains("22 times finer"), "{text}");
+        assert!(warned(width / 3.0 * 1.01).is_some());
+        assert!(warned(width / 3.0 * 0.99).is_none());
+        assert!(tip_edge_resolution_warning(0.0, p, modulus, 180e-6).is_none());
+    }
 }

@@ -390,3 +390,38 @@ fn the_flow_pressure_at_the_rounded_tip_edge_is_counted_as_the_worm_tips() {
     assert!(trace > trace_sharp, "{trace} <= {trace_sharp}");
     assert_eq!(trace - trace_sharp, elsewhere_sharp - elsewhere);
 }
+
+/// A broken tip edge whose own contact is narrower than the contact cells is said (session
+/// 60): the 0.5 mm round of the design gear touches over 4 R P_max / E* (Hertz, a cylinder on
+/// a plane), about 26 um at the flow pressure, against cells of about 0.1-0.2 mm across the
+/// line; its strip's pressures read the cells (VALIDATION.md). The sharp tip has no round to
+/// resolve.
+#[test]
+fn a_tip_edge_narrower_than_the_contact_cells_is_warned_with_its_hertz_width() {
+    let ltca = |g: &GearSet| {
+        let request = Request::new([Stage::Ltca]);
+        let r = wormwear::run(g, Source::default(), request, &mut |_| Ok(())).unwrap();
+        r.ltca.unwrap()
+    };
+    let said = |w: &[String]| -> Option<String> {
+        w.iter()
+            .find(|w| w.contains("broken tip edge") && w.contains("Hertz width"))
+            .cloned()
+    };
+    let sharp = ltca(&design(0.0, 0.0));
+    assert!(said(&sharp.warnings).is_none(), "{:?}", sharp.warnings);
+    let g = design(0.5, 0.0);
+    let l = ltca(&g);
+    let text = said(&l.warnings).expect("a 0.5 mm round in cells of 0.1-0.2 mm");
+    eprintln!("{text}");
+    let (m1, m2) = (&g.worm_material, &g.wheel_material);
+    let e_star = 1.0
+        / ((1.0 - m1.poisson_ratio.powi(2)) / m1.youngs_modulus
+            + (1.0 - m2.poisson_ratio.powi(2)) / m2.youngs_modulus);
+    let width = 4.0 * g.worm.tip_edge_radius * l.max_pressure / e_star;
+    assert!(
+        text.contains(&format!("{:.1} um (at P_max", width * 1e6)),
+        "{text}: Hertz width {width}"
+    );
+    assert!(width < 30e-6, "{width}");
+}
