@@ -677,12 +677,14 @@ pub fn analyse_changed(
             rows_per_row,
         )
     };
-    ltca.warnings.extend(tip_edge_resolution_warning(
-        gear.worm.tip_edge_radius,
-        ltca.max_pressure,
-        pair.effective_modulus,
-        loaded_cell_width(&ltca.positions),
-    ));
+    if gear.worm.tip_edge_radius > 0.0 {
+        ltca.warnings.extend(tip_edge_resolution_warning(
+            gear.worm.tip_edge_radius,
+            ltca.max_pressure,
+            pair.effective_modulus,
+            loaded_cell_width(&ltca.positions),
+        ));
+    }
     Ok(ltca)
 }
 
