@@ -313,6 +313,11 @@ pub struct Ltca {
     /// omega1) / mean T1, less 1 (0 for a model consistent with the kinematics; beyond
     /// [`POWER_BALANCE_LIMIT`] the contact is at non-conjugate points, see `warnings`).
     pub power_balance: f64,
+    /// The worm's broken tip edge against the contact cells where its contact spans less
+    /// than [`RESOLVED_CELLS_ACROSS`] of them (MODEL §2.3, §5.1); None: a sharp tip, or a
+    /// round the cells resolve.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tip_edge_resolution: Option<TipEdgeResolution>,
     /// What makes these results doubtful, with the reason.
     pub warnings: Vec<String>,
     /// The composite roughness R_q on the loaded flank's nodes after its running-in
@@ -677,15 +682,25 @@ pub fn analyse_changed(
             rows_per_row,
         )
     };
-    if gear.worm.tip_edge_radius > 0.0 {
-        ltca.warnings.extend(tip_edge_resolution_warning(
-            gear.worm.tip_edge_radius,
-            ltca.max_pressure,
-            pair.effective_modulus,
-            loaded_cell_width(&ltca.positions),
-        ));
-    }
+    ltca.tip_edge_resolution = tip_edge_resolution(gear.worm.tip_edge_radius, &ltca, &pair);
+    ltca.warnings
+        .extend(ltca.tip_edge_resolution.map(|t| t.text()));
     Ok(ltca)
+}
+
+/// The worm's broken tip edge of radius `radius` (m; 0: sharp, None without gathering the
+/// cells) against the loaded cells of `ltca` ([`TipEdgeResolution::of`], MODEL §2.3, §5.1).
+fn tip_edge_resolution(radius: f64, ltca: &Ltca, pair: &ElasticPair) -> Option<TipEdgeResolution> {
+    (radius > 0.0)
+        .then(|| {
+            TipEdgeResolution::of(
+                radius,
+                ltca.max_pressure,
+                pair.effective_modulus,
+                loaded_cell_width(&ltca.positions),
+            )
+        })
+        .flatten()
 }
 
 /// Refuses a bending model whose shaft torsion alone would turn the wheel by more than a pitch
@@ -843,6 +858,7 @@ fn over_the_cycle(
         torque_balance: settings.torque_balance,
         mesh_efficiency: wheel_torque / (ratio * worm_torque),
         power_balance,
+        tip_edge_resolution: None,
         warnings,
         roughness: None,
         passage_samples: std::sync::Arc::new(passage_samples),

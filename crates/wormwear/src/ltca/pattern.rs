@@ -123,25 +123,56 @@ pub fn tip_edge_contact_width(radius: f64, pressure: f64, effective_modulus: f64
     4.0 * radius * pressure / effective_modulus
 }
 
-/// A warning when the worm's broken tip edge (radius `radius`, m; 0: sharp, no warning)
-/// touches the wheel over a contact narrower than [`RESOLVED_CELLS_ACROSS`] contact cells
-/// across the line (`cell_width`, m): its Hertz width at the analysis' largest pressure
-/// `max_pressure` (Pa, at most the flow pressure), with the Hertz modulus `effective_modulus`
-/// (Pa), bounds the contact the round makes anywhere. Its strip's pressures, plastic set and
-/// equivalent pressures then read the cells, not the round, and grow as the cells are refined
-/// (VALIDATION.md, session 60).
-pub(super) fn tip_edge_resolution_warning(
-    radius: f64,
-    max_pressure: f64,
-    effective_modulus: f64,
-    cell_width: f64,
-) -> Option<String> {
-    if !(radius > 0.0 && max_pressure > 0.0 && cell_width > 0.0) {
-        return None;
+/// How the worm's broken tip edge (MODEL §2.3) meets the contact cells when its contact is
+/// narrower than [`RESOLVED_CELLS_ACROSS`] cells across the line
+/// ([`TipEdgeResolution::of`]): its strip's pressures, plastic set and equivalent pressures
+/// then read the cells, not the round, and grow as the cells are refined (VALIDATION.md,
+/// session 60).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TipEdgeResolution {
+    /// The tip edge's radius `worm.tip_edge_radius`, m.
+    pub radius_m: f64,
+    /// The analysis' largest pressure, Pa (at most the flow pressure).
+    pub max_pressure_pa: f64,
+    /// The round's Hertz contact width at that pressure, 4 R P_max / E*, m
+    /// ([`tip_edge_contact_width`]).
+    pub contact_width_m: f64,
+    /// The median width across the line of the loaded contact cells, m
+    /// ([`loaded_cell_width`]).
+    pub cell_width_m: f64,
+}
+
+impl TipEdgeResolution {
+    /// The tip edge of radius `radius` (m; 0: sharp, None) against contact cells `cell_width`
+    /// wide across the line (m), at the analysis' largest pressure `max_pressure` (Pa) with
+    /// the Hertz modulus `effective_modulus` (Pa): Some where its Hertz width, which bounds
+    /// the contact the round makes anywhere, spans less than [`RESOLVED_CELLS_ACROSS`] cells.
+    pub fn of(
+        radius: f64,
+        max_pressure: f64,
+        effective_modulus: f64,
+        cell_width: f64,
+    ) -> Option<Self> {
+        if !(radius > 0.0 && max_pressure > 0.0 && cell_width > 0.0) {
+            return None;
+        }
+        let width = tip_edge_contact_width(radius, max_pressure, effective_modulus);
+        (width < RESOLVED_CELLS_ACROSS * cell_width).then_some(Self {
+            radius_m: radius,
+            max_pressure_pa: max_pressure,
+            contact_width_m: width,
+            cell_width_m: cell_width,
+        })
     }
-    let width = tip_edge_contact_width(radius, max_pressure, effective_modulus);
-    let resolved = RESOLVED_CELLS_ACROSS * cell_width;
-    (width < resolved).then(|| {
+
+    /// The cell width across the line that would resolve the round's contact, m.
+    pub fn resolving_cell_width(&self) -> f64 {
+        self.contact_width_m / RESOLVED_CELLS_ACROSS
+    }
+
+    /// What this says, for the warnings: the round's width against the cells', and the cells
+    /// that would resolve it.
+    pub fn text(&self) -> String {
         format!(
             "the worm's broken tip edge (worm.tip_edge_radius_mm = {:.3}) touches the wheel over \
              a Hertz width of at most 4 R P_max / E* = {:.1} um (at P_max = {:.0} MPa), less \
@@ -149,18 +180,18 @@ pub(super) fn tip_edge_resolution_warning(
              the pressures, the plastic set and the equivalent pressures on the strip it \
              sweeps read the cells, not the round, and grow as they are refined; resolving it \
              takes cells about {:.1} um wide there, {:.0} times finer (MODEL §2.3, §5.1)",
-            radius * 1e3,
-            width * 1e6,
-            max_pressure * 1e-6,
-            cell_width * 1e6,
-            width / RESOLVED_CELLS_ACROSS * 1e6,
-            (resolved / width).ceil()
+            self.radius_m * 1e3,
+            self.contact_width_m * 1e6,
+            self.max_pressure_pa * 1e-6,
+            self.cell_width_m * 1e6,
+            self.resolving_cell_width() * 1e6,
+            (self.cell_width_m / self.resolving_cell_width()).ceil()
         )
-    })
+    }
 }
 
 /// The median width across the contact line of the positions' loaded cells, m (0 when none
-/// is loaded): the width [`tip_edge_resolution_warning`] compares.
+/// is loaded): the width [`TipEdgeResolution::of`] compares.
 pub(super) fn loaded_cell_width(positions: &[PositionResult]) -> f64 {
     let mut widths: Vec<f64> = positions
         .iter()
@@ -690,7 +721,8 @@ mod tests {
         let (radius, p, modulus) = (0.5e-3, 1e9, 77.9e9);
         // 2 a = 4 R p / E* = 25.7 um.
         let width = tip_edge_contact_width(radius, p, modulus);
-        let warned = |cells: f64| tip_edge_resolution_warning(radius, p, modulus, cells);
+        let warned =
+            |cells: f64| TipEdgeResolution::of(radius, p, modulus, cells).map(|t| t.text());
         let text = warned(180e-6).expect("a 25.7 um contact in 180 um cells");
         assert!(text.contains("worm.tip_edge_radius_mm = 0.500"), "{text}");
         assert!(text.contains("25.7 um"), "{text}");
@@ -698,6 +730,6 @@ mod tests {
         assert!(text.contains("22 times finer"), "{text}");
         assert!(warned(width / 3.0 * 1.01).is_some());
         assert!(warned(width / 3.0 * 0.99).is_none());
-        assert!(tip_edge_resolution_warning(0.0, p, modulus, 180e-6).is_none());
+        assert!(TipEdgeResolution::of(0.0, p, modulus, 180e-6).is_none());
     }
 }

@@ -258,6 +258,11 @@ pub struct StepRecord {
     /// local mesh, MODEL §5.1); None: every position's band held its contact.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub band_edge_share: Option<f64>,
+    /// The worm's broken tip edge against the contact cells where this state's analysis does
+    /// not resolve its contact (`Ltca::tip_edge_resolution`, MODEL §2.3, §5.1); None: a sharp
+    /// tip, or a round the cells resolve.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_edge_resolution: Option<crate::ltca::TipEdgeResolution>,
     /// Largest equivalent pressure below the flank over the pattern (MODEL §8.1), Pa (0 in
     /// records of earlier versions).
     #[serde(default)]
@@ -413,6 +418,7 @@ impl WearState {
                 100.0 * worst
             ));
         }
+        w.extend(self.tip_edge_warning());
         w.extend(self.damage_warning(wf, onset));
         if let Some(r) = self
             .records
@@ -429,6 +435,31 @@ impl WearState {
             ));
         }
         w
+    }
+
+    /// The warning on the worm's broken tip edge where the life's analyses did not resolve its
+    /// contact (MODEL §2.3, §5.1; [`crate::ltca::TipEdgeResolution`]): from which cycles, in
+    /// how many states, and the state where the cells were widest against the round's width.
+    fn tip_edge_warning(&self) -> Option<String> {
+        let unresolved: Vec<(f64, crate::ltca::TipEdgeResolution)> = self
+            .records
+            .iter()
+            .filter_map(|r| r.tip_edge_resolution.map(|t| (r.cycles, t)))
+            .collect();
+        let first = unresolved.first()?.0;
+        let ratio = |t: &crate::ltca::TipEdgeResolution| t.cell_width_m / t.contact_width_m;
+        let (worst_cycles, worst) = unresolved
+            .iter()
+            .max_by(|a, b| ratio(&a.1).total_cmp(&ratio(&b.1)))?;
+        Some(format!(
+            "contact: from {} cycles, in {} of the life's {} states, {} (the worst state, at {} \
+             cycles)",
+            cycles_label(first),
+            unresolved.len(),
+            self.records.len(),
+            worst.text(),
+            cycles_label(*worst_cycles)
+        ))
     }
 
     /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how

@@ -425,3 +425,60 @@ fn a_tip_edge_narrower_than_the_contact_cells_is_warned_with_its_hertz_width() {
     );
     assert!(width < 30e-6, "{width}");
 }
+
+/// A life carries the unresolved tip edge into its own warnings (summary.json, stderr, the
+/// report), from the records: each state's analysis has its own P_max and cells. The round's
+/// width in each record is Hertz's 4 R P_max / E* at that state's P_max, and a sharp tip's
+/// records carry nothing (their JSON unchanged).
+#[test]
+fn a_life_warns_of_the_unresolved_tip_edge_from_its_records() {
+    let life = |g: &GearSet| {
+        let plan = wormwear::wear::WearPlan {
+            step: wormwear::wear::StepControl::Cycles(30_000.0),
+            ..wormwear::wear::WearPlan::with_life(60_000.0)
+        };
+        let request = Request::new([Stage::Wear]).with_life(plan);
+        let r = wormwear::run(g, Source::default(), request, &mut |_| Ok(())).unwrap();
+        let wf = r
+            .geometry
+            .wheel_flank(r.tca.as_ref().unwrap().loaded_flank)
+            .clone();
+        let life = r.life.unwrap();
+        let warnings = life.end.warnings(&wf, life.plan.pitting_onset_share);
+        (life.end.records, warnings)
+    };
+    let said = |w: &[String]| -> Option<String> {
+        w.iter().find(|w| w.contains("broken tip edge")).cloned()
+    };
+    let (sharp, sharp_warnings) = life(&design(0.0, 0.0));
+    assert!(said(&sharp_warnings).is_none(), "{sharp_warnings:?}");
+    for r in &sharp {
+        assert!(r.tip_edge_resolution.is_none());
+        let json = serde_json::to_string(r).unwrap();
+        assert!(!json.contains("tip_edge_resolution"), "{json}");
+    }
+    let g = design(0.5, 0.0);
+    let (records, warnings) = life(&g);
+    let text = said(&warnings).expect("a 0.5 mm round in cells of 0.1-0.2 mm, all life");
+    eprintln!("{text}");
+    assert!(
+        text.starts_with(&format!(
+            "contact: from 0 cycles, in {n} of the life's {n} states,",
+            n = records.len()
+        )),
+        "{text}"
+    );
+    let (m1, m2) = (&g.worm_material, &g.wheel_material);
+    let e_star = 1.0
+        / ((1.0 - m1.poisson_ratio.powi(2)) / m1.youngs_modulus
+            + (1.0 - m2.poisson_ratio.powi(2)) / m2.youngs_modulus);
+    for r in &records {
+        let t = r.tip_edge_resolution.expect("every state unresolved");
+        let width = 4.0 * g.worm.tip_edge_radius * r.max_pressure_pa / e_star;
+        assert!(
+            (t.contact_width_m - width).abs() < 1e-9 * width,
+            "{t:?}: {width}"
+        );
+        assert!(t.contact_width_m < 3.0 * t.cell_width_m, "{t:?}");
+    }
+}

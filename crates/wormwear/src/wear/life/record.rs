@@ -139,6 +139,7 @@ impl LifeLoop<'_> {
             yielded_area_fraction: l.yielded_area_fraction,
             band_edge_share: Some(l.band_edge_share())
                 .filter(|&s| s > crate::ltca::BAND_EDGE_WARNING),
+            tip_edge_resolution: l.tip_edge_resolution,
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
             area_damage: 0.0,
