@@ -391,7 +391,7 @@ impl NativeResults {
         let mut w = r.warnings.clone();
         if let (Some(life), Some(tca)) = (&r.life, &r.tca) {
             let wf = r.geometry.wheel_flank(tca.loaded_flank);
-            w.extend(life.end.warnings(wf, life.plan.pitting_onset_share));
+            w.extend(life.warnings(wf));
         }
         if let Some(r) = &self.results.rating {
             w.extend(r.warnings.iter().map(|x| format!("rating: {x}")));

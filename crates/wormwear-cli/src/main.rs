@@ -867,7 +867,7 @@ fn print_life(end: &wormwear::wear::WearState, rating: &wormwear::rating::Rating
 fn warn_about_the_life(results: &wormwear::Results, life: &wormwear::runner::Life) {
     let Some(tca) = &results.tca else { return };
     let wf = results.geometry.wheel_flank(tca.loaded_flank);
-    for w in life.end.warnings(wf, life.plan.pitting_onset_share) {
+    for w in life.warnings(wf) {
         eprintln!("warning: {w}");
     }
 }

@@ -385,6 +385,16 @@ pub struct Life {
     pub maps: Vec<MapState>,
 }
 
+impl Life {
+    /// The life's warnings at its last state on the loaded flank `wf`, read with its plan's
+    /// onset share and pressure–life curve ([`WearState::warnings`]).
+    pub fn warnings(&self, wf: &crate::geometry::WheelFlank) -> Vec<String> {
+        let plan = &self.plan;
+        self.end
+            .warnings(wf, plan.pitting_onset_share, &plan.endurance)
+    }
+}
+
 /// Everything a run computed.
 #[derive(Debug, Clone)]
 pub struct Results {

@@ -288,6 +288,82 @@ pub fn area_first_pitting_cycles(records: &[StepRecord], curve: &Endurance) -> O
     })
 }
 
+/// How much of the area reading's Miner sum (MODEL §8.1) rests on the pressure–life curve
+/// beyond its data: the curve's points span lives from 0.6e6 to 11e6 cycles (MODEL §8,
+/// [`Endurance::data_span`]); a p_eq,2% whose life is shorter lies above the highest pressure
+/// tested, where the power law is extrapolated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AreaExtrapolation {
+    /// The Miner sum over the wear steps up to the cycles read (the records' `area_damage`
+    /// there).
+    pub damage: f64,
+    /// Its part from states (with a duty cycle, bins) whose p_eq,2% has a life shorter than
+    /// the data's shortest.
+    pub beyond: f64,
+    /// The largest such p_eq,2%, Pa (0: none).
+    pub highest_pa: f64,
+    /// The cycles of the first state with one (None: none).
+    pub first_cycles: Option<f64>,
+}
+
+impl AreaExtrapolation {
+    /// The share of the sum beyond the data (0 for no sum).
+    pub fn share(&self) -> f64 {
+        if self.damage > 0.0 {
+            self.beyond / self.damage
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The area reading's Miner sum over `records` up to `until` cycles, split by where on the
+/// pressure–life curve `curve` its parts lie ([`AreaExtrapolation`]): each wear step adds its
+/// cycles over the life of the starting state's p_eq,2% (each bin's at its cycle share), as
+/// [`area_damage_rate`] does; a pitting phase adds nothing.
+pub fn area_damage_beyond_data(
+    records: &[StepRecord],
+    curve: &Endurance,
+    until: f64,
+) -> AreaExtrapolation {
+    let shortest = curve.data_span().0;
+    let mut out = AreaExtrapolation {
+        damage: 0.0,
+        beyond: 0.0,
+        highest_pa: 0.0,
+        first_cycles: None,
+    };
+    for w in records.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let span = b.cycles.min(until) - a.cycles;
+        if span <= 0.0 {
+            break;
+        }
+        if a.phase == "pitting" {
+            continue;
+        }
+        let loads: Vec<(f64, f64)> = match a.bins.is_empty() {
+            true => vec![(1.0, a.equivalent_pressure_first_pitting_pa)],
+            false => a
+                .bins
+                .iter()
+                .map(|b| (b.cycle_share, b.equivalent_pressure_first_pitting_pa))
+                .collect(),
+        };
+        for (share, p) in loads {
+            let life = curve.life(p);
+            let damage = span * share / life;
+            out.damage += damage;
+            if life < shortest {
+                out.beyond += damage;
+                out.highest_pa = out.highest_pa.max(p);
+                out.first_cycles.get_or_insert(a.cycles);
+            }
+        }
+    }
+    out
+}
+
 /// A phase of a life as it happened: kind ("wear" or "pitting"), start and end cycles, and
 /// the pitted share of the active flank at its end.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -327,6 +403,77 @@ pub fn phase_spans(records: &[super::StepRecord]) -> Vec<PhaseSpan> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A record at `cycles` in `phase` whose p_eq,2% is `p` (Pa).
+    fn record(cycles: f64, phase: &str, p: f64) -> StepRecord {
+        StepRecord {
+            cycles,
+            phase: phase.into(),
+            equivalent_pressure_first_pitting_pa: p,
+            ..StepRecord::default()
+        }
+    }
+
+    #[test]
+    fn the_area_sum_beyond_the_curve_s_data_is_its_steps_above_the_highest_tested_pressure() {
+        // MODEL §8: the CuSn12 curve's points span 0.6e6 to 11e6 cycles, 709 to 425 MPa. A
+        // step at 900 MPa (life 0.14e6) lies beyond them, one at 500 MPa (4.3e6) within; a
+        // pitting phase adds nothing. Lives from the power law written out here.
+        let curve = Endurance::DEFAULT;
+        let life = |p: f64| 11e6 * (p / 425e6).powf(-1.0 / 0.176);
+        let highest = 425e6 * (0.6e6f64 / 11e6).powf(-0.176);
+        assert!((curve.pressure(curve.data_span().0) - highest).abs() < 1.0);
+        assert!(life(900e6) < 0.6e6 && life(500e6) > 0.6e6 && highest < 900e6);
+        let records = [
+            record(0.0, "wear", 900e6),
+            record(1e5, "wear", 500e6),
+            record(3e5, "pitting", 950e6),
+            record(4e5, "wear", 600e6),
+            record(5e5, "wear", 600e6),
+        ];
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        let e = area_damage_beyond_data(&records, &curve, 5e5);
+        let beyond = 1e5 / life(900e6);
+        let damage = beyond + 2e5 / life(500e6) + 1e5 / life(600e6);
+        assert!(close(e.beyond, beyond), "{e:?}");
+        assert!(close(e.damage, damage), "{e:?}: {damage}");
+        assert!(close(e.share(), beyond / damage));
+        assert_eq!((e.highest_pa, e.first_cycles), (900e6, Some(0.0)));
+        // Read part-way: the crossed step counts up to there.
+        let e = area_damage_beyond_data(&records, &curve, 1.5e5);
+        assert!(close(e.damage, beyond + 0.5e5 / life(500e6)), "{e:?}");
+        // The same steps as the records' sum: each step at area_damage_rate.
+        let rates: f64 = records
+            .windows(2)
+            .map(|w| (w[1].cycles - w[0].cycles) * area_damage_rate(&w[0], &curve))
+            .sum();
+        assert!(close(rates, damage));
+        // Within the data throughout: nothing beyond, no place.
+        let within = [record(0.0, "wear", 600e6), record(1e6, "wear", 450e6)];
+        let e = area_damage_beyond_data(&within, &curve, 1e6);
+        assert_eq!((e.beyond, e.highest_pa, e.first_cycles), (0.0, 0.0, None));
+        assert!(close(e.damage, 1e6 / life(600e6)));
+    }
+
+    #[test]
+    fn a_duty_cycle_s_bins_each_count_at_their_share() {
+        let curve = Endurance::DEFAULT;
+        let bin = |share: f64, p: f64| crate::wear::spectrum::BinRecord {
+            cycle_share: share,
+            equivalent_pressure_first_pitting_pa: p,
+            ..Default::default()
+        };
+        let mut start = record(0.0, "wear", 0.0);
+        start.bins = vec![bin(0.25, 900e6), bin(0.75, 500e6)];
+        let records = [start, record(2e5, "wear", 500e6)];
+        let e = area_damage_beyond_data(&records, &curve, 2e5);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        assert!(close(e.beyond, 2e5 * 0.25 / curve.life(900e6)), "{e:?}");
+        assert!(close(
+            e.damage,
+            2e5 * (0.25 / curve.life(900e6) + 0.75 / curve.life(500e6))
+        ));
+    }
 
     /// The four cells around a node at (i, j) of a field f(x, y) given at cell centres
     /// (i +- 1/2, j +- 1/2), with depth 1 mm times the value's rank.

@@ -27,7 +27,7 @@ pub struct BinStart {
 }
 
 /// What a life's record keeps of one bin of its spectrum (units in the names).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BinRecord {
     /// Share of the wheel's cycles the bin runs.
     pub cycle_share: f64,

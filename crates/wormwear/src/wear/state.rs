@@ -4,7 +4,7 @@
 
 use super::{cycles_label, forecast, CycleWear, Phase};
 use crate::geometry::{FlankField, WheelFlank};
-use crate::input::PitDepth;
+use crate::input::{Endurance, PitDepth};
 use crate::ltca::Ltca;
 
 /// State of a life run after a completed step: what a checkpoint holds.
@@ -150,7 +150,7 @@ impl WearState {
 
 /// The gear's state at some cycles: wear so far and the loaded analysis on that geometry
 /// (units in the names; MODEL §7.7).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepRecord {
     /// Completed steps (0: the unworn gear).
     pub step: usize,
@@ -370,13 +370,19 @@ pub struct PositionState {
     pub max_pressure_pa: f64,
 }
 
+/// The share of the area reading's Miner sum from beyond the pressure–life curve's data above
+/// which a life warns ([`WearState::warnings`]).
+pub const EXTRAPOLATED_SHARE: f64 = 0.01;
+
 impl WearState {
     /// What an engineer must see about this life at its last state (summary.json, stderr, the
     /// top of report.html): why it stopped early, loaded analyses off the power balance,
     /// contact on worn-through teeth, flank nodes whose fatigue damage has reached 1 (read as
     /// first pitting where they make up the `onset` share of the active flank, the plan's
-    /// `pitting_onset_share`; MODEL §8.1), and pressures at the flow pressure (MODEL §5.7).
-    pub fn warnings(&self, wf: &WheelFlank, onset: f64) -> Vec<String> {
+    /// `pitting_onset_share`; MODEL §8.1), the area reading's Miner sum where it rests on the
+    /// pressure–life curve `curve` beyond its data (MODEL §8), and pressures at the flow
+    /// pressure (MODEL §5.7).
+    pub fn warnings(&self, wf: &WheelFlank, onset: f64, curve: &Endurance) -> Vec<String> {
         let mut w = Vec::new();
         if let Some(why) = &self.stopped {
             w.push(format!("wear limit: {why}"));
@@ -419,7 +425,8 @@ impl WearState {
             ));
         }
         w.extend(self.tip_edge_warning());
-        w.extend(self.damage_warning(wf, onset));
+        w.extend(self.damage_warning(wf, onset, curve));
+        w.extend(self.area_extrapolation_warning(curve));
         if let Some(r) = self
             .records
             .last()
@@ -462,6 +469,37 @@ impl WearState {
         ))
     }
 
+    /// The area reading's Miner sum (MODEL §8.1) where more than [`EXTRAPOLATED_SHARE`] of it,
+    /// at first pitting or at the last state, comes from states whose p_eq,2% lies above the
+    /// pressure–life curve's data ([`forecast::area_damage_beyond_data`]): that part of
+    /// `area_damage` and of `area_first_pitting_cycles` extrapolates the curve (MODEL §8).
+    fn area_extrapolation_warning(&self, curve: &Endurance) -> Option<String> {
+        let last = self.records.last()?;
+        let first_pitting = forecast::area_first_pitting_cycles(&self.records, curve);
+        let until = first_pitting.unwrap_or(last.cycles);
+        let e = forecast::area_damage_beyond_data(&self.records, curve, until);
+        if e.share() <= EXTRAPOLATED_SHARE {
+            return None;
+        }
+        let at = match first_pitting {
+            Some(c) => format!("at first pitting, {} cycles", cycles_label(c)),
+            None => format!("at {} cycles", cycles_label(until)),
+        };
+        let shortest = curve.data_span().0;
+        Some(format!(
+            "pitting: {:.0} % of the area reading's Miner sum ({:.3} {at}) comes from states \
+             whose p_eq,2% lies above the pressure–life curve's data (from {} cycles, up to {:.0} \
+             MPa, against {:.0} MPa at its shortest tested life, {} cycles; MODEL §8): that part \
+             of area_damage and area_first_pitting_cycles extrapolates the curve",
+            100.0 * e.share(),
+            e.damage,
+            cycles_label(e.first_cycles.unwrap_or(0.0)),
+            e.highest_pa * 1e-6,
+            curve.pressure(shortest) * 1e-6,
+            cycles_label(shortest)
+        ))
+    }
+
     /// Flank nodes whose fatigue damage has reached 1 at the last state (MODEL §8.1): how
     /// many, their share of the active flank, the largest damage, read as first pitting only
     /// where they make up the `onset` share of the flank (2 %, A_p10, "Which p_eq decides";
@@ -469,7 +507,7 @@ impl WearState {
     /// such. The share is the nodes' own areas ([`forecast::node_shares`]), as a forecast's
     /// onset counts them: the cells touching a damaged node would count a strip of nodes
     /// about twice.
-    fn damage_warning(&self, wf: &WheelFlank, onset: f64) -> Option<String> {
+    fn damage_warning(&self, wf: &WheelFlank, onset: f64, curve: &Endurance) -> Option<String> {
         let due: Vec<usize> = (0..self.damage.len())
             .filter(|&k| self.damage[k] >= forecast::REACHED)
             .collect();
@@ -495,12 +533,35 @@ impl WearState {
         };
         Some(format!(
             "pitting: {} flank nodes (about {:.2} % of the active flank) have reached a fatigue \
-             damage of 1 at {} cycles (largest {:.3}): {reading} (damage map; MODEL §8.1)",
+             damage of 1 at {} cycles (largest {:.3}): {reading} (damage map; MODEL §8.1){}",
             due.len(),
             100.0 * share,
             cycles_label(self.cycles),
-            largest
+            largest,
+            self.beyond_data_note(curve)
         ))
+    }
+
+    /// Where some state's largest equivalent pressure lies above the pressure–life curve's
+    /// data (MODEL §8), the damage warning's note that the damage there extrapolates it: the
+    /// life's largest p_eq and its cycles against the highest tested pressure; empty where
+    /// every state stays within the data.
+    fn beyond_data_note(&self, curve: &Endurance) -> String {
+        let tested = curve.pressure(curve.data_span().0);
+        let worst = self.records.iter().max_by(|a, b| {
+            a.equivalent_pressure_max_pa
+                .total_cmp(&b.equivalent_pressure_max_pa)
+        });
+        match worst.filter(|r| r.equivalent_pressure_max_pa > tested) {
+            Some(r) => format!(
+                "; the damage of nodes loaded above {:.0} MPa, the curve's highest tested \
+                 pressure, extrapolates it (the life's largest p_eq {:.0} MPa, at {} cycles)",
+                tested * 1e-6,
+                r.equivalent_pressure_max_pa * 1e-6,
+                cycles_label(r.cycles)
+            ),
+            None => String::new(),
+        }
     }
 }
 

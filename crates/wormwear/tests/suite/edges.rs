@@ -444,7 +444,7 @@ fn a_life_warns_of_the_unresolved_tip_edge_from_its_records() {
             .wheel_flank(r.tca.as_ref().unwrap().loaded_flank)
             .clone();
         let life = r.life.unwrap();
-        let warnings = life.end.warnings(&wf, life.plan.pitting_onset_share);
+        let warnings = life.warnings(&wf);
         (life.end.records, warnings)
     };
     let said = |w: &[String]| -> Option<String> {

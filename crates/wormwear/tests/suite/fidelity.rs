@@ -511,3 +511,57 @@ fn map_cycles_stop_the_life_there_and_mark_the_states() {
     assert!(substeps > 4);
     assert_eq!(end.records.last().unwrap().loaded_analyses, 1 + substeps);
 }
+
+#[test]
+fn a_life_warns_where_its_area_reading_rests_on_the_curve_beyond_its_data() {
+    // MODEL §8: the CuSn12 curve's points reach 709 MPa (0.6e6 cycles). The design gear's
+    // running-in starts with p_eq,2% near the flow pressure (its sharp edges, MODEL §5.7): the
+    // first steps' lives on the curve are extrapolated, and the warning gives their share of
+    // the area sum, recomputed here from the records with the curve's power law. A curve
+    // whose data reach beyond every state's p_eq,2% gives none.
+    let g = design();
+    let (geo, tca) = prepared(&g);
+    let wf = geo.wheel_flank(tca.loaded_flank);
+    let mut plan = WearPlan::with_life(20_000.0);
+    plan.step = wormwear::wear::StepControl::Cycles(10_000.0);
+    let (end, _) = life(&g, &geo, &tca, &plan, WearState::new(wf));
+    let records = &end.records;
+    let life_at = |p: f64| 11e6 * (p / 425e6).powf(-1.0 / 0.176);
+    let (mut sum, mut beyond) = (0.0, 0.0);
+    for w in records.windows(2) {
+        let p = w[0].equivalent_pressure_first_pitting_pa;
+        let damage = (w[1].cycles - w[0].cycles) / life_at(p);
+        sum += damage;
+        if life_at(p) < 0.6e6 {
+            beyond += damage;
+        }
+        eprintln!("{:>6.0} cycles: p_eq,2% {:.1} MPa", w[0].cycles, p / 1e6);
+    }
+    assert!(
+        beyond > 0.0,
+        "the unworn p_eq,2% within the data: {records:?}"
+    );
+    let said = |curve: &wormwear::input::Endurance| -> Option<String> {
+        let w = end.warnings(wf, plan.pitting_onset_share, curve);
+        w.into_iter().find(|w| w.contains("extrapolates the curve"))
+    };
+    let text = said(&plan.endurance).expect("a warning");
+    eprintln!("{text}");
+    assert!(
+        text.starts_with(&format!(
+            "pitting: {:.0} % of the area reading's Miner sum ({:.3} at 20 000 cycles)",
+            100.0 * beyond / sum,
+            sum
+        )),
+        "{text}: {beyond} of {sum}"
+    );
+    assert!(
+        text.contains("against 709 MPa at its shortest tested life"),
+        "{text}"
+    );
+    let higher = wormwear::input::Endurance {
+        reference_pressure: 1500e6,
+        ..plan.endurance
+    };
+    assert_eq!(said(&higher), None);
+}

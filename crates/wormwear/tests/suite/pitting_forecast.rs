@@ -312,14 +312,14 @@ fn the_damage_warning_counts_a_row_of_damaged_nodes_as_the_area_between_its_neig
         .map(|c| wf.cell_area[c])
         .sum();
     let expected = 100.0 * 0.5 * rows / wf.active_area();
-    let warning = |onset: f64| {
+    let warning = |state: &wear::WearState, onset: f64| {
         state
-            .warnings(wf, onset)
+            .warnings(wf, onset, &wormwear::input::Endurance::DEFAULT)
             .into_iter()
             .find(|w| w.contains("fatigue damage of 1"))
             .expect("a damage warning")
     };
-    let at_two = warning(0.02);
+    let at_two = warning(&state, 0.02);
     let nodes = format!("{} flank nodes", wf.cells_face + 1);
     let share = format!("about {expected:.2} % of the active flank");
     assert!(at_two.contains(&nodes), "{at_two}");
@@ -329,12 +329,32 @@ fn the_damage_warning_counts_a_row_of_damaged_nodes_as_the_area_between_its_neig
     // forecast's onset share of 5 %: the warning reads the life's own onset.
     assert!(expected > 2.0 && expected < 5.0, "{expected}");
     assert!(at_two.contains("first pitting (2 % of the flank, A_p10, or more)"));
-    let at_five = warning(0.05);
+    let at_five = warning(&state, 0.05);
     assert!(
         at_five
             .contains("less than first pitting (5.00 % of the flank, wear.pitting_onset_percent)"),
         "{at_five}"
     );
+    // No records: no note on the curve's data. A state whose largest p_eq lies above the
+    // curve's highest tested pressure (709 MPa at 0.6e6 cycles, MODEL §8) adds it; one within
+    // does not.
+    assert!(!at_two.contains("extrapolates"), "{at_two}");
+    let record = |cycles: f64, p: f64| wear::StepRecord {
+        cycles,
+        equivalent_pressure_max_pa: p,
+        ..Default::default()
+    };
+    state.records = vec![record(0.0, 650e6), record(2e4, 1080e6), record(4e4, 700e6)];
+    let noted = warning(&state, 0.02);
+    assert!(
+        noted.ends_with(
+            "; the damage of nodes loaded above 709 MPa, the curve's highest tested pressure, \
+             extrapolates it (the life's largest p_eq 1080 MPa, at 20 000 cycles)"
+        ),
+        "{noted}"
+    );
+    state.records = vec![record(0.0, 650e6), record(2e4, 700e6)];
+    assert_eq!(warning(&state, 0.02), at_two);
 }
 
 #[test]

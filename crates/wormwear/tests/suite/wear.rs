@@ -182,7 +182,8 @@ fn a_life_whose_band_cannot_hold_its_contact_records_and_warns_it() {
     g.analysis.positions = 4;
     g.bending.kind = wormwear::input::BendingKind::None;
     let says = |geo: &Geometry, tca: &kinematics::Tca, end: &wear::WearState| {
-        let w = end.warnings(geo.wheel_flank(tca.loaded_flank), 0.02);
+        let curve = wormwear::input::Endurance::DEFAULT;
+        let w = end.warnings(geo.wheel_flank(tca.loaded_flank), 0.02, &curve);
         w.iter()
             .any(|w| w.contains("still reaches the local band's edge"))
     };

@@ -313,7 +313,11 @@ pub fn summary_value(
             &plan.endurance,
         ),
         found_phases: &state.found_phases,
-        warnings: state.warnings(geo.wheel_flank(tca.loaded_flank), plan.pitting_onset_share),
+        warnings: state.warnings(
+            geo.wheel_flank(tca.loaded_flank),
+            plan.pitting_onset_share,
+            &plan.endurance,
+        ),
         steps: state
             .records
             .iter()
