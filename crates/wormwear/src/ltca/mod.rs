@@ -297,6 +297,9 @@ pub struct Ltca {
     /// "Which p_eq decides"; [`crate::pitting::exceeded_on_share`] of `equivalent_pattern`), Pa:
     /// what the pitting safety reads.
     pub equivalent_pressure_first_pitting: f64,
+    /// Where the cells at or above p_eq,2% lie (MODEL §8.1; shares of the active flank at the
+    /// worm tip's trace, the face ends, the blank top and elsewhere; zeros for no load).
+    pub first_pitting_places: FlankPlaces,
     /// How the equivalent pressure was evaluated (its criterion, the wheel's Poisson ratio).
     pub subsurface: SubsurfaceSettings,
     /// Mean worm torque T1 and transmitted wheel torque T2 over the positions, N m.
@@ -565,6 +568,12 @@ impl Ltca {
             .fold(0.0, f64::max)
     }
 
+    /// [`Self::band_edge_share`] where above [`BAND_EDGE_WARNING`] (the contact cut by the
+    /// local mesh), None where not.
+    pub fn band_edge_share_warned(&self) -> Option<f64> {
+        Some(self.band_edge_share()).filter(|&s| s > BAND_EDGE_WARNING)
+    }
+
     /// The loads of this analysis as a start for the next ([`WarmStart`]).
     pub fn warm_start(&self) -> WarmStart {
         let loads = |p: &PositionResult| -> Vec<f64> {
@@ -784,6 +793,26 @@ fn pattern_warnings(
     warnings
 }
 
+/// p_eq,2% of the equivalent pattern `equivalent` (Pa per global cell; MODEL §8.1: the level
+/// exceeded on 2 % of the active flank, Pa) and where the cells at or above it lie (None
+/// without load), with the worm tip's trace and the tip edge's height of `settings`.
+fn first_pitting_level(
+    wf: &WheelFlank,
+    tca: &Tca,
+    settings: &LtcaSettings,
+    equivalent: &[f64],
+) -> (f64, Option<pattern::YieldedPlaces>) {
+    let level = crate::pitting::exceeded_on_share(
+        equivalent,
+        &wf.cell_area,
+        &wf.active,
+        crate::pitting::FIRST_PITTING_SHARE,
+    );
+    let trace = (tca.tip_trace.as_slice(), settings.tip_edge_height);
+    let places = (level > 0.0).then(|| pattern::YieldedPlaces::of(wf, equivalent, level, trace));
+    (level, places)
+}
+
 /// The loaded analysis over the mesh cycle from its positions (MODEL §5.6, §5.7, §8.1): the
 /// swept patterns, their statistics, the torques and the warnings. `gear_set` holds the loaded
 /// flank, the TCA, the wheel's teeth and the ratio u.
@@ -811,12 +840,8 @@ fn over_the_cycle(
         .iter()
         .flat_map(|p| p.equivalent.iter().map(|e| e.pressure))
         .fold(0.0, f64::max);
-    let equivalent_pressure_first_pitting = crate::pitting::exceeded_on_share(
-        &equivalent_pattern,
-        &wf.cell_area,
-        &wf.active,
-        crate::pitting::FIRST_PITTING_SHARE,
-    );
+    let (equivalent_pressure_first_pitting, first_pitting_places) =
+        first_pitting_level(wf, tca, settings, &equivalent_pattern);
     let stats = PatternStats::of(wf, &pattern, settings.flow_pressure);
     // The largest local cell (the published P_max): the pattern's cell centres read the
     // profiles between cell centres, which can only be lower.
@@ -832,6 +857,9 @@ fn over_the_cycle(
         (&pattern, stats.yielded_area_fraction),
         settings,
     ));
+    warnings.extend(first_pitting_places.as_ref().and_then(|places| {
+        pattern::first_pitting_edge_warning(equivalent_pressure_first_pitting, places)
+    }));
     Ltca {
         bending_model: bending.map(|b| b.name()).unwrap_or("none").to_string(),
         shaft_torsion_compliance: bending.map_or(0.0, |b| b.rigid_rotation_compliance()),
@@ -851,6 +879,8 @@ fn over_the_cycle(
         equivalent_depth,
         equivalent_pressure_max,
         equivalent_pressure_first_pitting,
+        first_pitting_places: first_pitting_places
+            .map_or_else(FlankPlaces::default, |p| p.places()),
         subsurface: settings.subsurface,
         worm_torque,
         wheel_torque,

@@ -227,10 +227,69 @@ impl HasPlace for LocalCell {
     }
 }
 
-/// Where the cells at the flow pressure lie (MODEL §2.3, §5.7): their shares of the active
-/// flank at the worm tip's trace (the two rows of cells above the lowest radius the worm's
-/// flank reaches in their column, above the rounded tip edge's strip where the worm has one),
-/// at the face ends (the first and last columns), at the blank top (the top row) and
+/// Where the cells of a pattern at or above a level lie on the flank (MODEL §2.3, §8.1), as
+/// shares of the active flank ([`YieldedPlaces`]'s places): the edges (the worm tip's trace,
+/// the face ends, the blank top) and elsewhere.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FlankPlaces {
+    pub tip_trace: f64,
+    pub face_ends: f64,
+    pub blank_top: f64,
+    pub elsewhere: f64,
+}
+
+impl FlankPlaces {
+    /// All of it, a share of the active flank.
+    pub fn total(&self) -> f64 {
+        self.tip_trace + self.face_ends + self.blank_top + self.elsewhere
+    }
+
+    /// The edges' part of the total (the worm tip's trace, the face ends, the blank top); 0
+    /// for none.
+    pub fn edge_share(&self) -> f64 {
+        let total = self.total();
+        if total > 0.0 {
+            (total - self.elsewhere) / total
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The edges' part of the area at or above p_eq,2% above which the loaded analysis warns that
+/// p_eq,2% reads the edges ([`first_pitting_edge_warning`]).
+pub const EDGE_READING_SHARE: f64 = 0.5;
+
+/// A warning when p_eq,2% (`first_pitting`, Pa, > 0; MODEL §8.1), what S_H and the area
+/// reading of first pitting read, lies mostly on the flank's edges: more than [`EDGE_READING_SHARE`] of
+/// the cells at or above it (`places`) at the worm tip's trace, the face ends or the blank top.
+/// Its value then follows the edges' shape and the contact cells more than the load
+/// (VALIDATION.md, sessions 60-61).
+pub(super) fn first_pitting_edge_warning(
+    first_pitting: f64,
+    places: &YieldedPlaces,
+) -> Option<String> {
+    let shares = places.places();
+    (shares.edge_share() > EDGE_READING_SHARE).then(|| {
+        format!(
+            "p_eq,2% = {:.0} MPa, what S_H and the area reading of first pitting read (MODEL \
+             §8.1), lies on the flank's edges: {:.0} % of the {:.2} % of the active flank at or \
+             above it is at the worm tip's trace, the face ends or the blank top ({}); it \
+             follows their shape (worm.tip_edge_radius_mm, wheel.face_edge_chamfer_mm, the \
+             reliefs) and the contact cells across the line more than the flank's load \
+             (VALIDATION.md, sessions 60-61)",
+            first_pitting * 1e-6,
+            100.0 * shares.edge_share(),
+            100.0 * shares.total(),
+            places.text()
+        )
+    })
+}
+
+/// Where the cells of a pattern at or above a level lie (MODEL §2.3, §5.7, §8.1): their shares
+/// of the active flank at the worm tip's trace (the two rows of cells above the lowest radius
+/// the worm's flank reaches in their column, above the rounded tip edge's strip where the worm
+/// has one), at the face ends (the first and last columns), at the blank top (the top row) and
 /// elsewhere, and the span of their radii and face positions, m.
 pub(super) struct YieldedPlaces {
     shares: [f64; 4],
@@ -239,17 +298,18 @@ pub(super) struct YieldedPlaces {
 }
 
 impl YieldedPlaces {
-    /// The places of the cells of `pattern` at `flow_pressure` on `wf`, with the worm tip's
-    /// trace `tip_trace` (per node column: z, radius; `Tca::tip_trace`) and the height its
-    /// rounded edge reaches above it (m; `LtcaSettings::tip_edge_height`).
+    /// The places of the cells of `pattern` at or above `level` (the flow pressure, p_eq,2%;
+    /// Pa) on `wf`, with the worm tip's trace `tip_trace` (per node column: z, radius;
+    /// `Tca::tip_trace`) and the height its rounded edge reaches above it (m;
+    /// `LtcaSettings::tip_edge_height`).
     pub(super) fn of(
         wf: &WheelFlank,
         pattern: &[f64],
-        flow_pressure: f64,
+        level: f64,
         (tip_trace, tip_edge_height): (&[(f64, f64)], f64),
     ) -> Self {
         let (ni, nj) = (wf.cells_height, wf.cells_face);
-        let bound = flow_pressure * (1.0 - 1e-9);
+        let bound = level * (1.0 - 1e-9);
         let active = wf.active_area();
         let mut place = Self::empty();
         for k in (0..pattern.len()).filter(|&k| pattern[k] >= bound) {
@@ -263,6 +323,17 @@ impl YieldedPlaces {
             place.add(which, cell, wf.cell_area[k] / active);
         }
         place
+    }
+
+    /// The shares by place.
+    pub(super) fn places(&self) -> FlankPlaces {
+        let [tip_trace, face_ends, blank_top, elsewhere] = self.shares;
+        FlankPlaces {
+            tip_trace,
+            face_ends,
+            blank_top,
+            elsewhere,
+        }
     }
 
     fn empty() -> Self {
@@ -699,6 +770,19 @@ pub(super) fn patch_mean_max(cells: &[[f64; 5]], across: f64, along: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_edges_share_is_their_part_of_the_placed_area() {
+        let places = FlankPlaces {
+            tip_trace: 0.012,
+            face_ends: 0.003,
+            blank_top: 0.001,
+            elsewhere: 0.004,
+        };
+        assert!((places.total() - 0.02).abs() < 1e-15);
+        assert!((places.edge_share() - 0.8).abs() < 1e-12);
+        assert_eq!(FlankPlaces::default().edge_share(), 0.0);
+    }
 
     #[test]
     fn the_tip_edge_s_contact_width_is_hertz_s_for_a_cylinder_on_a_plane() {

@@ -56,6 +56,9 @@ pub struct LtcaSummary {
     pub equivalent_pressure_depth_mm: f64,
     /// p_eq,2%: exceeded on 2 % of the active flank (MODEL §8.1), what S_H reads, Pa.
     pub equivalent_pressure_first_pitting_pa: f64,
+    /// Where the cells at or above it lie: shares of the active flank at the worm tip's trace,
+    /// the face ends, the blank top and elsewhere (MODEL §8.1).
+    pub first_pitting_places: crate::ltca::FlankPlaces,
     pub equivalent_pressure_definition: &'static str,
     /// S0: contact area / active flank area.
     pub contact_area_fraction: f64,
@@ -142,6 +145,7 @@ impl LtcaSummary {
                 .max_by(|a, b| a.0.total_cmp(b.0))
                 .map_or(f64::NAN, |(_, d)| d * MM),
             equivalent_pressure_first_pitting_pa: ltca.equivalent_pressure_first_pitting,
+            first_pitting_places: ltca.first_pitting_places,
             equivalent_pressure_definition: ltca.subsurface.criterion.definition(),
             contact_area_fraction: ltca.s0,
             pattern_shape: crate::kinematics::pattern_shape::PatternShape::of(

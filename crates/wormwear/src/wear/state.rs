@@ -271,6 +271,11 @@ pub struct StepRecord {
     /// area of first pitting, A_p10, which S_H reads), Pa (0 in records of earlier versions).
     #[serde(default)]
     pub equivalent_pressure_first_pitting_pa: f64,
+    /// The edges' part of the flank at or above that p_eq,2% (the worm tip's trace, the face
+    /// ends, the blank top; `Ltca::first_pitting_places`), 0-1 (0 in records of earlier
+    /// versions).
+    #[serde(default)]
+    pub first_pitting_edge_share: f64,
     /// The area reading of first pitting (MODEL §8.1): the Miner sum over the wear steps so far
     /// of each step's cycles over the life of p_eq,2% (of the state that starts it, each bin's
     /// at its cycle share with a duty cycle) on the pressure–life curve; 1 is first pitting on
@@ -427,6 +432,7 @@ impl WearState {
         w.extend(self.tip_edge_warning());
         w.extend(self.damage_warning(wf, onset, curve));
         w.extend(self.area_extrapolation_warning(curve));
+        w.extend(self.edge_reading_warning());
         if let Some(r) = self
             .records
             .last()
@@ -466,6 +472,36 @@ impl WearState {
             self.records.len(),
             worst.text(),
             cycles_label(*worst_cycles)
+        ))
+    }
+
+    /// The states whose p_eq,2% lay mostly on the flank's edges (more than
+    /// [`crate::ltca::EDGE_READING_SHARE`] of the flank at or above it at the worm tip's trace,
+    /// the face ends or the blank top; MODEL §8.1): how many, from which cycles, and the
+    /// largest share.
+    fn edge_reading_warning(&self) -> Option<String> {
+        let on_edges: Vec<&StepRecord> = self
+            .records
+            .iter()
+            .filter(|r| r.first_pitting_edge_share > crate::ltca::EDGE_READING_SHARE)
+            .collect();
+        let first = on_edges.first()?;
+        let most = on_edges.iter().max_by(|a, b| {
+            a.first_pitting_edge_share
+                .total_cmp(&b.first_pitting_edge_share)
+        })?;
+        Some(format!(
+            "pitting: in {} of the life's {} states, from {} cycles, p_eq,2% lay on the flank's \
+             edges: more than half of the flank at or above it at the worm tip's trace, the face \
+             ends or the blank top (up to {:.0} %, at {} cycles; first_pitting_edge_share); the \
+             area reading (area_damage, area_first_pitting_cycles) then reads the edges, which \
+             follow their shape and the contact cells across the line more than the flank's \
+             load (VALIDATION.md, sessions 60-61)",
+            on_edges.len(),
+            self.records.len(),
+            cycles_label(first.cycles),
+            100.0 * most.first_pitting_edge_share,
+            cycles_label(most.cycles)
         ))
     }
 

@@ -482,3 +482,55 @@ fn a_life_warns_of_the_unresolved_tip_edge_from_its_records() {
         assert!(t.contact_width_m < 3.0 * t.cell_width_m, "{t:?}");
     }
 }
+
+/// MODEL §8.1: p_eq,2% is the level exceeded on 2 % of the active flank, and the loaded
+/// analysis says where the flank at or above it lies. The places' total is that area, summed
+/// here from the equivalent pattern and the cell areas (at least 2 % by the quantile's
+/// definition). On the sharp design gear it lies at the edges (the worm tip's trace, the face
+/// ends), which is warned; with 20 um reliefs over 1 mm on the worm's tip and the wheel's
+/// edges (session 60's values) it moves into the flank's body, and nothing is warned.
+#[test]
+fn the_flank_at_or_above_p_eq_2_percent_is_placed_and_an_edge_reading_is_warned() {
+    let analyse = |g: &GearSet| {
+        let request = Request::new([Stage::Ltca]);
+        wormwear::run(g, Source::default(), request, &mut |_| Ok(())).unwrap()
+    };
+    let said = |w: &[String]| w.iter().any(|w| w.contains("lies on the flank's edges"));
+    let sharp = analyse(&design(0.0, 0.0));
+    let relieved = {
+        let mut g = design(0.0, 0.0);
+        let relief = wormwear::input::EdgeRelief {
+            amount: 20e-6,
+            length: 1e-3,
+        };
+        g.worm.tip_relief = relief;
+        g.wheel.edge_relief = relief;
+        analyse(&g)
+    };
+    let mut edge_shares = Vec::new();
+    for r in [&sharp, &relieved] {
+        let l = r.ltca.as_ref().unwrap();
+        let wf = r.geometry.wheel_flank(r.tca.as_ref().unwrap().loaded_flank);
+        let level = l.equivalent_pressure_first_pitting * (1.0 - 1e-9);
+        let at_or_above: f64 = (0..wf.cell_area.len())
+            .filter(|&k| l.equivalent_pattern[k] >= level)
+            .map(|k| wf.cell_area[k])
+            .sum::<f64>()
+            / wf.active_area();
+        let places = l.first_pitting_places;
+        eprintln!(
+            "p_eq,2% {:.0} MPa: {places:?}",
+            l.equivalent_pressure_first_pitting / 1e6
+        );
+        assert!(
+            (places.total() - at_or_above).abs() < 1e-12,
+            "{at_or_above}"
+        );
+        assert!(places.total() >= 0.02 * (1.0 - 1e-9), "{places:?}");
+        edge_shares.push(places.edge_share());
+    }
+    assert!(edge_shares[0] > 0.9, "{edge_shares:?}");
+    assert!(said(&sharp.ltca.as_ref().unwrap().warnings));
+    assert!(edge_shares[1] < 0.5, "{edge_shares:?}");
+    assert!(!said(&relieved.ltca.as_ref().unwrap().warnings));
+}

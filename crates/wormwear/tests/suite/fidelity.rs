@@ -559,6 +559,22 @@ fn a_life_warns_where_its_area_reading_rests_on_the_curve_beyond_its_data() {
         text.contains("against 709 MPa at its shortest tested life"),
         "{text}"
     );
+    // Where the flank at or above each state's p_eq,2% lay mostly on the edges, the life says
+    // in how many states (the sharp design gear: its worm tip's trace and face ends).
+    let on_edges = records
+        .iter()
+        .filter(|r| r.first_pitting_edge_share > wormwear::ltca::EDGE_READING_SHARE)
+        .count();
+    assert!(on_edges > 0, "{records:?}");
+    let edges = end.warnings(wf, plan.pitting_onset_share, &plan.endurance);
+    let edges = edges
+        .iter()
+        .find(|w| w.contains("lay on the flank's edges"));
+    let prefix = format!(
+        "pitting: in {on_edges} of the life's {} states,",
+        records.len()
+    );
+    assert!(edges.is_some_and(|w| w.starts_with(&prefix)), "{edges:?}");
     let higher = wormwear::input::Endurance {
         reference_pressure: 1500e6,
         ..plan.endurance

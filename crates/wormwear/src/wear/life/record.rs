@@ -137,11 +137,11 @@ impl LifeLoop<'_> {
             max_plastic_set_m: state.plastic_set_after(l).max(),
             max_plastic_indentation_m: l.plastic_indentation.max(),
             yielded_area_fraction: l.yielded_area_fraction,
-            band_edge_share: Some(l.band_edge_share())
-                .filter(|&s| s > crate::ltca::BAND_EDGE_WARNING),
+            band_edge_share: l.band_edge_share_warned(),
             tip_edge_resolution: l.tip_edge_resolution,
             equivalent_pressure_max_pa: l.equivalent_pattern.iter().copied().fold(0.0, f64::max),
             equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
+            first_pitting_edge_share: l.first_pitting_places.edge_share(),
             area_damage: 0.0,
             roughness_mean_m: roughness.0,
             roughness_min_m: roughness.1,
