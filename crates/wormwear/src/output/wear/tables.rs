@@ -212,7 +212,7 @@ pub fn te_orders_table(records: &[crate::wear::StepRecord]) -> Csv {
 /// The columns of `wear_steps.csv` (units in the names) and how each reads a record.
 type StepColumn = (&'static str, fn(&crate::wear::StepRecord) -> f64);
 
-const STEP_COLUMNS: [StepColumn; 45] = [
+const STEP_COLUMNS: [StepColumn; 46] = [
     ("step", |r| r.step as f64),
     ("cycles", |r| r.cycles),
     ("step_cycles", |r| r.step_cycles),
@@ -259,6 +259,7 @@ const STEP_COLUMNS: [StepColumn; 45] = [
     ("equivalent_pressure_first_pitting_pa", |r| {
         r.equivalent_pressure_first_pitting_pa
     }),
+    ("first_pitting_edge_share", |r| r.first_pitting_edge_share),
     ("area_damage", |r| r.area_damage),
     ("friction_coefficient_mean", |r| {
         r.friction.friction_coefficient_mean
