@@ -258,14 +258,23 @@ pub fn area_damage_rate(record: &StepRecord, curve: &Endurance) -> f64 {
     if record.phase == "pitting" {
         return 0.0;
     }
+    area_loads(record)
+        .iter()
+        .map(|&(share, p)| share / curve.life(p))
+        .sum()
+}
+
+/// What the area reading reads in the state of `record`: (share of the cycles, p_eq,2% in Pa)
+/// of the state's own analysis (share 1), or of each bin of a duty cycle.
+fn area_loads(record: &StepRecord) -> Vec<(f64, f64)> {
     if record.bins.is_empty() {
-        return 1.0 / curve.life(record.equivalent_pressure_first_pitting_pa);
+        return vec![(1.0, record.equivalent_pressure_first_pitting_pa)];
     }
     record
         .bins
         .iter()
-        .map(|b| b.cycle_share / curve.life(b.equivalent_pressure_first_pitting_pa))
-        .sum()
+        .map(|b| (b.cycle_share, b.equivalent_pressure_first_pitting_pa))
+        .collect()
 }
 
 /// The area reading's Miner sum at `cycles` after the state of `last` (none: the life's first
@@ -342,15 +351,7 @@ pub fn area_damage_beyond_data(
         if a.phase == "pitting" {
             continue;
         }
-        let loads: Vec<(f64, f64)> = match a.bins.is_empty() {
-            true => vec![(1.0, a.equivalent_pressure_first_pitting_pa)],
-            false => a
-                .bins
-                .iter()
-                .map(|b| (b.cycle_share, b.equivalent_pressure_first_pitting_pa))
-                .collect(),
-        };
-        for (share, p) in loads {
+        for (share, p) in area_loads(a) {
             let life = curve.life(p);
             let damage = span * share / life;
             out.damage += damage;
