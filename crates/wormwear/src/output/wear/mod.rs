@@ -163,7 +163,9 @@ pub use super::ltca::MAX_PRESSURE_DEFINITION;
 /// default level 31 % below the finer ones once the band has widened), and the worn flank's
 /// p_eq,2% with the area reading's sum from it (case C: 530-560 MPa over 0.06-0.33e6 cycles
 /// at 11 cells across the line, 650-740 MPa at 21, likely the edges' running-in, which does
-/// not converge with the cells; VALIDATION.md, session 59). Listed in the wear
+/// not converge with the cells; VALIDATION.md, session 59), and the edges' part of the flank at
+/// or above it (the design gear unworn: 0.92-0.99 at 31 cells where 11 give 0.99-1.00; session
+/// 61). Listed in the wear
 /// summary as `mesh_dependent`; no other stage reads them (the pitting forecast reads the
 /// damage field's share at its onset, the step control the largest per-cycle wear as a step
 /// size, the safety table the unworn analysis).
@@ -176,6 +178,7 @@ pub const MESH_DEPENDENT: &[&str] = &[
     "pressure_patch_max_pa (worn states)",
     "equivalent_pressure_max_pa (worn states)",
     "equivalent_pressure_first_pitting_pa (worn states)",
+    "first_pitting_edge_share",
     "area_damage",
     "mean_pressure_pa (worn states)",
     "n_li_model_cycles (worn states)",
