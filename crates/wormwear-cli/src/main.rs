@@ -216,6 +216,10 @@ enum Command {
         /// variants), section (a) without its mesh-refinement rows.
         #[arg(long)]
         quick: bool,
+        /// Only these jobs, comma-separated ids as in the report's "Run times" (e.g.
+        /// case-a,case-a-forecast): the report leaves out the tables of the others.
+        #[arg(long, value_delimiter = ',')]
+        jobs: Vec<String>,
     },
     /// A design study: variants of a base gear file (a grid or a list of cases, by dotted
     /// name) run in parallel on the local cores; sweep.csv (one row per variant), sweep.html,
@@ -451,7 +455,8 @@ fn dispatch(cli: &Cli) -> Result<(), Failure> {
             output,
             examples,
             quick,
-        } => validate(output, examples, *quick, cli.quiet),
+            jobs,
+        } => validate(output, examples, *quick, jobs, cli.quiet),
         Command::Sweep {
             file,
             output,
@@ -935,7 +940,13 @@ fn calibrate(
 }
 
 /// Runs the validation study into `dir` (VALIDATION.md at its root).
-fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(), Failure> {
+fn validate(
+    dir: &Path,
+    examples: &Path,
+    quick: bool,
+    only: &[String],
+    quiet: bool,
+) -> Result<(), Failure> {
     if !examples.join("gear-1x40-design.toml").is_file() {
         return Err(Failure::Input(anyhow::anyhow!(
             "--examples = {}: no gear-1x40-design.toml there (run from the repository root or give the examples directory)",
@@ -945,6 +956,7 @@ fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(),
     let settings = wormwear::validation::Settings {
         examples: examples.to_path_buf(),
         quick,
+        only: only.to_vec(),
     };
     let path = wormwear::validation::run(&settings, dir, &mut |line| {
         if !quiet {
@@ -952,7 +964,8 @@ fn validate(dir: &Path, examples: &Path, quick: bool, quiet: bool) -> Result<(),
         }
     })
     .map_err(|e| match e {
-        wormwear::validation::ValidationError::Input { .. } => Failure::Input(e.into()),
+        wormwear::validation::ValidationError::Input { .. }
+        | wormwear::validation::ValidationError::UnknownJob { .. } => Failure::Input(e.into()),
         _ => Failure::Run(anyhow::Error::new(e).context("validation study")),
     })?;
     if !quiet {

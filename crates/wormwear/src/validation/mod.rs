@@ -32,6 +32,8 @@ pub enum ValidationError {
     },
     #[error("job {id}: {message}")]
     Job { id: String, message: String },
+    #[error("--jobs: no job {id} in the study (its jobs: {known})")]
+    UnknownJob { id: String, known: String },
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
 }
@@ -44,6 +46,9 @@ pub struct Settings {
     /// Smoke run: lives cut to a hundredth, no bending, no million-cycle studies, one job per
     /// table (checks the machinery, not the model).
     pub quick: bool,
+    /// Only these jobs (ids as in the report's "Run times"; empty: every job): the tables
+    /// of the others are left out of the report.
+    pub only: Vec<String>,
 }
 
 /// One job: a loaded analysis of the unworn gear (no plan) or a life.
@@ -91,6 +96,17 @@ pub struct UnwornPattern {
     pub te_mean_rad: f64,
     pub te_p2p_rad: f64,
     pub stiffness_nm_per_rad: f64,
+    /// p_eq,2%, the equivalent pressure below the flank exceeded on 2 % of the active flank
+    /// (MODEL §8.1: what S_H reads), Pa.
+    #[serde(default)]
+    pub equivalent_pressure_first_pitting_pa: f64,
+    /// The largest equivalent pressure (an edge's, MODEL §5.7), Pa.
+    #[serde(default)]
+    pub equivalent_pressure_max_pa: f64,
+    /// The edges' share of the flank at or above p_eq,2% (the worm tip's trace, the face ends,
+    /// the blank top; `ltca.first_pitting_places`).
+    #[serde(default)]
+    pub first_pitting_edge_share: f64,
 }
 
 /// Results of the study by job id.
@@ -353,6 +369,9 @@ fn unworn_pattern(
         te_mean_rad: te_mean,
         te_p2p_rad: te_p2p,
         stiffness_nm_per_rad: l.stiffness_mean(),
+        equivalent_pressure_first_pitting_pa: l.equivalent_pressure_first_pitting,
+        equivalent_pressure_max_pa: l.equivalent_pressure_max,
+        first_pitting_edge_share: l.first_pitting_places.edge_share(),
     }
 }
 
@@ -404,6 +423,23 @@ pub fn jobs(settings: &Settings) -> Result<Vec<Job>, ValidationError> {
     if settings.quick {
         jobs.retain(|j| QUICK_JOBS.contains(&j.id.as_str()));
     }
+    if let Some(id) = settings
+        .only
+        .iter()
+        .find(|id| !jobs.iter().any(|j| &j.id == *id))
+    {
+        return Err(ValidationError::UnknownJob {
+            id: id.clone(),
+            known: jobs
+                .iter()
+                .map(|j| j.id.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    if !settings.only.is_empty() {
+        jobs.retain(|j| settings.only.contains(&j.id));
+    }
     Ok(jobs)
 }
 
@@ -447,6 +483,9 @@ fn push_job(jobs: &mut Vec<Job>, id: &str, gear: GearSet, plan: Option<WearPlan>
     })
 }
 
+/// The worm torques of the load study besides the design example's 60 N m, N m.
+pub const LOAD_STUDY_NM: [f64; 3] = [20.0, 30.0, 90.0];
+
 /// (b) The design case: its unworn pattern, step controls over 180 000 cycles, and (not in
 /// the quick study) a million cycles.
 fn design_jobs(jobs: &mut Vec<Job>, design: &GearSet, scale: f64, quick: bool) {
@@ -466,6 +505,18 @@ fn design_jobs(jobs: &mut Vec<Job>, design: &GearSet, scale: f64, quick: bool) {
         push_job(jobs, id, design.clone(), Some(plan));
     }
     if !quick {
+        // S_H against the load (MODEL §8.1, §9.1): the same life at other worm torques
+        // (design-adaptive is the example's 60 N m).
+        for torque in LOAD_STUDY_NM {
+            let plan = WearPlan {
+                step: StepControl::MaxRemoval(4e-6),
+                ..design_life.clone()
+            };
+            let g = variant(design, |g| {
+                g.conditions.torque = input::Torque::Worm(torque)
+            });
+            push_job(jobs, &format!("design-{torque:.0}nm"), g, Some(plan));
+        }
         for (id, step) in [
             ("design-1e6-fixed", StepControl::Cycles(30_000.0)),
             ("design-1e6-adaptive", StepControl::MaxRemoval(4e-6)),
@@ -590,6 +641,16 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
         }),
         plan.clone(),
     ));
+    // Edge breaks (MODEL §2.3): no citable default, so the default is sharp; 0.5 mm, the
+    // middle of the 0.2-1 mm issue 54 names, on the worm's tip and the wheel's face ends.
+    out.push((
+        "c-edge-breaks".to_string(),
+        variant(c, |g| {
+            g.worm.tip_edge_radius = 0.5e-3;
+            g.wheel.face_edge_chamfer = 0.5e-3;
+        }),
+        plan.clone(),
+    ));
     // Our options of the loaded analysis, one at a time.
     let analysis_options: [(&str, GearChange); 3] = [
         ("c-elastic", |g| {
@@ -635,6 +696,7 @@ mod tests {
         let settings = |quick| Settings {
             examples: examples.clone(),
             quick,
+            only: Vec::new(),
         };
         let ids = |quick| -> Vec<String> {
             jobs(&settings(quick))
@@ -646,5 +708,35 @@ mod tests {
         let (full, quick) = (ids(false), ids(true));
         assert_eq!(quick.len(), QUICK_JOBS.len(), "{quick:?}");
         assert!(quick.iter().all(|id| full.contains(id)));
+    }
+
+    #[test]
+    fn a_subset_of_jobs_runs_just_those_and_an_unknown_id_is_named() {
+        let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+        let settings = |only: &[&str]| Settings {
+            examples: examples.clone(),
+            quick: false,
+            only: only.iter().map(|s| s.to_string()).collect(),
+        };
+        let all: Vec<String> = jobs(&settings(&[]))
+            .unwrap()
+            .into_iter()
+            .map(|j| j.id)
+            .collect();
+        assert!(all.len() > 30, "{all:?}");
+        let some: Vec<String> = jobs(&settings(&["case-c", "c-edge-breaks", "design-90nm"]))
+            .unwrap()
+            .into_iter()
+            .map(|j| j.id)
+            .collect();
+        // In the study's order, not the list's.
+        assert_eq!(some, ["design-90nm", "case-c", "c-edge-breaks"]);
+        let message = jobs(&settings(&["case-c", "case-d"]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("--jobs") && message.contains("case-d") && message.contains("case-a"),
+            "{message}"
+        );
     }
 }

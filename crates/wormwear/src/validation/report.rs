@@ -385,6 +385,7 @@ fn section_b(m: &mut String, results: &Results) {
     let _ = writeln!(m, "## (b) The published studies on the reference gears\n");
     unworn_table(m, results);
     step_tables(m, results);
+    load_table(m, results);
     schedule_table(m, results);
     forecast_table(m, results);
     wear_only_table(m, results);
@@ -402,9 +403,12 @@ fn unworn_table(m: &mut String, results: &Results) {
     );
     let _ = writeln!(
         m,
-        "| case | P_max | P_patch | P_mean | S0 | S1 | S2 | max at r, z (mm) | above tip trace (mm) | TE mean | TE p2p | stiffness (N m/rad) |"
+        "| case | P_max | P_patch | P_mean | S0 | S1 | S2 | max at r, z (mm) | above tip trace (mm) | TE mean | TE p2p | stiffness (N m/rad) | p_eq,2% | largest p_eq | edges' share at p_eq,2% |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        m,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for (name, id) in [
         ("design (60 N m, 1500 rpm)", "unworn-design"),
         ("A (40 N m, 1600 rpm)", "case-a"),
@@ -415,7 +419,7 @@ fn unworn_table(m: &mut String, results: &Results) {
         let u = &r.unworn;
         let _ = writeln!(
             m,
-            "| {name} | {:.0} | {:.0} | {:.0} | {:.3} | {:.3} | {:.3} | {:.2}, {:.2} | {:.2} | {:.1} | {:.1} | {:.3e} |",
+            "| {name} | {:.0} | {:.0} | {:.0} | {:.3} | {:.3} | {:.3} | {:.2}, {:.2} | {:.2} | {:.1} | {:.1} | {:.3e} | {:.0} | {:.0} | {:.2} |",
             u.max_pressure_pa * MPA,
             u.pressure_patch_max_pa * MPA,
             u.mean_pressure_pa * MPA,
@@ -427,7 +431,10 @@ fn unworn_table(m: &mut String, results: &Results) {
             u.max_above_tip_trace_m * MM,
             u.te_mean_rad * UM,
             u.te_p2p_rad * UM,
-            u.stiffness_nm_per_rad
+            u.stiffness_nm_per_rad,
+            u.equivalent_pressure_first_pitting_pa * MPA,
+            u.equivalent_pressure_max_pa * MPA,
+            u.first_pitting_edge_share
         );
     }
     m.push('\n');
@@ -504,6 +511,74 @@ fn step_tables(m: &mut String, results: &Results) {
         );
     }
     m.push('\n');
+}
+
+/// The design example's required life (400 h at 1500 rpm, i = 40) in wheel cycles, at which
+/// the load table reads S_H on the default curve (the study clears the examples' safety
+/// inputs so that its jobs keep their keys).
+const DESIGN_REQUIRED_CYCLES: f64 = 400.0 * 3600.0 * 1500.0 / 60.0 / 40.0;
+
+/// S_H against the load (MODEL §8.1, §9.1): the design gear's lives at the load study's
+/// torques, p_eq,2% of the unworn state and at the end.
+fn load_table(m: &mut String, results: &Results) {
+    let mut rows: Vec<(f64, &JobResult)> = super::LOAD_STUDY_NM
+        .iter()
+        .filter_map(|&t| Some((t, results.get(&format!("design-{t:.0}nm"))?)))
+        .chain(results.get("design-adaptive").map(|r| (60.0, r)))
+        .filter(|(_, r)| r.records.len() >= 2)
+        .collect();
+    if rows.len() < 2 {
+        return;
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let curve = crate::input::Endurance::DEFAULT;
+    let allowed = curve.pressure(DESIGN_REQUIRED_CYCLES);
+    let _ = writeln!(
+        m,
+        "### S_H against the load\n\n\
+         The design gear at other worm torques (60 N m is `design-adaptive`), each over 180 000 \
+         cycles with adaptive 4 um steps. S_H reads p_eq,2% of the unworn state (MODEL §8.1, \
+         §9.1: the equivalent pressure exceeded on 2 % of the active flank) against the default \
+         curve at the design example's required {DESIGN_REQUIRED_CYCLES:.2e} wheel cycles (400 \
+         h), {:.0} MPa, K_A 1. The edges' share: the part of the flank at or above p_eq,2% on \
+         the worm tip's trace, the face ends and the blank top. The area sum: the Miner sum of \
+         the area reading at the end (first pitting at 1). The largest node damage: the node \
+         forecast's reading.\n",
+        allowed * MPA
+    );
+    let _ = writeln!(
+        m,
+        "| worm torque (N m) | p_eq,2% unworn | largest p_eq unworn | edges' share unworn | P_patch unworn | P_mean unworn | S_H | p_eq,2% at the end | edges' share at the end | area sum at the end | largest node damage at the end |"
+    );
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|---|---|");
+    for (torque, r) in &rows {
+        let (u, e) = (&r.records[0], &r.records[r.records.len() - 1]);
+        let _ = writeln!(
+            m,
+            "| {torque:.0} | {:.0} | {:.0} | {:.2} | {:.0} | {:.0} | {:.2} | {:.0} | {:.2} | {:.3} | {:.2} |",
+            u.equivalent_pressure_first_pitting_pa * MPA,
+            u.equivalent_pressure_max_pa * MPA,
+            u.first_pitting_edge_share,
+            u.pressure_patch_max_pa * MPA,
+            u.mean_pressure_pa * MPA,
+            allowed / u.equivalent_pressure_first_pitting_pa,
+            e.equivalent_pressure_first_pitting_pa * MPA,
+            e.first_pitting_edge_share,
+            e.area_damage,
+            e.max_damage
+        );
+    }
+    let p2 = |r: &JobResult| r.records[0].equivalent_pressure_first_pitting_pa;
+    let (low, high) = (rows[0], rows[rows.len() - 1]);
+    let _ = writeln!(
+        m,
+        "\nFrom {:.0} to {:.0} N m p_eq,2% unworn grows {:.2}x (Hertz: sqrt of the torque ratio, \
+         {:.2}x).\n",
+        low.0,
+        high.0,
+        p2(high.1) / p2(low.1),
+        (high.0 / low.0).sqrt()
+    );
 }
 
 fn schedule_table(m: &mut String, results: &Results) {
@@ -584,14 +659,17 @@ fn forecast_table(m: &mut String, results: &Results) {
          MODEL §8.1; the default curve, life factor 1, onset share 2 %, nothing fitted per \
          case). Pitting phases in millions of cycles; the pitted share at the end of life; \
          first pitting against the observed (the schedule's first pitting phase; B pits from \
-         the start, no ratio).
-"
+         the start, no ratio). The area reading beside it (MODEL §8.1; the summary's \
+         `area_first_pitting_cycles`): the Miner sum over the steps of each step's cycles over \
+         the curve's life at its state's p_eq,2%, first pitting where it reaches 1, nothing \
+         acting on the flank; with the share of that sum (to first pitting, or the end) from \
+         states above the curve's data (above 709 MPa, lives shorter than its 0.6e6 cycles).\n"
     );
     let _ = writeln!(
         m,
-        "| case | observed pitting phases | forecast pitting phases | forecast first pitting | forecast / observed first pitting | pitted share: schedule / forecast | states: schedule / forecast |"
+        "| case | observed pitting phases | forecast pitting phases | forecast first pitting | forecast / observed first pitting | area reading: first pitting (/ observed) | area sum beyond the curve's data | pitted share: schedule / forecast | states: schedule / forecast |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|---|---|");
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|");
     for (name, id) in cases {
         let (Some(s), Some(f)) = (results.get(id), results.get(&format!("{id}-forecast"))) else {
             continue;
@@ -603,9 +681,10 @@ fn forecast_table(m: &mut String, results: &Results) {
             _ => "-".to_string(),
         };
         let share = |r: &JobResult| last(r).map_or(f64::NAN, |x| x.pitted_area_fraction);
+        let (area, beyond) = area_reading(f, first_of(s));
         let _ = writeln!(
             m,
-            "| {name} | {} | {} | {first} | {ratio} | {:.3} / {:.3} | {} / {} |",
+            "| {name} | {} | {} | {first} | {ratio} | {area} | {beyond} | {:.3} / {:.3} | {} / {} |",
             pitting_phases(&s.phases),
             pitting_phases(&f.phases),
             share(s),
@@ -639,6 +718,27 @@ fn forecast_table(m: &mut String, results: &Results) {
         let _ = writeln!(m, "| {n} | {} | {} | {} |", row[0], row[1], row[2]);
     }
     m.push('\n');
+}
+
+/// The area reading of a forecast life (MODEL §8.1: the Miner sum of each step's cycles over
+/// the life of its p_eq,2% on the default curve): its first pitting in millions of cycles with
+/// its ratio to `observed`, and the share of its sum (to first pitting, or the end) from states
+/// above the curve's data.
+fn area_reading(f: &JobResult, observed: Option<f64>) -> (String, String) {
+    let curve = crate::input::Endurance::DEFAULT;
+    let first = crate::wear::forecast::area_first_pitting_cycles(&f.records, &curve);
+    let text = match (first, observed) {
+        (Some(c), Some(o)) if o > 0.0 => format!("{:.3} ({:.2})", c * 1e-6, c / o),
+        (Some(c), _) => format!("{:.3}", c * 1e-6),
+        (None, _) => format!(
+            "none (sum {:.2})",
+            last(f).map_or(f64::NAN, |x| x.area_damage)
+        ),
+    };
+    let until = first.or(last(f).map(|x| x.cycles)).unwrap_or(0.0);
+    let split = crate::wear::forecast::area_damage_beyond_data(&f.records, &curve, until);
+    let beyond = format!("{:.0} %", 100.0 * split.share());
+    (text, beyond)
 }
 
 fn wear_only_table(m: &mut String, results: &Results) {
@@ -731,7 +831,7 @@ fn speed_table(m: &mut String, results: &Results) {
 }
 
 /// Rows of section (c): (variant, job id).
-const SENSITIVITY_ROWS: [(&str, &str); 8] = [
+const SENSITIVITY_ROWS: [(&str, &str); 9] = [
     ("default (case C)", "case-c"),
     ("composite roughness 0.2 um", "c-roughness-0.2"),
     ("composite roughness 0.5 um", "c-roughness-0.5"),
@@ -743,6 +843,10 @@ const SENSITIVITY_ROWS: [(&str, &str); 8] = [
     ("K x 2", "c-k-double"),
     ("no bending", "c-no-bending"),
     ("20 um tip and edge reliefs over 1 mm", "c-reliefs"),
+    (
+        "edge breaks: worm tip edge radius 0.5 mm, wheel face chamfers 0.5 mm (MODEL §2.3)",
+        "c-edge-breaks",
+    ),
 ];
 
 /// Rows of section (d): (option and its input, job id).
@@ -809,21 +913,24 @@ fn section_c_d(m: &mut String, results: &Results) {
 fn variant_table(m: &mut String, results: &Results, base: &StepRecord, rows: &[(&str, &str)]) {
     let _ = writeln!(
         m,
-        "| variant | backlash at the end (vs default) | max wear | P_max | P_patch | P_mean | states | analyses | time (s) |"
+        "| variant | backlash at the end (vs default) | max wear | P_max | P_patch | P_mean | p_eq,2% unworn / at the end | area sum at the end | states | analyses | time (s) |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|---|---|---|---|");
     for &(name, id) in rows {
         let Some(r) = results.get(id) else { continue };
         let Some(e) = last(r) else { continue };
         let _ = writeln!(
             m,
-            "| {name} | {:.1} ({:+.0} %) | {:.1} | {:.0} | {:.0} | {:.0} | {} | {} | {:.0} |",
+            "| {name} | {:.1} ({:+.0} %) | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} / {:.0} | {:.2} | {} | {} | {:.0} |",
             e.backlash_increase_m * UM,
             100.0 * (e.backlash_increase_m / base.backlash_increase_m - 1.0),
             e.max_wear_m * UM,
             e.max_pressure_pa * MPA,
             e.pressure_patch_max_pa * MPA,
             e.mean_pressure_pa * MPA,
+            r.records[0].equivalent_pressure_first_pitting_pa * MPA,
+            e.equivalent_pressure_first_pitting_pa * MPA,
+            e.area_damage,
             r.records.len(),
             e.loaded_analyses,
             r.seconds

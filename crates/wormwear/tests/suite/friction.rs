@@ -233,6 +233,7 @@ fn study_settings() -> wormwear::validation::Settings {
     wormwear::validation::Settings {
         examples: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples"),
         quick: false,
+        only: Vec::new(),
     }
 }
 
