@@ -51,12 +51,7 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
          refinements against it. The published work gives no measured backlash values in \
          REFERENCE_GEARS.md, only the observed phases, so section (b) compares behaviours and \
          the phases, not curves.\n",
-        if settings.quick {
-            " with `--quick` (lives cut to a hundredth, no bending, one job per table, section (a) \
-             without its mesh-refinement rows: a smoke run, not a validation)"
-        } else {
-            ""
-        }
+        run_kind(settings, results.len())
     );
     let without: Vec<&str> = results
         .values()
@@ -78,6 +73,27 @@ fn header(m: &mut String, settings: &Settings, results: &Results) {
             format!(" but {} (none)", without.join(", "))
         }
     );
+}
+
+/// How the run behind the report was asked for, when not the whole study: `--quick`, or
+/// `--jobs` (`jobs` of them run).
+fn run_kind(settings: &Settings, jobs: usize) -> String {
+    let mut kind = String::new();
+    if settings.quick {
+        kind.push_str(
+            " with `--quick` (lives cut to a hundredth, no bending, one job per table, section \
+             (a) without its mesh-refinement rows: a smoke run, not a validation)",
+        );
+    }
+    if !settings.only.is_empty() {
+        let _ = write!(
+            kind,
+            "{} `--jobs` ({jobs} of the study's jobs; the tables and rows of the others are left \
+             out)",
+            if kind.is_empty() { " with" } else { " and" }
+        );
+    }
+    kind
 }
 
 /// The points a reader needs first, each with its figures from the tables below.
