@@ -1432,6 +1432,37 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
         std::fs::read_to_string(out.join("VALIDATION.md")).unwrap(),
         text
     );
+    // A subset (--jobs) reuses its stored runs and writes only their tables, and says so.
+    let o = bin()
+        .args([
+            "validate",
+            "--quick",
+            "--jobs",
+            "case-c,case-c-forecast",
+            "-o",
+        ])
+        .arg(&out)
+        .arg("--examples")
+        .arg(example("gear-1x40-design.toml").parent().unwrap())
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{log}");
+    assert_eq!(log.matches(": from ").count(), 2, "{log}");
+    let subset = std::fs::read_to_string(out.join("VALIDATION.md")).unwrap();
+    assert!(subset.contains("`--jobs` (2 of the study's jobs"));
+    assert!(subset.contains("### Pitting forecast against the observed schedules"));
+    assert!(!subset.contains("### Speed study"));
+    // An id that is not a job of the study is an input error naming it.
+    let o = bin()
+        .args(["validate", "--quick", "--jobs", "case-c,case-d", "-o"])
+        .arg(&out)
+        .arg("--examples")
+        .arg(example("gear-1x40-design.toml").parent().unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no job case-d"));
     // A wrong examples directory is an input error.
     let o = bin()
         .args(["validate", "--quick", "-o"])

@@ -433,6 +433,16 @@ fn reference_cases_table(m: &mut String, settings: &Settings, results: &Results)
 /// Case C and the speed study with the heat balance against the fixed 60 C: oil temperature
 /// and efficiency at the start and the end, and the final backlash of both.
 fn thermal_life_table(m: &mut String, results: &Results) {
+    const BALANCE: [&str; 4] = [
+        "speed-100-balance",
+        "speed-600-balance",
+        "c-balance",
+        "speed-1200-balance",
+    ];
+    // (A --jobs run without them: no table.)
+    if !BALANCE.iter().any(|id| results.contains_key(*id)) {
+        return;
+    }
     let _ = writeln!(
         m,
         "\nWith the oil temperature from the heat balance of the example's fan-cooled housing \

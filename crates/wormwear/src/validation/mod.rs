@@ -594,12 +594,36 @@ fn thermal_jobs(jobs: &mut Vec<Job>, c: &GearSet, scale: f64) {
 /// A change of a gear (a variant's).
 type GearChange = fn(&mut GearSet);
 
-/// The variants of case C for (c) and (d): id, gear, plan.
-fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
+/// Case C's edge variants: 20 um reliefs over 1 mm on the worm's tip and the wheel's edges,
+/// and broken edges (MODEL §2.3: no citable default, so the default is sharp; 0.5 mm, the
+/// middle of the 0.2-1 mm issue 54 names, on the worm's tip and the wheel's face ends).
+fn edge_variants(c: &GearSet, plan: &WearPlan) -> [(String, GearSet, WearPlan); 2] {
     let relief = input::EdgeRelief {
         amount: 20e-6,
         length: 1e-3,
     };
+    [
+        (
+            "c-reliefs".to_string(),
+            variant(c, |g| {
+                g.worm.tip_relief = relief;
+                g.wheel.edge_relief = relief;
+            }),
+            plan.clone(),
+        ),
+        (
+            "c-edge-breaks".to_string(),
+            variant(c, |g| {
+                g.worm.tip_edge_radius = 0.5e-3;
+                g.wheel.face_edge_chamfer = 0.5e-3;
+            }),
+            plan.clone(),
+        ),
+    ]
+}
+
+/// The variants of case C for (c) and (d): id, gear, plan.
+fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
     let mut out = Vec::new();
     for rq in [0.2, 0.5] {
         out.push((
@@ -633,24 +657,7 @@ fn variants(c: &GearSet, plan: WearPlan) -> Vec<(String, GearSet, WearPlan)> {
             plan.clone(),
         ));
     }
-    out.push((
-        "c-reliefs".to_string(),
-        variant(c, |g| {
-            g.worm.tip_relief = relief;
-            g.wheel.edge_relief = relief;
-        }),
-        plan.clone(),
-    ));
-    // Edge breaks (MODEL §2.3): no citable default, so the default is sharp; 0.5 mm, the
-    // middle of the 0.2-1 mm issue 54 names, on the worm's tip and the wheel's face ends.
-    out.push((
-        "c-edge-breaks".to_string(),
-        variant(c, |g| {
-            g.worm.tip_edge_radius = 0.5e-3;
-            g.wheel.face_edge_chamfer = 0.5e-3;
-        }),
-        plan.clone(),
-    ));
+    out.extend(edge_variants(c, &plan));
     // Our options of the loaded analysis, one at a time.
     let analysis_options: [(&str, GearChange); 3] = [
         ("c-elastic", |g| {

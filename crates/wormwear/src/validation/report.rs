@@ -810,6 +810,13 @@ fn wear_only_table(m: &mut String, results: &Results) {
 }
 
 fn speed_table(m: &mut String, results: &Results) {
+    // (A --jobs run without the other speeds: no table of case C alone.)
+    if !["speed-100", "speed-600", "speed-1200"]
+        .iter()
+        .any(|id| results.contains_key(*id))
+    {
+        return;
+    }
     let _ = writeln!(m, "### Speed study (case C's torque and schedule)\n");
     let _ = writeln!(
         m,
