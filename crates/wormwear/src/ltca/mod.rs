@@ -829,7 +829,7 @@ fn over_the_cycle(
     // indentation (MODEL §5.7); the equivalent pressure's (MODEL §8.1). The band's instants
     // are kept for the cycle's wear (MODEL §7.2), which reads the same passages.
     let tau = 2.0 * std::f64::consts::PI / teeth as f64;
-    let passage_samples = passage::band_samples(wf, tca, &positions, tau);
+    let passage_samples = passage::band_samples(wf, tca, &positions, tau, settings.slice_step);
     let Swept {
         pattern,
         plastic_indentation,

@@ -150,11 +150,18 @@ impl Located {
 
 /// The band's instants on each node column of the loaded flank `wf` (index j = 0..=nj), from
 /// the loaded analysis' positions: unsorted; `tau` is the wheel's tooth pitch angle, rad.
+///
+/// With `slice_step` > 1 only every `slice_step`-th node column is a slice of the local
+/// meshes (MODEL §5.1), its cells `slice_step` columns long; a column between slices reads
+/// the slice whose cells cover it ([`covering_slice`]), its profile moved across the line by
+/// the contact line's shift from the slice's column to its own (the band keeps its offset
+/// from its line), so that every column has its passages.
 pub(crate) fn band_samples(
     wf: &WheelFlank,
     tca: &Tca,
     positions: &[PositionResult],
     tau: f64,
+    slice_step: usize,
 ) -> Vec<Vec<Sample>> {
     use rayon::prelude::*;
     let runs = CellRuns::index(
@@ -167,8 +174,12 @@ pub(crate) fn band_samples(
     // cores this part would otherwise wait for one thread, issue 55).
     let mut lines_of: Vec<Vec<&crate::kinematics::SliceContact>> =
         vec![Vec::new(); wf.cells_face + 1];
+    let mut line_at = std::collections::HashMap::new();
     for line in &tca.contact_lines {
         lines_of[line.slice].push(line);
+        line_at
+            .entry((line.position, line.tooth, line.slice))
+            .or_insert(line.r);
     }
     lines_of
         .par_iter()
@@ -181,7 +192,18 @@ pub(crate) fn band_samples(
                     let theta2 =
                         tca.positions[line.position].theta2 + tca.sigma * line.tooth as f64 * tau;
                     let tooth = tca.teeth.iter().position(|&k| k == line.tooth);
-                    let key = tooth.map(|t| runs.key(line.position, t, line.slice));
+                    let slice = covering_slice(line.slice, slice_step, wf.cells_face);
+                    // The slice's line where the column borrows its cells (none: no profile).
+                    let shift = if slice == line.slice {
+                        Some(0.0)
+                    } else {
+                        line_at
+                            .get(&(line.position, line.tooth, slice))
+                            .map(|r| line.r - r)
+                    };
+                    let key = tooth
+                        .zip(shift)
+                        .map(|(t, _)| runs.key(line.position, t, slice));
                     let mut cells = match key.filter(|k| !taken.contains(k)) {
                         Some(k) => {
                             taken.push(k);
@@ -189,6 +211,10 @@ pub(crate) fn band_samples(
                         }
                         None => Vec::new(),
                     };
+                    let shift = shift.unwrap_or(0.0);
+                    if shift != 0.0 {
+                        cells.iter_mut().for_each(|c| c.r += shift);
+                    }
                     cells.sort_by(|a, b| a.r.total_cmp(&b.r));
                     let time = tca.sigma * theta2;
                     sample_of(cells, line, time, wf, tca)
@@ -198,6 +224,24 @@ pub(crate) fn band_samples(
             samples
         })
         .collect()
+}
+
+/// The slice whose cells cover node column `column` when every `slice_step`-th column of
+/// 0..=`last` is a slice (MODEL §5.1; `local_mesh`): the nearest such column, the lower one
+/// where two are as near (an even step's boundary column).
+pub(crate) fn covering_slice(column: usize, slice_step: usize, last: usize) -> usize {
+    let step = slice_step.max(1);
+    let below = column - column % step;
+    let slice = if column - below > step / 2 {
+        below + step
+    } else {
+        below
+    };
+    if slice > last {
+        below
+    } else {
+        slice
+    }
 }
 
 /// Pressure profiles per (position, tooth, slice) from the local cells. A slice's cells are
@@ -608,6 +652,20 @@ pub(crate) fn swept_max(samples: &[Sample], radii: &[f64], dt: f64, what: Swept)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_column_between_slices_reads_the_slice_whose_cells_cover_it() {
+        // Every column its own slice.
+        assert!((0..=10).all(|j| covering_slice(j, 1, 10) == j));
+        // Slices 0, 3, 6, 9 with cells three columns long: 0..=1, 2..=4, 5..=7, 8..=10.
+        let three: Vec<usize> = (0..=10).map(|j| covering_slice(j, 3, 10)).collect();
+        assert_eq!(three, [0, 0, 3, 3, 3, 6, 6, 6, 9, 9, 9]);
+        // Slices 0, 2, 4 with cells two columns long: a boundary column takes the lower one;
+        // the last column past the last slice takes the last slice.
+        let two: Vec<usize> = (0..=5).map(|j| covering_slice(j, 2, 5)).collect();
+        assert_eq!(two, [0, 0, 2, 2, 4, 4]);
+        assert_eq!(covering_slice(60, 7, 60), 56);
+    }
 
     fn sample(profile: Vec<(f64, f64)>) -> Sample {
         Sample {
