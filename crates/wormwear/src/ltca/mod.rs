@@ -124,10 +124,7 @@ impl LtcaSettings {
             flow_pressure: a.contact.pressure_bound(),
             patch_across: a.pressure_patch_across,
             patch_along: a.pressure_patch_along,
-            solver: SolverSettings {
-                kind: a.solver,
-                ..SolverSettings::default()
-            },
+            solver: SolverSettings::for_kind(a.solver),
             pressure_direction: a.pressure_direction,
             torque_balance: a.torque_balance,
             oil_temperature: gear.lubricant.temperature,

@@ -161,6 +161,29 @@ fn a_sphere_beyond_yield_agrees_with_tamaas_kato_saturated() {
     }
 }
 
+/// A fixed point stopped by its pass budget says how far it got: its last relative change,
+/// finite and above the tolerance (it reported NaN before session 63).
+#[test]
+fn a_fixed_point_out_of_passes_reports_its_last_change() {
+    let (_, elastic, _, _) = sphere(24, 2.8);
+    let settings = SolverSettings {
+        kind: SolverKind::FixedPoint,
+        tolerance: 1e-11,
+        max_iterations: 5,
+    };
+    match solve(&elastic, &settings, None) {
+        Err(wormwear::ltca::solver::SolverError::NotConverged {
+            residual,
+            tolerance,
+            ..
+        }) => assert!(residual.is_finite() && residual > tolerance, "{residual:e}"),
+        other => panic!(
+            "expected NotConverged, got {:?}",
+            other.map(|s| s.residuals)
+        ),
+    }
+}
+
 #[test]
 fn both_solvers_carry_the_bound_and_agree() {
     // The bounded fixed point (MODEL §5.4 with §5.7) against the bounded conjugate gradient,

@@ -40,6 +40,8 @@ pub(super) fn fixed_point(
     let mut y0 = vec![0.0; n];
     let mut ratio = vec![0.0; n];
     let mut approach = 0.0;
+    // The last pass's relative changes of the approach and of the loads (what `settled` reads).
+    let mut residual = f64::INFINITY;
     for it in 1..=settings.max_iterations {
         problem.apply(&q, &mut y0);
         for i in 0..n {
@@ -65,6 +67,8 @@ pub(super) fn fixed_point(
             let s = problem.load / total;
             q.iter_mut().for_each(|v| *v *= s);
         }
+        residual =
+            ((new_approach - approach).abs() / new_approach.abs()).max(change / problem.load);
         let settled = (new_approach - approach).abs() <= settings.tolerance * new_approach.abs()
             && change / problem.load < settings.tolerance;
         approach = new_approach;
@@ -82,7 +86,7 @@ pub(super) fn fixed_point(
     Err(SolverError::NotConverged {
         kind: SolverKind::FixedPoint,
         iterations: settings.max_iterations,
-        residual: f64::NAN,
+        residual,
         tolerance: settings.tolerance,
     })
 }

@@ -69,6 +69,27 @@ impl Default for SolverSettings {
     }
 }
 
+impl SolverSettings {
+    /// The defaults for solver `kind`: the published fixed point (MODEL §5.4) converges
+    /// linearly, so it gets [`FIXED_POINT_ITERATIONS`] passes (on the design example without
+    /// bending one position stood at a relative change of 1.9e-10 after the 20 000 the
+    /// conjugate gradient's budget allows, against the tolerance 1e-10).
+    pub fn for_kind(kind: SolverKind) -> Self {
+        let max_iterations = match kind {
+            SolverKind::FixedPoint => FIXED_POINT_ITERATIONS,
+            SolverKind::ConjugateGradient => Self::default().max_iterations,
+        };
+        Self {
+            kind,
+            max_iterations,
+            ..Self::default()
+        }
+    }
+}
+
+/// Passes the published fixed point may take on one solve ([`SolverSettings::for_kind`]).
+pub const FIXED_POINT_ITERATIONS: usize = 400_000;
+
 /// Residuals of a solution.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Residuals {
