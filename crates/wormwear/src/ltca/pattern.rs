@@ -145,8 +145,12 @@ pub struct TipEdgeResolution {
 impl TipEdgeResolution {
     /// The tip edge of radius `radius` (m; 0: sharp, None) against contact cells `cell_width`
     /// wide across the line (m), at the analysis' largest pressure `max_pressure` (Pa) with
-    /// the Hertz modulus `effective_modulus` (Pa): Some where its Hertz width, which bounds
-    /// the contact the round makes anywhere, spans less than [`RESOLVED_CELLS_ACROSS`] cells.
+    /// the Hertz modulus `effective_modulus` (Pa): Some where its Hertz width spans less than
+    /// [`RESOLVED_CELLS_ACROSS`] cells. The Hertz width is the round's elastic contact at
+    /// P_max; where the edge carries more than that contact can at the flow pressure, its
+    /// contact spreads into a plastic plateau of width load / flow pressure, wider than the
+    /// Hertz width (0.1-0.25 mm against 51 um for a 1 mm round on the design gear, VALIDATION.md
+    /// session 63), so the cells this asks for are then finer than the plateau needs.
     pub fn of(
         radius: f64,
         max_pressure: f64,
