@@ -174,12 +174,15 @@ pub(crate) fn band_samples(
     // cores this part would otherwise wait for one thread, issue 55).
     let mut lines_of: Vec<Vec<&crate::kinematics::SliceContact>> =
         vec![Vec::new(); wf.cells_face + 1];
+    // The lines' crossings by (position, tooth, column), read only where slices skip columns.
     let mut line_at = std::collections::HashMap::new();
     for line in &tca.contact_lines {
         lines_of[line.slice].push(line);
-        line_at
-            .entry((line.position, line.tooth, line.slice))
-            .or_insert(line.r);
+        if slice_step > 1 {
+            line_at
+                .entry((line.position, line.tooth, line.slice))
+                .or_insert(line.r);
+        }
     }
     lines_of
         .par_iter()
