@@ -686,6 +686,12 @@ mod tests {
         for (set, rank) in [(left, 2), (across, 4)] {
             let sub = pb.restrict(&set);
             assert_eq!(sub.low_rank.as_ref().unwrap().rank, rank);
+            // A set that keeps every column shares the whole term's core instead of a copy.
+            let (whole, part) = (
+                pb.low_rank.as_ref().unwrap(),
+                sub.low_rank.as_ref().unwrap(),
+            );
+            assert_eq!(std::sync::Arc::ptr_eq(&whole.core, &part.core), rank == 4);
             let all: Vec<usize> = (0..set.len()).collect();
             let (a, b) = (sub.dense(&all), pb.dense(&set));
             let scale = b.amax();

@@ -167,15 +167,15 @@ pub struct LowRank {
     /// ranges' columns.
     values: Vec<f64>,
     offsets: Vec<usize>,
-    /// Row-major rank x rank, symmetric.
-    pub core: Vec<f64>,
+    /// Row-major rank x rank, symmetric (shared by the restrictions that keep every column).
+    pub core: std::sync::Arc<Vec<f64>>,
     /// Column ranges [start, end) outside which row i of F is zero (up to three per row: a
     /// member's functions live on the row's tooth or thread only, plus the wheel shaft's rigid
     /// body terms); unused entries are (0, 0).
     pub ranges: Vec<[(usize, usize); 3]>,
     /// Per row of the core: its runs of non-zero columns [start, end) (the core is block
     /// sparse: tooth relations reach the neighbours only, the members do not couple).
-    core_runs: Vec<Vec<(usize, usize)>>,
+    core_runs: std::sync::Arc<Vec<Vec<(usize, usize)>>>,
 }
 
 impl LowRank {
@@ -249,12 +249,12 @@ impl LowRank {
         core: Vec<f64>,
         ranges: Vec<[(usize, usize); 3]>,
     ) -> Self {
-        let core_runs = core_runs(&core, rank);
+        let core_runs = std::sync::Arc::new(core_runs(&core, rank));
         Self {
             rank,
             values,
             offsets,
-            core,
+            core: std::sync::Arc::new(core),
             ranges,
             core_runs,
         }
@@ -354,6 +354,18 @@ impl LowRank {
             }));
         }
         offsets.push(values.len());
+        if rank == self.rank {
+            // Every column stays: the same core and runs (a third of a restriction's work on
+            // the design life when copied and scanned again).
+            return LowRank {
+                rank,
+                values,
+                offsets,
+                core: self.core.clone(),
+                ranges,
+                core_runs: self.core_runs.clone(),
+            };
+        }
         let mut core = vec![0.0; rank * rank];
         for (r, &cr) in columns.iter().enumerate() {
             let row = &self.core[cr * self.rank..(cr + 1) * self.rank];
