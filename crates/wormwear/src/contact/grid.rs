@@ -16,8 +16,10 @@
 //! (the Hertz checks) have such cells; a gear flank's cells never do (their normals turn).
 
 use super::{coefficient, ContactCell, ElasticPair};
+use realfft::num_complex::Complex;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use rustfft::Fft;
 use std::sync::{Arc, OnceLock};
-use wormwear_fft::{Complex, ComplexToReal, Fft, RealToComplex};
 
 /// Relative tolerance of the lattice test: centres within this fraction of the lattice
 /// spacing, unit vectors within it, half sides within it relatively. The coefficients then
@@ -145,8 +147,8 @@ impl GridInfluence {
             transform_size(2 * nx - 1, true),
             transform_size(2 * ny - 1, false),
         );
-        let (forward_rows, inverse_rows) = wormwear_fft::real_plans(px);
-        let (forward_columns, inverse_columns) = wormwear_fft::complex_plans(py);
+        let mut real_planner = RealFftPlanner::<f64>::new();
+        let mut planner = rustfft::FftPlanner::<f64>::new();
         let mut grid = Self {
             nx,
             ny,
@@ -155,10 +157,10 @@ impl GridInfluence {
             kernel,
             scale: levers.iter().map(|l| 1.0 / l).collect(),
             spectrum: Vec::new(),
-            forward_rows,
-            inverse_rows,
-            forward_columns,
-            inverse_columns,
+            forward_rows: real_planner.plan_fft_forward(px),
+            inverse_rows: real_planner.plan_fft_inverse(px),
+            forward_columns: planner.plan_fft_forward(py),
+            inverse_columns: planner.plan_fft_inverse(py),
             rows: (0..cells.len()).map(|_| OnceLock::new()).collect(),
         };
         grid.spectrum = grid.kernel_spectrum();
