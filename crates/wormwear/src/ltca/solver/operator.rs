@@ -355,8 +355,8 @@ impl LowRank {
         }
         offsets.push(values.len());
         if rank == self.rank {
-            // Every column stays: the same core and runs (a third of a restriction's work on
-            // the design life when copied and scanned again).
+            // Every column stays: the same core and runs (copied and scanned again, they were
+            // about 40 % of the restrictions' time on the design life, BENCHMARKS.md session 64).
             return LowRank {
                 rank,
                 values,
