@@ -91,14 +91,3 @@ fn quoted(a: &str) -> String {
         false => format!("'{}'", a.replace('\'', "'\\''")),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn words_a_shell_would_split_are_quoted() {
-        assert_eq!(super::quoted("out/b"), "out/b");
-        assert_eq!(super::quoted("my gear.toml"), "'my gear.toml'");
-        assert_eq!(super::quoted("it's"), "'it'\\''s'");
-        assert_eq!(super::quoted(""), "''");
-    }
-}

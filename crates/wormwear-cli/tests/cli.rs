@@ -1476,19 +1476,21 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
 
 #[test]
 fn a_life_killed_after_every_state_and_resumed_ends_as_the_uninterrupted_one() {
-    // Fault injection (issue 16): the design case to 60 000 cycles in 10 000-cycle steps (sub-
-    // steps from the stability guard) with a pitting phase from 20 000 to 30 000 cycles, killed
-    // as soon as each new state is on disk and resumed, until it ends. The records and the
-    // step table equal the uninterrupted run's byte for byte.
+    // Fault injection (issue 16): the design case (FE bending) to 60 000 cycles in 10 000-cycle
+    // steps (sub-steps from the stability guard) with a pitting phase from 20 000 to 30 000
+    // cycles, killed as soon as each new state is on disk and resumed, until it ends. The
+    // records and the step table equal the uninterrupted run's byte for byte. On 10 positions
+    // (the resume is the subject; as many states as on 20, with sub-steps and the pitting phase).
     let files = tempfile::tempdir().unwrap();
     let phases =
         "step_wear_um = 4.0\nphases = [\n    { kind = \"wear\", until_cycles = 20000 },\n    \
                   { kind = \"pitting\", until_cycles = 30000, pressure_limit_mpa = 500.0 },\n    \
                   { kind = \"wear\", until_cycles = 60000 },\n]";
+    let positions = ("positions = 20", "positions = 10");
     let design = edited_design(
         files.path(),
         "pitted.toml",
-        &[("step_wear_um = 4.0", phases)],
+        &[("step_wear_um = 4.0", phases), positions],
     );
     let life = ["-q", "--cycles", "60000", "--step-cycles", "10000"];
     let whole = tempfile::tempdir().unwrap();
@@ -1626,15 +1628,18 @@ fn a_life_in_the_directory_is_not_restarted_without_force_and_stale_maps_go() {
 #[cfg(unix)]
 #[test]
 fn ctrl_c_in_a_life_says_where_it_stopped_and_how_to_resume() {
-    // Issue 59: Ctrl-C ended a life with exit 130 and no word of --resume.
-    let dir = tempfile::tempdir().unwrap();
+    // Issue 59: Ctrl-C ended a life with exit 130 and no word of --resume. The command it
+    // prints quotes the words a shell would split (here the output folder's name, with a
+    // space and an apostrophe) so that it can be pasted as it is.
+    let parent = tempfile::tempdir().unwrap();
+    let folder = parent.path().join("my life's run");
     let design = example("gear-1x40-design.toml");
     let life = ["-q", "--cycles", "40000", "--step-cycles", "10000"];
-    let run = into("wear", &design, dir.path(), &life)
+    let run = into("wear", &design, &folder, &life)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    let checkpoint = dir.path().join("wear_checkpoint.json");
+    let checkpoint = folder.join("wear_checkpoint.json");
     let start = std::time::Instant::now();
     while !checkpoint.exists() && start.elapsed().as_secs() < 300 {
         std::thread::sleep(std::time::Duration::from_millis(5));
@@ -1648,10 +1653,12 @@ fn ctrl_c_in_a_life_says_where_it_stopped_and_how_to_resume() {
         err.contains("interrupted: the life's last saved state is step"),
         "{err}"
     );
+    // The folder's name as a POSIX shell reads it: in single quotes, the apostrophe closed,
+    // escaped and reopened.
+    let quoted = format!("'{}'", folder.display().to_string().replace('\'', "'\\''"));
     let command = format!(
-        "wormwear wear {} -o {} {} --resume",
+        "wormwear wear {} -o {quoted} {} --resume",
         design.display(),
-        dir.path().display(),
         life.join(" ")
     );
     assert!(err.contains(&command), "{err}\nnot: {command}");
@@ -2547,9 +2554,10 @@ fn an_explicit_one_bin_duty_cycle_writes_the_design_examples_bytes() {
 fn the_duty_cycle_example_runs_its_life_and_rating() {
     let dir = tempfile::tempdir().unwrap();
     let file = example("gear-1x40-duty-cycle.toml");
-    let args = ["--cycles", "20000", "--step-cycles", "10000"];
-    // `run` with the life, then `rating` of the same life resumed in the same directory (the
-    // finished life: only its last state is recomputed), which prints the spectrum and table.
+    let args = ["--cycles", "10000", "--step-cycles", "10000"];
+    // `run` with a life of two states, then `rating` of the same life resumed in the same
+    // directory (the finished life: only its last state is recomputed), which prints the
+    // spectrum and table.
     let run = into("run", &file, dir.path(), &[&["-q"], &args[..]].concat())
         .output()
         .unwrap();
