@@ -1424,9 +1424,17 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
     }
     let runs = std::fs::read_dir(out.join("runs")).unwrap().count();
     assert_eq!(runs, first.matches(" done in ").count());
+    let stored = std::fs::read_dir(out.join("friction-runs"))
+        .unwrap()
+        .count();
+    assert!(stored > 0);
+    let computed = format!("friction studies: {stored} unworn analyses computed, 0 read");
+    assert!(first.contains(&computed), "{first}");
     let second = call();
     assert_eq!(second.matches(": from ").count(), runs, "{second}");
     assert!(!second.contains(" done in "));
+    let read = format!("friction studies: 0 unworn analyses computed, {stored} read");
+    assert!(second.contains(&read), "{second}");
     // Same results, so the same tables (the run times are those stored with the results).
     assert_eq!(
         std::fs::read_to_string(out.join("VALIDATION.md")).unwrap(),
@@ -1449,6 +1457,10 @@ fn validate_writes_every_section_and_resumes_from_its_runs() {
     let log = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{log}");
     assert_eq!(log.matches(": from ").count(), 2, "{log}");
+    assert!(
+        log.contains("friction studies: 0 unworn analyses computed"),
+        "{log}"
+    );
     let subset = std::fs::read_to_string(out.join("VALIDATION.md")).unwrap();
     assert!(subset.contains("`--jobs` (2 of the study's jobs"));
     assert!(subset.contains("### Pitting forecast against the observed schedules"));

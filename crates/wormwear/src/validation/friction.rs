@@ -52,15 +52,17 @@ pub struct SpeedPoint {
 }
 
 /// The study's points, gear by gear in [`SPEED_STUDY`]'s order (with `settings.quick` the
-/// slowest and the fastest speed of each), with the examples' own friction inputs.
-pub fn over_speeds(settings: &Settings) -> Result<Vec<SpeedPoint>, ValidationError> {
-    speed_points(settings, None)
+/// slowest and the fastest speed of each), with the examples' own friction inputs; each unworn
+/// analysis read from `store` when it holds one of the same inputs ([`Store`]).
+pub fn over_speeds(settings: &Settings, store: &Store) -> Result<Vec<SpeedPoint>, ValidationError> {
+    speed_points(settings, store, None)
 }
 
 /// [`over_speeds`] with the film's limiting shear coefficient Lambda set to `limiting_shear`
 /// on both gears (None: the examples' own).
 fn speed_points(
     settings: &Settings,
+    store: &Store,
     limiting_shear: Option<f64>,
 ) -> Result<Vec<SpeedPoint>, ValidationError> {
     let mut points = Vec::new();
@@ -78,8 +80,11 @@ fn speed_points(
             if let Some(lambda) = limiting_shear {
                 g.friction.limiting_shear = lambda;
             }
-            let id = format!("friction-{}-{rpm:.0}", name.trim_end_matches(".toml"));
-            let unworn = unworn_friction(&g, &id)?;
+            let mut id = format!("friction-{}-{rpm:.0}", name.trim_end_matches(".toml"));
+            if let Some(lambda) = limiting_shear {
+                id.push_str(&format!("-lambda-{lambda}"));
+            }
+            let unworn = store.unworn_friction(&g, &id)?;
             let iso = crate::rating::rate(&g);
             let mu0 = crate::rating::base_friction(iso.sliding_speed_m_s);
             points.push(SpeedPoint {
@@ -101,6 +106,7 @@ fn speed_points(
 
 /// The unworn gear's friction from its loaded analysis (with its bending model, from the
 /// cache when built before).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct UnwornFriction {
     friction: f64,
     asperity_share: f64,
@@ -108,6 +114,80 @@ struct UnwornFriction {
     mesh_efficiency: f64,
     /// T2 / (u T1), the loaded analysis' torques.
     torque_efficiency: f64,
+}
+
+/// Where the friction studies keep their unworn analyses between calls of the study: one
+/// sealed file per analysis (`<id>.json`, [`crate::integrity`]) with the text of its inputs
+/// (gear, study version, program), read back only when that text is the same, as the jobs'
+/// results are ([`super::run`]). Counts what it read and what it computed.
+pub struct Store {
+    dir: Option<std::path::PathBuf>,
+    read: std::cell::Cell<usize>,
+    computed: std::cell::Cell<usize>,
+}
+
+/// A stored unworn analysis: its inputs' text and its friction.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Stored {
+    key: String,
+    friction: UnwornFriction,
+}
+
+impl Store {
+    /// A store in the folder `dir` (made when first written); None: every analysis computed,
+    /// nothing kept.
+    pub fn new(dir: Option<&Path>) -> Self {
+        Store {
+            dir: dir.map(Path::to_path_buf),
+            read: std::cell::Cell::new(0),
+            computed: std::cell::Cell::new(0),
+        }
+    }
+
+    /// The analyses read from the store and computed so far.
+    pub fn counts(&self) -> (usize, usize) {
+        (self.read.get(), self.computed.get())
+    }
+
+    /// [`unworn_friction`] of `g`, from the store when it holds the same inputs under `id`,
+    /// else computed and stored.
+    fn unworn_friction(
+        &self,
+        g: &crate::input::GearSet,
+        id: &str,
+    ) -> Result<UnwornFriction, ValidationError> {
+        let key = serde_json::json!({
+            "version": super::STUDY_VERSION,
+            "program": crate::PROGRAM,
+            "gear": g,
+        })
+        .to_string();
+        let path = self.dir.as_ref().map(|d| d.join(format!("{id}.json")));
+        let stored = path.as_ref().and_then(|p| {
+            let text = crate::files::read_text(p, crate::files::OWN_FILE_LIMIT).ok()?;
+            // (A file that fails its checksum is computed again.)
+            let s: Stored = crate::integrity::open(&text).ok()?;
+            (s.key == key).then_some(s.friction)
+        });
+        if let Some(friction) = stored {
+            self.read.set(self.read.get() + 1);
+            return Ok(friction);
+        }
+        let friction = unworn_friction(g, id)?;
+        self.computed.set(self.computed.get() + 1);
+        if let Some(path) = path {
+            let text = crate::integrity::seal(&Stored {
+                key,
+                friction: friction.clone(),
+            })
+            .map_err(|e| ValidationError::Job {
+                id: id.to_string(),
+                message: e.to_string(),
+            })?;
+            crate::output::write_atomic(&path, text.as_bytes())?;
+        }
+        Ok(friction)
+    }
 }
 
 /// The unworn loaded analysis of `g` ([`super::Unworn`]) and its contact's friction (MODEL
@@ -153,6 +233,7 @@ pub struct LimitingShearRow {
 /// shears at its limit (most of the loaded flank at these pressures).
 pub fn limiting_shear_window(
     settings: &Settings,
+    store: &Store,
 ) -> Result<Vec<LimitingShearRow>, ValidationError> {
     let lambdas = if settings.quick {
         // The smoke run: the machinery on one value (the test command runs it twice).
@@ -162,7 +243,7 @@ pub fn limiting_shear_window(
     };
     let mut rows = Vec::new();
     for lambda in lambdas {
-        let points = speed_points(settings, Some(lambda))?;
+        let points = speed_points(settings, store, Some(lambda))?;
         let largest = |gear: &str, iso: fn(&SpeedPoint) -> f64| {
             points
                 .iter()
@@ -184,7 +265,7 @@ pub fn limiting_shear_window(
             .collect();
         let mut c = example(settings, "gear-1x40-case-c.toml")?;
         c.friction.limiting_shear = lambda;
-        let unworn = unworn_friction(&c, &format!("friction-case-c-lambda-{lambda}"))?;
+        let unworn = store.unworn_friction(&c, &format!("friction-case-c-lambda-{lambda}"))?;
         rows.push(LimitingShearRow {
             limiting_shear: lambda,
             departures,

@@ -5,8 +5,9 @@
 //! A study is a list of jobs: loaded analyses of an unworn gear and lives. Each job's result is
 //! written to `DIR/runs/<id>.json` with the full text of its inputs (gear, plan, code version);
 //! a later run reuses a result only when that text is the same, so an interrupted study resumes
-//! where it stopped and a changed input is always recomputed. The report is then written from
-//! the results ([`report`]).
+//! where it stopped and a changed input is always recomputed; the friction studies keep their
+//! unworn analyses the same way in `DIR/friction-runs`. The report is then written from the
+//! results ([`report`]).
 
 pub mod analytic;
 pub mod friction;
@@ -128,9 +129,10 @@ pub fn example(settings: &Settings, name: &str) -> Result<GearSet, ValidationErr
     Ok(g)
 }
 
-/// Runs every job not already in `dir/runs` (same key) and the friction study over sliding
-/// speeds ([`friction`]), and writes the report and its figures (`dir/validation-figures`);
-/// returns the path of `dir/VALIDATION.md`. `progress` receives a line per job.
+/// Runs every job not already in `dir/runs` (same key) and the friction studies over sliding
+/// speeds ([`friction`]; each analysis not already in `dir/friction-runs`), and writes the
+/// report and its figures (`dir/validation-figures`); returns the path of
+/// `dir/VALIDATION.md`. `progress` receives a line per job.
 pub fn run(
     settings: &Settings,
     dir: &Path,
@@ -184,15 +186,7 @@ pub fn run(
         results.insert(job.id.clone(), result);
     }
     let analytic = analytic::checks(&example(settings, "gear-1x40-design.toml")?, settings.quick);
-    progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
-    let speeds = friction::over_speeds(settings)?;
-    friction::charts(&speeds, &dir.join(FIGURES))?;
-    progress(&format!(
-        "the film's limiting shear over its window (MODEL §13: the speed study and case C at \
-         {} values) ...",
-        friction::LIMITING_SHEAR_STUDY.len()
-    ));
-    let window = friction::limiting_shear_window(settings)?;
+    let (speeds, window) = friction_studies(settings, dir, progress)?;
     let markdown = report::markdown(settings, &results, &analytic, (&speeds, &window));
     let path = dir.join("VALIDATION.md");
     crate::output::write_atomic(&path, markdown.as_bytes())?;
@@ -211,8 +205,38 @@ pub fn run(
     Ok(path)
 }
 
+/// The friction studies of the report's section (e) ([`friction`]): the speed study (its
+/// charts written into `dir/validation-figures`) and the limiting shear's window, each unworn
+/// analysis read from `dir/friction-runs` when stored there with the same inputs.
+fn friction_studies(
+    settings: &Settings,
+    dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<friction::SpeedPoint>, Vec<friction::LimitingShearRow>), ValidationError> {
+    progress("friction over sliding speeds (MODEL §13, 14 unworn loaded analyses) ...");
+    let store = friction::Store::new(Some(&dir.join(FRICTION_RUNS)));
+    let speeds = friction::over_speeds(settings, &store)?;
+    friction::charts(&speeds, &dir.join(FIGURES))?;
+    progress(&format!(
+        "the film's limiting shear over its window (MODEL §13: the speed study and case C at \
+         {} values) ...",
+        friction::LIMITING_SHEAR_STUDY.len()
+    ));
+    let window = friction::limiting_shear_window(settings, &store)?;
+    let (read, computed) = store.counts();
+    progress(&format!(
+        "    friction studies: {computed} unworn analyses computed, {read} read from {}",
+        dir.join(FRICTION_RUNS).display()
+    ));
+    Ok((speeds, window))
+}
+
 /// The folder beside `VALIDATION.md` that holds its figures (copied with it).
 pub const FIGURES: &str = "validation-figures";
+
+/// The folder beside `VALIDATION.md` that keeps the friction studies' unworn analyses between
+/// calls ([`friction::Store`]).
+pub const FRICTION_RUNS: &str = "friction-runs";
 
 fn run_path(dir: &Path, id: &str) -> PathBuf {
     dir.join("runs").join(format!("{id}.json"))

@@ -249,7 +249,7 @@ fn study_settings() -> wormwear::validation::Settings {
 fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
     use wormwear::validation::{self, friction};
     let settings = study_settings();
-    let points = friction::over_speeds(&settings).unwrap();
+    let points = friction::over_speeds(&settings, &friction::Store::new(None)).unwrap();
     print!("{}", friction::table(&points));
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(validation::FIGURES);
     friction::charts(&points, &dir).unwrap();
@@ -293,7 +293,8 @@ fn the_contacts_friction_over_sliding_speeds_beside_iso_tr_14521() {
 #[ignore = "heavy validation: scripts/validate-heavy runs it"]
 fn the_film_limiting_shear_sets_the_friction_at_speed() {
     use wormwear::validation::friction;
-    let rows = friction::limiting_shear_window(&study_settings()).unwrap();
+    let rows =
+        friction::limiting_shear_window(&study_settings(), &friction::Store::new(None)).unwrap();
     print!("{}", friction::limiting_shear_table(&rows));
     for pair in rows.windows(2) {
         let (low, high) = (&pair[0], &pair[1]);
