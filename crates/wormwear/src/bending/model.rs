@@ -21,8 +21,9 @@ use crate::input::{BendingKind, GearSet};
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 
-/// Version of the FE models and their fit: bump when a change alters the coefficients.
-const MODEL_VERSION: &str = "fe-bending-5";
+/// Version of the FE models and their fit: bump when a change alters the coefficients or what
+/// a cache entry holds.
+const MODEL_VERSION: &str = "fe-bending-6";
 
 /// Version of the worm deflection's compliance (MODEL §9.1): bump when a change alters it.
 const DEFLECTION_VERSION: &str = "worm-deflection-3";
@@ -333,6 +334,12 @@ pub fn build(
     build_in(gear, geo, Some(&cache_dir())).map(|(b, w)| (Some(b), w))
 }
 
+/// The worm's fit points up and across the thread (`bending.height_points`,
+/// `bending.worm_width_points`).
+fn fit_points(gear: &GearSet) -> (usize, usize) {
+    (gear.bending.height_points, gear.bending.worm_width_points)
+}
+
 /// As [`build`] for "fe" with an explicit cache directory (None: no cache).
 pub fn build_in(
     gear: &GearSet,
@@ -343,7 +350,7 @@ pub fn build_in(
     let key = cache_key(gear);
     let path = dir.map(|d| cache_path(d, "bending", &key));
     let mut warnings = Vec::new();
-    let cached = match path.as_deref().map(|p| read_cache(p, &key)) {
+    let cached = match path.as_deref().map(|p| read_cache::<FeBending>(p, &key)) {
         Some(Ok(model)) => model,
         Some(Err(reason)) => {
             warnings.push(format!(
@@ -356,6 +363,7 @@ pub fn build_in(
         None => None,
     };
     if let Some(model) = cached {
+        let fit = model.edge_fit_warning(fit_points(gear));
         return Ok((
             BuiltBending {
                 model,
@@ -363,10 +371,11 @@ pub fn build_in(
                 cache_file: path,
                 seconds: start.elapsed().as_secs_f64(),
             },
-            Vec::new(),
+            fit.into_iter().collect(),
         ));
     }
     let (model, deflection) = compute_with_deflection(gear, geo)?;
+    warnings.extend(model.edge_fit_warning(fit_points(gear)));
     if let Some(p) = &path {
         if let Err(e) = write_cache(p, &key, &model) {
             warnings.push(format!(

@@ -45,9 +45,18 @@ pub struct WormBending {
     pub signed_lead_per_rad: f64,
     /// Axial profile of the loaded flank, (rho, X) pairs at equal steps, m.
     pub profile: Vec<(f64, f64)>,
+    /// The fitted self-compliance's relative error against the FE at the loaded thread's root
+    /// and tip rows in the middle of the zone, [root, tip]: outside the fit zone (MODEL §5.5:
+    /// r_f1 + 0.1 H to r_a1 - 0.1 H) the LTCA extrapolates the height functions, and the
+    /// wheel's contact reaches the worm's tip.
+    pub edge_fit_errors: [f64; 2],
     #[serde(skip)]
     pub(crate) cores: CoreCache,
 }
+
+/// The largest error of the worm's fitted compliance at its thread's root and tip rows
+/// ([`WormBending::edge_fit_errors`]) that passes without a warning.
+pub const EDGE_FIT_TOLERANCE: f64 = 0.10;
 
 /// A fit data point: lattice indices (along, across) of a node of the central thread's flank
 /// and its basis coordinates (r~, theta~).
@@ -76,6 +85,39 @@ fn fit_data_points(m: &WormMesh, (rf, thread_height): (f64, f64), theta_m: f64) 
             inside.then_some((li, hi, (r, w)))
         })
         .collect()
+}
+
+/// The unit normal loads of the fit (node, outward normal of the loaded `flank`), at the
+/// central thread's data points (`ids[1]`; a thread's normals are its neighbours'), then at
+/// its root and tip rows in the middle of the zone (the check of
+/// [`WormBending::edge_fit_errors`]); and the nodes observed: the data points on the three
+/// threads (ids[t][l] is observed[t * n + l]), then the two edge nodes.
+fn fit_loads(
+    m: &WormMesh,
+    geo: &Geometry,
+    flank: Flank,
+    ids: &[Vec<usize>],
+) -> (Vec<(usize, Vector3<f64>)>, Vec<usize>) {
+    let normal_at = |node: usize| {
+        let x = m.mesh.nodes[node];
+        (node, geo.worm.outward_normal(flank, x[1], x[2]))
+    };
+    let mut loads: Vec<(usize, Vector3<f64>)> = ids[1].iter().map(|&n| normal_at(n)).collect();
+    let mut observed: Vec<usize> = ids.iter().flatten().copied().collect();
+    let rows = m.loaded[1].iter().map(|f| f.1);
+    let (root, tip) = (rows.clone().min(), rows.max());
+    for row in [root, tip].into_iter().flatten() {
+        let mid_zone = m.loaded[1]
+            .iter()
+            .filter(|f| f.1 == row)
+            .map(|&(_, _, n)| (m.mesh.nodes[n][2].atan2(m.mesh.nodes[n][1]).abs(), n))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((_, node)) = mid_zone {
+            loads.push(normal_at(node));
+            observed.push(node);
+        }
+    }
+    (loads, observed)
 }
 
 /// The FE nodes of the data points on the three threads (before, loaded, after), or an error
@@ -171,26 +213,11 @@ impl WormBending {
             )));
         }
         let ids = thread_nodes(&m, &data)?;
-        // Outward normals at the central thread's points (the same on the neighbours: a thread
-        // is its neighbour translated by one pitch).
-        let normals: Vec<Vector3<f64>> = ids[1]
-            .iter()
-            .map(|&n| {
-                let x = m.mesh.nodes[n];
-                geo.worm.outward_normal(flank, x[1], x[2])
-            })
-            .collect();
         let material = Elastic {
             youngs_modulus: gear.worm_material.youngs_modulus,
             poisson_ratio: gear.worm_material.poisson_ratio,
         };
-        let loads: Vec<(usize, Vector3<f64>)> = ids[1]
-            .iter()
-            .copied()
-            .zip(normals.iter().copied())
-            .collect();
-        // Observed: the data points on the three threads (ids[t][l] is observed[t * n + l]).
-        let observed: Vec<usize> = ids.iter().flatten().copied().collect();
+        let (loads, observed) = fit_loads(&m, geo, flank, &ids);
         let deflection = deflection_cases(&m, theta_m).ok();
         let plain = deflection
             .as_ref()
@@ -202,13 +229,13 @@ impl WormBending {
         let relation = |t: usize| {
             Mat::from_fn(n, n, |l, c| {
                 let d = bending[c][t * n + l];
-                let nn = normals[l];
+                let nn = loads[l].1;
                 -(d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2])
             })
         };
         let coords: Vec<(f64, f64)> = data.iter().map(|d| d.2).collect();
         let profile = axial_profile_table(geo, flank, (rf, ra));
-        let model = Self {
+        let mut model = Self {
             basis,
             same: basis.fit_least_squares(&coords, &relation(1)),
             before: basis.fit_least_squares(&coords, &relation(0)),
@@ -220,9 +247,34 @@ impl WormBending {
             signed_lead_per_rad: geo.worm.hand_sign() * geo.worm.lead()
                 / (2.0 * std::f64::consts::PI),
             profile,
+            edge_fit_errors: [0.0; 2],
             cores: CoreCache::default(),
         };
+        model.edge_fit_errors = model.edge_errors(&m, &loads[n..], &bending[n..], 3 * n);
         Ok((model, compliance))
+    }
+
+    /// [`WormBending::edge_fit_errors`] from the FE bending under the two edge loads
+    /// (`edge_loads`: node and outward normal; `edge_bending`: their displacements, the edge
+    /// nodes' at `observed_at` and the next).
+    fn edge_errors(
+        &self,
+        m: &WormMesh,
+        edge_loads: &[(usize, Vector3<f64>)],
+        edge_bending: &[Vec<[f64; 3]>],
+        observed_at: usize,
+    ) -> [f64; 2] {
+        if edge_loads.len() < 2 || edge_bending.len() < 2 {
+            return [f64::NAN; 2];
+        }
+        [0, 1].map(|e| {
+            let (node, nn) = edge_loads[e];
+            let d = edge_bending[e][observed_at + e];
+            let fe = -(d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2]);
+            let x = m.mesh.nodes[node];
+            let c = self.coordinates(&Vector3::new(x[0], x[1], x[2]));
+            self.basis.coefficient(&self.same, c, c) / fe - 1.0
+        })
     }
 
     /// Basis coordinates (r~, theta~) of a worm-frame point: r~ = (rho - r_f1)/(r_a1 - r_f1),
@@ -511,6 +563,28 @@ impl BendingModel for WormBending {
 pub struct FeBending {
     pub wheel: super::wheel_model::WheelBending,
     pub worm: WormBending,
+}
+
+impl FeBending {
+    /// A warning when the worm's fit is off its FE by more than [`EDGE_FIT_TOLERANCE`] at the
+    /// thread's root or tip row; `(height, width)`: the gear's `bending.height_points` and
+    /// `bending.worm_width_points`, named in it.
+    pub fn edge_fit_warning(&self, (height, width): (usize, usize)) -> Option<String> {
+        let [root, tip] = self.worm.edge_fit_errors;
+        if !(root.abs() > EDGE_FIT_TOLERANCE || tip.abs() > EDGE_FIT_TOLERANCE) {
+            return None;
+        }
+        Some(format!(
+            "bending: the worm's fitted compliance is {:+.1} % off its FE at the thread's root \
+             and {:+.1} % at its tip, outside the fit zone (0.1 to 0.9 of the thread height, \
+             MODEL §5.5) where the loaded analysis extrapolates the fit: the contact there, the \
+             worm's pressures and TE peak-to-peak carry that error; the default fit points \
+             (bending.height_points 5, bending.worm_width_points 13; here {height} and {width}) \
+             hold it within 10 % on the examples' gears",
+            100.0 * root,
+            100.0 * tip
+        ))
+    }
 }
 
 impl BendingModel for FeBending {

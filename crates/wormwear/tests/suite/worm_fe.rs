@@ -171,11 +171,7 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
     // MODEL §5.5 step 5 at the worm's 5 x 13 points (least-squares fit on the lattice's corner
     // nodes of the zone): FE vs fitted coefficients between points midway between fit points.
     let q2 = 13;
-    let g = example("gear-1x40-design.toml");
-    let geo = Geometry::build(&g).unwrap();
-    let b = body(&g);
-    let s = settings(1);
-    let model = WormBending::build(&g, &geo, &b, &s, 5, q2).unwrap();
+    let (geo, b, model, m) = design_worm_fit(5, q2);
     // Reciprocity (Maxwell-Betti): the same-thread core is symmetric up to round-off.
     let k = model.basis.len();
     let (mut asym, mut scale) = (0.0f64, 0.0f64);
@@ -187,13 +183,6 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
     }
     assert!(asym < 1e-8 * scale, "{asym:e} vs {scale:e}");
     // Off-grid points of the central thread's loaded flank (inside the fitted zone).
-    let m = worm_mesh_on(
-        &geo.worm,
-        Flank::Left,
-        &b,
-        &s,
-        &WormLattice::aligned(&s, model.theta_m, 5, q2),
-    );
     let theta_m = model.theta_m;
     // Midway between fit points across the width, at the fit heights (corners of the lattice).
     let picks: Vec<usize> = [(0usize, 0usize), (1, 3), (2, 1), (3, 4), (4, 5)]
@@ -206,32 +195,9 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
         })
         .collect::<Vec<_>>()
         .iter()
-        .map(|&(rt, wt): &(f64, f64)| {
-            let rho = b.root_radius + (b.tip_radius - b.root_radius) * rt;
-            let phi = wt * theta_m;
-            m.loaded[1]
-                .iter()
-                .filter(|f| f.0 % 2 == 0 && f.1 % 2 == 0)
-                .map(|&(_, _, n)| {
-                    let x = m.mesh.nodes[n];
-                    let rn = (x[1] * x[1] + x[2] * x[2]).sqrt();
-                    let d = (rn - rho).powi(2) + (rho * (x[2].atan2(x[1]) - phi)).powi(2);
-                    (d, n)
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .unwrap()
-                .1
-        })
+        .map(|&(rt, wt): &(f64, f64)| nearest_flank_node(&m, &b, (rt, wt * theta_m), true))
         .collect();
-    let normals: Vec<nalgebra::Vector3<f64>> = picks
-        .iter()
-        .map(|&n| {
-            let x = m.mesh.nodes[n];
-            geo.worm.outward_normal(Flank::Left, x[1], x[2])
-        })
-        .collect();
-    let loads: Vec<_> = picks.iter().copied().zip(normals.iter().copied()).collect();
-    let bend = worm_bending_displacements(&m, &b, &STEEL, &loads, &picks).unwrap();
+    let (normals, bend) = bending_at(&geo, &m, &b, &picks);
     let point = |n: usize| {
         let x = m.mesh.nodes[n];
         nalgebra::Vector3::new(x[0], x[1], x[2])
@@ -256,6 +222,108 @@ fn worm_bending_coefficients_match_the_fe_off_the_fit_grid() {
         100.0 * worst / umax
     );
     assert!(worst < 0.05 * umax);
+}
+
+/// The design case's worm: its geometry, body, bending model at q1 x q2 fit points, and the FE
+/// mesh of the thread lattice that model was fitted on (MODEL §5.5).
+fn design_worm_fit(
+    q1: usize,
+    q2: usize,
+) -> (
+    Geometry,
+    WormBody,
+    WormBending,
+    wormwear::bending::worm_mesh::WormMesh,
+) {
+    let g = example("gear-1x40-design.toml");
+    let geo = Geometry::build(&g).unwrap();
+    let (b, s) = (body(&g), settings(1));
+    let model = WormBending::build(&g, &geo, &b, &s, q1, q2).unwrap();
+    let lattice = WormLattice::aligned(&s, model.theta_m, q1, q2);
+    let m = worm_mesh_on(&geo.worm, Flank::Left, &b, &s, &lattice);
+    (geo, b, model, m)
+}
+
+/// The central thread's loaded-flank node nearest the point at height share rt of the thread
+/// (0 root, 1 tip) and polar angle phi (rad); `corners`: the lattice's corner nodes only.
+fn nearest_flank_node(
+    m: &wormwear::bending::worm_mesh::WormMesh,
+    b: &WormBody,
+    (rt, phi): (f64, f64),
+    corners: bool,
+) -> usize {
+    let rho = b.root_radius + (b.tip_radius - b.root_radius) * rt;
+    m.loaded[1]
+        .iter()
+        .filter(|f| !corners || (f.0 % 2 == 0 && f.1 % 2 == 0))
+        .map(|&(_, _, n)| {
+            let x = m.mesh.nodes[n];
+            let rn = (x[1] * x[1] + x[2] * x[2]).sqrt();
+            let d = (rn - rho).powi(2) + (rho * (x[2].atan2(x[1]) - phi)).powi(2);
+            (d, n)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap()
+        .1
+}
+
+/// The outward normals at `picks` (loaded-flank nodes) and the FE bending displacements of
+/// every pick under a unit normal load at each (MODEL §5.5 step 2), m/N.
+fn bending_at(
+    geo: &Geometry,
+    m: &wormwear::bending::worm_mesh::WormMesh,
+    b: &WormBody,
+    picks: &[usize],
+) -> (Vec<nalgebra::Vector3<f64>>, Vec<Vec<[f64; 3]>>) {
+    let normals: Vec<nalgebra::Vector3<f64>> = picks
+        .iter()
+        .map(|&n| {
+            let x = m.mesh.nodes[n];
+            geo.worm.outward_normal(Flank::Left, x[1], x[2])
+        })
+        .collect();
+    let loads: Vec<_> = picks.iter().copied().zip(normals.iter().copied()).collect();
+    let bend = worm_bending_displacements(m, b, &STEEL, &loads, picks).unwrap();
+    (normals, bend)
+}
+
+#[test]
+#[ignore = "heavy validation: scripts/validate-heavy runs it"]
+fn worm_bending_holds_at_the_thread_root_and_tip_beyond_the_fit_zone() {
+    // MODEL §5.5 fits the worm between r_f1 + 0.1 H and r_a1 - 0.1 H, but the wheel's contact
+    // reaches the worm's tip (its edge carries the flow pressure), where the LTCA extrapolates
+    // the height monomials. At the default 5 points the fitted self-compliance at the root and
+    // tip rows (mid-zone) stays within 10 % of the FE; with more points the extrapolation
+    // grows (session 67: +28 % at the tip with 7, +152 % with 9, which is what moved TE
+    // peak-to-peak by +8.5 % and +36 %), so 7 and 9 are printed, not checked.
+    for q1 in [5usize, 7, 9] {
+        let (geo, b, model, m) = design_worm_fit(q1, 13);
+        let picks = [0.0, 1.0].map(|rt| nearest_flank_node(&m, &b, (rt, 0.0), false));
+        let (normals, bend) = bending_at(&geo, &m, &b, &picks);
+        let errors: Vec<f64> = (0..2)
+            .map(|a| {
+                let d = bend[a][a];
+                let fe = -(d[0] * normals[a][0] + d[1] * normals[a][1] + d[2] * normals[a][2]);
+                let x = m.mesh.nodes[picks[a]];
+                let c = model.coordinates(&nalgebra::Vector3::new(x[0], x[1], x[2]));
+                model.basis.coefficient(&model.same, c, c) / fe - 1.0
+            })
+            .collect();
+        eprintln!(
+            "worm {q1} x 13 height points: fitted self-compliance against the FE at the root row \
+             {:+.1} %, at the tip row {:+.1} %",
+            100.0 * errors[0],
+            100.0 * errors[1]
+        );
+        if q1 == 5 {
+            assert!(errors.iter().all(|e| e.abs() < 0.1), "{errors:?}");
+        }
+        // The model's own check of the same rows, from the fit's factorisation (the warning's
+        // numbers), agrees with this separate solve.
+        for (own, here) in model.edge_fit_errors.iter().zip(&errors) {
+            assert!((own - here).abs() < 1e-6, "{own} vs {here}");
+        }
+    }
 }
 
 #[test]
