@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;
-use wormwear::geometry::{Geometry, ThreadSurface};
+use wormwear::geometry::{Geometry, GeometryInputs, ThreadSurface};
 use wormwear::input;
 
 fn example(name: &str) -> input::GearSet {
@@ -22,11 +22,16 @@ fn bench(c: &mut Criterion) {
     let gk = example("gear-k-2x25.toml");
     let mut group = c.benchmark_group("geometry");
     group.sample_size(20);
+    // `generate`, not `build_with_grid`: the build would return its kept copy after the first.
+    let (i140, ik) = (
+        GeometryInputs::of(&g140, 40, 60),
+        GeometryInputs::of(&gk, 40, 60),
+    );
     group.bench_function("1x40 worm + wheel, 40 x 60 cells per flank", |b| {
-        b.iter(|| Geometry::build_with_grid(black_box(&g140), 40, 60).unwrap())
+        b.iter(|| Geometry::generate(black_box(&i140)).unwrap())
     });
     group.bench_function("2x25 ZK worm + wheel, 40 x 60 cells per flank", |b| {
-        b.iter(|| Geometry::build_with_grid(black_box(&gk), 40, 60).unwrap())
+        b.iter(|| Geometry::generate(black_box(&ik)).unwrap())
     });
     group.bench_function("ZK thread surface (grinding envelope table)", |b| {
         b.iter(|| ThreadSurface::new(black_box(&gk.worm)).unwrap())

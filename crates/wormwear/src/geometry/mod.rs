@@ -4,6 +4,7 @@
 //! [`Geometry::build`] is the entry point; its result is a plain struct the next stages read.
 
 pub mod hobbing;
+mod memo;
 pub mod placement;
 pub mod profile;
 pub mod roots;
@@ -13,7 +14,7 @@ pub mod stl;
 pub mod thread;
 pub mod wheel;
 
-use crate::input::{GearSet, ProfileType};
+use crate::input::{GearSet, Placement, ProfileType, ThreadDef, WheelBlank};
 pub use hobbing::{EnvelopePoint, Hobbing, PointKind};
 pub use thread::{Flank, ThreadSurface};
 pub use wheel::{BlankLimits, FlankField, FlankPoint, WheelFlank};
@@ -44,10 +45,10 @@ pub struct Geometry {
 /// lies well below the hob's reach at the throat (the centre distance moved, the blank did
 /// not), the throat and outer radii that follow the cutting centre distance; else the inputs
 /// that shape the envelope and the direction that brings the blank inside it.
-fn blank_fit(gear: &GearSet) -> String {
+fn blank_fit(inputs: &GeometryInputs) -> String {
     let mm = 1e3;
-    let reach = gear.cutting.centre_distance - gear.hob.root_radius;
-    let below = reach - gear.wheel.throat_radius;
+    let reach = inputs.cutting.centre_distance - inputs.hob.root_radius;
+    let below = reach - inputs.wheel.throat_radius;
     // The examples' blanks sit 0.01 mm below the hob's root; half a millimetre is a blank
     // left behind by a changed centre distance.
     if below > 0.5e-3 {
@@ -61,9 +62,9 @@ fn blank_fit(gear: &GearSet) -> String {
              and change the worm and the hob instead",
             reach * mm,
             below * mm,
-            gear.wheel.throat_radius * mm,
+            inputs.wheel.throat_radius * mm,
             throat * mm,
-            (gear.wheel.outer_radius + throat - gear.wheel.throat_radius) * mm
+            (inputs.wheel.outer_radius + throat - inputs.wheel.throat_radius) * mm
         );
     }
     "the blank must lie inside the region the hob envelops: lower wheel.outer_radius_mm or \
@@ -71,6 +72,45 @@ fn blank_fit(gear: &GearSet) -> String {
      tip_radius_mm and pressure angle; [cutting] centre_distance_mm, offset_mm and \
      inclination_deg; wheel.teeth)"
         .to_string()
+}
+
+/// What the geometry is generated from: the parts of a gear set that shape the flanks (its
+/// conditions, materials, lubricant, life and the other analysis settings do not), and the
+/// flank grid. [`Geometry::generate`] reads nothing else, so equal inputs give the same
+/// geometry, which is what lets [`Geometry::build_with_grid`] reuse a recent one.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GeometryInputs {
+    pub worm: ThreadDef,
+    pub hob: ThreadDef,
+    /// The hob's placement when it cut the wheel.
+    pub cutting: Placement,
+    /// The worm's placement in operation (where its tip reaches the wheel flank).
+    pub operating: Placement,
+    pub wheel: WheelBlank,
+    /// Nominal centre distance a, m (with the throat radius, the blank's gorge radius).
+    pub nominal_centre_distance: f64,
+    /// Node rows of the band above the worm-tip trace (`analysis.tip_trace_refinement`).
+    pub tip_trace_refinement: usize,
+    /// Cells of the global flank grid along the height and along the face width.
+    pub cells_height: usize,
+    pub cells_face: usize,
+}
+
+impl GeometryInputs {
+    /// The geometry inputs of `gear` with the grid `cells_height` x `cells_face`.
+    pub fn of(gear: &GearSet, cells_height: usize, cells_face: usize) -> Self {
+        Self {
+            worm: gear.worm.clone(),
+            hob: gear.hob.clone(),
+            cutting: gear.cutting,
+            operating: gear.operating,
+            wheel: gear.wheel.clone(),
+            nominal_centre_distance: gear.nominal_centre_distance,
+            tip_trace_refinement: gear.analysis.tip_trace_refinement,
+            cells_height,
+            cells_face,
+        }
+    }
 }
 
 impl Geometry {
@@ -83,12 +123,27 @@ impl Geometry {
         )
     }
 
-    /// Builds all flanks with an explicit grid (cells along the height and the face width).
+    /// Builds all flanks with an explicit grid (cells along the height and the face width):
+    /// a copy of the geometry of one of the last few builds with equal [`GeometryInputs`]
+    /// (a variant of the gear in its conditions, materials or lubricant, a Python session
+    /// running the same gear again), else [`Self::generate`]d and kept.
     pub fn build_with_grid(
         gear: &GearSet,
         cells_height: usize,
         cells_face: usize,
     ) -> Result<Self, GeometryError> {
+        let inputs = GeometryInputs::of(gear, cells_height, cells_face);
+        if let Some(kept) = memo::recall(&inputs) {
+            return Ok(kept);
+        }
+        let geometry = Self::generate(&inputs)?;
+        memo::keep(&inputs, &geometry);
+        Ok(geometry)
+    }
+
+    /// Generates worm, hob and wheel flanks from `inputs` (MODEL §2-3), every time.
+    pub fn generate(inputs: &GeometryInputs) -> Result<Self, GeometryError> {
+        let (cells_height, cells_face) = (inputs.cells_height, inputs.cells_face);
         let thread_hint = |member: &'static str| {
             move |e: GeometryError| {
                 match e {
@@ -102,23 +157,23 @@ impl Geometry {
             }
             }
         };
-        let worm = ThreadSurface::new(&gear.worm).map_err(thread_hint("worm"))?;
-        let hob = ThreadSurface::new(&gear.hob).map_err(thread_hint("hob"))?;
+        let worm = ThreadSurface::new(&inputs.worm).map_err(thread_hint("worm"))?;
+        let hob = ThreadSurface::new(&inputs.hob).map_err(thread_hint("hob"))?;
         let blank = BlankLimits {
-            face_width: gear.wheel.face_width,
-            outer_radius: gear.wheel.outer_radius,
-            gorge_radius: gear.gorge_radius(),
-            centre_distance: gear.nominal_centre_distance,
+            face_width: inputs.wheel.face_width,
+            outer_radius: inputs.wheel.outer_radius,
+            gorge_radius: inputs.nominal_centre_distance - inputs.wheel.throat_radius,
+            centre_distance: inputs.nominal_centre_distance,
         };
-        let hobbing = Hobbing::new(&hob, gear.cutting, gear.wheel.teeth);
+        let hobbing = Hobbing::new(&hob, inputs.cutting, inputs.wheel.teeth);
         let wheel_hint = |e: GeometryError| match e {
-            GeometryError::Wheel(m) => GeometryError::Wheel(format!("{m}; {}", blank_fit(gear))),
+            GeometryError::Wheel(m) => GeometryError::Wheel(format!("{m}; {}", blank_fit(inputs))),
             other => other,
         };
-        let worm_cut = Hobbing::new(&worm, gear.operating, gear.wheel.teeth);
-        let refinement = gear.analysis.tip_trace_refinement;
+        let worm_cut = Hobbing::new(&worm, inputs.operating, inputs.wheel.teeth);
+        let refinement = inputs.tip_trace_refinement;
         let frame = |flank: Flank| {
-            let strip = worm_edge_strip(&worm, flank, gear);
+            let strip = worm_edge_strip(&worm, flank, &inputs.worm);
             let reach =
                 |z: f64, foot: f64, top: f64| worm_reach(&worm_cut, flank, z, (foot, top), strip);
             wheel::FlankFrame::new(
@@ -149,7 +204,7 @@ impl Geometry {
             hob,
             wheel_flanks: [left, right],
             blank,
-            teeth: gear.wheel.teeth,
+            teeth: inputs.wheel.teeth,
         })
     }
 
@@ -170,9 +225,9 @@ impl Geometry {
 /// The worm's radial height, from its tip down, of the strip its broken tip edge (MODEL §2.3:
 /// R (1 - sin psi), psi the axial profile's angle at the tip) or its tip relief (its length)
 /// sweeps on `flank`, m; 0 for a sharp, unrelieved tip.
-fn worm_edge_strip(worm: &ThreadSurface, flank: Flank, gear: &GearSet) -> f64 {
-    let edge = gear.worm.tip_edge_radius * (1.0 - worm.tip_profile_angle(flank).sin());
-    let relief = &gear.worm.tip_relief;
+fn worm_edge_strip(worm: &ThreadSurface, flank: Flank, def: &ThreadDef) -> f64 {
+    let edge = def.tip_edge_radius * (1.0 - worm.tip_profile_angle(flank).sin());
+    let relief = &def.tip_relief;
     edge.max(if relief.amount > 0.0 {
         relief.length
     } else {
