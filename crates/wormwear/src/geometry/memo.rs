@@ -5,8 +5,9 @@
 //! design's `wormwear ltca` on two cores), and the geometry does not change with the
 //! conditions, the materials, the lubricant or the analysis settings other than the grid: the
 //! bins of a duty cycle, the jobs of the validation study, a Python session that runs a gear
-//! again and the variants of a sweep over torques or oils (once the sweep's FE bending models,
-//! built one after the other first, have built it) all need the same one. The
+//! again and the variants of a sweep over torques or oils (those started after the first
+//! build has finished, or after the sweep's FE bending models were built) all need the same
+//! one. The
 //! key is the whole of [`GeometryInputs`] in its exact JSON text (every float to its last bit,
 //! -0 apart from 0), and [`Geometry::generate`] reads nothing else, so a kept geometry is only
 //! returned for the inputs it was generated from. The store is bounded, the least recently
